@@ -1,0 +1,587 @@
+! SPDX-License-Identifier: MIT
+!> Force law from a measured table of (strain, force) rows, strain = lambda - 1.
+!>
+!> The table is interpolated by a monotone C1 piecewise-cubic Hermite (PCHIP) in the
+!> strain. Knot slopes follow Fritsch and Carlson (1980) with the weighted harmonic mean of
+!> Fritsch and Butland (1984) at interior knots, as in SLATEC PCHIM and scipy's
+!> PchipInterpolator. With strictly increasing data every secant slope is > 0, and:
+!>
+!> - interior slope: the weighted harmonic mean of the two secants is > 0 and strictly less
+!>   than 3 times either secant;
+!> - end slopes: the non-centred three-point formula, which is always below twice the end
+!>   secant; where it falls below `end_slope_ratio` times the end secant (including when it
+!>   is <= 0, for strongly convex or concave ends) it is raised to that floor. This keeps
+!>   the end slope > 0 (so `get_reference_stiffness` is positive) and depends continuously
+!>   on the data;
+!>
+!> so on every interval both ratios slope/secant lie in the open square (0, 3)**2, inside
+!> the Fritsch-Carlson monotonicity region and away from the points where the cubic's
+!> derivative touches zero: the interpolant is strictly increasing on the table range.
+!>
+!> Beyond the last row the law continues linearly with the last knot's slope (C1, strictly
+!> increasing, energy quadratic). For lambda <= 1 the string is slack (f = 0).
+module yarnfort_material_table
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: iso_fortran_env, only: iostat_end, iostat_eor
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_text, only: format_real
+    implicit none
+    private
+
+    public :: table_law_type, new_table_law, read_table_law
+    public :: default_end_slope_ratio
+
+    !> Default floor of an end slope as a fraction of the adjacent secant slope.
+    real(wp), parameter :: default_end_slope_ratio = 0.1_wp
+
+    !> Largest end-slope floor accepted (the secant itself).
+    real(wp), parameter :: max_end_slope_ratio = 1.0_wp
+
+    !> Fewest rows in a table: (0, 0) and one more.
+    integer, parameter :: min_rows = 2
+
+    !> Rows allocated before the first growth while reading a file.
+    integer, parameter :: initial_rows = 16
+
+    !> Longest piece of an input line quoted in a message.
+    integer, parameter :: max_quote = 60
+
+    !> Characters that may start a data row of a CSV table.
+    character(len=*), parameter :: numeric_start = '0123456789+-.'
+
+    !> Outcomes of parsing one CSV line.
+    integer, parameter :: line_row = 0, line_skip = 1, line_bad = 2
+
+    !> Tabulated string; the components are set by `new_table_law` / `read_table_law`.
+    type, extends(force_law_type) :: table_law_type
+        !> Knot strains (lambda - 1), strain(1) = 0, strictly increasing.
+        real(wp), allocatable :: strain(:)
+        !> Knot forces in N, force(1) = 0, strictly increasing.
+        real(wp), allocatable :: force(:)
+        !> Interpolant's df/dstrain at the knots (> 0).
+        real(wp), allocatable :: slope(:)
+        !> Energy per unit reference length at the knots, integral of f from 0 to strain(k).
+        real(wp), allocatable :: energy(:)
+        !> Floor of the end slopes as a fraction of the adjacent secant slope.
+        real(wp) :: end_slope_ratio = default_end_slope_ratio
+    contains
+        procedure :: get_force
+        procedure :: get_energy
+        procedure :: get_reference_stiffness
+    end type table_law_type
+
+    !> One row while it is checked: values, their text, and where it came from.
+    type :: row_type
+        real(wp) :: strain = 0.0_wp
+        real(wp) :: force = 0.0_wp
+        character(len=:), allocatable :: strain_text, force_text
+        !> 'row 3' or 'line 7'.
+        character(len=:), allocatable :: place
+    end type row_type
+
+contains
+
+    !> Create a table law from knot strains (lambda - 1) and forces in N. The first row must
+    !> be (0, 0), both columns strictly increasing, at least 2 rows, all finite.
+    !> `end_slope_ratio` (default `default_end_slope_ratio`, in (0, 1]) is the floor of the
+    !> end slopes as a fraction of the adjacent secant slope.
+    subroutine new_table_law(self, strain, force, error, end_slope_ratio)
+        type(table_law_type), intent(out) :: self
+        real(wp), intent(in) :: strain(:), force(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: end_slope_ratio
+        character(len=*), parameter :: context = 'table'
+        type(row_type) :: row, previous
+        integer :: i, bad
+
+        if (size(strain) /= size(force)) then
+            call fatal_error(error, context // ': ' // to_text(size(strain)) &
+                // ' strains but ' // to_text(size(force)) // ' forces')
+            return
+        end if
+        do i = 1, size(strain)
+            row%strain = strain(i)
+            row%force = force(i)
+            row%strain_text = format_real(strain(i))
+            row%force_text = format_real(force(i))
+            row%place = 'row ' // to_text(i)
+            if (i == 1) then
+                call check_row(row, error=error)
+            else
+                call check_row(row, previous, error)
+            end if
+            if (allocated(error)) then
+                error%message = context // ', ' // row%place // ': ' // error%message
+                return
+            end if
+            previous = row
+        end do
+        if (size(strain) < min_rows) then
+            call fatal_error(error, context // ': ' // too_few_rows(size(strain)))
+            return
+        end if
+        call set_ratio(self, end_slope_ratio, context, error)
+        if (allocated(error)) return
+        call setup_table(self, strain, force, bad)
+        if (bad > 0) then
+            call fatal_error(error, context // ', row ' // to_text(bad + 1) // ': ' &
+                // slope_range_message(strain, force, bad))
+        end if
+    end subroutine new_table_law
+
+    !> Read a table law from a CSV file of rows "strain,force" (spaces allowed). Lines
+    !> before the first row that start with a non-numeric character and do not read as
+    !> two numbers are headers; blank lines and lines starting with '#' are skipped
+    !> anywhere. Same rules and `end_slope_ratio` as `new_table_law`; messages name the
+    !> file, the line and the offending value.
+    subroutine read_table_law(self, path, error, end_slope_ratio)
+        type(table_law_type), intent(out) :: self
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: end_slope_ratio
+        character(len=:), allocatable :: context, line, message
+        character(len=512) :: iomsg
+        real(wp), allocatable :: strain(:), force(:)
+        integer, allocatable :: lines(:)
+        type(row_type) :: row, previous
+        integer :: unit, stat, line_number, nrow, outcome, bad
+
+        context = "table '" // path // "'"
+        open(newunit=unit, file=path, status='old', action='read', form='formatted', &
+            access='sequential', iostat=stat, iomsg=iomsg)
+        if (stat /= 0) then
+            call fatal_error(error, context // ': cannot open the file (' // trim(iomsg) // ')')
+            return
+        end if
+
+        allocate(strain(initial_rows), force(initial_rows), lines(initial_rows))
+        nrow = 0
+        line_number = 0
+        do
+            call read_line(unit, line, stat, iomsg)
+            if (stat == iostat_end) exit
+            line_number = line_number + 1
+            if (stat /= 0) then
+                call fatal_error(error, context // ', line ' // to_text(line_number) &
+                    // ': cannot read the line (' // trim(iomsg) // ')')
+                exit
+            end if
+            call parse_line(line, row, outcome, message)
+            if (outcome == line_skip) cycle
+            if (outcome == line_bad) then
+                if (nrow == 0 .and. is_header(line)) cycle
+                call fatal_error(error, context // ', line ' // to_text(line_number) &
+                    // ': ' // message)
+                exit
+            end if
+            row%place = 'line ' // to_text(line_number)
+            if (nrow == 0) then
+                call check_row(row, error=error)
+            else
+                call check_row(row, previous, error)
+            end if
+            if (allocated(error)) then
+                error%message = context // ', ' // row%place // ': ' // error%message
+                exit
+            end if
+            call append_row(strain, force, lines, nrow, row%strain, row%force, line_number)
+            previous = row
+        end do
+        close(unit)
+        if (allocated(error)) return
+
+        if (nrow < min_rows) then
+            call fatal_error(error, context // ': ' // too_few_rows(nrow))
+            return
+        end if
+        call set_ratio(self, end_slope_ratio, context, error)
+        if (allocated(error)) return
+        call setup_table(self, strain(:nrow), force(:nrow), bad)
+        if (bad > 0) then
+            call fatal_error(error, context // ', line ' // to_text(lines(bad + 1)) // ': ' &
+                // slope_range_message(strain(:nrow), force(:nrow), bad))
+        end if
+    end subroutine read_table_law
+
+    !> Tension and df/dlambda: the Hermite cubic of the interval holding the strain, the
+    !> linear extension beyond the last row, zero when slack.
+    pure subroutine get_force(self, stretch, force, dforce)
+        class(table_law_type), intent(in) :: self
+        real(wp), intent(in) :: stretch
+        real(wp), intent(out) :: force, dforce
+        real(wp) :: strain, width, secant, t
+        integer :: k, n
+
+        if (stretch <= 1.0_wp) then
+            force = 0.0_wp
+            dforce = 0.0_wp
+            return
+        end if
+        n = size(self%strain)
+        strain = stretch - 1.0_wp
+        if (strain >= self%strain(n)) then
+            force = self%force(n) + self%slope(n) * (strain - self%strain(n))
+            dforce = self%slope(n)
+            return
+        end if
+        k = find_interval(self%strain, strain)
+        width = self%strain(k + 1) - self%strain(k)
+        secant = (self%force(k + 1) - self%force(k)) / width
+        t = (strain - self%strain(k)) / width
+        ! Hermite basis form: exact values at t = 0 and accurate slopes at both ends.
+        force = self%force(k) &
+            + (self%force(k + 1) - self%force(k)) * t**2 * (3.0_wp - 2.0_wp * t) &
+            + width * t * (1.0_wp - t) * ((1.0_wp - t) * self%slope(k) - t * self%slope(k + 1))
+        dforce = 6.0_wp * secant * t * (1.0_wp - t) &
+            + self%slope(k) * (1.0_wp - t) * (1.0_wp - 3.0_wp * t) &
+            + self%slope(k + 1) * t * (3.0_wp * t - 2.0_wp)
+    end subroutine get_force
+
+    !> Energy per unit reference length: the precomputed integral up to the knot below plus
+    !> the closed-form integral of the Hermite cubic (or of the linear extension).
+    pure function get_energy(self, stretch) result(energy)
+        class(table_law_type), intent(in) :: self
+        real(wp), intent(in) :: stretch
+        real(wp) :: energy
+        real(wp) :: strain, step
+        integer :: k, n
+
+        if (stretch <= 1.0_wp) then
+            energy = 0.0_wp
+            return
+        end if
+        n = size(self%strain)
+        strain = stretch - 1.0_wp
+        if (strain >= self%strain(n)) then
+            step = strain - self%strain(n)
+            energy = self%energy(n) + step * (self%force(n) + 0.5_wp * self%slope(n) * step)
+            return
+        end if
+        k = find_interval(self%strain, strain)
+        energy = self%energy(k) + hermite_integral(self, k, strain - self%strain(k))
+    end function get_energy
+
+    !> The right-hand slope df/dlambda at lambda = 1 (the first knot slope, > 0).
+    pure function get_reference_stiffness(self) result(stiffness)
+        class(table_law_type), intent(in) :: self
+        real(wp) :: stiffness
+
+        stiffness = self%slope(1)
+    end function get_reference_stiffness
+
+    !> Integral of the Hermite cubic of interval k from its left knot over `step`:
+    !> width * integral_0^t [y_k + dy*H01 + width*(d_k*H10 + d_k+1*H11)] with
+    !> H01 = s**2*(3 - 2*s), H10 = s*(1 - s)**2, H11 = s**2*(s - 1).
+    pure function hermite_integral(self, k, step) result(integral)
+        type(table_law_type), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: step
+        real(wp) :: integral
+        real(wp) :: width, t, t2
+
+        width = self%strain(k + 1) - self%strain(k)
+        t = step / width
+        t2 = t**2
+        integral = width * (self%force(k) * t &
+            + (self%force(k + 1) - self%force(k)) * t2 * t * (1.0_wp - 0.5_wp * t) &
+            + width * t2 * (self%slope(k) * (0.5_wp - t * (2.0_wp / 3.0_wp - 0.25_wp * t)) &
+            - self%slope(k + 1) * t * (1.0_wp / 3.0_wp - 0.25_wp * t)))
+    end function hermite_integral
+
+    !> Index k of the interval with knot(k) <= x < knot(k+1), for knot(1) <= x < knot(n).
+    pure function find_interval(knot, x) result(k)
+        real(wp), intent(in) :: knot(:), x
+        integer :: k
+        integer :: high, middle
+
+        k = 1
+        high = size(knot)
+        do while (high - k > 1)
+            middle = (k + high) / 2
+            if (x >= knot(middle)) then
+                k = middle
+            else
+                high = middle
+            end if
+        end do
+    end function find_interval
+
+    !> Store the checked knots, compute the slopes and the cumulative energies. `bad` is the
+    !> first interval whose secant slope is not a normal positive number, else 0.
+    pure subroutine setup_table(self, strain, force, bad)
+        type(table_law_type), intent(inout) :: self
+        real(wp), intent(in) :: strain(:), force(:)
+        integer, intent(out) :: bad
+        real(wp), allocatable :: width(:), secant(:)
+        real(wp) :: weight_left, weight_right
+        integer :: k, n
+
+        n = size(strain)
+        allocate(width(n - 1), secant(n - 1))
+        width(:) = strain(2:) - strain(:n - 1)
+        secant(:) = (force(2:) - force(:n - 1)) / width
+        bad = 0
+        do k = 1, n - 1
+            if (.not. (ieee_is_finite(secant(k)) .and. ieee_is_finite(1.0_wp / secant(k)))) then
+                bad = k
+                return
+            end if
+        end do
+
+        self%strain = strain
+        self%force = force
+        allocate(self%slope(n), self%energy(n))
+        if (n == 2) then
+            self%slope(:) = secant(1)
+        else
+            ! Interior: weighted harmonic mean of the neighbouring secants (Fritsch-Butland).
+            do k = 2, n - 1
+                weight_left = (2.0_wp * width(k) + width(k - 1)) &
+                    / (3.0_wp * (width(k) + width(k - 1)))
+                weight_right = 1.0_wp - weight_left
+                self%slope(k) = 1.0_wp / (weight_left / secant(k - 1) + weight_right / secant(k))
+            end do
+            self%slope(1) = end_slope(width(1), width(2), secant(1), secant(2), &
+                self%end_slope_ratio)
+            self%slope(n) = end_slope(width(n - 1), width(n - 2), secant(n - 1), &
+                secant(n - 2), self%end_slope_ratio)
+        end if
+
+        self%energy(1) = 0.0_wp
+        do k = 1, n - 1
+            self%energy(k + 1) = self%energy(k) + width(k) * (0.5_wp * (force(k) + force(k + 1)) &
+                + width(k) * (self%slope(k) - self%slope(k + 1)) / 12.0_wp)
+        end do
+    end subroutine setup_table
+
+    !> End slope from the end interval (width, secant) and its neighbour: the non-centred
+    !> three-point formula (< 2*secant for positive secants), raised to ratio*secant.
+    pure function end_slope(width, next_width, secant, next_secant, ratio) result(slope)
+        real(wp), intent(in) :: width, next_width, secant, next_secant, ratio
+        real(wp) :: slope
+
+        slope = secant + width * (secant - next_secant) / (width + next_width)
+        slope = max(slope, ratio * secant)
+    end function end_slope
+
+    !> Check one row on its own (first row: must be 0, 0) or against the previous row.
+    pure subroutine check_row(row, previous, error)
+        type(row_type), intent(in) :: row
+        type(row_type), intent(in), optional :: previous
+        type(error_type), allocatable, intent(out) :: error
+
+        if (.not. ieee_is_finite(row%strain)) then
+            call fatal_error(error, 'strain ' // row%strain_text // ' is not finite')
+        else if (.not. ieee_is_finite(row%force)) then
+            call fatal_error(error, 'force ' // row%force_text // ' is not finite')
+        else if (.not. present(previous)) then
+            if (abs(row%strain) > 0.0_wp .or. abs(row%force) > 0.0_wp) then
+                call fatal_error(error, 'the first row must be strain 0, force 0 (f = 0 at ' &
+                    // 'lambda = 1), found ' // row%strain_text // ', ' // row%force_text)
+            end if
+        else if (.not. row%strain > previous%strain) then
+            call fatal_error(error, 'strain ' // row%strain_text // ' is not greater than ' &
+                // previous%strain_text // ' on ' // previous%place &
+                // ' (strains must increase strictly)')
+        else if (.not. row%force > previous%force) then
+            call fatal_error(error, 'force ' // row%force_text // ' is not greater than ' &
+                // previous%force_text // ' on ' // previous%place &
+                // ' (forces must increase strictly)')
+        end if
+    end subroutine check_row
+
+    !> Take the end-slope floor, checking it lies in (0, max_end_slope_ratio].
+    subroutine set_ratio(self, ratio, context, error)
+        type(table_law_type), intent(inout) :: self
+        real(wp), intent(in), optional :: ratio
+        character(len=*), intent(in) :: context
+        type(error_type), allocatable, intent(out) :: error
+
+        self%end_slope_ratio = default_end_slope_ratio
+        if (.not. present(ratio)) return
+        ! Nested tests: no ordered comparison with a NaN.
+        if (ieee_is_finite(ratio)) then
+            if (ratio > 0.0_wp .and. ratio <= max_end_slope_ratio) then
+                self%end_slope_ratio = ratio
+                return
+            end if
+        end if
+        call fatal_error(error, context // ': end_slope_ratio ' // format_real(ratio) &
+            // ' must lie in (0, ' // format_real(max_end_slope_ratio) // ']')
+    end subroutine set_ratio
+
+    !> Message for an interval whose secant slope leaves the floating-point range.
+    pure function slope_range_message(strain, force, k) result(message)
+        real(wp), intent(in) :: strain(:), force(:)
+        integer, intent(in) :: k
+        character(len=:), allocatable :: message
+
+        message = 'force step ' // format_real(force(k + 1) - force(k)) &
+            // ' over strain step ' // format_real(strain(k + 1) - strain(k)) &
+            // ' gives a slope outside the floating-point range'
+    end function slope_range_message
+
+    !> Message for a table with fewer than `min_rows` rows.
+    pure function too_few_rows(nrow) result(message)
+        integer, intent(in) :: nrow
+        character(len=:), allocatable :: message
+
+        message = 'found ' // to_text(nrow) // ' data rows, at least ' // to_text(min_rows) &
+            // ' rows are needed (the first row 0,0 and more)'
+    end function too_few_rows
+
+    !> Parse one CSV line into a row, or report it as skipped (blank, '#') or bad.
+    pure subroutine parse_line(line, row, outcome, message)
+        character(len=*), intent(in) :: line
+        type(row_type), intent(out) :: row
+        integer, intent(out) :: outcome
+        character(len=:), allocatable, intent(out) :: message
+        character(len=:), allocatable :: text
+        integer :: comma
+        logical :: ok
+
+        text = clean_line(line)
+        outcome = line_skip
+        if (len(text) == 0) return
+        if (text(1:1) == '#') return
+
+        outcome = line_bad
+        comma = index(text, ',')
+        if (comma == 0) then
+            message = 'expected "strain,force", found ' // quote(text)
+            return
+        end if
+        if (index(text(comma + 1:), ',') /= 0) then
+            message = 'expected 2 comma-separated values "strain,force", found ' // quote(text)
+            return
+        end if
+        call read_value(text(:comma - 1), row%strain, row%strain_text, ok)
+        if (.not. ok) then
+            message = 'strain ' // quote(row%strain_text) // ' is not a number'
+            return
+        end if
+        call read_value(text(comma + 1:), row%force, row%force_text, ok)
+        if (.not. ok) then
+            message = 'force ' // quote(row%force_text) // ' is not a number'
+            return
+        end if
+        outcome = line_row
+    end subroutine parse_line
+
+    !> Read one real from a CSV field (surrounding blanks allowed).
+    pure subroutine read_value(field, value, text, ok)
+        character(len=*), intent(in) :: field
+        real(wp), intent(out) :: value
+        character(len=:), allocatable, intent(out) :: text
+        logical, intent(out) :: ok
+        integer :: stat
+
+        text = trim(adjustl(field))
+        value = 0.0_wp
+        ! Characters list-directed input would treat specially (separators, repeat counts).
+        ok = len(text) > 0 .and. scan(text, ' */;"''') == 0
+        if (.not. ok) return
+        read(text, *, iostat=stat) value
+        ok = stat == 0
+    end subroutine read_value
+
+    !> A line with tabs and carriage returns turned into blanks, leading and trailing
+    !> blanks removed.
+    pure function clean_line(line) result(text)
+        character(len=*), intent(in) :: line
+        character(len=:), allocatable :: text
+        character(len=len(line)) :: buffer
+        integer :: i
+
+        buffer = line
+        do i = 1, len(buffer)
+            if (buffer(i:i) == achar(9) .or. buffer(i:i) == achar(13)) buffer(i:i) = ' '
+        end do
+        text = trim(adjustl(buffer))
+    end function clean_line
+
+    !> Whether a line that is not a data row may be a header: its first character is not
+    !> one that starts a number.
+    pure function is_header(line) result(header)
+        character(len=*), intent(in) :: line
+        logical :: header
+        character(len=:), allocatable :: text
+
+        text = clean_line(line)
+        header = len(text) > 0
+        if (header) header = verify(text(1:1), numeric_start) /= 0
+    end function is_header
+
+    !> Text in single quotes, shortened to `max_quote` characters.
+    pure function quote(text) result(quoted)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: quoted
+
+        if (len(text) > max_quote) then
+            quoted = "'" // text(:max_quote) // "...'"
+        else
+            quoted = "'" // text // "'"
+        end if
+    end function quote
+
+    !> Decimal text of an integer.
+    pure function to_text(value) result(text)
+        integer, intent(in) :: value
+        character(len=:), allocatable :: text
+        character(len=20) :: buffer
+
+        write(buffer, '(i0)') value
+        text = trim(buffer)
+    end function to_text
+
+    !> Read one whole line of any length. `stat` is 0, iostat_end at the end of the file,
+    !> or another non-zero value with `iomsg` set.
+    subroutine read_line(unit, line, stat, iomsg)
+        integer, intent(in) :: unit
+        character(len=:), allocatable, intent(out) :: line
+        integer, intent(out) :: stat
+        character(len=*), intent(inout) :: iomsg
+        character(len=256) :: buffer
+        integer :: count
+
+        line = ''
+        do
+            read(unit, '(a)', advance='no', iostat=stat, iomsg=iomsg, size=count) buffer
+            line = line // buffer(:count)
+            if (stat /= 0) exit
+        end do
+        if (stat == iostat_eor) stat = 0
+        ! A last line without a newline still counts as a line.
+        if (stat == iostat_end .and. len(line) > 0) stat = 0
+    end subroutine read_line
+
+    !> Append one row, growing the arrays geometrically.
+    pure subroutine append_row(strain, force, lines, nrow, new_strain, new_force, new_line)
+        real(wp), allocatable, intent(inout) :: strain(:), force(:)
+        integer, allocatable, intent(inout) :: lines(:)
+        integer, intent(inout) :: nrow
+        real(wp), intent(in) :: new_strain, new_force
+        integer, intent(in) :: new_line
+        real(wp), allocatable :: real_buffer(:)
+        integer, allocatable :: int_buffer(:)
+
+        if (nrow == size(strain)) then
+            allocate(real_buffer(2 * nrow))
+            real_buffer(:nrow) = strain(:nrow)
+            call move_alloc(real_buffer, strain)
+            allocate(real_buffer(2 * nrow))
+            real_buffer(:nrow) = force(:nrow)
+            call move_alloc(real_buffer, force)
+            allocate(int_buffer(2 * nrow))
+            int_buffer(:nrow) = lines(:nrow)
+            call move_alloc(int_buffer, lines)
+        end if
+        nrow = nrow + 1
+        strain(nrow) = new_strain
+        force(nrow) = new_force
+        lines(nrow) = new_line
+    end subroutine append_row
+
+end module yarnfort_material_table
