@@ -1,4 +1,106 @@
 ! SPDX-License-Identifier: MIT
+!> yarnfort: stretch a yarn network described by a namelist on standard input.
+!>     ./yarnfort < scene.nml
+!> Progress goes to stderr; results to the &output folder. Exit code 0 only on success.
 program yarnfort_main
+    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+    use yarnfort_error, only: error_type
+    use yarnfort_version, only: yarnfort_version_string
+    use yarnfort_input_config, only: config_type
+    use yarnfort_input_namelist, only: read_config_from_stdin, check_config
+    use yarnfort_input_echo, only: write_config
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_builder, only: new_scene
+    use yarnfort_driver, only: run_scene, get_linear_solver_name
+    use yarnfort_app_progress, only: progress_writer_type
     implicit none
+    type(config_type) :: config
+    type(scene_type), target :: scene
+    type(progress_writer_type) :: writer
+    type(error_type), allocatable :: error
+    type(error_type), allocatable :: finish_error
+    integer :: unit, status
+
+    call handle_arguments()
+
+    call read_config_from_stdin(config, error)
+    if (allocated(error)) call fail('input', error, 2)
+    call check_config(config, error)
+    if (allocated(error)) call fail('input', error, 2)
+    call new_scene(scene, config, error)
+    if (allocated(error)) call fail('input', error, 2)
+
+    write(error_unit, '(a, i0, a, i0, a, i0, a, a)') 'yarnfort: ', scene%network%n_nodes(), &
+        ' nodes, ', scene%network%n_elements(), ' elements, ', scene%dofs%n_unknowns, &
+        ' unknowns; linear solver ', get_linear_solver_name(scene)
+    if (config%control%check_only) then
+        write(error_unit, '(a)') 'yarnfort: input checked (check_only = .true.), nothing solved'
+        stop
+    end if
+
+    writer%progress = config%output%progress
+    call writer%open(scene, error)
+    if (allocated(error)) call fail('output', error, 2)
+    open(newunit=unit, file=trim(config%output%folder) // '/input.nml', status='replace', &
+        action='write', iostat=status)
+    if (status == 0) then
+        call write_config(unit, config)
+        close(unit)
+    end if
+
+    call run_scene(scene, writer, error)
+    call writer%finish(scene, finish_error)
+    if (allocated(error)) call fail('solve', error, 1)
+    if (allocated(finish_error)) call fail('output', finish_error, 1)
+    write(error_unit, '(a)') 'yarnfort: done; results in ' // trim(config%output%folder)
+
+contains
+
+    subroutine handle_arguments()
+        integer :: i
+        character(len=256) :: argument
+
+        do i = 1, command_argument_count()
+            call get_command_argument(i, argument)
+            select case (trim(argument))
+            case ('--help', '-h')
+                call print_help()
+                stop
+            case ('--version', '-V')
+                write(output_unit, '(a)') 'yarnfort ' // yarnfort_version_string
+                stop
+            case default
+                write(error_unit, '(a)') "yarnfort: error: unknown argument '" // trim(argument) &
+                    // "' (try --help)"
+                error stop 2
+            end select
+        end do
+    end subroutine handle_arguments
+
+    subroutine print_help()
+        write(output_unit, '(a)') &
+            'usage: yarnfort [--help | --version] < scene.nml', &
+            '', &
+            'Simulates the stretching of a network of hyperelastic strings (yarns) described', &
+            'by a Fortran namelist read from standard input, following its load path with', &
+            "Newton's method (SUNDIALS KINSOL) and sparse direct linear solvers.", &
+            '', &
+            'Namelist groups: &control &solver &material &nodes &geometry &yarn &support', &
+            '&load &path &output; every variable, default and unit: inputs/REFERENCE.md.', &
+            '', &
+            'Writes to the &output folder: curve.csv (one row per converged step),', &
+            'state_NNNNN.vtu + states.pvd (ParaView) and input.nml (the effective input).', &
+            'Progress lines go to stderr. Exit code 0 on success, 1 if the solve failed', &
+            '(converged steps are kept), 2 for bad input or an unwritable output folder.'
+    end subroutine print_help
+
+    subroutine fail(stage, error, code)
+        character(len=*), intent(in) :: stage
+        type(error_type), intent(in) :: error
+        integer, intent(in) :: code
+        write(error_unit, '(a)') 'yarnfort: error (' // stage // '): ' // error%message
+        if (code == 1) error stop 1
+        error stop 2
+    end subroutine fail
+
 end program yarnfort_main

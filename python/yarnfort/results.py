@@ -1,0 +1,79 @@
+# SPDX-License-Identifier: MIT
+"""Read a run's output folder: ``curve.csv`` and the ``state_NNNNN.vtu`` files."""
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+
+@dataclass
+class Curve:
+    """One row per converged step; ``columns`` maps a column name to a numpy array."""
+
+    columns: dict[str, np.ndarray]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.columns[name]
+
+    @property
+    def names(self) -> list[str]:
+        return list(self.columns)
+
+    def reaction(self, support: str) -> np.ndarray:
+        """Reaction force (n_steps, 3) applied by the named support set on the net."""
+        return np.column_stack([self.columns[f"{support}_r{k}"] for k in "xyz"])
+
+
+@dataclass
+class State:
+    """A converged network state: node positions (n, 3) and per-element fields."""
+
+    position: np.ndarray
+    elements: np.ndarray
+    tension: np.ndarray
+    stretch: np.ndarray
+    length0: np.ndarray
+
+
+def read_curve(path: str | Path) -> Curve:
+    """Read ``curve.csv`` (a file, or the output folder holding it)."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / "curve.csv"
+    data = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
+    return Curve({name: np.atleast_1d(data[name]) for name in data.dtype.names})
+
+
+def _array(piece: ET.Element, name: str) -> np.ndarray:
+    for node in piece.iter("DataArray"):
+        if node.get("Name") == name:
+            return np.array(node.text.split(), dtype=float)
+    raise KeyError(f"no DataArray named {name!r}")
+
+
+def read_state(path: str | Path) -> State:
+    """Read one ``state_NNNNN.vtu`` file written by yarnfort."""
+    root = ET.parse(path).getroot()
+    piece = root.find("UnstructuredGrid/Piece")
+    points = np.array(piece.find("Points/DataArray").text.split(), dtype=float)
+    connectivity = _array(piece, "connectivity").astype(int)
+    return State(
+        position=points.reshape(-1, 3),
+        elements=connectivity.reshape(-1, 2),
+        tension=_array(piece, "tension"),
+        stretch=_array(piece, "stretch"),
+        length0=_array(piece, "L0"),
+    )
+
+
+def read_states(folder: str | Path) -> list[State]:
+    """All VTK states of an output folder, in step order."""
+    return [read_state(p) for p in sorted(Path(folder).glob("state_*.vtu"))]
+
+
+def read_run(folder: str | Path) -> tuple[Curve, list[State]]:
+    """The curve and every written state of an output folder."""
+    return read_curve(folder), read_states(folder)

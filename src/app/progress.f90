@@ -1,0 +1,48 @@
+! SPDX-License-Identifier: MIT
+!> The program's step observer: the library's file writer plus progress lines on stderr.
+module yarnfort_app_progress
+    use, intrinsic :: iso_fortran_env, only: error_unit
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_solver_continuation, only: step_state_type
+    use yarnfort_output_writer, only: output_writer_type
+    implicit none
+    private
+
+    public :: progress_writer_type
+
+    type, extends(output_writer_type) :: progress_writer_type
+        logical :: progress = .true.
+    contains
+        procedure :: on_step
+        procedure :: on_cut
+    end type progress_writer_type
+
+contains
+
+    subroutine on_step(self, scene, state, error)
+        class(progress_writer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%output_writer_type%on_step(scene, state, error)
+        if (allocated(error) .or. .not. self%progress) return
+        write(error_unit, '("step ", i5, "  t = ", f9.5, "  p_force = ", f8.4, "  p_disp = ", &
+            & f8.4, "  newton ", i3, "  residual ", es9.2, "  ", f8.3, " s")') &
+            state%step, state%time, state%p_force, state%p_disp, state%newton%iterations, &
+            state%newton%residual_norm, state%wall_time
+    end subroutine on_step
+
+    subroutine on_cut(self, time, step, reason)
+        class(progress_writer_type), intent(inout) :: self
+        real(wp), intent(in) :: time, step
+        character(len=*), intent(in) :: reason
+
+        if (.not. self%progress) return
+        write(error_unit, '("  cut: step of ", es9.2, " from t = ", f9.5, " failed: ", a)') &
+            step, time, reason
+    end subroutine on_cut
+
+end module yarnfort_app_progress

@@ -1,0 +1,106 @@
+! SPDX-License-Identifier: MIT
+!> Global assembly: internal forces, residual and sparse Jacobian of the equilibrium
+!> equations (paper eq. 46 with constraints eliminated, eqs. 51-52).
+module yarnfort_assembly_assemble
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_assembly_truss, only: get_truss_response
+    use yarnfort_assembly_pattern, only: pattern_type
+    implicit none
+    private
+
+    public :: assemble_internal_force, assemble_residual, assemble_jacobian
+
+    !> Elements shorter than this fraction of their reference length are degenerate.
+    real(wp), parameter :: degenerate_length_ratio = 1.0e-12_wp
+
+contains
+
+    !> Internal force (gradient of the elastic energy) at every coordinate, (3*n_nodes),
+    !> and each element's tension and stretch, for node positions x (3, n_nodes).
+    subroutine assemble_internal_force(scene, x, internal, tension, stretch, error)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: x(:, :)
+        real(wp), intent(out) :: internal(:), tension(:), stretch(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: e, n1, n2
+        real(wp) :: force(3)
+
+        internal = 0.0_wp
+        do e = 1, scene%network%n_elements()
+            n1 = scene%network%element_nodes(1, e)
+            n2 = scene%network%element_nodes(2, e)
+            call check_length(scene, x, e, error)
+            if (allocated(error)) return
+            call get_truss_response(scene%laws(scene%network%element_material(e))%law, &
+                scene%solver%slack_stiffness, scene%network%length0(e), x(:, n1), x(:, n2), &
+                tension(e), stretch(e), force)
+            internal(3 * n1 - 2:3 * n1) = internal(3 * n1 - 2:3 * n1) - force
+            internal(3 * n2 - 2:3 * n2) = internal(3 * n2 - 2:3 * n2) + force
+        end do
+    end subroutine assemble_internal_force
+
+    !> Residual on the unknowns: P^T (internal - p_force * external).
+    subroutine assemble_residual(scene, x, p_force, residual, error)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: x(:, :), p_force
+        real(wp), intent(out) :: residual(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: internal(:), tension(:), stretch(:)
+
+        allocate(internal(size(scene%external_force)))
+        allocate(tension(scene%network%n_elements()), stretch(scene%network%n_elements()))
+        call assemble_internal_force(scene, x, internal, tension, stretch, error)
+        if (allocated(error)) return
+        call scene%dofs%gather(internal - p_force * scene%external_force, residual)
+    end subroutine assemble_residual
+
+    !> Jacobian values P^T K P in the slots of `pattern` (values are overwritten).
+    subroutine assemble_jacobian(scene, pattern, x, values, error)
+        type(scene_type), intent(in) :: scene
+        type(pattern_type), intent(in) :: pattern
+        real(wp), intent(in) :: x(:, :)
+        real(wp), intent(out) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: e, n1, n2, a, b, slot
+        real(wp) :: force(3), block(3, 3), tension, stretch, sign_ab
+
+        values = 0.0_wp
+        do e = 1, scene%network%n_elements()
+            n1 = scene%network%element_nodes(1, e)
+            n2 = scene%network%element_nodes(2, e)
+            call check_length(scene, x, e, error)
+            if (allocated(error)) return
+            call get_truss_response(scene%laws(scene%network%element_material(e))%law, &
+                scene%solver%slack_stiffness, scene%network%length0(e), x(:, n1), x(:, n2), &
+                tension, stretch, force, block)
+            do b = 1, 6
+                do a = 1, 6
+                    slot = pattern%element_slot(a, b, e)
+                    if (slot == 0) cycle
+                    sign_ab = merge(1.0_wp, -1.0_wp, (a <= 3) .eqv. (b <= 3))
+                    values(slot) = values(slot) + sign_ab * block(mod(a - 1, 3) + 1, mod(b - 1, 3) + 1)
+                end do
+            end do
+        end do
+    end subroutine assemble_jacobian
+
+    subroutine check_length(scene, x, e, error)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: x(:, :)
+        integer, intent(in) :: e
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: length
+        character(len=160) :: buffer
+
+        length = norm2(x(:, scene%network%element_nodes(2, e)) &
+            - x(:, scene%network%element_nodes(1, e)))
+        if (.not. (length > degenerate_length_ratio * scene%network%length0(e))) then
+            write(buffer, '("element ", i0, " (nodes ", i0, ", ", i0, ") has length ", es10.3)') &
+                e, scene%network%element_nodes(:, e), length
+            call fatal_error(error, trim(buffer))
+        end if
+    end subroutine check_length
+
+end module yarnfort_assembly_assemble

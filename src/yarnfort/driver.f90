@@ -1,0 +1,50 @@
+! SPDX-License-Identifier: MIT
+!> Run a scene: choose the linear solver, set up Newton (KINSOL) and follow the load path.
+module yarnfort_driver
+    use yarnfort_error, only: error_type, prefix_error
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
+    use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver
+    use yarnfort_solver_continuation, only: step_observer_type, run_continuation
+    implicit none
+    private
+
+    public :: run_scene, get_linear_solver_name
+
+contains
+
+    !> The linear solver a scene uses: its &solver linear_solver, or for 'auto' the
+    !> measured default for its size. The elastic tangent is symmetric but not always
+    !> positive definite (slack regularisation, compressed strings), so 'auto' does not
+    !> pick the Cholesky solver.
+    function get_linear_solver_name(scene) result(name)
+        type(scene_type), intent(in) :: scene
+        character(len=:), allocatable :: name
+
+        if (trim(scene%solver%linear_solver) == 'auto') then
+            name = default_linear_solver_name(int(scene%dofs%n_unknowns, 8), .false.)
+        else
+            name = trim(scene%solver%linear_solver)
+        end if
+    end function get_linear_solver_name
+
+    !> Follow the scene's load path; `observer` receives every converged step.
+    subroutine run_scene(scene, observer, error)
+        type(scene_type), target, intent(in) :: scene
+        class(step_observer_type), intent(inout) :: observer
+        type(error_type), allocatable, intent(out) :: error
+        class(linear_solver_type), allocatable :: linear
+        type(newton_solver_type) :: newton
+
+        call new_linear_solver(linear, get_linear_solver_name(scene), error)
+        if (allocated(error)) then
+            call prefix_error(error, '&solver linear_solver')
+            return
+        end if
+        call new_newton_solver(newton, scene, linear, error)
+        if (allocated(error)) return
+        call run_continuation(scene, newton, observer, error)
+    end subroutine run_scene
+
+end module yarnfort_driver

@@ -1,0 +1,363 @@
+! SPDX-License-Identifier: MIT
+!> Newton's method for the equilibrium of the network at given load factors, driven by
+!> SUNDIALS KINSOL (line search globalisation) with the analytic sparse Jacobian and a
+!> yarnfort linear solver behind a Fortran SUNLinearSolver.
+module yarnfort_solver_newton
+    use, intrinsic :: iso_c_binding
+    use fsundials_context_mod
+    use fkinsol_mod
+    use fnvector_serial_mod
+    use fsunmatrix_sparse_mod
+    use fsundials_matrix_mod
+    use fsundials_nvector_mod
+    use fsundials_linearsolver_mod
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_assembly_pattern, only: pattern_type, new_pattern
+    use yarnfort_assembly_assemble, only: assemble_residual, assemble_jacobian
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc
+    use yarnfort_solver_timer, only: wall_time
+    implicit none
+    private
+
+    public :: newton_solver_type, newton_stats_type, new_newton_solver
+
+    interface
+        !> C's strlen, for KINSOL's messages.
+        function c_strlen(text) result(length) bind(C, name='strlen')
+            import :: c_ptr, c_size_t
+            type(c_ptr), value :: text
+            integer(c_size_t) :: length
+        end function c_strlen
+    end interface
+
+    !> Figures of one Newton solve.
+    type :: newton_stats_type
+        integer :: iterations = 0
+        integer :: residual_evaluations = 0
+        integer :: jacobian_evaluations = 0
+        !> Scaled max-norm of the residual, max|F| / force_scale, at each iterate
+        !> (iterate 0 is the initial guess) and at the end.
+        real(wp), allocatable :: residual_history(:)
+        real(wp) :: residual_norm = huge(1.0_wp)
+        !> KINSOL's return flag.
+        integer :: flag = 0
+    end type newton_stats_type
+
+    !> The problem KINSOL's callbacks see through their user-data pointer.
+    type :: equilibrium_type
+        type(scene_type), pointer :: scene => null()
+        type(pattern_type) :: pattern
+        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
+        real(wp), allocatable :: x(:, :)
+        real(wp), allocatable :: history(:)
+        integer :: n_history = 0
+        type(error_type), allocatable :: error
+        character(len=:), allocatable :: kinsol_message
+        !> Accumulated wall time of residual and Jacobian assembly.
+        real(wp) :: residual_time = 0.0_wp, jacobian_time = 0.0_wp
+    end type equilibrium_type
+
+    !> Owns KINSOL's memory, vectors, matrix and the linear solver for one scene.
+    type :: newton_solver_type
+        type(c_ptr) :: sunctx = c_null_ptr
+        type(c_ptr) :: kinsol = c_null_ptr
+        type(N_Vector), pointer :: u_vector => null(), u_scale => null(), f_scale => null()
+        type(SUNMatrix), pointer :: jacobian => null()
+        type(SUNLinearSolver), pointer :: sunls => null()
+        real(c_double), pointer :: u(:) => null(), u_scale_data(:) => null()
+        real(c_double), pointer :: f_scale_data(:) => null()
+        type(equilibrium_type), pointer :: problem => null()
+        type(adapter_type), pointer :: adapter => null()
+        class(linear_solver_type), pointer :: linear => null()
+    contains
+        !> Solve for unknowns u (in: initial guess, out: solution) at the load factors.
+        procedure :: solve
+        !> Timing and counters of assembly and linear algebra so far.
+        procedure :: get_timings
+        procedure :: destroy
+        final :: finalize
+    end type newton_solver_type
+
+contains
+
+    !> Set up KINSOL for `scene` (which must outlive the solver) with `linear` as the
+    !> linear solver (ownership passes to the Newton solver).
+    subroutine new_newton_solver(self, scene, linear, error)
+        type(newton_solver_type), intent(out) :: self
+        type(scene_type), target, intent(in) :: scene
+        class(linear_solver_type), allocatable, intent(inout) :: linear
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_int64_t) :: n, nnz
+        integer(c_int) :: ierr
+
+        allocate(self%problem)
+        self%problem%scene => scene
+        call new_pattern(self%problem%pattern, scene%network, scene%dofs)
+        allocate(self%problem%x(3, scene%network%n_nodes()))
+        allocate(self%problem%history(scene%solver%max_iterations + 2))
+        n = int(scene%dofs%n_unknowns, c_int64_t)
+        nnz = max(int(self%problem%pattern%nnz, c_int64_t), 1_c_int64_t)
+        if (n == 0) then
+            call fatal_error(error, 'the scene has no unknowns: every coordinate is prescribed')
+            return
+        end if
+
+        allocate(self%linear, source=linear)
+        deallocate(linear)
+        allocate(self%adapter)
+        self%adapter%solver => self%linear
+
+        ierr = FSUNContext_Create(c_null_ptr, self%sunctx)
+        if (ierr /= 0) then
+            call fatal_error(error, 'SUNDIALS: could not create a context')
+            return
+        end if
+        allocate(self%u(n), self%u_scale_data(n), self%f_scale_data(n))
+        self%u = 0.0_wp
+        self%u_scale_data = 1.0_wp / scene%length_scale
+        self%f_scale_data = 1.0_wp / scene%force_scale
+        self%u_vector => FN_VMake_Serial(n, self%u, self%sunctx)
+        self%u_scale => FN_VMake_Serial(n, self%u_scale_data, self%sunctx)
+        self%f_scale => FN_VMake_Serial(n, self%f_scale_data, self%sunctx)
+        self%jacobian => FSUNSparseMatrix(n, n, nnz, CSC_MAT, self%sunctx)
+        self%sunls => new_sunlinsol_adapter(self%adapter, self%sunctx)
+        if (.not. (associated(self%u_vector) .and. associated(self%jacobian) &
+                .and. associated(self%sunls))) then
+            call fatal_error(error, 'SUNDIALS: could not create vectors, matrix or linear solver')
+            return
+        end if
+
+        self%kinsol = FKINCreate(self%sunctx)
+        if (.not. c_associated(self%kinsol)) then
+            call fatal_error(error, 'KINSOL: could not create solver memory')
+            return
+        end if
+        call check(FKINInit(self%kinsol, c_funloc(residual_callback), self%u_vector), &
+            'FKINInit', error)
+        if (allocated(error)) return
+        call check(FKINSetErrHandlerFn(self%kinsol, c_funloc(error_handler), &
+            c_loc(self%problem)), 'FKINSetErrHandlerFn', error)
+        if (allocated(error)) return
+        call check(FKINSetLinearSolver(self%kinsol, self%sunls, self%jacobian), &
+            'FKINSetLinearSolver', error)
+        if (allocated(error)) return
+        call check(FKINSetJacFn(self%kinsol, c_funloc(jacobian_callback)), 'FKINSetJacFn', error)
+        if (allocated(error)) return
+        call check(FKINSetMaxSetupCalls(self%kinsol, int(scene%solver%max_setup_calls, c_long)), &
+            'FKINSetMaxSetupCalls', error)
+        if (allocated(error)) return
+        call check(FKINSetNumMaxIters(self%kinsol, int(scene%solver%max_iterations, c_long)), &
+            'FKINSetNumMaxIters', error)
+        if (allocated(error)) return
+        call check(FKINSetFuncNormTol(self%kinsol, real(scene%solver%residual_tolerance, c_double)), &
+            'FKINSetFuncNormTol', error)
+        if (allocated(error)) return
+        call check(FKINSetScaledStepTol(self%kinsol, real(scene%solver%step_tolerance, c_double)), &
+            'FKINSetScaledStepTol', error)
+        if (allocated(error)) return
+        call check(FKINSetUserData(self%kinsol, c_loc(self%problem)), 'FKINSetUserData', error)
+    end subroutine new_newton_solver
+
+    subroutine check(ierr, where, error)
+        integer(c_int), intent(in) :: ierr
+        character(len=*), intent(in) :: where
+        type(error_type), allocatable, intent(out) :: error
+        character(len=16) :: code
+        if (ierr < 0) then
+            write(code, '(i0)') ierr
+            call fatal_error(error, 'SUNDIALS ' // where // ' failed with flag ' // trim(code))
+        end if
+    end subroutine check
+
+    subroutine solve(self, u, p_force, p_disp, stats, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: u(:)
+        real(wp), intent(in) :: p_force, p_disp
+        type(newton_stats_type), intent(out) :: stats
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_int) :: ierr, strategy
+        integer(c_long) :: count(1)
+        real(c_double) :: residual(size(u))
+        character(len=200) :: buffer
+        type(scene_type), pointer :: scene
+
+        scene => self%problem%scene
+        self%problem%p_force = p_force
+        self%problem%p_disp = p_disp
+        self%problem%n_history = 0
+        if (allocated(self%problem%error)) deallocate(self%problem%error)
+        if (allocated(self%problem%kinsol_message)) deallocate(self%problem%kinsol_message)
+        self%u = u
+        strategy = merge(KIN_LINESEARCH, KIN_NONE, scene%solver%line_search)
+        ierr = FKINSol(self%kinsol, self%u_vector, strategy, self%u_scale, self%f_scale)
+        stats%flag = ierr
+
+        if (FKINGetNumNonlinSolvIters(self%kinsol, count) == 0) stats%iterations = int(count(1))
+        if (FKINGetNumFuncEvals(self%kinsol, count) == 0) stats%residual_evaluations = int(count(1))
+        if (FKINGetNumJacEvals(self%kinsol, count) == 0) stats%jacobian_evaluations = int(count(1))
+
+        ! Judge convergence by our own residual check on the final iterate.
+        call residual_at(self%problem, self%u, residual, error)
+        if (allocated(error)) return
+        stats%residual_norm = maxval(abs(residual)) / scene%force_scale
+        self%problem%n_history = min(self%problem%n_history + 1, size(self%problem%history))
+        self%problem%history(self%problem%n_history) = stats%residual_norm
+        stats%residual_history = self%problem%history(1:self%problem%n_history)
+
+        if (allocated(self%problem%error)) then
+            call move_alloc(self%problem%error, error)
+            return
+        end if
+        if (allocated(self%adapter%error) .and. ierr < 0) then
+            call fatal_error(error, 'linear solver (' // self%linear%get_name() // '): ' &
+                // self%adapter%error%message)
+            return
+        end if
+        if (ierr < 0 .or. .not. (stats%residual_norm <= scene%solver%residual_tolerance)) then
+            write(buffer, '("Newton did not converge: KINSOL flag ", i0, ", ", i0, &
+                & " iterations, scaled residual ", es10.3, " > tolerance ", es10.3)') &
+                ierr, stats%iterations, stats%residual_norm, scene%solver%residual_tolerance
+            if (allocated(self%problem%kinsol_message)) then
+                call fatal_error(error, trim(buffer) // ' (' // self%problem%kinsol_message // ')')
+            else
+                call fatal_error(error, trim(buffer))
+            end if
+            return
+        end if
+        u = self%u
+    end subroutine solve
+
+    subroutine residual_at(problem, u, residual, error)
+        type(equilibrium_type), intent(inout) :: problem
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: residual(:)
+        type(error_type), allocatable, intent(out) :: error
+        call problem%scene%dofs%expand(u, problem%p_disp, problem%x)
+        call assemble_residual(problem%scene, problem%x, problem%p_force, residual, error)
+    end subroutine residual_at
+
+    !> KINSOL residual callback F(u).
+    integer(c_int) function residual_callback(sunvec_u, sunvec_f, user_data) &
+            result(ierr) bind(C)
+        type(N_Vector) :: sunvec_u, sunvec_f
+        type(c_ptr), value :: user_data
+        type(equilibrium_type), pointer :: problem
+        real(c_double), pointer :: u(:), f(:)
+        real(wp) :: start
+
+        call c_f_pointer(user_data, problem)
+        u => FN_VGetArrayPointer(sunvec_u)
+        f => FN_VGetArrayPointer(sunvec_f)
+        start = wall_time()
+        call residual_at(problem, u, f, problem%error)
+        problem%residual_time = problem%residual_time + (wall_time() - start)
+        ierr = 0
+        if (allocated(problem%error)) ierr = -1
+        if (ierr == 0 .and. any(f /= f)) then
+            ierr = -1
+            call fatal_error(problem%error, 'the residual is not a number (NaN)')
+        end if
+    end function residual_callback
+
+    !> KINSOL Jacobian callback: writes the CSC pattern (KINSOL zeroes the whole matrix,
+    !> index arrays included, before each call) and the values. It also records the
+    !> residual norm of the current iterate for the convergence history.
+    integer(c_int) function jacobian_callback(sunvec_u, sunvec_f, sunmat_j, user_data, &
+            tmp1, tmp2) result(ierr) bind(C)
+        type(N_Vector) :: sunvec_u, sunvec_f, tmp1, tmp2
+        type(SUNMatrix) :: sunmat_j
+        type(c_ptr), value :: user_data
+        type(equilibrium_type), pointer :: problem
+        real(c_double), pointer :: u(:), f(:), values(:)
+        integer(c_int64_t), pointer :: col_ptr(:), row_index(:)
+        integer(ik) :: n, nnz
+        real(wp) :: start
+        integer(c_int64_t), pointer :: p(:)
+        real(c_double), pointer :: d(:)
+
+        call c_f_pointer(user_data, problem)
+        u => FN_VGetArrayPointer(sunvec_u)
+        f => FN_VGetArrayPointer(sunvec_f)
+        if (problem%n_history < size(problem%history)) then
+            problem%n_history = problem%n_history + 1
+            problem%history(problem%n_history) = maxval(abs(f)) / problem%scene%force_scale
+        end if
+        start = wall_time()
+        n = problem%pattern%n
+        nnz = problem%pattern%nnz
+        p => FSUNSparseMatrix_IndexPointers(sunmat_j)
+        call c_f_pointer(c_loc(p(1)), col_ptr, [n + 1])
+        col_ptr = problem%pattern%col_ptr
+        p => FSUNSparseMatrix_IndexValues(sunmat_j)
+        call c_f_pointer(c_loc(p(1)), row_index, [nnz])
+        row_index = problem%pattern%row_index
+        d => FSUNSparseMatrix_Data(sunmat_j)
+        call c_f_pointer(c_loc(d(1)), values, [nnz])
+        call problem%scene%dofs%expand(u, problem%p_disp, problem%x)
+        call assemble_jacobian(problem%scene, problem%pattern, problem%x, values, problem%error)
+        problem%jacobian_time = problem%jacobian_time + (wall_time() - start)
+        ierr = 0
+        if (allocated(problem%error)) ierr = -1
+    end function jacobian_callback
+
+    !> KINSOL error handler: keep the message for our error value instead of printing.
+    subroutine error_handler(error_code, module_name, function_name, message, user_data) bind(C)
+        integer(c_int), value :: error_code
+        type(c_ptr), value :: module_name, function_name, message, user_data
+        type(equilibrium_type), pointer :: problem
+        character(kind=c_char), pointer :: text(:)
+        integer :: length
+
+        call c_f_pointer(user_data, problem)
+        length = int(c_strlen(message))
+        call c_f_pointer(message, text, [length])
+        allocate(character(len=length) :: problem%kinsol_message)
+        problem%kinsol_message = transfer(text, problem%kinsol_message)
+    end subroutine error_handler
+
+    !> Accumulated figures: assembly (residual, Jacobian) and linear algebra times.
+    subroutine get_timings(self, residual_time, jacobian_time, analyse_time, factor_time, &
+            solve_time, n_factorisations)
+        class(newton_solver_type), intent(in) :: self
+        real(wp), intent(out) :: residual_time, jacobian_time, analyse_time, factor_time
+        real(wp), intent(out) :: solve_time
+        integer, intent(out) :: n_factorisations
+        residual_time = self%problem%residual_time
+        jacobian_time = self%problem%jacobian_time
+        analyse_time = self%adapter%analyse_time
+        factor_time = self%adapter%factor_time
+        solve_time = self%adapter%solve_time
+        n_factorisations = self%adapter%n_factorisations
+    end subroutine get_timings
+
+    subroutine destroy(self)
+        class(newton_solver_type), intent(inout) :: self
+        integer(c_int) :: ierr
+        if (c_associated(self%kinsol)) call FKINFree(self%kinsol)
+        self%kinsol = c_null_ptr
+        if (associated(self%sunls)) ierr = FSUNLinSolFree(self%sunls)
+        if (associated(self%jacobian)) call FSUNMatDestroy(self%jacobian)
+        if (associated(self%u_vector)) call FN_VDestroy(self%u_vector)
+        if (associated(self%u_scale)) call FN_VDestroy(self%u_scale)
+        if (associated(self%f_scale)) call FN_VDestroy(self%f_scale)
+        nullify(self%sunls, self%jacobian, self%u_vector, self%u_scale, self%f_scale)
+        if (c_associated(self%sunctx)) ierr = FSUNContext_Free(self%sunctx)
+        self%sunctx = c_null_ptr
+        if (associated(self%linear)) then
+            call self%linear%destroy()
+            deallocate(self%linear)
+        end if
+        if (associated(self%adapter)) deallocate(self%adapter)
+        if (associated(self%problem)) deallocate(self%problem)
+        if (associated(self%u)) deallocate(self%u, self%u_scale_data, self%f_scale_data)
+    end subroutine destroy
+
+    subroutine finalize(self)
+        type(newton_solver_type), intent(inout) :: self
+        call self%destroy()
+    end subroutine finalize
+
+end module yarnfort_solver_newton
