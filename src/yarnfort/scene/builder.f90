@@ -17,7 +17,7 @@ module yarnfort_scene_builder
 contains
 
     !> Build `scene` from a checked `config`. Relative table paths are taken relative to
-    !> the working directory.
+    !> the input file's folder (the working directory for standard input).
     subroutine new_scene(scene, config, error)
         type(scene_type), intent(out) :: scene
         type(config_type), intent(in) :: config
@@ -30,7 +30,8 @@ contains
         allocate(scene%laws(size(config%materials)))
         do m = 1, size(config%materials)
             scene%laws(m)%name = config%materials(m)%name
-            call new_force_law(scene%laws(m)%law, config%materials(m), error)
+            call new_force_law(scene%laws(m)%law, config%materials(m), error, &
+                config%input_folder)
             if (allocated(error)) then
                 call prefix_error(error, "&material '" // trim(config%materials(m)%name) // "'")
                 return
@@ -51,11 +52,14 @@ contains
         scene%length_scale = sum(scene%network%length0) / size(scene%network%length0)
     end subroutine new_scene
 
-    !> The force law a &material group describes.
-    subroutine new_force_law(law, material, error)
+    !> The force law a &material group describes. A relative table_file is taken
+    !> relative to `folder` (the input file's folder; the working directory if empty).
+    subroutine new_force_law(law, material, error, folder)
         class(force_law_type), allocatable, intent(out) :: law
         type(material_config_type), intent(in) :: material
         type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in), optional :: folder
+        character(len=:), allocatable :: path
 
         select case (trim(material%law))
         case ('linear')
@@ -76,7 +80,12 @@ contains
             block
                 type(table_law_type), allocatable :: table
                 allocate(table)
-                call read_table_law(table, trim(material%table_file), error)
+                path = trim(material%table_file)
+                if (present(folder)) then
+                    if (len_trim(folder) > 0 .and. path(1:1) /= '/') &
+                        path = trim(folder) // '/' // path
+                end if
+                call read_table_law(table, path, error)
                 call move_alloc(table, law)
             end block
         case default

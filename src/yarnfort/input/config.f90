@@ -1,0 +1,137 @@
+! SPDX-License-Identifier: MIT
+!> What the user asked for, as read from the namelist input, before any scene is built.
+!> Plain data with defaults; units are SI (N, m) unless a unit is given.
+!> Reading is in yarnfort_input_namelist; building the scene from it is in yarnfort_scene.
+module yarnfort_input_config
+    use yarnfort_kinds, only: wp
+    implicit none
+    private
+
+    public :: config_type, control_config_type, solver_config_type, material_config_type
+    public :: yarn_config_type, support_config_type, load_config_type, path_config_type
+    public :: output_config_type, geometry_config_type, name_length, path_length
+
+    integer, parameter :: name_length = 64
+    integer, parameter :: path_length = 512
+
+    !> &control: what the run is.
+    type :: control_config_type
+        character(len=256) :: title = ''
+        !> Stop after reading and checking the input (no solve, no output).
+        logical :: check_only = .false.
+    end type control_config_type
+
+    !> &solver: nonlinear and linear solver settings, continuation step control.
+    type :: solver_config_type
+        !> 'auto', 'umfpack', 'klu', 'cholmod' or 'dense'.
+        character(len=16) :: linear_solver = 'auto'
+        !> Newton stops when max |residual| <= residual_tolerance * force_scale.
+        real(wp) :: residual_tolerance = 1.0e-12_wp
+        !> Newton also stops when the scaled step is below this (then checked against
+        !> the residual tolerance, never accepted alone).
+        real(wp) :: step_tolerance = 1.0e-14_wp
+        integer :: max_iterations = 50
+        !> Newton iterations between Jacobian updates (1 = full Newton).
+        integer :: max_setup_calls = 1
+        logical :: line_search = .true.
+        !> Stiffness of a slack (compressed) element as a fraction of its law's reference
+        !> stiffness (regularisation of the tension-only law; 0 switches it off).
+        real(wp) :: slack_stiffness = 1.0e-6_wp
+        !> Continuation: first, smallest and largest pseudo-time step.
+        real(wp) :: initial_step = 0.1_wp
+        real(wp) :: min_step = 1.0e-6_wp
+        real(wp) :: max_step = 0.25_wp
+        !> Step growth factor after easy convergence and cut factor after a failure.
+        real(wp) :: step_growth = 1.5_wp
+        real(wp) :: step_cut = 0.5_wp
+        !> A step converged in at most this many Newton iterations is "easy".
+        integer :: easy_iterations = 4
+        !> Give up after this many consecutive step cuts.
+        integer :: max_step_cuts = 30
+    end type solver_config_type
+
+    !> &material: one yarn type and its force law (one group per yarn type).
+    type :: material_config_type
+        character(len=name_length) :: name = ''
+        !> 'linear', 'neo_hookean' or 'table'.
+        character(len=16) :: law = ''
+        !> linear: EA in N.
+        real(wp) :: stiffness = -1.0_wp
+        !> neo_hookean: modulus C in Pa and undeformed cross-section S(1) in m^2.
+        real(wp) :: modulus = -1.0_wp
+        real(wp) :: area = -1.0_wp
+        !> table: CSV file of (strain, force in N), relative to the input file's folder
+        !> or the working directory.
+        character(len=path_length) :: table_file = ''
+    end type material_config_type
+
+    !> &yarn: one yarn, a polyline through node ids, split into elements.
+    type :: yarn_config_type
+        character(len=name_length) :: material = ''
+        integer, allocatable :: nodes(:)
+        !> Each segment between listed nodes is split into this many elements.
+        integer :: elements_per_segment = 1
+    end type yarn_config_type
+
+    !> &support: a named set of nodes whose listed components are prescribed.
+    type :: support_config_type
+        character(len=name_length) :: name = ''
+        integer, allocatable :: nodes(:)
+        !> Which components are prescribed: any of 'x', 'y', 'z'.
+        character(len=3) :: fix = 'xyz'
+        !> Displacement D at load factor p_disp = 1 (m), per component.
+        real(wp) :: displacement(3) = 0.0_wp
+    end type support_config_type
+
+    !> &load: a force P (N) at load factor p_force = 1 on each listed node.
+    type :: load_config_type
+        integer, allocatable :: nodes(:)
+        real(wp) :: force(3) = 0.0_wp
+    end type load_config_type
+
+    !> &path: the load path as knots over pseudo-time, linear in between.
+    type :: path_config_type
+        real(wp), allocatable :: time(:)
+        real(wp), allocatable :: p_force(:)
+        real(wp), allocatable :: p_disp(:)
+    end type path_config_type
+
+    !> &geometry: node positions and yarns from a plain text file instead of &nodes and
+    !> &yarn groups (format in inputs/REFERENCE.md).
+    type :: geometry_config_type
+        !> Geometry file; a relative name is resolved against `config_type%input_folder`.
+        !> Empty: no geometry file.
+        character(len=path_length) :: file = ''
+    end type geometry_config_type
+
+    !> &output: where and what to write.
+    type :: output_config_type
+        character(len=path_length) :: folder = 'out'
+        !> Write a VTK state every this many converged steps (0: none; the last step is
+        !> always written when vtk_every > 0).
+        integer :: vtk_every = 1
+        !> Progress lines on stderr.
+        logical :: progress = .true.
+    end type output_config_type
+
+    !> The whole input.
+    type :: config_type
+        type(control_config_type) :: control
+        type(solver_config_type) :: solver
+        type(material_config_type), allocatable :: materials(:)
+        !> &geometry group: a file with the nodes and yarns (then no &nodes or &yarn).
+        type(geometry_config_type) :: geometry
+        !> &nodes group or geometry file: node coordinates (3, n_nodes), ids 1..n_nodes.
+        real(wp), allocatable :: node_positions(:, :)
+        !> &yarn groups or geometry file.
+        type(yarn_config_type), allocatable :: yarns(:)
+        type(support_config_type), allocatable :: supports(:)
+        type(load_config_type), allocatable :: loads(:)
+        type(path_config_type) :: path
+        type(output_config_type) :: output
+        !> Not a namelist variable: the folder of the input file, against which relative
+        !> file names in the input are resolved ('' = the working directory, as for stdin).
+        character(len=path_length) :: input_folder = ''
+    end type config_type
+
+end module yarnfort_input_config

@@ -1,0 +1,250 @@
+! SPDX-License-Identifier: MIT
+!> The plain text geometry file of &geometry: nodes and yarns of large scenes.
+!>
+!>     # comment (to the end of the line)
+!>     node <id> <x> <y> <z>
+!>     yarn <material> <elements_per_segment> <id> <id> ... [&]
+!>
+!> Words are separated by blanks; keywords are case-insensitive. Node ids are 1..n, each
+!> defined exactly once, in any order. A yarn line ending in '&' continues on the next
+!> line. Node and yarn lines may be mixed in any order.
+module yarnfort_input_geometry
+    use, intrinsic :: iso_fortran_env, only: int64
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_input_config, only: yarn_config_type, name_length
+    use yarnfort_input_text, only: string_type, to_lower, format_integer, split_words, &
+        parse_integer, parse_real
+    implicit none
+    private
+
+    public :: read_geometry_file
+
+contains
+
+    !> Read node positions (3, n) and yarns from the geometry file `path`.
+    subroutine read_geometry_file(path, node_positions, yarns, error)
+        character(len=*), intent(in) :: path
+        real(wp), allocatable, intent(out) :: node_positions(:, :)
+        type(yarn_config_type), allocatable, intent(out) :: yarns(:)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: content, line, record
+        type(string_type), allocatable :: words(:)
+        integer :: position, line_number, first_line, n_nodes, n_yarns, id, k, i
+        integer, allocatable :: node_ids(:), node_lines(:), yarn_lines(:), defined_on(:)
+        real(wp), allocatable :: node_xyz(:, :)
+        type(yarn_config_type), allocatable :: grown(:)
+        real(wp) :: xyz(3)
+        logical :: ok
+
+        content = ''
+        call read_whole_file(path, content, error)
+        if (allocated(error)) return
+        allocate(node_ids(1024), node_lines(1024), node_xyz(3, 1024))
+        allocate(yarns(16), yarn_lines(16))
+        n_nodes = 0
+        n_yarns = 0
+        line_number = 0
+        position = 1
+        read_lines: do
+            ! A logical line: lines joined while they end in '&'.
+            record = ''
+            first_line = line_number + 1
+            do
+                if (position > len(content)) then
+                    if (len_trim(record) > 0) then
+                        call fail(line_number, "the last line ends in '&' but nothing follows")
+                        return
+                    end if
+                    exit read_lines
+                end if
+                call next_line(content, position, line)
+                line_number = line_number + 1
+                if (index(line, '#') > 0) line = line(:index(line, '#') - 1)
+                line = trim(line)
+                if (len(line) > 0) then
+                    if (line(len(line):len(line)) == '&') then
+                        record = record // ' ' // line(:len(line) - 1)
+                        cycle
+                    end if
+                end if
+                record = record // ' ' // line
+                exit
+            end do
+            call split_words(record, words)
+            if (size(words) == 0) cycle read_lines
+            select case (to_lower(words(1)%text))
+            case ('node')
+                if (size(words) /= 5) then
+                    call fail(first_line, 'a node line is: node <id> <x> <y> <z>')
+                    return
+                end if
+                call parse_integer(words(2)%text, id, ok)
+                if (.not. ok .or. id < 1) then
+                    call fail(first_line, "node id '" // words(2)%text &
+                        // "' is not an integer >= 1")
+                    return
+                end if
+                do k = 1, 3
+                    call parse_real(words(2 + k)%text, xyz(k), ok)
+                    if (.not. ok) then
+                        call fail(first_line, 'node ' // format_integer(id) // ': ' &
+                            // 'xyz'(k:k) // " = '" // words(2 + k)%text &
+                            // "' is not a number")
+                        return
+                    end if
+                end do
+                if (n_nodes == size(node_ids)) then
+                    node_ids = [node_ids, node_ids]
+                    node_lines = [node_lines, node_lines]
+                    node_xyz = reshape([node_xyz, node_xyz], [3, 2 * n_nodes])
+                end if
+                n_nodes = n_nodes + 1
+                node_ids(n_nodes) = id
+                node_lines(n_nodes) = first_line
+                node_xyz(:, n_nodes) = xyz
+            case ('yarn')
+                if (size(words) < 5) then
+                    call fail(first_line, 'a yarn line is: yarn <material> ' &
+                        // '<elements_per_segment> <id> <id> ... (at least 2 node ids)')
+                    return
+                end if
+                if (len(words(2)%text) > name_length) then
+                    call fail(first_line, "material name '" // words(2)%text &
+                        // "' is longer than " // format_integer(name_length) &
+                        // ' characters')
+                    return
+                end if
+                if (n_yarns == size(yarns)) then
+                    allocate(grown(2 * n_yarns))
+                    grown(:n_yarns) = yarns
+                    call move_alloc(grown, yarns)
+                    yarn_lines = [yarn_lines, yarn_lines]
+                end if
+                n_yarns = n_yarns + 1
+                yarn_lines(n_yarns) = first_line
+                yarns(n_yarns)%material = words(2)%text
+                call parse_integer(words(3)%text, yarns(n_yarns)%elements_per_segment, ok)
+                if (.not. ok) then
+                    call fail(first_line, "elements_per_segment '" // words(3)%text &
+                        // "' is not an integer")
+                    return
+                end if
+                allocate(yarns(n_yarns)%nodes(size(words) - 3))
+                do k = 4, size(words)
+                    call parse_integer(words(k)%text, yarns(n_yarns)%nodes(k - 3), ok)
+                    if (.not. ok) then
+                        call fail(first_line, "yarn node id '" // words(k)%text &
+                            // "' is not an integer")
+                        return
+                    end if
+                end do
+            case default
+                call fail(first_line, "unknown keyword '" // words(1)%text &
+                    // "' (a line is 'node ...' or 'yarn ...'; comments start with #)")
+                return
+            end select
+        end do read_lines
+
+        ! Node ids must be exactly 1..n.
+        yarns = yarns(:n_yarns)
+        id = 0
+        if (n_nodes > 0) id = maxval(node_ids(:n_nodes))
+        allocate(node_positions(3, id), defined_on(id))
+        defined_on = 0
+        do i = 1, n_nodes
+            if (defined_on(node_ids(i)) /= 0) then
+                call fail(node_lines(i), 'node ' // format_integer(node_ids(i)) &
+                    // ' is defined twice (lines ' // format_integer(defined_on(node_ids(i))) &
+                    // ' and ' // format_integer(node_lines(i)) // ')')
+                return
+            end if
+            defined_on(node_ids(i)) = node_lines(i)
+            node_positions(:, node_ids(i)) = node_xyz(:, i)
+        end do
+        do i = 1, id
+            if (defined_on(i) == 0) then
+                call fatal_error(error, "&geometry: file '" // path // "': node " &
+                    // format_integer(i) // ' is missing (node ids must be 1..n, each ' &
+                    // 'once; the largest id is ' // format_integer(id) // ')')
+                return
+            end if
+        end do
+        do i = 1, n_yarns
+            do k = 1, size(yarns(i)%nodes)
+                if (yarns(i)%nodes(k) < 1 .or. yarns(i)%nodes(k) > id) then
+                    call fail(yarn_lines(i), 'yarn node id ' &
+                        // format_integer(yarns(i)%nodes(k)) // ' is not a node (ids are 1..' &
+                        // format_integer(id) // ')')
+                    return
+                end if
+            end do
+        end do
+
+    contains
+
+        subroutine fail(line, text)
+            integer, intent(in) :: line
+            character(len=*), intent(in) :: text
+
+            call fatal_error(error, "&geometry: file '" // path // "', line " &
+                // format_integer(line) // ': ' // text)
+        end subroutine fail
+
+    end subroutine read_geometry_file
+
+    !> The whole content of a file (read as a stream: much faster than record by record).
+    subroutine read_whole_file(path, content, error)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable, intent(out) :: content
+        type(error_type), allocatable, intent(out) :: error
+        character(len=512) :: message
+        integer :: unit, stat
+        integer(int64) :: file_size
+
+        open(newunit=unit, file=path, status='old', action='read', access='stream', &
+            form='unformatted', iostat=stat, iomsg=message)
+        if (stat /= 0) then
+            call fatal_error(error, "&geometry: cannot open file '" // path // "': " &
+                // trim(message))
+            return
+        end if
+        inquire(unit=unit, size=file_size)
+        if (file_size < 0) then
+            call fatal_error(error, "&geometry: cannot get the size of file '" // path // "'")
+            close(unit)
+            return
+        end if
+        allocate(character(len=file_size) :: content)
+        stat = 0
+        if (file_size > 0) read(unit, iostat=stat, iomsg=message) content
+        close(unit)
+        if (stat /= 0) then
+            call fatal_error(error, "&geometry: cannot read file '" // path // "': " &
+                // trim(message))
+        end if
+    end subroutine read_whole_file
+
+    !> The line of `content` starting at `position` (without its end: LF or CR LF);
+    !> `position` moves to the start of the next line.
+    pure subroutine next_line(content, position, line)
+        character(len=*), intent(in) :: content
+        integer, intent(inout) :: position
+        character(len=:), allocatable, intent(out) :: line
+        integer :: last
+
+        last = index(content(position:), achar(10))
+        if (last == 0) then
+            last = len(content)
+            line = content(position:last)
+        else
+            last = position + last - 1
+            line = content(position:last - 1)
+        end if
+        position = last + 1
+        if (len(line) > 0) then
+            if (line(len(line):len(line)) == achar(13)) line = line(:len(line) - 1)
+        end if
+    end subroutine next_line
+
+end module yarnfort_input_geometry

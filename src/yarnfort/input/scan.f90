@@ -1,0 +1,560 @@
+! SPDX-License-Identifier: MIT
+!> A structural pass over namelist input text before the Fortran namelist reads: finds
+!> every '&group ... /' occurrence with its lines and tokens, and rejects what the
+!> Fortran reader would silently ignore or misread (unknown or misspelt group names,
+!> text outside groups, a group not closed with '/', a variable set twice in one group,
+!> a '&group' inside a character value). It also explains the namelist reader's iomsg
+!> (which variable, which line, what was probably meant).
+module yarnfort_input_scan
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_input_text, only: string_type, read_line, to_lower, format_integer, &
+        closest_name, join_names
+    implicit none
+    private
+
+    public :: namelist_scan_type, scan_namelist, explain_read_error
+
+    !> A word of a group's text: a variable name (followed by '=') or a value.
+    type :: token_type
+        integer :: line = 0
+        !> Columns of the token on its line.
+        integer :: first = 0, last = 0
+        !> Followed by '=': a variable name, possibly with a subscript.
+        logical :: is_name = .false.
+    end type token_type
+
+    !> One '&name ... /' group in the text.
+    type :: group_occurrence_type
+        character(len=:), allocatable :: name
+        integer :: first_line = 0, last_line = 0
+        type(token_type), allocatable :: tokens(:)
+        integer :: n_tokens = 0
+    end type group_occurrence_type
+
+    !> The text and its groups, in the order of the text.
+    type :: namelist_scan_type
+        type(string_type), allocatable :: lines(:)
+        !> Column of the '!' starting a comment on each line, 0 for none.
+        integer, allocatable :: comment_start(:)
+        type(group_occurrence_type), allocatable :: groups(:)
+        integer :: n_groups = 0
+    contains
+        !> Write the text without its comments (same lines) for the namelist reads.
+        procedure :: write_without_comments
+        !> Number of occurrences of a group.
+        procedure :: count_group
+        !> Index in `groups` of the k-th occurrence of a group (0 if there is none).
+        procedure :: find_group
+        !> Text of a token.
+        procedure :: token_text
+    end type namelist_scan_type
+
+    character(len=1), parameter :: tab = achar(9), carriage_return = achar(13)
+    character(len=*), parameter :: name_characters = &
+        'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_'
+    !> Characters that end a bare (unquoted) word inside a group.
+    character(len=*), parameter :: word_ends = " ,;=/!&$'""" // tab // carriage_return
+    !> Characters that may follow a group name for the Fortran reader to take it as one.
+    character(len=*), parameter :: name_ends = " ,;/!" // tab // carriage_return
+
+contains
+
+    !> Read the whole text of `unit` (from its start) and find its groups. `known_groups`
+    !> are the valid group names in lower case.
+    subroutine scan_namelist(unit, known_groups, scan, error)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: known_groups(:)
+        type(namelist_scan_type), intent(out) :: scan
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: line
+        character(len=512) :: message
+        integer :: stat, n_lines
+        type(string_type), allocatable :: grown(:)
+
+        rewind(unit)
+        allocate(scan%lines(64))
+        n_lines = 0
+        do
+            call read_line(unit, line, stat, message)
+            if (is_iostat_end(stat)) exit
+            if (stat /= 0) then
+                call fatal_error(error, 'input line ' // format_integer(n_lines + 1) &
+                    // ': ' // trim(message))
+                return
+            end if
+            if (n_lines == size(scan%lines)) then
+                allocate(grown(2 * n_lines))
+                grown(:n_lines) = scan%lines
+                call move_alloc(grown, scan%lines)
+            end if
+            n_lines = n_lines + 1
+            call move_alloc(line, scan%lines(n_lines)%text)
+        end do
+        scan%lines = scan%lines(:n_lines)
+        rewind(unit)
+        call find_groups(scan, known_groups, error)
+    end subroutine scan_namelist
+
+    subroutine find_groups(scan, known_groups, error)
+        type(namelist_scan_type), intent(inout) :: scan
+        character(len=*), intent(in) :: known_groups(:)
+        type(error_type), allocatable, intent(out) :: error
+        logical :: in_group, in_string
+        character(len=1) :: c, quote
+        character(len=:), allocatable :: name
+        integer :: iline, i, j, depth
+        type(group_occurrence_type), allocatable :: grown(:)
+
+        allocate(scan%groups(16))
+        allocate(scan%comment_start(size(scan%lines)), source=0)
+        scan%n_groups = 0
+        in_group = .false.
+        in_string = .false.
+        quote = ''
+        do iline = 1, size(scan%lines)
+            associate(text => scan%lines(iline)%text)
+                i = 1
+                do while (i <= len(text))
+                    c = text(i:i)
+                    if (in_string) then
+                        if (c == quote) then
+                            if (i < len(text)) then
+                                if (text(i + 1:i + 1) == quote) then
+                                    i = i + 2
+                                    cycle
+                                end if
+                            end if
+                            in_string = .false.
+                            associate(group => scan%groups(scan%n_groups))
+                                if (group%tokens(group%n_tokens)%line == iline) &
+                                    group%tokens(group%n_tokens)%last = i
+                            end associate
+                        else if (c == '&' .or. c == '$') then
+                            call read_name(text, i + 1, j, name)
+                            if (any(known_groups == name)) then
+                                if (j > len(text)) then
+                                    call string_group_error()
+                                    return
+                                else if (index(name_ends, text(j:j)) > 0) then
+                                    call string_group_error()
+                                    return
+                                end if
+                            end if
+                        end if
+                        i = i + 1
+                        cycle
+                    end if
+                    if (.not. in_group) then
+                        select case (c)
+                        case (' ', tab, carriage_return)
+                            i = i + 1
+                        case ('!')
+                            scan%comment_start(iline) = i
+                            exit
+                        case ('&', '$')
+                            call read_name(text, i + 1, j, name)
+                            if (len(name) == 0) then
+                                call fatal_error(error, 'line ' // format_integer(iline) &
+                                    // ": '" // c // "' is not followed by a group name")
+                                return
+                            else if (name == 'end') then
+                                call fatal_error(error, 'line ' // format_integer(iline) &
+                                    // ': ' // c // 'end outside a group')
+                                return
+                            else if (.not. any(known_groups == name)) then
+                                call unknown_group_error(error, text(i + 1:j - 1), iline, &
+                                    known_groups)
+                                return
+                            end if
+                            call start_group(name)
+                            in_group = .true.
+                            i = j
+                        case default
+                            call fatal_error(error, 'line ' // format_integer(iline) &
+                                // ": text outside a group: '" // shorten(text(i:)) &
+                                // "' (a group starts with &name and ends with /; " &
+                                // 'comments start with !)')
+                            return
+                        end select
+                        cycle
+                    end if
+                    ! In a group.
+                    select case (c)
+                    case (' ', tab, carriage_return, ',', ';')
+                        i = i + 1
+                    case ('!')
+                        scan%comment_start(iline) = i
+                        exit
+                    case ("'", '"')
+                        call add_token(iline, i, i)
+                        quote = c
+                        in_string = .true.
+                        i = i + 1
+                    case ('=')
+                        call mark_name(iline)
+                        if (allocated(error)) return
+                        i = i + 1
+                    case ('/')
+                        call end_group(iline)
+                        i = i + 1
+                    case ('&', '$')
+                        call read_name(text, i + 1, j, name)
+                        if (name == 'end') then
+                            call end_group(iline)
+                            i = j
+                        else if (len(name) == 0) then
+                            call fatal_error(error, 'line ' // format_integer(iline) &
+                                // ": stray '" // c // "' in &" &
+                                // scan%groups(scan%n_groups)%name)
+                            return
+                        else
+                            associate(group => scan%groups(scan%n_groups))
+                                call fatal_error(error, 'line ' // format_integer(iline) &
+                                    // ': ' // text(i:j - 1) // ' starts before &' &
+                                    // group%name // ' (line ' &
+                                    // format_integer(group%first_line) &
+                                    // ") is closed with '/'")
+                            end associate
+                            return
+                        end if
+                    case default
+                        ! A bare word; a subscript in parentheses may contain blanks.
+                        j = i
+                        depth = 0
+                        do while (j <= len(text))
+                            if (text(j:j) == '(') depth = depth + 1
+                            if (text(j:j) == ')') depth = max(depth - 1, 0)
+                            if (depth == 0 .and. index(word_ends, text(j:j)) > 0) exit
+                            j = j + 1
+                        end do
+                        call add_token(iline, i, j - 1)
+                        i = j
+                    end select
+                end do
+                if (in_string) then
+                    ! The Fortran reader would run on into the next lines; no value of
+                    ! the input needs that, a forgotten quote is far more likely.
+                    call fatal_error(error, 'line ' // format_integer(iline) &
+                        // ': character value not closed with ' // quote &
+                        // ' on its line')
+                    return
+                end if
+            end associate
+        end do
+        if (in_group) then
+            associate(group => scan%groups(scan%n_groups))
+                call fatal_error(error, '&' // group%name // ' (line ' &
+                    // format_integer(group%first_line) // ") is not closed with '/'")
+            end associate
+        end if
+        scan%groups = scan%groups(:scan%n_groups)
+
+    contains
+
+        subroutine start_group(group_name)
+            character(len=*), intent(in) :: group_name
+
+            if (scan%n_groups == size(scan%groups)) then
+                allocate(grown(2 * scan%n_groups))
+                grown(:scan%n_groups) = scan%groups
+                call move_alloc(grown, scan%groups)
+            end if
+            scan%n_groups = scan%n_groups + 1
+            associate(group => scan%groups(scan%n_groups))
+                group%name = group_name
+                group%first_line = iline
+                allocate(group%tokens(16))
+                group%n_tokens = 0
+            end associate
+        end subroutine start_group
+
+        subroutine end_group(last_line)
+            integer, intent(in) :: last_line
+
+            associate(group => scan%groups(scan%n_groups))
+                group%last_line = last_line
+                group%tokens = group%tokens(:group%n_tokens)
+            end associate
+            in_group = .false.
+        end subroutine end_group
+
+        subroutine add_token(line, first, last)
+            integer, intent(in) :: line, first, last
+            type(token_type), allocatable :: more(:)
+
+            associate(group => scan%groups(scan%n_groups))
+                if (group%n_tokens == size(group%tokens)) then
+                    allocate(more(2 * group%n_tokens))
+                    more(:group%n_tokens) = group%tokens
+                    call move_alloc(more, group%tokens)
+                end if
+                group%n_tokens = group%n_tokens + 1
+                group%tokens(group%n_tokens) = token_type(line, first, last, .false.)
+            end associate
+        end subroutine add_token
+
+        !> The token before '=' is a variable name; it must not be set twice in a group.
+        subroutine mark_name(line)
+            integer, intent(in) :: line
+            integer :: k
+            character(len=:), allocatable :: this
+
+            associate(group => scan%groups(scan%n_groups))
+                if (group%n_tokens == 0) then
+                    call no_name_error()
+                    return
+                end if
+                associate(last => group%tokens(group%n_tokens))
+                    if (last%is_name .or. index("'""", &
+                        scan%lines(last%line)%text(last%first:last%first)) > 0) then
+                        call no_name_error()
+                        return
+                    end if
+                    last%is_name = .true.
+                    this = normalized_name(scan%token_text(last))
+                end associate
+                do k = 1, group%n_tokens - 1
+                    if (.not. group%tokens(k)%is_name) cycle
+                    if (normalized_name(scan%token_text(group%tokens(k))) /= this) cycle
+                    call fatal_error(error, '&' // group%name // ': ' &
+                        // scan%token_text(group%tokens(k)) // ' is set twice (lines ' &
+                        // format_integer(group%tokens(k)%line) // ' and ' &
+                        // format_integer(line) // ')')
+                    return
+                end do
+            end associate
+        end subroutine mark_name
+
+        subroutine no_name_error()
+            call fatal_error(error, 'line ' // format_integer(iline) &
+                // ": '=' without a variable name before it in &" &
+                // scan%groups(scan%n_groups)%name)
+        end subroutine no_name_error
+
+        subroutine string_group_error()
+            call fatal_error(error, 'line ' // format_integer(iline) // ": '&" // name &
+                // "' inside a character value would be read as the start of group &" &
+                // name // "; remove the '&'")
+        end subroutine string_group_error
+
+    end subroutine find_groups
+
+    !> The name (letters, digits, '_') starting at column `first`, in lower case; `next`
+    !> is the column after it.
+    pure subroutine read_name(text, first, next, name)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: first
+        integer, intent(out) :: next
+        character(len=:), allocatable, intent(out) :: name
+
+        next = first
+        do while (next <= len(text))
+            if (index(name_characters, text(next:next)) == 0) exit
+            next = next + 1
+        end do
+        name = to_lower(text(first:next - 1))
+    end subroutine read_name
+
+    subroutine unknown_group_error(error, name, line, known_groups)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: line
+        character(len=*), intent(in) :: known_groups(:)
+        character(len=:), allocatable :: guess, hint
+
+        guess = closest_name(name, known_groups)
+        if (len(guess) > 0) then
+            hint = ' (did you mean &' // guess // '?)'
+        else
+            hint = ' (known groups: ' // join_names(known_groups, '&') // ')'
+        end if
+        call fatal_error(error, 'unknown group &' // name // ' on line ' &
+            // format_integer(line) // hint)
+    end subroutine unknown_group_error
+
+    !> A variable name in lower case without blanks (subscript kept).
+    pure function normalized_name(text) result(name)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: name
+        integer :: i
+
+        name = ''
+        do i = 1, len(text)
+            if (text(i:i) /= ' ' .and. text(i:i) /= tab) name = name // text(i:i)
+        end do
+        name = to_lower(name)
+    end function normalized_name
+
+    !> At most 40 characters of a text for a message.
+    pure function shorten(text) result(short)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: short
+        integer, parameter :: max_length = 40
+
+        if (len_trim(text) > max_length) then
+            short = text(:max_length) // '...'
+        else
+            short = trim(text)
+        end if
+    end function shorten
+
+    !> gfortran takes a ',' before a '!' comment at the end of a line for an empty value
+    !> (x = 1, 2, ! ...  3 gives x(3) no value and x(4) = 3), and a '!' hides the rest of
+    !> its line from the search for a group: the namelist reads get the text without
+    !> its comments, line for line.
+    subroutine write_without_comments(self, unit, error)
+        class(namelist_scan_type), intent(in) :: self
+        integer, intent(in) :: unit
+        type(error_type), allocatable, intent(out) :: error
+        character(len=512) :: message
+        integer :: iline, stat
+
+        do iline = 1, size(self%lines)
+            associate(text => self%lines(iline)%text, comment => self%comment_start(iline))
+                if (comment > 0) then
+                    write(unit, '(a)', iostat=stat, iomsg=message) text(:comment - 1)
+                else
+                    write(unit, '(a)', iostat=stat, iomsg=message) text
+                end if
+            end associate
+            if (stat /= 0) then
+                call fatal_error(error, 'cannot write the input to a scratch file: ' &
+                    // trim(message))
+                return
+            end if
+        end do
+        rewind(unit)
+    end subroutine write_without_comments
+
+    pure function count_group(self, name) result(n)
+        class(namelist_scan_type), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer :: n, k
+
+        n = 0
+        do k = 1, self%n_groups
+            if (self%groups(k)%name == name) n = n + 1
+        end do
+    end function count_group
+
+    pure function find_group(self, name, occurrence) result(index)
+        class(namelist_scan_type), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: occurrence
+        integer :: index, k, n
+
+        index = 0
+        n = 0
+        do k = 1, self%n_groups
+            if (self%groups(k)%name /= name) cycle
+            n = n + 1
+            if (n == occurrence) then
+                index = k
+                return
+            end if
+        end do
+    end function find_group
+
+    pure function token_text(self, token) result(text)
+        class(namelist_scan_type), intent(in) :: self
+        type(token_type), intent(in) :: token
+        character(len=:), allocatable :: text
+
+        text = self%lines(token%line)%text(token%first:token%last)
+    end function token_text
+
+    !> Words to append to the namelist reader's iomsg for the `occurrence`-th group `name`
+    !> (known variables `variables`): the line, and for "Cannot match namelist object
+    !> name X" whether X is an unknown variable (with a suggestion) or a bad value of the
+    !> variable before it.
+    function explain_read_error(scan, name, occurrence, message, variables) result(hint)
+        type(namelist_scan_type), intent(in) :: scan
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: occurrence
+        character(len=*), intent(in) :: message
+        character(len=*), intent(in) :: variables(:)
+        character(len=:), allocatable :: hint
+        character(len=*), parameter :: no_match = 'Cannot match namelist object name '
+        character(len=:), allocatable :: object, text, guess, variable
+        integer :: g, k, pass
+
+        g = scan%find_group(name, occurrence)
+        if (g == 0) then
+            hint = ''
+            return
+        end if
+        associate(group => scan%groups(g))
+            hint = ' (group on line ' // format_integer(group%first_line) // ')'
+            if (index(message, no_match) /= 1) return
+            object = to_lower(trim(message(len(no_match) + 1:)))
+            ! Pass 1: the reader names a whole token (or a string and what followed it);
+            ! pass 2: the end of a token it read in part (the '.5' of '2.5' for an integer).
+            do pass = 1, 2
+                variable = ''
+                do k = 1, group%n_tokens
+                    text = scan%token_text(group%tokens(k))
+                    if (group%tokens(k)%is_name) then
+                        if (pass == 1 .and. (to_lower(text) == object &
+                            .or. base_name(text) == object)) then
+                            guess = closest_name(base_name(text), variables)
+                            hint = ' (line ' // format_integer(group%tokens(k)%line) &
+                                // ': unknown variable'
+                            if (len(guess) > 0) then
+                                hint = hint // ', did you mean ' // guess // '?)'
+                            else
+                                hint = hint // '; &' // name // ' has ' &
+                                    // join_names(variables, '') // ')'
+                            end if
+                            return
+                        end if
+                        variable = base_name(text)
+                    else if (len(variable) > 0 .and. matches(to_lower(text), pass)) then
+                        hint = ' (line ' // format_integer(group%tokens(k)%line) // ': ' &
+                            // text // ' is not a valid value of ' // variable &
+                            // ': wrong type, text without quotes, or more values than ' &
+                            // variable // ' holds)'
+                        return
+                    end if
+                end do
+            end do
+        end associate
+
+    contains
+
+        logical function matches(token, pass)
+            character(len=*), intent(in) :: token
+            integer, intent(in) :: pass
+
+            if (pass == 1) then
+                matches = token == object .or. (is_string(token) .and. index(object, token) == 1)
+            else
+                matches = len(token) > len(object) .and. len(object) > 0
+                if (matches) matches = token(len(token) - len(object) + 1:) == object
+            end if
+        end function matches
+
+    end function explain_read_error
+
+    !> A quoted character value (the namelist reader may print more after it).
+    pure logical function is_string(text)
+        character(len=*), intent(in) :: text
+
+        is_string = .false.
+        if (len(text) > 0) is_string = text(1:1) == "'" .or. text(1:1) == '"'
+    end function is_string
+
+    !> A variable name without subscript, lower case.
+    pure function base_name(text) result(name)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: name
+        integer :: paren
+
+        paren = index(text, '(')
+        if (paren == 0) then
+            name = to_lower(trim(text))
+        else
+            name = to_lower(trim(text(:paren - 1)))
+        end if
+    end function base_name
+
+end module yarnfort_input_scan

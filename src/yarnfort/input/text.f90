@@ -1,0 +1,420 @@
+! SPDX-License-Identifier: MIT
+!> Text helpers for the input readers: records of any length, case folding, numbers
+!> written so that they read back exactly, words, strict number parsing, and the
+!> "did you mean" suggestions of error messages.
+module yarnfort_input_text
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
+    use, intrinsic :: iso_fortran_env, only: int64
+    use yarnfort_kinds, only: wp
+    implicit none
+    private
+
+    public :: string_type, read_line, to_lower, format_integer, format_real, quote_string
+    public :: split_words, parse_integer, parse_real, edit_distance, closest_name
+    public :: join_names, folder_of, resolve_path
+
+    !> One string of an array of strings of different lengths.
+    type :: string_type
+        character(len=:), allocatable :: text
+    end type string_type
+
+    !> Characters read per chunk of a record (each read pads its whole chunk, so this is
+    !> about a usual line, not the longest).
+    integer, parameter :: chunk_length = 256
+    !> Largest edit distance at which a known name is suggested for a mistyped one.
+    integer, parameter :: max_suggestion_distance = 2
+    character(len=1), parameter :: tab = achar(9)
+
+contains
+
+    !> Read one whole record, of any length, from a formatted sequential unit.
+    !> `stat` is 0, or iostat_end at the end of the file, or another iostat value.
+    subroutine read_line(unit, line, stat, message)
+        integer, intent(in) :: unit
+        character(len=:), allocatable, intent(out) :: line
+        integer, intent(out) :: stat
+        character(len=*), intent(out) :: message
+        character(len=chunk_length) :: chunk
+        integer :: size_read
+
+        line = ''
+        message = ''
+        do
+            read(unit, '(a)', advance='no', iostat=stat, iomsg=message, size=size_read) chunk
+            if (stat > 0) return
+            line = line // chunk(:size_read)
+            if (is_iostat_eor(stat)) then
+                stat = 0
+                return
+            end if
+            if (is_iostat_end(stat)) then
+                ! A last record without a newline is still a record.
+                if (len(line) > 0) stat = 0
+                return
+            end if
+        end do
+    end subroutine read_line
+
+    !> The string in lower case (ASCII letters only).
+    pure function to_lower(text) result(lower)
+        character(len=*), intent(in) :: text
+        character(len=len(text)) :: lower
+        integer :: i, code
+
+        lower = text
+        do i = 1, len(text)
+            code = iachar(text(i:i))
+            if (code >= iachar('A') .and. code <= iachar('Z')) then
+                lower(i:i) = achar(code + iachar('a') - iachar('A'))
+            end if
+        end do
+    end function to_lower
+
+    !> An integer as text without blanks.
+    pure function format_integer(value) result(text)
+        integer, intent(in) :: value
+        character(len=:), allocatable :: text
+        character(len=24) :: buffer
+
+        write(buffer, '(i0)') value
+        text = trim(buffer)
+    end function format_integer
+
+    !> A real as the shortest decimal text that reads back to exactly the same value
+    !> ('0.25', '150.0', '1.0e-6', '-3.0e12'); 'NaN', 'Infinity' and '-Infinity' as such.
+    function format_real(value) result(text)
+        real(wp), intent(in) :: value
+        character(len=:), allocatable :: text
+        integer, parameter :: max_digits = 17
+        character(len=48) :: buffer
+        character(len=24) :: form
+        character(len=:), allocatable :: digits, minus
+        real(wp) :: back
+        integer :: decimals, first_decimals, stat, exponent, mark
+
+        if (ieee_is_nan(value)) then
+            text = 'NaN'
+            return
+        end if
+        if (.not. ieee_is_finite(value)) then
+            if (value > 0.0_wp) then
+                text = 'Infinity'
+            else
+                text = '-Infinity'
+            end if
+            return
+        end if
+        if (value == 0.0_wp) then
+            if (sign(1.0_wp, value) < 0.0_wp) then
+                text = '-0.0'
+            else
+                text = '0.0'
+            end if
+            return
+        end if
+        ! Near the overflow threshold a rounded-up candidate would overflow when read
+        ! back: use the full 17 significant digits there.
+        first_decimals = 0
+        if (abs(value) > huge(value) / 10) first_decimals = max_digits - 1
+        do decimals = first_decimals, max_digits
+            write(form, '("(es48.", i0, "e4)")') decimals
+            write(buffer, form) value
+            read(buffer, *, iostat=stat) back
+            if (stat == 0 .and. back == value) exit
+        end do
+        ! buffer is like '  -2.5E-0001': sign, digits and a decimal exponent.
+        buffer = adjustl(buffer)
+        mark = index(buffer, 'E')
+        read(buffer(mark + 1:), *) exponent
+        minus = ''
+        if (buffer(1:1) == '-') minus = '-'
+        digits = remove_characters(buffer(len(minus) + 1:mark - 1), '.')
+        do while (len(digits) > 1 .and. digits(len(digits):len(digits)) == '0')
+            digits = digits(:len(digits) - 1)
+        end do
+        if (exponent >= -4 .and. exponent <= 6) then
+            if (exponent >= 0) then
+                if (len(digits) <= exponent + 1) then
+                    text = minus // digits // repeat('0', exponent + 1 - len(digits)) // '.0'
+                else
+                    text = minus // digits(:exponent + 1) // '.' // digits(exponent + 2:)
+                end if
+            else
+                text = minus // '0.' // repeat('0', -exponent - 1) // digits
+            end if
+        else
+            if (len(digits) == 1) then
+                text = minus // digits // '.0e' // format_integer(exponent)
+            else
+                text = minus // digits(1:1) // '.' // digits(2:) // 'e' // format_integer(exponent)
+            end if
+        end if
+    end function format_real
+
+    pure function remove_characters(text, set) result(cleaned)
+        character(len=*), intent(in) :: text, set
+        character(len=:), allocatable :: cleaned
+        integer :: i
+
+        cleaned = ''
+        do i = 1, len(text)
+            if (index(set, text(i:i)) == 0) cleaned = cleaned // text(i:i)
+        end do
+    end function remove_characters
+
+    !> A character value as a namelist literal: in apostrophes, inner apostrophes doubled,
+    !> trailing blanks dropped.
+    pure function quote_string(text) result(quoted)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: quoted
+        integer :: i
+
+        quoted = "'"
+        do i = 1, len_trim(text)
+            if (text(i:i) == "'") then
+                quoted = quoted // "''"
+            else
+                quoted = quoted // text(i:i)
+            end if
+        end do
+        quoted = quoted // "'"
+    end function quote_string
+
+    !> The blank-separated (spaces, tabs) words of a line.
+    pure subroutine split_words(line, words)
+        character(len=*), intent(in) :: line
+        type(string_type), allocatable, intent(out) :: words(:)
+        integer :: i, first, n
+        type(string_type), allocatable :: grown(:)
+
+        allocate(words(8))
+        n = 0
+        i = 1
+        do while (i <= len(line))
+            if (line(i:i) == ' ' .or. line(i:i) == tab) then
+                i = i + 1
+                cycle
+            end if
+            first = i
+            do while (i <= len(line))
+                if (line(i:i) == ' ' .or. line(i:i) == tab) exit
+                i = i + 1
+            end do
+            if (n == size(words)) then
+                allocate(grown(2 * n))
+                grown(:n) = words
+                call move_alloc(grown, words)
+            end if
+            n = n + 1
+            words(n)%text = line(first:i - 1)
+        end do
+        words = words(:n)
+    end subroutine split_words
+
+    !> Read a whole word as an integer (optional sign, digits); `ok` is false otherwise,
+    !> also when the value does not fit the integer kind.
+    pure subroutine parse_integer(word, value, ok)
+        character(len=*), intent(in) :: word
+        integer, intent(out) :: value
+        logical, intent(out) :: ok
+        integer :: i, first, digit
+        logical :: negative
+
+        value = 0
+        ok = .false.
+        first = 1
+        negative = .false.
+        if (len(word) > 0) then
+            if (word(1:1) == '+' .or. word(1:1) == '-') first = 2
+            negative = word(1:1) == '-'
+        end if
+        if (first > len(word)) return
+        ! Accumulate as a negative number: -huge(1) - 1 fits, +huge(1) + 1 does not.
+        do i = first, len(word)
+            digit = index('0123456789', word(i:i)) - 1
+            if (digit < 0) return
+            if (value < (-huge(value) - 1 + digit) / 10) return
+            value = 10 * value - digit
+        end do
+        if (.not. negative) then
+            if (value < -huge(value)) return
+            value = -value
+        end if
+        ok = .true.
+    end subroutine parse_integer
+
+    !> Read a whole word as a real (Fortran syntax, also NaN and Infinity); `ok` is false
+    !> unless the whole word is a number.
+    subroutine parse_real(word, value, ok)
+        character(len=*), intent(in) :: word
+        real(wp), intent(out) :: value
+        logical, intent(out) :: ok
+        integer :: stat
+
+        call parse_short_decimal(word, value, ok)
+        if (ok) return
+        value = 0.0_wp
+        ! Without separators, quotes and repeat counts, a list-directed read takes the
+        ! whole word or fails.
+        if (len(word) == 0 .or. scan(word, " ,;/*()'""" // tab) > 0) return
+        read(word, *, iostat=stat) value
+        ok = stat == 0
+    end subroutine parse_real
+
+    !> Fast path of parse_real for the usual coordinates: [sign] digits [. digits]
+    !> [e|d [sign] digits] with a mantissa below 2**53 and a power of ten up to 22. Both
+    !> are then exact doubles and one multiplication or division rounds correctly
+    !> (Clinger's fast path); `ok` is false for anything else.
+    pure subroutine parse_short_decimal(word, value, ok)
+        character(len=*), intent(in) :: word
+        real(wp), intent(out) :: value
+        logical, intent(out) :: ok
+        integer, parameter :: max_exact_power = 22
+        integer(int64), parameter :: max_exact_mantissa = 2_int64**53
+        integer :: i, digit, exponent, exponent_part, n_digits, exponent_sign
+        integer(int64) :: mantissa
+        logical :: negative, in_fraction
+
+        value = 0.0_wp
+        ok = .false.
+        i = 1
+        negative = .false.
+        if (len(word) == 0) return
+        if (word(1:1) == '+' .or. word(1:1) == '-') then
+            negative = word(1:1) == '-'
+            i = 2
+        end if
+        mantissa = 0
+        exponent = 0
+        n_digits = 0
+        in_fraction = .false.
+        do while (i <= len(word))
+            if (word(i:i) == '.') then
+                if (in_fraction) return
+                in_fraction = .true.
+            else
+                digit = index('0123456789', word(i:i)) - 1
+                if (digit < 0) exit
+                if (mantissa > (max_exact_mantissa - digit) / 10) return
+                mantissa = 10 * mantissa + digit
+                n_digits = n_digits + 1
+                if (in_fraction) exponent = exponent - 1
+            end if
+            i = i + 1
+        end do
+        if (n_digits == 0) return
+        if (i <= len(word)) then
+            if (index('eEdD', word(i:i)) == 0) return
+            i = i + 1
+            exponent_sign = 1
+            if (i <= len(word)) then
+                if (word(i:i) == '+' .or. word(i:i) == '-') then
+                    if (word(i:i) == '-') exponent_sign = -1
+                    i = i + 1
+                end if
+            end if
+            if (i > len(word)) return
+            exponent_part = 0
+            do while (i <= len(word))
+                digit = index('0123456789', word(i:i)) - 1
+                if (digit < 0 .or. exponent_part > 1000) return
+                exponent_part = 10 * exponent_part + digit
+                i = i + 1
+            end do
+            exponent = exponent + exponent_sign * exponent_part
+        end if
+        if (abs(exponent) > max_exact_power) return
+        value = real(mantissa, wp)
+        if (exponent >= 0) then
+            value = value * 10.0_wp**exponent
+        else
+            value = value / 10.0_wp**(-exponent)
+        end if
+        if (negative) value = -value
+        ok = .true.
+    end subroutine parse_short_decimal
+
+    !> Levenshtein distance between two strings (insertions, deletions, substitutions).
+    pure function edit_distance(a, b) result(distance)
+        character(len=*), intent(in) :: a, b
+        integer :: distance
+        integer :: previous(0:len(b)), current(0:len(b)), i, j, cost
+
+        do j = 0, len(b)
+            previous(j) = j
+        end do
+        do i = 1, len(a)
+            current(0) = i
+            do j = 1, len(b)
+                cost = merge(0, 1, a(i:i) == b(j:j))
+                current(j) = min(previous(j) + 1, current(j - 1) + 1, previous(j - 1) + cost)
+            end do
+            previous = current
+        end do
+        distance = previous(len(b))
+    end function edit_distance
+
+    !> The known name closest to `name` if it is close enough to be a typing error, else ''.
+    pure function closest_name(name, names) result(closest)
+        character(len=*), intent(in) :: name
+        character(len=*), intent(in) :: names(:)
+        character(len=:), allocatable :: closest
+        integer :: i, distance, best
+
+        closest = ''
+        best = max_suggestion_distance + 1
+        do i = 1, size(names)
+            distance = edit_distance(to_lower(name), to_lower(trim(names(i))))
+            if (distance < best .and. distance < len(name)) then
+                best = distance
+                closest = trim(names(i))
+            end if
+        end do
+    end function closest_name
+
+    !> Names joined as 'a, b, c', each with an optional prefix (e.g. '&').
+    pure function join_names(names, prefix) result(joined)
+        character(len=*), intent(in) :: names(:)
+        character(len=*), intent(in) :: prefix
+        character(len=:), allocatable :: joined
+        integer :: i
+
+        joined = ''
+        do i = 1, size(names)
+            if (i > 1) joined = joined // ', '
+            joined = joined // prefix // trim(names(i))
+        end do
+    end function join_names
+
+    !> The folder part of a file name ('' for a bare file name, '/' for a file in '/').
+    pure function folder_of(path) result(folder)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: folder
+        integer :: slash
+
+        slash = index(trim(path), '/', back=.true.)
+        if (slash == 0) then
+            folder = ''
+        else if (slash == 1) then
+            folder = '/'
+        else
+            folder = path(:slash - 1)
+        end if
+    end function folder_of
+
+    !> A file name resolved against a folder: absolute names and names with an empty
+    !> folder are returned as they are.
+    pure function resolve_path(file, folder) result(path)
+        character(len=*), intent(in) :: file, folder
+        character(len=:), allocatable :: path
+
+        if (len_trim(folder) == 0 .or. file(1:min(1, len(file))) == '/') then
+            path = trim(file)
+        else if (folder(len_trim(folder):len_trim(folder)) == '/') then
+            path = trim(folder) // trim(file)
+        else
+            path = trim(folder) // '/' // trim(file)
+        end if
+    end function resolve_path
+
+end module yarnfort_input_text

@@ -1,0 +1,677 @@
+! SPDX-License-Identifier: MIT
+!> Checks of a read `config_type` that need no network: known names, positive and finite
+!> parameters, node ids in range, no zero-length segments or elements, consistent
+!> supports, loads and load path. Each message names the group, the variable and the value.
+module yarnfort_input_validate
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_input_config, only: config_type, solver_config_type, output_config_type, &
+        material_config_type, path_config_type, name_length
+    use yarnfort_input_text, only: format_integer, format_real, join_names, closest_name
+    implicit none
+    private
+
+    public :: check_config, coincidence_tolerance, known_laws, known_linear_solvers
+
+    !> A segment between consecutive yarn nodes is of zero length when it is not longer
+    !> than this times the diagonal of the box around all nodes.
+    real(wp), parameter :: coincidence_tolerance = 100 * epsilon(1.0_wp)
+    !> Values of &material law.
+    character(len=*), parameter :: known_laws(*) = [character(len=11) :: 'linear', &
+        'neo_hookean', 'table']
+    !> Values of &solver linear_solver.
+    character(len=*), parameter :: known_linear_solvers(*) = [character(len=7) :: 'auto', &
+        'umfpack', 'klu', 'cholmod', 'dense']
+    character(len=1), parameter :: axis(3) = ['x', 'y', 'z']
+    !> Characters of material and support names.
+    character(len=*), parameter :: name_characters = &
+        'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
+
+contains
+
+    !> Check everything that can be checked before the network is built.
+    subroutine check_config(config, error)
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        integer, allocatable :: owner(:, :)
+
+        call check_solver(config%solver, error)
+        if (allocated(error)) return
+        call check_output(config%output, error)
+        if (allocated(error)) return
+        call check_materials(config%materials, error)
+        if (allocated(error)) return
+        call check_nodes(config, error)
+        if (allocated(error)) return
+        call check_yarns(config, error)
+        if (allocated(error)) return
+        call check_supports(config, owner, error)
+        if (allocated(error)) return
+        call check_loads(config, owner, error)
+        if (allocated(error)) return
+        call check_path(config%path, error)
+    end subroutine check_config
+
+    subroutine check_solver(solver, error)
+        type(solver_config_type), intent(in) :: solver
+        type(error_type), allocatable, intent(out) :: error
+
+        if (.not. any(known_linear_solvers == solver%linear_solver)) then
+            call fatal_error(error, "&solver: linear_solver = '" // trim(solver%linear_solver) &
+                // "' is unknown (use " // join_names(known_linear_solvers, '') // ')')
+            return
+        end if
+        call require_positive(error, '&solver', 'residual_tolerance', solver%residual_tolerance)
+        if (allocated(error)) return
+        call require_positive(error, '&solver', 'step_tolerance', solver%step_tolerance)
+        if (allocated(error)) return
+        call require_at_least(error, '&solver', 'max_iterations', solver%max_iterations, 1)
+        if (allocated(error)) return
+        call require_at_least(error, '&solver', 'max_setup_calls', solver%max_setup_calls, 1)
+        if (allocated(error)) return
+        call require_at_least(error, '&solver', 'easy_iterations', solver%easy_iterations, 0)
+        if (allocated(error)) return
+        call require_at_least(error, '&solver', 'max_step_cuts', solver%max_step_cuts, 0)
+        if (allocated(error)) return
+        if (.not. ieee_is_finite(solver%slack_stiffness)) then
+            call not_finite(error, '&solver', 'slack_stiffness', solver%slack_stiffness)
+            return
+        end if
+        if (solver%slack_stiffness < 0.0_wp) then
+            call fatal_error(error, '&solver: slack_stiffness = ' &
+                // format_real(solver%slack_stiffness) // ' must be >= 0')
+            return
+        end if
+        call require_positive(error, '&solver', 'min_step', solver%min_step)
+        if (allocated(error)) return
+        call require_positive(error, '&solver', 'initial_step', solver%initial_step)
+        if (allocated(error)) return
+        call require_positive(error, '&solver', 'max_step', solver%max_step)
+        if (allocated(error)) return
+        if (solver%min_step > solver%max_step) then
+            call fatal_error(error, '&solver: min_step = ' // format_real(solver%min_step) &
+                // ' is larger than max_step = ' // format_real(solver%max_step))
+            return
+        end if
+        if (solver%initial_step < solver%min_step .or. solver%initial_step > solver%max_step) then
+            call fatal_error(error, '&solver: initial_step = ' &
+                // format_real(solver%initial_step) // ' must lie between min_step = ' &
+                // format_real(solver%min_step) // ' and max_step = ' &
+                // format_real(solver%max_step))
+            return
+        end if
+        if (.not. ieee_is_finite(solver%step_cut)) then
+            call not_finite(error, '&solver', 'step_cut', solver%step_cut)
+            return
+        end if
+        if (solver%step_cut <= 0.0_wp .or. solver%step_cut >= 1.0_wp) then
+            call fatal_error(error, '&solver: step_cut = ' // format_real(solver%step_cut) &
+                // ' must lie strictly between 0 and 1')
+            return
+        end if
+        if (.not. ieee_is_finite(solver%step_growth)) then
+            call not_finite(error, '&solver', 'step_growth', solver%step_growth)
+            return
+        end if
+        if (solver%step_growth < 1.0_wp) then
+            call fatal_error(error, '&solver: step_growth = ' // format_real(solver%step_growth) &
+                // ' must be >= 1')
+            return
+        end if
+    end subroutine check_solver
+
+    subroutine check_output(output, error)
+        type(output_config_type), intent(in) :: output
+        type(error_type), allocatable, intent(out) :: error
+
+        if (len_trim(output%folder) == 0) then
+            call fatal_error(error, "&output: folder = '' is empty (give a folder name)")
+            return
+        end if
+        call require_at_least(error, '&output', 'vtk_every', output%vtk_every, 0)
+    end subroutine check_output
+
+    subroutine check_materials(materials, error)
+        type(material_config_type), intent(in), allocatable :: materials(:)
+        type(error_type), allocatable, intent(out) :: error
+        type(material_config_type) :: unset
+        integer :: m, other
+        character(len=:), allocatable :: label
+
+        if (.not. allocated(materials)) then
+            call fatal_error(error, 'no &material group: at least one material is needed')
+            return
+        end if
+        if (size(materials) == 0) then
+            call fatal_error(error, 'no &material group: at least one material is needed')
+            return
+        end if
+        do m = 1, size(materials)
+            associate(material => materials(m))
+                label = '&material #' // format_integer(m)
+                if (len_trim(material%name) == 0) then
+                    call fatal_error(error, label // ': name is empty')
+                    return
+                end if
+                call check_name(error, label, material%name)
+                if (allocated(error)) return
+                label = "&material '" // trim(material%name) // "'"
+                do other = 1, m - 1
+                    if (materials(other)%name == material%name) then
+                        call fatal_error(error, "&material: name = '" // trim(material%name) &
+                            // "' is defined twice (&material #" // format_integer(other) &
+                            // ' and #' // format_integer(m) // ')')
+                        return
+                    end if
+                end do
+                select case (trim(material%law))
+                case ('')
+                    call fatal_error(error, label // ": law is not set (use " &
+                        // join_names(known_laws, '') // ')')
+                case ('linear')
+                    call require_parameter(error, label, 'stiffness', material%stiffness, &
+                        unset%stiffness, 'linear')
+                    if (allocated(error)) return
+                    call forbid_parameter(error, label, 'modulus', material%modulus, &
+                        unset%modulus, 'linear')
+                    if (allocated(error)) return
+                    call forbid_parameter(error, label, 'area', material%area, unset%area, &
+                        'linear')
+                    if (allocated(error)) return
+                    call forbid_table(error, label, material%table_file, 'linear')
+                case ('neo_hookean')
+                    call require_parameter(error, label, 'modulus', material%modulus, &
+                        unset%modulus, 'neo_hookean')
+                    if (allocated(error)) return
+                    call require_parameter(error, label, 'area', material%area, unset%area, &
+                        'neo_hookean')
+                    if (allocated(error)) return
+                    call forbid_parameter(error, label, 'stiffness', material%stiffness, &
+                        unset%stiffness, 'neo_hookean')
+                    if (allocated(error)) return
+                    call forbid_table(error, label, material%table_file, 'neo_hookean')
+                case ('table')
+                    if (len_trim(material%table_file) == 0) then
+                        call fatal_error(error, label // ": table_file is not set (law " &
+                            // "'table' needs a CSV file of strain, force)")
+                        return
+                    end if
+                    call forbid_parameter(error, label, 'stiffness', material%stiffness, &
+                        unset%stiffness, 'table')
+                    if (allocated(error)) return
+                    call forbid_parameter(error, label, 'modulus', material%modulus, &
+                        unset%modulus, 'table')
+                    if (allocated(error)) return
+                    call forbid_parameter(error, label, 'area', material%area, unset%area, &
+                        'table')
+                case default
+                    call fatal_error(error, label // ": law = '" // trim(material%law) &
+                        // "' is unknown (use " // join_names(known_laws, '') // ')')
+                end select
+                if (allocated(error)) return
+            end associate
+        end do
+    end subroutine check_materials
+
+    !> Names are single words (the geometry file and the curve CSV header use them).
+    subroutine check_name(error, label, name)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, name
+
+        if (verify(trim(name), name_characters) > 0) then
+            call fatal_error(error, label // ": name = '" // trim(name) // "' may contain " &
+                // "only letters, digits, '_', '-' and '.'")
+        end if
+    end subroutine check_name
+
+    !> A law parameter must be set, positive and finite.
+    subroutine require_parameter(error, label, variable, value, unset, law)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, variable, law
+        real(wp), intent(in) :: value, unset
+
+        if (value == unset) then
+            call fatal_error(error, label // ': ' // variable // " is not set (law '" // law &
+                // "' needs it)")
+            return
+        end if
+        call require_positive(error, label, variable, value)
+    end subroutine require_parameter
+
+    !> A parameter another law uses must stay unset (a silently ignored value is a mistake).
+    subroutine forbid_parameter(error, label, variable, value, unset, law)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, variable, law
+        real(wp), intent(in) :: value, unset
+
+        if (.not. (value == unset)) then
+            call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
+                // " is not used by law '" // law // "' (remove it)")
+        end if
+    end subroutine forbid_parameter
+
+    subroutine forbid_table(error, label, table_file, law)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, table_file, law
+
+        if (len_trim(table_file) > 0) then
+            call fatal_error(error, label // ": table_file = '" // trim(table_file) &
+                // "' is not used by law '" // law // "' (remove it)")
+        end if
+    end subroutine forbid_table
+
+    subroutine check_nodes(config, error)
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        integer :: n, k
+
+        if (.not. allocated(config%node_positions)) then
+            call fatal_error(error, "no nodes: give &nodes xyz = ... / or &geometry file = " &
+                // "'...' /")
+            return
+        end if
+        if (size(config%node_positions, 2) == 0) then
+            call fatal_error(error, "no nodes: give &nodes xyz = ... / or &geometry file = " &
+                // "'...' /")
+            return
+        end if
+        do n = 1, size(config%node_positions, 2)
+            do k = 1, 3
+                if (ieee_is_finite(config%node_positions(k, n))) cycle
+                if (len_trim(config%geometry%file) > 0) then
+                    call fatal_error(error, "&geometry: file '" &
+                        // trim(config%geometry%file) // "': node " // format_integer(n) &
+                        // ' ' // axis(k) // ' = ' // format_real(config%node_positions(k, n)) &
+                        // ' is not finite')
+                else
+                    call fatal_error(error, '&nodes: xyz(' // format_integer(3 * (n - 1) + k) &
+                        // ') = ' // format_real(config%node_positions(k, n)) // ' (node ' &
+                        // format_integer(n) // ' ' // axis(k) // ') is not finite')
+                end if
+                return
+            end do
+        end do
+    end subroutine check_nodes
+
+    !> '&yarn #k', or 'yarn #k of the geometry file' when the yarns come from a file.
+    function yarn_label(config, k) result(label)
+        type(config_type), intent(in) :: config
+        integer, intent(in) :: k
+        character(len=:), allocatable :: label
+
+        if (len_trim(config%geometry%file) > 0) then
+            label = 'yarn #' // format_integer(k) // " of &geometry file '" &
+                // trim(config%geometry%file) // "'"
+        else
+            label = '&yarn #' // format_integer(k)
+        end if
+    end function yarn_label
+
+    subroutine check_yarns(config, error)
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        integer :: y, i, n_nodes, a, b
+        logical, allocatable :: used(:)
+        real(wp) :: scale, length
+        character(len=:), allocatable :: label, guess
+        character(len=name_length), allocatable :: material_names(:)
+
+        if (.not. allocated(config%yarns)) then
+            call fatal_error(error, 'no yarns: give &yarn groups or yarn lines in the ' &
+                // '&geometry file')
+            return
+        end if
+        if (size(config%yarns) == 0) then
+            call fatal_error(error, 'no yarns: give &yarn groups or yarn lines in the ' &
+                // '&geometry file')
+            return
+        end if
+        material_names = config%materials%name
+        n_nodes = size(config%node_positions, 2)
+        scale = norm2(maxval(config%node_positions, dim=2) - minval(config%node_positions, dim=2))
+        allocate(used(n_nodes), source=.false.)
+        do y = 1, size(config%yarns)
+            associate(yarn => config%yarns(y))
+                label = yarn_label(config, y)
+                if (len_trim(yarn%material) == 0) then
+                    call fatal_error(error, label // ': material is not set')
+                    return
+                end if
+                if (.not. any(material_names == yarn%material)) then
+                    guess = closest_name(trim(yarn%material), material_names)
+                    if (len(guess) > 0) guess = "; did you mean '" // guess // "'?"
+                    call fatal_error(error, label // ": material = '" // trim(yarn%material) &
+                        // "' is not defined by any &material (defined: " &
+                        // quoted_list(material_names) // ')' // guess)
+                    return
+                end if
+                if (yarn%elements_per_segment < 1) then
+                    call fatal_error(error, label // ': elements_per_segment = ' &
+                        // format_integer(yarn%elements_per_segment) // ' must be >= 1')
+                    return
+                end if
+                if (size(yarn%nodes) < 2) then
+                    call fatal_error(error, label // ': nodes has ' &
+                        // format_integer(size(yarn%nodes)) &
+                        // ' node id(s); a yarn needs at least 2')
+                    return
+                end if
+                do i = 1, size(yarn%nodes)
+                    call require_node(error, label, 'nodes', i, yarn%nodes(i), n_nodes)
+                    if (allocated(error)) return
+                    used(yarn%nodes(i)) = .true.
+                end do
+                do i = 1, size(yarn%nodes) - 1
+                    a = yarn%nodes(i)
+                    b = yarn%nodes(i + 1)
+                    if (a == b) then
+                        call fatal_error(error, label // ': nodes(' // format_integer(i) &
+                            // ') = nodes(' // format_integer(i + 1) // ') = ' &
+                            // format_integer(a) // ': zero-length segment')
+                        return
+                    end if
+                    length = norm2(config%node_positions(:, b) - config%node_positions(:, a))
+                    if (length <= coincidence_tolerance * scale) then
+                        call fatal_error(error, label // ': nodes ' // format_integer(a) &
+                            // ' and ' // format_integer(b) // ' (nodes(' // format_integer(i) &
+                            // ') and nodes(' // format_integer(i + 1) // ')) are at the ' &
+                            // 'same position (' // format_position(config%node_positions(:, a)) &
+                            // '): zero-length element')
+                        return
+                    end if
+                end do
+            end associate
+        end do
+        do i = 1, n_nodes
+            if (.not. used(i)) then
+                call fatal_error(error, node_source(config) // ': node ' // format_integer(i) &
+                    // ' is on no yarn (a node off all yarns has no stiffness)')
+                return
+            end if
+        end do
+    end subroutine check_yarns
+
+    !> Where the nodes come from, for messages.
+    function node_source(config) result(source)
+        type(config_type), intent(in) :: config
+        character(len=:), allocatable :: source
+
+        if (len_trim(config%geometry%file) > 0) then
+            source = "&geometry: file '" // trim(config%geometry%file) // "'"
+        else
+            source = '&nodes'
+        end if
+    end function node_source
+
+    !> Supports: names, fix letters, node ids, and at most one support per coordinate
+    !> (`owner(k, node)` is the support prescribing component k of node, or 0).
+    subroutine check_supports(config, owner, error)
+        type(config_type), intent(in) :: config
+        integer, allocatable, intent(out) :: owner(:, :)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: s, other, i, k, n_nodes, node
+        character(len=:), allocatable :: label
+
+        n_nodes = size(config%node_positions, 2)
+        allocate(owner(3, n_nodes), source=0)
+        if (.not. allocated(config%supports)) return
+        do s = 1, size(config%supports)
+            associate(support => config%supports(s))
+                label = '&support #' // format_integer(s)
+                if (len_trim(support%name) == 0) then
+                    call fatal_error(error, label // ': name is empty (give each support a name)')
+                    return
+                end if
+                call check_name(error, label, support%name)
+                if (allocated(error)) return
+                label = "&support '" // trim(support%name) // "'"
+                do other = 1, s - 1
+                    if (config%supports(other)%name == support%name) then
+                        call fatal_error(error, "&support: name = '" // trim(support%name) &
+                            // "' is used twice (&support #" // format_integer(other) &
+                            // ' and #' // format_integer(s) // ')')
+                        return
+                    end if
+                end do
+                call check_fix(error, label, support%fix)
+                if (allocated(error)) return
+                do k = 1, 3
+                    if (.not. ieee_is_finite(support%displacement(k))) then
+                        call not_finite(error, label, 'displacement(' // format_integer(k) &
+                            // ')', support%displacement(k))
+                        return
+                    end if
+                    if (support%displacement(k) /= 0.0_wp &
+                        .and. index(support%fix, axis(k)) == 0) then
+                        call fatal_error(error, label // ': displacement(' &
+                            // format_integer(k) // ') = ' &
+                            // format_real(support%displacement(k)) // ' but ' // axis(k) &
+                            // " is not in fix = '" // trim(support%fix) &
+                            // "' (it would be ignored)")
+                        return
+                    end if
+                end do
+                call check_node_list(error, label, support%nodes, n_nodes)
+                if (allocated(error)) return
+                do i = 1, size(support%nodes)
+                    node = support%nodes(i)
+                    do k = 1, 3
+                        if (index(support%fix, axis(k)) == 0) cycle
+                        if (owner(k, node) /= 0) then
+                            call fatal_error(error, label // ': node ' // format_integer(node) &
+                                // ' ' // axis(k) // " is already prescribed by &support '" &
+                                // trim(config%supports(owner(k, node))%name) // "'")
+                            return
+                        end if
+                        owner(k, node) = s
+                    end do
+                end do
+            end associate
+        end do
+    end subroutine check_supports
+
+    !> fix: one or more of 'x', 'y', 'z', each at most once.
+    subroutine check_fix(error, label, fix)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, fix
+        integer :: i
+
+        if (len_trim(fix) == 0) then
+            call fatal_error(error, label // ": fix = '' prescribes nothing (use any of x, y, z)")
+            return
+        end if
+        do i = 1, len_trim(fix)
+            if (index('xyz', fix(i:i)) == 0) then
+                call fatal_error(error, label // ": fix = '" // trim(fix) // "' has '" &
+                    // fix(i:i) // "' (use any of x, y, z)")
+                return
+            end if
+            if (index(fix(:i - 1), fix(i:i)) > 0) then
+                call fatal_error(error, label // ": fix = '" // trim(fix) // "' has '" &
+                    // fix(i:i) // "' twice")
+                return
+            end if
+        end do
+    end subroutine check_fix
+
+    !> Loads: node ids, finite forces, no force on a prescribed coordinate.
+    subroutine check_loads(config, owner, error)
+        type(config_type), intent(in) :: config
+        integer, intent(in) :: owner(:, :)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: l, i, k, node
+        character(len=:), allocatable :: label
+
+        if (.not. allocated(config%loads)) return
+        do l = 1, size(config%loads)
+            associate(load => config%loads(l))
+                label = '&load #' // format_integer(l)
+                do k = 1, 3
+                    if (.not. ieee_is_finite(load%force(k))) then
+                        call not_finite(error, label, 'force(' // format_integer(k) // ')', &
+                            load%force(k))
+                        return
+                    end if
+                end do
+                call check_node_list(error, label, load%nodes, size(config%node_positions, 2))
+                if (allocated(error)) return
+                do i = 1, size(load%nodes)
+                    node = load%nodes(i)
+                    do k = 1, 3
+                        if (load%force(k) == 0.0_wp .or. owner(k, node) == 0) cycle
+                        call fatal_error(error, label // ': node ' // format_integer(node) &
+                            // ' has force(' // format_integer(k) // ') = ' &
+                            // format_real(load%force(k)) // ' but its ' // axis(k) &
+                            // " is prescribed by &support '" &
+                            // trim(config%supports(owner(k, node))%name) &
+                            // "' (the force would be ignored)")
+                        return
+                    end do
+                end do
+            end associate
+        end do
+    end subroutine check_loads
+
+    !> A list of node ids of a support or load: not empty, in range, no repeats.
+    subroutine check_node_list(error, label, nodes, n_nodes)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label
+        integer, intent(in) :: nodes(:)
+        integer, intent(in) :: n_nodes
+        integer, allocatable :: position(:)
+        integer :: i
+
+        if (size(nodes) == 0) then
+            call fatal_error(error, label // ': nodes is empty (give at least one node id)')
+            return
+        end if
+        allocate(position(n_nodes), source=0)
+        do i = 1, size(nodes)
+            call require_node(error, label, 'nodes', i, nodes(i), n_nodes)
+            if (allocated(error)) return
+            if (position(nodes(i)) /= 0) then
+                call fatal_error(error, label // ': nodes(' // format_integer(position(nodes(i))) &
+                    // ') and nodes(' // format_integer(i) // ') are both node ' &
+                    // format_integer(nodes(i)))
+                return
+            end if
+            position(nodes(i)) = i
+        end do
+    end subroutine check_node_list
+
+    subroutine require_node(error, label, variable, i, node, n_nodes)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, variable
+        integer, intent(in) :: i, node, n_nodes
+
+        if (node < 1 .or. node > n_nodes) then
+            call fatal_error(error, label // ': ' // variable // '(' // format_integer(i) &
+                // ') = ' // format_integer(node) // ' is not a node (node ids are 1..' &
+                // format_integer(n_nodes) // ')')
+        end if
+    end subroutine require_node
+
+    subroutine check_path(path, error)
+        type(path_config_type), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        integer :: n, i
+
+        if (.not. allocated(path%time)) then
+            call fatal_error(error, '&path: group missing (give the load path, e.g. ' &
+                // '&path time = 0, 1, p_disp = 0, 1 /)')
+            return
+        end if
+        n = size(path%time)
+        if (n < 2) then
+            call fatal_error(error, '&path: time has ' // format_integer(n) &
+                // ' knot(s); at least 2 are needed')
+            return
+        end if
+        if (size(path%p_force) /= n) then
+            call fatal_error(error, '&path: p_force has ' // format_integer(size(path%p_force)) &
+                // ' values but time has ' // format_integer(n))
+            return
+        end if
+        if (size(path%p_disp) /= n) then
+            call fatal_error(error, '&path: p_disp has ' // format_integer(size(path%p_disp)) &
+                // ' values but time has ' // format_integer(n))
+            return
+        end if
+        do i = 1, n
+            if (.not. ieee_is_finite(path%time(i))) then
+                call not_finite(error, '&path', 'time(' // format_integer(i) // ')', path%time(i))
+            else if (.not. ieee_is_finite(path%p_force(i))) then
+                call not_finite(error, '&path', 'p_force(' // format_integer(i) // ')', &
+                    path%p_force(i))
+            else if (.not. ieee_is_finite(path%p_disp(i))) then
+                call not_finite(error, '&path', 'p_disp(' // format_integer(i) // ')', &
+                    path%p_disp(i))
+            end if
+            if (allocated(error)) return
+        end do
+        do i = 2, n
+            if (.not. (path%time(i) > path%time(i - 1))) then
+                call fatal_error(error, '&path: time(' // format_integer(i) // ') = ' &
+                    // format_real(path%time(i)) // ' is not greater than time(' &
+                    // format_integer(i - 1) // ') = ' // format_real(path%time(i - 1)) &
+                    // ' (time must be strictly increasing)')
+                return
+            end if
+        end do
+    end subroutine check_path
+
+    subroutine require_positive(error, label, variable, value)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, variable
+        real(wp), intent(in) :: value
+
+        if (.not. ieee_is_finite(value)) then
+            call not_finite(error, label, variable, value)
+        else if (value <= 0.0_wp) then
+            call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
+                // ' must be positive')
+        end if
+    end subroutine require_positive
+
+    subroutine not_finite(error, label, variable, value)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, variable
+        real(wp), intent(in) :: value
+
+        call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
+            // ' is not finite')
+    end subroutine not_finite
+
+    subroutine require_at_least(error, label, variable, value, minimum)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, variable
+        integer, intent(in) :: value, minimum
+
+        if (value < minimum) then
+            call fatal_error(error, label // ': ' // variable // ' = ' // format_integer(value) &
+                // ' must be >= ' // format_integer(minimum))
+        end if
+    end subroutine require_at_least
+
+    !> "'a', 'b', 'c'"
+    pure function quoted_list(names) result(list)
+        character(len=*), intent(in) :: names(:)
+        character(len=:), allocatable :: list
+        integer :: i
+
+        list = ''
+        do i = 1, size(names)
+            if (i > 1) list = list // ', '
+            list = list // "'" // trim(names(i)) // "'"
+        end do
+    end function quoted_list
+
+    function format_position(x) result(text)
+        real(wp), intent(in) :: x(3)
+        character(len=:), allocatable :: text
+
+        text = format_real(x(1)) // ', ' // format_real(x(2)) // ', ' // format_real(x(3))
+    end function format_position
+
+end module yarnfort_input_validate

@@ -1,0 +1,173 @@
+! SPDX-License-Identifier: MIT
+!> Sparse Cholesky (LL') with CHOLMOD's 64-bit API, for symmetric positive definite
+!> matrices: fastest for large SPD systems (design.md section 5). The caller passes the
+!> full symmetric pattern; only the upper triangle (row <= column) is read (stype = 1),
+!> entries below the diagonal are ignored. A matrix that is not positive definite gives
+!> an error value saying so, and the caller may fall back to UMFPACK.
+module yarnfort_linalg_cholmod
+    use, intrinsic :: iso_c_binding, only: c_int, c_long, c_ptr, c_null_ptr, c_associated
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size, format_integer
+    use yarnfort_linalg_cholmod_binding, only: cholmod_ok, cholmod_not_posdef, &
+        cholmod_dsmall, cholmod_not_installed, cholmod_out_of_memory, cholmod_too_large, &
+        cholmod_invalid, cholmod_gpu_problem, cholmod_no_handle, yarnfort_cholmod_create, &
+        yarnfort_cholmod_free, yarnfort_cholmod_analyze, yarnfort_cholmod_factorize, &
+        yarnfort_cholmod_solve
+    implicit none
+    private
+
+    public :: cholmod_solver_type
+
+    !> CHOLMOD solver. Owns a C handle: never copy an analysed object by assignment.
+    type, extends(linear_solver_type) :: cholmod_solver_type
+        private
+        !> Matrix order, 0 before `analyse`.
+        integer(ik) :: n = 0
+        !> Copies of the pattern (CHOLMOD reads it again at factor time).
+        integer(c_long), allocatable :: col_ptr(:), row_index(:)
+        !> Opaque cholmod_shim.c handle (common, factor, solve workspaces).
+        type(c_ptr) :: handle = c_null_ptr
+        logical :: factored = .false.
+    contains
+        procedure :: analyse
+        procedure :: factor
+        procedure :: solve
+        procedure :: destroy
+        procedure :: get_name
+        final :: finalize
+    end type cholmod_solver_type
+
+contains
+
+    !> Keep a copy of the pattern, order it and build the symbolic factor.
+    subroutine analyse(self, n, col_ptr, row_index, error)
+        class(cholmod_solver_type), intent(inout) :: self
+        integer(ik), intent(in) :: n
+        integer(ik), intent(in) :: col_ptr(:), row_index(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_int) :: status
+
+        call self%destroy()
+        call check_csc_pattern('cholmod', n, col_ptr, row_index, error)
+        if (allocated(error)) return
+
+        self%handle = yarnfort_cholmod_create()
+        if (.not. c_associated(self%handle)) then
+            call fatal_error(error, 'cholmod: could not start CHOLMOD (cholmod_l_start)')
+            return
+        end if
+        self%col_ptr = col_ptr
+        self%row_index = row_index(1:col_ptr(n + 1))
+        status = yarnfort_cholmod_analyze(self%handle, n, self%col_ptr, self%row_index)
+        if (status < cholmod_ok) then
+            call fatal_error(error, 'cholmod: symbolic analysis failed: ' &
+                // status_message(status))
+            call self%destroy()
+            return
+        end if
+        self%n = n
+    end subroutine analyse
+
+    !> Numeric LL' factorisation; not positive definite is an error.
+    subroutine factor(self, values, error)
+        class(cholmod_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_int) :: status
+        integer(c_long) :: minor
+
+        self%factored = .false.
+        if (self%n == 0) then
+            call fatal_error(error, 'cholmod: factor called before analyse')
+            return
+        end if
+        call check_array_size('cholmod', 'values', size(values, kind=ik), &
+            int(size(self%row_index), ik), error, at_least=.true.)
+        if (allocated(error)) return
+
+        status = yarnfort_cholmod_factorize(self%handle, self%n, self%col_ptr, &
+            self%row_index, values, minor)
+        if (status == cholmod_ok .or. status == cholmod_dsmall) then
+            self%factored = .true.
+        else if (status == cholmod_not_posdef) then
+            call fatal_error(error, 'cholmod: factorisation failed: matrix is not positive ' &
+                // 'definite (pivot of column ' // format_integer(int(minor, ik)) &
+                // ' in the fill-reducing order is not positive; use umfpack or klu)')
+        else
+            call fatal_error(error, 'cholmod: factorisation failed: ' // status_message(status))
+        end if
+    end subroutine factor
+
+    !> Overwrite rhs with the solution (workspaces allocated once, by the first solve).
+    subroutine solve(self, rhs, error)
+        class(cholmod_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_int) :: status
+
+        if (.not. self%factored) then
+            call fatal_error(error, 'cholmod: solve called without a valid factorisation')
+            return
+        end if
+        call check_array_size('cholmod', 'rhs', size(rhs, kind=ik), self%n, error)
+        if (allocated(error)) return
+
+        status = yarnfort_cholmod_solve(self%handle, self%n, rhs)
+        if (status < cholmod_ok) then
+            call fatal_error(error, 'cholmod: solve failed: ' // status_message(status))
+        end if
+    end subroutine solve
+
+    !> Free the CHOLMOD handle and the pattern copies (safe to call twice).
+    subroutine destroy(self)
+        class(cholmod_solver_type), intent(inout) :: self
+
+        if (c_associated(self%handle)) call yarnfort_cholmod_free(self%handle)
+        self%handle = c_null_ptr
+        self%factored = .false.
+        self%n = 0
+        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
+        if (allocated(self%row_index)) deallocate(self%row_index)
+    end subroutine destroy
+
+    pure function get_name(self) result(name)
+        class(cholmod_solver_type), intent(in) :: self
+        character(len=:), allocatable :: name
+
+        name = 'cholmod'
+    end function get_name
+
+    subroutine finalize(self)
+        type(cholmod_solver_type), intent(inout) :: self
+
+        call self%destroy()
+    end subroutine finalize
+
+    !> The cholmod_core.h name of a status code and what it means.
+    pure function status_message(status) result(message)
+        integer(c_int), intent(in) :: status
+        character(len=:), allocatable :: message
+
+        select case (status)
+        case (cholmod_not_posdef)
+            message = 'matrix is not positive definite (CHOLMOD_NOT_POSDEF)'
+        case (cholmod_not_installed)
+            message = 'method not installed (CHOLMOD_NOT_INSTALLED)'
+        case (cholmod_out_of_memory)
+            message = 'out of memory (CHOLMOD_OUT_OF_MEMORY)'
+        case (cholmod_too_large)
+            message = 'integer overflow (CHOLMOD_TOO_LARGE)'
+        case (cholmod_invalid)
+            message = 'invalid input (CHOLMOD_INVALID)'
+        case (cholmod_gpu_problem)
+            message = 'GPU error (CHOLMOD_GPU_PROBLEM)'
+        case (cholmod_no_handle)
+            message = 'no CHOLMOD handle'
+        case default
+            message = 'CHOLMOD status ' // format_integer(int(status, ik))
+        end select
+    end function status_message
+
+end module yarnfort_linalg_cholmod

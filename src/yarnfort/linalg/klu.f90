@@ -1,0 +1,195 @@
+! SPDX-License-Identifier: MIT
+!> Sparse LU with KLU's 64-bit interface (`klu_l_*`): BTF + AMD ordering, fastest for
+!> small systems such as unit cells (design.md section 5). After the first factorisation
+!> `factor` refactors with the old pivot order (`klu_l_refactor`) and falls back to a
+!> full pivoting factorisation when that hits a zero pivot or the cheap reciprocal
+!> condition estimate drops below `refactor_rcond_min` (the rule of SUNDIALS'
+!> SUNLinSol_KLU).
+module yarnfort_linalg_klu
+    use, intrinsic :: iso_c_binding, only: c_long, c_ptr, c_null_ptr, c_null_funptr, &
+        c_associated
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size, format_integer
+    use yarnfort_linalg_klu_binding, only: klu_l_common, klu_ok, klu_singular, &
+        klu_out_of_memory, klu_invalid, klu_too_large, klu_l_defaults, klu_l_analyze, &
+        klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_rcond, klu_l_free_symbolic, &
+        klu_l_free_numeric
+    implicit none
+    private
+
+    public :: klu_solver_type, default_refactor_rcond_min
+
+    !> Smallest crude reciprocal condition number (min|U(k,k)|/max|U(k,k)|) accepted after
+    !> a refactorisation with the old pivot order: epsilon**(2/3), as in SUNLinSol_KLU.
+    real(wp), parameter :: default_refactor_rcond_min = epsilon(1.0_wp)**(2.0_wp / 3.0_wp)
+
+    !> C TRUE as returned by the klu_l_* functions and stored in klu_l_common flags.
+    integer(c_long), parameter :: c_true = 1
+
+    !> KLU solver. Owns C handles: never copy an analysed object by assignment.
+    type, extends(linear_solver_type) :: klu_solver_type
+        private
+        !> Refactorisations below this reciprocal condition estimate are redone with pivoting.
+        real(wp), public :: refactor_rcond_min = default_refactor_rcond_min
+        !> Matrix order, 0 before `analyse`.
+        integer(ik) :: n = 0
+        !> Copies of the pattern (KLU needs them again at factor time).
+        integer(c_long), allocatable :: col_ptr(:), row_index(:)
+        type(klu_l_common) :: common
+        logical :: common_ready = .false.
+        type(c_ptr) :: symbolic = c_null_ptr
+        type(c_ptr) :: numeric = c_null_ptr
+    contains
+        procedure :: analyse
+        procedure :: factor
+        procedure :: solve
+        procedure :: destroy
+        procedure :: get_name
+        final :: finalize
+    end type klu_solver_type
+
+contains
+
+    !> Keep a copy of the pattern and order it (BTF + AMD).
+    subroutine analyse(self, n, col_ptr, row_index, error)
+        class(klu_solver_type), intent(inout) :: self
+        integer(ik), intent(in) :: n
+        integer(ik), intent(in) :: col_ptr(:), row_index(:)
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%destroy()
+        call check_csc_pattern('klu', n, col_ptr, row_index, error)
+        if (allocated(error)) return
+
+        if (klu_l_defaults(self%common) /= c_true) then
+            call fatal_error(error, 'klu: klu_l_defaults failed')
+            return
+        end if
+        self%common%user_order = c_null_funptr
+        self%common%user_data = c_null_ptr
+        self%common%halt_if_singular = c_true
+        self%common_ready = .true.
+
+        self%col_ptr = col_ptr
+        self%row_index = row_index(1:col_ptr(n + 1))
+        self%symbolic = klu_l_analyze(n, self%col_ptr, self%row_index, self%common)
+        if (.not. c_associated(self%symbolic)) then
+            call fatal_error(error, 'klu: symbolic analysis failed: ' &
+                // status_message(self%common%status))
+            call self%destroy()
+            return
+        end if
+        self%n = n
+    end subroutine analyse
+
+    !> Refactor with the old pivot order when possible, else factor with pivoting.
+    subroutine factor(self, values, error)
+        class(klu_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_long) :: ok
+
+        if (.not. c_associated(self%symbolic)) then
+            call fatal_error(error, 'klu: factor called before analyse')
+            return
+        end if
+        call check_array_size('klu', 'values', size(values, kind=ik), &
+            int(size(self%row_index), ik), error, at_least=.true.)
+        if (allocated(error)) return
+
+        if (c_associated(self%numeric)) then
+            ok = klu_l_refactor(self%col_ptr, self%row_index, values, self%symbolic, &
+                self%numeric, self%common)
+            if (ok == c_true .and. self%common%status == klu_ok) then
+                ok = klu_l_rcond(self%symbolic, self%numeric, self%common)
+                if (ok == c_true .and. self%common%rcond >= self%refactor_rcond_min) return
+            end if
+            ok = klu_l_free_numeric(self%numeric, self%common)
+        end if
+
+        self%numeric = klu_l_factor(self%col_ptr, self%row_index, values, self%symbolic, &
+            self%common)
+        if (c_associated(self%numeric)) return
+        if (self%common%status == klu_singular) then
+            call fatal_error(error, 'klu: factorisation failed: matrix is singular (zero ' &
+                // 'pivot in column ' // format_integer(int(self%common%singular_col, ik)) &
+                // ', KLU_SINGULAR)')
+        else
+            call fatal_error(error, 'klu: factorisation failed: ' &
+                // status_message(self%common%status))
+        end if
+    end subroutine factor
+
+    !> Overwrite rhs with the solution (in place, no allocation).
+    subroutine solve(self, rhs, error)
+        class(klu_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_long) :: ok
+
+        if (.not. c_associated(self%numeric)) then
+            call fatal_error(error, 'klu: solve called without a valid factorisation')
+            return
+        end if
+        call check_array_size('klu', 'rhs', size(rhs, kind=ik), self%n, error)
+        if (allocated(error)) return
+
+        ok = klu_l_solve(self%symbolic, self%numeric, self%n, 1_c_long, rhs, self%common)
+        if (ok /= c_true) then
+            call fatal_error(error, 'klu: solve failed: ' // status_message(self%common%status))
+        end if
+    end subroutine solve
+
+    !> Free the Numeric and Symbolic objects and the pattern copies (safe to call twice).
+    subroutine destroy(self)
+        class(klu_solver_type), intent(inout) :: self
+        integer(c_long) :: ok
+
+        if (self%common_ready) then
+            if (c_associated(self%numeric)) ok = klu_l_free_numeric(self%numeric, self%common)
+            if (c_associated(self%symbolic)) then
+                ok = klu_l_free_symbolic(self%symbolic, self%common)
+            end if
+        end if
+        self%numeric = c_null_ptr
+        self%symbolic = c_null_ptr
+        self%n = 0
+        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
+        if (allocated(self%row_index)) deallocate(self%row_index)
+    end subroutine destroy
+
+    pure function get_name(self) result(name)
+        class(klu_solver_type), intent(in) :: self
+        character(len=:), allocatable :: name
+
+        name = 'klu'
+    end function get_name
+
+    subroutine finalize(self)
+        type(klu_solver_type), intent(inout) :: self
+
+        call self%destroy()
+    end subroutine finalize
+
+    !> The klu.h name of a status code and what it means.
+    pure function status_message(status) result(message)
+        integer(c_long), intent(in) :: status
+        character(len=:), allocatable :: message
+
+        select case (status)
+        case (klu_singular)
+            message = 'matrix is singular (KLU_SINGULAR)'
+        case (klu_out_of_memory)
+            message = 'out of memory (KLU_OUT_OF_MEMORY)'
+        case (klu_invalid)
+            message = 'invalid matrix or argument (KLU_INVALID)'
+        case (klu_too_large)
+            message = 'integer overflow (KLU_TOO_LARGE)'
+        case default
+            message = 'KLU status ' // format_integer(int(status, ik))
+        end select
+    end function status_message
+
+end module yarnfort_linalg_klu

@@ -1,0 +1,205 @@
+! SPDX-License-Identifier: MIT
+!> Sparse LU with UMFPACK's 64-bit interface (`umfpack_dl_*`): the general solver for
+!> unsymmetric or indefinite matrices. The Symbolic object is kept while the pattern is
+!> unchanged (analyse builds it, factor only refactors numerically) and iterative
+!> refinement is off (design.md section 5: it makes solves 3-4x slower; Newton corrects).
+module yarnfort_linalg_umfpack
+    use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr, c_null_ptr, c_associated
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size, format_integer
+    use yarnfort_linalg_umfpack_binding, only: umfpack_control, umfpack_info, umfpack_prl, &
+        umfpack_irstep, umfpack_rcond, umfpack_a, umfpack_ok, &
+        umfpack_warning_singular_matrix, umfpack_error_out_of_memory, &
+        umfpack_error_invalid_numeric_object, umfpack_error_invalid_symbolic_object, &
+        umfpack_error_argument_missing, umfpack_error_n_nonpositive, &
+        umfpack_error_invalid_matrix, umfpack_error_different_pattern, &
+        umfpack_error_invalid_system, umfpack_error_invalid_permutation, &
+        umfpack_error_internal_error, umfpack_error_ordering_failed, umfpack_dl_defaults, &
+        umfpack_dl_symbolic, umfpack_dl_numeric, umfpack_dl_wsolve, &
+        umfpack_dl_free_symbolic, umfpack_dl_free_numeric
+    implicit none
+    private
+
+    public :: umfpack_solver_type, umfpack_refinement_steps
+
+    !> Iterative refinement steps per solve (Control(UMFPACK_IRSTEP)); see design.md sec. 5.
+    integer, parameter :: umfpack_refinement_steps = 0
+    !> UMFPACK print level (Control(UMFPACK_PRL)): library code never prints.
+    integer, parameter :: umfpack_print_level = 0
+
+    !> UMFPACK solver. Owns C handles: never copy an analysed object by assignment.
+    type, extends(linear_solver_type) :: umfpack_solver_type
+        private
+        !> Matrix order, 0 before `analyse`.
+        integer(ik) :: n = 0
+        !> Copies of the pattern (UMFPACK needs them again at numeric time).
+        integer(c_long), allocatable :: col_ptr(:), row_index(:)
+        real(c_double) :: control(0:umfpack_control - 1) = 0.0_c_double
+        real(c_double) :: info(0:umfpack_info - 1) = 0.0_c_double
+        type(c_ptr) :: symbolic = c_null_ptr
+        type(c_ptr) :: numeric = c_null_ptr
+        !> Solve workspace (umfpack_dl_wsolve) and a copy of the right-hand side.
+        integer(c_long), allocatable :: int_work(:)
+        real(c_double), allocatable :: real_work(:), rhs_copy(:)
+    contains
+        procedure :: analyse
+        procedure :: factor
+        procedure :: solve
+        procedure :: destroy
+        procedure :: get_name
+        final :: finalize
+    end type umfpack_solver_type
+
+contains
+
+    !> Keep a copy of the pattern and build the Symbolic object.
+    subroutine analyse(self, n, col_ptr, row_index, error)
+        class(umfpack_solver_type), intent(inout) :: self
+        integer(ik), intent(in) :: n
+        integer(ik), intent(in) :: col_ptr(:), row_index(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_long) :: status
+
+        call self%destroy()
+        call check_csc_pattern('umfpack', n, col_ptr, row_index, error)
+        if (allocated(error)) return
+
+        self%col_ptr = col_ptr
+        self%row_index = row_index(1:col_ptr(n + 1))
+        call umfpack_dl_defaults(self%control)
+        self%control(umfpack_irstep) = real(umfpack_refinement_steps, c_double)
+        self%control(umfpack_prl) = real(umfpack_print_level, c_double)
+        status = umfpack_dl_symbolic(n, n, self%col_ptr, self%row_index, &
+            symbolic=self%symbolic, control=self%control, info=self%info)
+        if (status /= umfpack_ok) then
+            call fatal_error(error, 'umfpack: symbolic analysis failed: ' &
+                // status_message(status))
+            call self%destroy()
+            return
+        end if
+        self%n = n
+        allocate(self%int_work(n), self%real_work(n), self%rhs_copy(n))
+    end subroutine analyse
+
+    !> Numeric factorisation with the analysed Symbolic object; a singular matrix is an error.
+    subroutine factor(self, values, error)
+        class(umfpack_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_long) :: status
+        character(len=24) :: rcond
+
+        if (.not. c_associated(self%symbolic)) then
+            call fatal_error(error, 'umfpack: factor called before analyse')
+            return
+        end if
+        call check_array_size('umfpack', 'values', size(values, kind=ik), &
+            int(size(self%row_index), ik), error, at_least=.true.)
+        if (allocated(error)) return
+
+        call umfpack_dl_free_numeric(self%numeric)
+        status = umfpack_dl_numeric(self%col_ptr, self%row_index, values, self%symbolic, &
+            self%numeric, self%control, self%info)
+        if (status == umfpack_ok) return
+
+        call umfpack_dl_free_numeric(self%numeric)
+        if (status == umfpack_warning_singular_matrix) then
+            write(rcond, '(es10.3)') self%info(umfpack_rcond)
+            call fatal_error(error, 'umfpack: numeric factorisation failed: matrix is ' &
+                // 'singular (zero pivot, UMFPACK_WARNING_singular_matrix, rcond = ' &
+                // trim(adjustl(rcond)) // ')')
+        else
+            call fatal_error(error, 'umfpack: numeric factorisation failed: ' &
+                // status_message(status))
+        end if
+    end subroutine factor
+
+    !> Overwrite rhs with the solution, without refinement and without allocation.
+    subroutine solve(self, rhs, error)
+        class(umfpack_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_long) :: status
+
+        if (.not. c_associated(self%numeric)) then
+            call fatal_error(error, 'umfpack: solve called without a valid factorisation')
+            return
+        end if
+        call check_array_size('umfpack', 'rhs', size(rhs, kind=ik), self%n, error)
+        if (allocated(error)) return
+
+        self%rhs_copy(:) = rhs
+        status = umfpack_dl_wsolve(umfpack_a, x=rhs, b=self%rhs_copy, numeric=self%numeric, &
+            control=self%control, info=self%info, wi=self%int_work, w=self%real_work)
+        if (status /= umfpack_ok) then
+            call fatal_error(error, 'umfpack: solve failed: ' // status_message(status))
+        end if
+    end subroutine solve
+
+    !> Free the Numeric and Symbolic objects and the pattern copies (safe to call twice).
+    subroutine destroy(self)
+        class(umfpack_solver_type), intent(inout) :: self
+
+        if (c_associated(self%numeric)) call umfpack_dl_free_numeric(self%numeric)
+        if (c_associated(self%symbolic)) call umfpack_dl_free_symbolic(self%symbolic)
+        self%numeric = c_null_ptr
+        self%symbolic = c_null_ptr
+        self%n = 0
+        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
+        if (allocated(self%row_index)) deallocate(self%row_index)
+        if (allocated(self%int_work)) deallocate(self%int_work)
+        if (allocated(self%real_work)) deallocate(self%real_work)
+        if (allocated(self%rhs_copy)) deallocate(self%rhs_copy)
+    end subroutine destroy
+
+    pure function get_name(self) result(name)
+        class(umfpack_solver_type), intent(in) :: self
+        character(len=:), allocatable :: name
+
+        name = 'umfpack'
+    end function get_name
+
+    subroutine finalize(self)
+        type(umfpack_solver_type), intent(inout) :: self
+
+        call self%destroy()
+    end subroutine finalize
+
+    !> The umfpack.h name of a status code and what it means.
+    pure function status_message(status) result(message)
+        integer(c_long), intent(in) :: status
+        character(len=:), allocatable :: message
+
+        select case (status)
+        case (umfpack_warning_singular_matrix)
+            message = 'matrix is singular (UMFPACK_WARNING_singular_matrix)'
+        case (umfpack_error_out_of_memory)
+            message = 'out of memory (UMFPACK_ERROR_out_of_memory)'
+        case (umfpack_error_invalid_numeric_object)
+            message = 'invalid Numeric object (UMFPACK_ERROR_invalid_Numeric_object)'
+        case (umfpack_error_invalid_symbolic_object)
+            message = 'invalid Symbolic object (UMFPACK_ERROR_invalid_Symbolic_object)'
+        case (umfpack_error_argument_missing)
+            message = 'argument missing (UMFPACK_ERROR_argument_missing)'
+        case (umfpack_error_n_nonpositive)
+            message = 'matrix order not positive (UMFPACK_ERROR_n_nonpositive)'
+        case (umfpack_error_invalid_matrix)
+            message = 'invalid CSC matrix (UMFPACK_ERROR_invalid_matrix)'
+        case (umfpack_error_different_pattern)
+            message = 'pattern changed since analyse (UMFPACK_ERROR_different_pattern)'
+        case (umfpack_error_invalid_system)
+            message = 'invalid system (UMFPACK_ERROR_invalid_system)'
+        case (umfpack_error_invalid_permutation)
+            message = 'invalid permutation (UMFPACK_ERROR_invalid_permutation)'
+        case (umfpack_error_internal_error)
+            message = 'internal error (UMFPACK_ERROR_internal_error)'
+        case (umfpack_error_ordering_failed)
+            message = 'ordering failed (UMFPACK_ERROR_ordering_failed)'
+        case default
+            message = 'UMFPACK status ' // format_integer(int(status, ik))
+        end select
+    end function status_message
+
+end module yarnfort_linalg_umfpack
