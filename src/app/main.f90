@@ -39,6 +39,7 @@ program yarnfort_main
     end if
 
     writer%progress = config%output%progress
+    writer%residual_history = config%output%residual_history
     call writer%open(scene, error)
     if (allocated(error)) call fail('output', error, 2)
     open(newunit=unit, file=trim(config%output%folder) // '/input.nml', status='replace', &

@@ -14,6 +14,7 @@ module yarnfort_app_progress
 
     type, extends(output_writer_type) :: progress_writer_type
         logical :: progress = .true.
+        logical :: residual_history = .false.
     contains
         procedure :: on_step
         procedure :: on_cut
@@ -33,6 +34,8 @@ contains
             & f8.4, "  newton ", i3, "  residual ", es9.2, "  ", f8.3, " s")') &
             state%step, state%time, state%p_force, state%p_disp, state%newton%iterations, &
             state%newton%residual_norm, state%wall_time
+        if (self%residual_history) write(error_unit, '("  residuals", *(1x, es9.2))') &
+            state%newton%residual_history
     end subroutine on_step
 
     subroutine on_cut(self, time, step, reason)

@@ -116,3 +116,109 @@ def test_initially_slack_straight_string_under_transverse_load(run_yarnfort):
     w = -state.position[1, 1]
     length = np.hypot(1.0, w)
     assert 2 * ea * (length - 1) * w / length == pytest.approx(load, rel=CLOSED_FORM_RTOL)
+
+
+def cable_net(n: int = 3, pretension_pull: float = 0.05, load: float = 0.5):
+    """An n x n pretensioned cable net in the xy plane (unit spacing, cables along x
+    and y through interior nodes, ends held by the boundary supports) under a
+    transverse point load at its centre: pretension first (p_disp 0 -> 1), then the
+    load (p_force 0 -> 1)."""
+    interior = {(i, j): None for i in range(1, n + 1) for j in range(1, n + 1)}
+    nodes, index = [], {}
+    for key in list(interior) + [(0, j) for j in range(1, n + 1)] \
+            + [(n + 1, j) for j in range(1, n + 1)] + [(i, 0) for i in range(1, n + 1)] \
+            + [(i, n + 1) for i in range(1, n + 1)]:
+        index[key] = len(nodes) + 1
+        nodes.append([key[0], key[1], 0.0])
+    yarns = [dict(material="cable", nodes=[index[(i, j)] for i in range(n + 2)])
+             for j in range(1, n + 1)]
+    yarns += [dict(material="cable", nodes=[index[(i, j)] for j in range(n + 2)])
+              for i in range(1, n + 1)]
+    supports = [
+        dict(name="west", nodes=[index[(0, j)] for j in range(1, n + 1)], fix="xyz",
+             displacement=[-pretension_pull, 0, 0]),
+        dict(name="east", nodes=[index[(n + 1, j)] for j in range(1, n + 1)], fix="xyz",
+             displacement=[pretension_pull, 0, 0]),
+        dict(name="south", nodes=[index[(i, 0)] for i in range(1, n + 1)], fix="xyz",
+             displacement=[0, -pretension_pull, 0]),
+        dict(name="north", nodes=[index[(i, n + 1)] for i in range(1, n + 1)], fix="xyz",
+             displacement=[0, pretension_pull, 0])]
+    centre = index[((n + 1) // 2, (n + 1) // 2)]
+    return dict(nodes=nodes, yarns=yarns, supports=supports,
+                materials=[dict(name="cable", law="neo_hookean", modulus=2e6, area=5e-6)],
+                loads=[dict(nodes=[centre], force=[0.0, 0.0, -load])],
+                path=dict(time=[0.0, 1.0, 2.0], p_disp=[0.0, 1.0, 1.0],
+                          p_force=[0.0, 0.0, 1.0]))
+
+
+def residual_histories(stderr: str) -> list[list[float]]:
+    return [[float(v) for v in line.split()[1:]] for line in stderr.splitlines()
+            if line.strip().startswith("residuals")]
+
+
+def test_cable_net_newton_converges_quadratically(run_yarnfort):
+    """Full Newton (a Jacobian at every iterate): once the residual is small, each
+    iterate roughly squares it, until round-off."""
+    net = cable_net()
+    run = run_yarnfort(scene(**net, solver=dict(initial_step=1.0, max_step=1.0,
+                                                residual_tolerance=1e-14),
+                             output=dict(folder="out", residual_history=True)))
+    assert run.returncode == 0, run.stderr
+    history = residual_histories(run.stderr)[-1]   # the load step
+    print("cable net, load step, scaled residual per Newton iterate:", history)
+    # Observed order from three consecutive iterates above round-off:
+    # p = log(e[k+1]/e[k]) / log(e[k]/e[k-1]), 2 for Newton's quadratic convergence.
+    orders = [np.log(c / b) / np.log(b / a) for a, b, c in
+              zip(history, history[1:], history[2:]) if c > 1e-14 and a < 1e-2]
+    print("observed orders:", orders)
+    assert orders, history
+    assert max(orders) > 1.8, (orders, history)
+
+
+def test_cable_net_answer_independent_of_load_steps(run_yarnfort, tmp_path):
+    """Elastic, hence path independent: 1 step per knot and 40 steps give one answer."""
+    net = cable_net()
+    finals = []
+    for name, step in (("coarse", 1.0), ("fine", 0.05)):
+        folder = tmp_path / name
+        folder.mkdir()
+        run = run_yarnfort(scene(**net, solver=dict(initial_step=step, max_step=step,
+                                                    residual_tolerance=1e-14)),
+                           cwd=folder)
+        assert run.returncode == 0, run.stderr
+        finals.append(read_states(folder / "out")[-1].position)
+        print(name, "steps:", len(read_curve(folder / "out")["step"]) - 1)
+    assert np.max(np.abs(finals[0] - finals[1])) <= 1e-8
+
+
+def test_slack_regularisation_changes_result_by_its_ratio(run_yarnfort, tmp_path):
+    """The V-shaped string plus a third string hanging from C to D = (0,-1,0): when C
+    is pushed down by the load that string goes slack (compressed). With the exact
+    tension-only law (slack_stiffness = 0) it carries nothing; the regularised law gives
+    it slack_stiffness * EA * (stretch - 1). Measure how much that moves C."""
+    depth = {}
+    for ratio in (0.0, 1e-6, 1e-4):
+        folder = tmp_path / f"r{ratio}"
+        folder.mkdir()
+        text = scene(
+            nodes=[[-1, 0, 0], [0, -0.2, 0], [1, 0, 0], [0, -1, 0]],
+            materials=[dict(name="yarn", law="linear", stiffness=10.0)],
+            yarns=[dict(material="yarn", nodes=[1, 2, 3]), dict(material="yarn", nodes=[2, 4])],
+            supports=[dict(name="west", nodes=[1], fix="xyz", displacement=[-0.05, 0, 0]),
+                      dict(name="east", nodes=[3], fix="xyz", displacement=[0.05, 0, 0]),
+                      dict(name="anchor", nodes=[4], fix="xyz"),
+                      dict(name="plane", nodes=[2], fix="z")],
+            loads=[dict(nodes=[2], force=[0.0, -0.5, 0.0])],
+            # Pull the ends apart first so that the V is taut: with the exact
+            # tension-only law a net at zero tension has no stiffness at all.
+            path=dict(time=[0.0, 1.0, 2.0], p_force=[0.0, 0.0, 1.0], p_disp=[0.0, 1.0, 1.0]),
+            solver=dict(slack_stiffness=ratio, residual_tolerance=1e-14))
+        run = run_yarnfort(text, cwd=folder)
+        assert run.returncode == 0, run.stderr
+        state = read_states(folder / "out")[-1]
+        assert state.stretch[2] < 1.0     # the hanging string is compressed (slack)
+        depth[ratio] = -state.position[1, 1]
+    for ratio in (1e-6, 1e-4):
+        change = abs(depth[ratio] - depth[0.0]) / depth[0.0]
+        print(f"slack_stiffness {ratio:g}: relative change of C's depth {change:.3e}")
+        assert 0 < change < 10 * ratio

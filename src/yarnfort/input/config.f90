@@ -112,6 +112,8 @@ module yarnfort_input_config
         integer :: vtk_every = 1
         !> Progress lines on stderr.
         logical :: progress = .true.
+        !> Also print each step's Newton residual history (scaled max-norm per iterate).
+        logical :: residual_history = .false.
     end type output_config_type
 
     !> The whole input.

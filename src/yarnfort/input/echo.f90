@@ -143,6 +143,7 @@ contains
             call put(indent // 'folder = ' // quote_string(output%folder))
             call put(indent // 'vtk_every = ' // format_integer(output%vtk_every))
             call put(indent // 'progress = ' // format_logical(output%progress))
+            call put(indent // 'residual_history = ' // format_logical(output%residual_history))
             call put('/')
         end associate
 

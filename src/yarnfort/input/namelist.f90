@@ -613,7 +613,7 @@ contains
         end if
     end subroutine read_path
 
-    !> &output: folder, vtk_every, progress.
+    !> &output: folder, vtk_every, progress, residual_history.
     subroutine read_output(unit, scan, cfg, error)
         integer, intent(in) :: unit
         type(namelist_scan_type), intent(in) :: scan
@@ -622,8 +622,8 @@ contains
         type(output_config_type) :: defaults
         character(len=buffer_length) :: folder
         integer :: vtk_every
-        logical :: progress
-        namelist /output/ folder, vtk_every, progress
+        logical :: progress, residual_history
+        namelist /output/ folder, vtk_every, progress, residual_history
         character(len=message_length) :: message
         integer :: stat
 
@@ -631,12 +631,13 @@ contains
         folder = defaults%folder
         vtk_every = defaults%vtk_every
         progress = defaults%progress
+        residual_history = defaults%residual_history
         rewind(unit)
         message = ''
         read(unit, nml=output, iostat=stat, iomsg=message)
         if (stat /= 0) then
             call read_failed(error, scan, 'output', 0, stat, message, &
-                [character(len=16) :: 'folder', 'vtk_every', 'progress'])
+                [character(len=16) :: 'folder', 'vtk_every', 'progress', 'residual_history'])
             return
         end if
         call check_length(error, scan, 'output', 0, 'folder', folder, len(cfg%output%folder))
@@ -644,6 +645,7 @@ contains
         cfg%output%folder = folder(:len(cfg%output%folder))
         cfg%output%vtk_every = vtk_every
         cfg%output%progress = progress
+        cfg%output%residual_history = residual_history
     end subroutine read_output
 
     !> '&name' for a singleton (occurrence 0), '&name #k' for the k-th of a repeatable.
