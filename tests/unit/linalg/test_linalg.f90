@@ -2,6 +2,7 @@
 !> Unit tests of the sparse direct solvers (UMFPACK, KLU, CHOLMOD, dense LAPACK) behind
 !> linear_solver_type, and of the factory.
 module test_linalg
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_testing, only: unittest_type, new_unittest, check
@@ -707,7 +708,7 @@ contains
         real(wp), allocatable, intent(out), optional :: x(:)
         real(wp), allocatable :: b(:), solution(:)
 
-        b = multiply(a, x_true)
+        allocate(b, source=multiply(a, x_true))
         call solve_with(name, a, b, solution, error)
         if (allocated(error)) return
         call check_solution(name // ' ' // what, a, b, solution, x_true, error)
@@ -722,7 +723,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         real(wp) :: residual
 
-        if (any(x /= x)) then
+        if (any(ieee_is_nan(x))) then
             call fatal_error(error, what // ': solution contains NaN')
             return
         end if
@@ -817,13 +818,12 @@ contains
         if (present(keep_zero_diagonal)) keep = keep_zero_diagonal
         a%n = size(dense, 2)
         allocate(a%col_ptr(a%n + 1))
-        allocate(a%row_index(count(dense /= 0.0_wp) + a%n), a%values(count(dense /= 0.0_wp) &
-            + a%n))
+        allocate(a%row_index(size(dense)), a%values(size(dense)))
         k = 0
         a%col_ptr(1) = 0
         do j = 1, size(dense, 2)
             do i = 1, size(dense, 1)
-                if (dense(i, j) /= 0.0_wp .or. (keep .and. i == j)) then
+                if (abs(dense(i, j)) > 0.0_wp .or. (keep .and. i == j)) then
                     k = k + 1
                     a%row_index(k) = i - 1
                     a%values(k) = dense(i, j)

@@ -1,0 +1,165 @@
+! SPDX-License-Identifier: MIT
+!> Benchmark of one Newton solve on a generated pretensioned cable net.
+!>     bench_newton <interior nodes per side> <linear solver> [max_setup_calls]
+!> Prints one line of figures per run (see the header printed with --header): unknowns,
+!> nonzeros, Newton iterations, factorisations, and per-iteration wall times of residual
+!> assembly, Jacobian assembly, numeric factorisation, solve, and everything else;
+!> total time and peak resident memory (VmHWM) of the process.
+program bench_newton
+    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type
+    use yarnfort_input_config, only: config_type
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_builder, only: new_scene
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_factory, only: new_linear_solver
+    use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
+    use yarnfort_solver_timer, only: wall_time
+    implicit none
+    type(config_type) :: config
+    type(scene_type), target :: scene
+    type(newton_solver_type) :: newton
+    class(linear_solver_type), allocatable :: linear
+    type(newton_stats_type) :: stats
+    type(error_type), allocatable :: error
+    real(wp), allocatable :: u(:)
+    real(wp) :: t_residual, t_jacobian, t_analyse, t_factor, t_solve, total, start, other
+    integer :: side, setup_calls, n_factor, iterations
+    character(len=32) :: argument, solver_name
+
+    call get_command_argument(1, argument)
+    if (trim(argument) == '--header') then
+        write(output_unit, '(a)') 'solver  setup  unknowns       nnz  iters  facts' // &
+            '  residual_ms  jacobian_ms  factor_ms  solve_ms  other_ms  other_%' // &
+            '  analyse_ms  total_s  peak_MiB'
+        stop
+    end if
+    read(argument, *) side
+    call get_command_argument(2, solver_name)
+    setup_calls = 1
+    if (command_argument_count() >= 3) then
+        call get_command_argument(3, argument)
+        read(argument, *) setup_calls
+    end if
+
+    call make_cable_net(config, side, setup_calls, solver_name)
+    call new_scene(scene, config, error)
+    if (allocated(error)) call fail(error)
+    call new_linear_solver(linear, trim(solver_name), error)
+    if (allocated(error)) call fail(error)
+    call new_newton_solver(newton, scene, linear, error)
+    if (allocated(error)) call fail(error)
+    allocate(u(scene%dofs%n_unknowns))
+    call scene%dofs%restrict(scene%network%position, u)
+
+    start = wall_time()
+    call newton%solve(u, 1.0_wp, 1.0_wp, stats, error)
+    total = wall_time() - start
+    if (allocated(error)) call fail(error)
+    call newton%get_timings(t_residual, t_jacobian, t_analyse, t_factor, t_solve, n_factor)
+    iterations = max(stats%iterations, 1)
+    other = total - (t_residual + t_jacobian + t_analyse + t_factor + t_solve)
+    write(output_unit, '(a7, i6, i10, i10, i7, i7, 5f11.3, f9.1, f12.3, f9.3, f10.1)') &
+        trim(solver_name), setup_calls, scene%dofs%n_unknowns, newton_nnz(), iterations, &
+        n_factor, 1e3_wp * [t_residual, t_jacobian, t_factor, t_solve, other] / iterations, &
+        100 * other / total, 1e3_wp * t_analyse, total, peak_memory_mib()
+
+contains
+
+    integer function newton_nnz()
+        ! Nonzeros of the Jacobian: 3x3 blocks of coupled node pairs.
+        newton_nnz = 9 * (scene%network%n_nodes() + 2 * scene%network%n_elements())
+    end function newton_nnz
+
+    !> side x side interior nodes, unit spacing, cables along x and y ending on boundary
+    !> nodes that are pulled outward by 2 % (pretension); a transverse force on every
+    !> interior node. Neo-Hookean cables. Everything ramps in one step.
+    subroutine make_cable_net(config, side, setup_calls, solver_name)
+        type(config_type), intent(out) :: config
+        integer, intent(in) :: side, setup_calls
+        character(len=*), intent(in) :: solver_name
+        integer :: i, j, n, y
+        integer, allocatable :: id(:, :)
+
+        allocate(id(0:side + 1, 0:side + 1), source=0)
+        n = 0
+        do j = 0, side + 1
+            do i = 0, side + 1
+                if ((i == 0 .or. i == side + 1) .and. (j == 0 .or. j == side + 1)) cycle
+                n = n + 1
+                id(i, j) = n
+            end do
+        end do
+        allocate(config%node_positions(3, n))
+        do j = 0, side + 1
+            do i = 0, side + 1
+                if (id(i, j) > 0) config%node_positions(:, id(i, j)) = [real(i, wp), &
+                    real(j, wp), 0.0_wp]
+            end do
+        end do
+        allocate(config%materials(1))
+        config%materials(1)%name = 'cable'
+        config%materials(1)%law = 'neo_hookean'
+        config%materials(1)%modulus = 2.0e6_wp
+        config%materials(1)%area = 5.0e-6_wp
+        allocate(config%yarns(2 * side))
+        y = 0
+        do j = 1, side
+            y = y + 1
+            config%yarns(y)%material = 'cable'
+            config%yarns(y)%nodes = id(0:side + 1, j)
+        end do
+        do i = 1, side
+            y = y + 1
+            config%yarns(y)%material = 'cable'
+            config%yarns(y)%nodes = id(i, 0:side + 1)
+        end do
+        allocate(config%supports(4))
+        config%supports(1)%name = 'west'
+        config%supports(1)%nodes = id(0, 1:side)
+        config%supports(1)%displacement = [-0.02_wp * (side + 1), 0.0_wp, 0.0_wp]
+        config%supports(2)%name = 'east'
+        config%supports(2)%nodes = id(side + 1, 1:side)
+        config%supports(2)%displacement = [0.02_wp * (side + 1), 0.0_wp, 0.0_wp]
+        config%supports(3)%name = 'south'
+        config%supports(3)%nodes = id(1:side, 0)
+        config%supports(3)%displacement = [0.0_wp, -0.02_wp * (side + 1), 0.0_wp]
+        config%supports(4)%name = 'north'
+        config%supports(4)%nodes = id(1:side, side + 1)
+        config%supports(4)%displacement = [0.0_wp, 0.02_wp * (side + 1), 0.0_wp]
+        allocate(config%loads(1))
+        config%loads(1)%nodes = pack(id(1:side, 1:side), .true.)
+        config%loads(1)%force = [0.0_wp, 0.0_wp, -0.01_wp]
+        config%path%time = [0.0_wp, 1.0_wp]
+        config%path%p_force = [0.0_wp, 1.0_wp]
+        config%path%p_disp = [0.0_wp, 1.0_wp]
+        config%solver%linear_solver = solver_name
+        config%solver%max_setup_calls = setup_calls
+        config%solver%max_iterations = 200
+    end subroutine make_cable_net
+
+    real(wp) function peak_memory_mib()
+        character(len=256) :: line
+        integer :: unit, status, kib
+        peak_memory_mib = -1.0_wp
+        open(newunit=unit, file='/proc/self/status', action='read', iostat=status)
+        if (status /= 0) return
+        do
+            read(unit, '(a)', iostat=status) line
+            if (status /= 0) exit
+            if (line(1:6) == 'VmHWM:') then
+                read(line(7:), *) kib
+                peak_memory_mib = kib / 1024.0_wp
+            end if
+        end do
+        close(unit)
+    end function peak_memory_mib
+
+    subroutine fail(error)
+        type(error_type), intent(in) :: error
+        write(error_unit, '(a)') 'bench_newton: ' // error%message
+        error stop 1
+    end subroutine fail
+
+end program bench_newton
