@@ -12,8 +12,8 @@ works without it, for the result readers) from the first of:
 
 1. ``$YARNFORT_NATIVE``: the extension file, or a folder holding it;
 2. the package folder ``yarnfort/`` (an installed or copied ``_yarnfort.<abi>.so``);
-3. the most recently built ``<top>/build*/python/_yarnfort.<abi>.so`` of this checkout
-   (the lead's ``build/``, or any other build folder configured with ``-Dpython=true``).
+3. ``<top>/build/python/`` (the build made by ``tools/bootstrap``), else the most
+   recently built ``<top>/build*/python/_yarnfort.<abi>.so`` of this checkout.
 
 Only files with an extension suffix of the running interpreter are considered.
 """
@@ -102,7 +102,7 @@ def native_path() -> Path:
         if not found:
             raise ImportError(f"{NATIVE_ENV}={override!r}: no {NATIVE_NAME} extension there")
         return found[0]
-    found = _candidates(_PACKAGE)
+    found = _candidates(_PACKAGE) or _candidates(_TOP / "build" / "python")
     if found:
         return found[0]
     built = [path for folder in _TOP.glob("build*/python") for path in _candidates(folder)]
