@@ -15,11 +15,13 @@ program bench_newton
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
+    use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_timer, only: wall_time
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
     type(newton_solver_type) :: newton
+    type(elastic_problem_type), target :: problem
     class(linear_solver_type), allocatable :: linear
     type(newton_stats_type) :: stats
     type(error_type), allocatable :: error
@@ -48,13 +50,16 @@ program bench_newton
     if (allocated(error)) call fail(error)
     call new_linear_solver(linear, trim(solver_name), error)
     if (allocated(error)) call fail(error)
-    call new_newton_solver(newton, scene, linear, error)
+    call new_elastic_problem(problem, scene)
+    problem%p_force = 1.0_wp
+    problem%p_disp = 1.0_wp
+    call new_newton_solver(newton, problem, linear, scene%solver, error)
     if (allocated(error)) call fail(error)
     allocate(u(scene%dofs%n_unknowns))
     call scene%dofs%restrict(scene%network%position, u)
 
     start = wall_time()
-    call newton%solve(u, 1.0_wp, 1.0_wp, stats, error)
+    call newton%solve(u, stats, error)
     total = wall_time() - start
     if (allocated(error)) call fail(error)
     call newton%get_timings(t_residual, t_jacobian, t_analyse, t_factor, t_solve, n_factor)

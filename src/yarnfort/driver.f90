@@ -5,7 +5,7 @@ module yarnfort_driver
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
-    use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver
+    use yarnfort_solver_elastic_stepper, only: elastic_stepper_type, new_elastic_stepper
     use yarnfort_solver_continuation, only: step_observer_type, run_continuation
     implicit none
     private
@@ -35,16 +35,16 @@ contains
         class(step_observer_type), intent(inout) :: observer
         type(error_type), allocatable, intent(out) :: error
         class(linear_solver_type), allocatable :: linear
-        type(newton_solver_type) :: newton
+        type(elastic_stepper_type) :: stepper
 
         call new_linear_solver(linear, get_linear_solver_name(scene), error)
         if (allocated(error)) then
             call prefix_error(error, '&solver linear_solver')
             return
         end if
-        call new_newton_solver(newton, scene, linear, error)
+        call new_elastic_stepper(stepper, scene, linear, error)
         if (allocated(error)) return
-        call run_continuation(scene, newton, observer, error)
+        call run_continuation(scene, stepper, observer, error)
     end subroutine run_scene
 
 end module yarnfort_driver

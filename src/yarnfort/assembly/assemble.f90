@@ -18,10 +18,11 @@ module yarnfort_assembly_assemble
 contains
 
     !> Internal force (gradient of the elastic energy) at every coordinate, (3*n_nodes),
-    !> and each element's tension and stretch, for node positions x (3, n_nodes).
-    subroutine assemble_internal_force(scene, x, internal, tension, stretch, error)
+    !> and each element's tension and stretch, for node positions x (3, n_nodes) and
+    !> element reference lengths length0.
+    subroutine assemble_internal_force(scene, x, length0, internal, tension, stretch, error)
         type(scene_type), intent(in) :: scene
-        real(wp), intent(in) :: x(:, :)
+        real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(out) :: internal(:), tension(:), stretch(:)
         type(error_type), allocatable, intent(out) :: error
         integer :: e, n1, n2
@@ -31,10 +32,10 @@ contains
         do e = 1, scene%network%n_elements()
             n1 = scene%network%element_nodes(1, e)
             n2 = scene%network%element_nodes(2, e)
-            call check_length(scene, x, e, error)
+            call check_length(scene, x, length0, e, error)
             if (allocated(error)) return
             call get_truss_response(scene%laws(scene%network%element_material(e))%law, &
-                scene%solver%slack_stiffness, scene%network%length0(e), x(:, n1), x(:, n2), &
+                scene%solver%slack_stiffness, length0(e), x(:, n1), x(:, n2), &
                 tension(e), stretch(e), force)
             internal(3 * n1 - 2:3 * n1) = internal(3 * n1 - 2:3 * n1) - force
             internal(3 * n2 - 2:3 * n2) = internal(3 * n2 - 2:3 * n2) + force
@@ -42,25 +43,25 @@ contains
     end subroutine assemble_internal_force
 
     !> Residual on the unknowns: P^T (internal - p_force * external).
-    subroutine assemble_residual(scene, x, p_force, residual, error)
+    subroutine assemble_residual(scene, x, length0, p_force, residual, error)
         type(scene_type), intent(in) :: scene
-        real(wp), intent(in) :: x(:, :), p_force
+        real(wp), intent(in) :: x(:, :), length0(:), p_force
         real(wp), intent(out) :: residual(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: internal(:), tension(:), stretch(:)
 
         allocate(internal(size(scene%external_force)))
         allocate(tension(scene%network%n_elements()), stretch(scene%network%n_elements()))
-        call assemble_internal_force(scene, x, internal, tension, stretch, error)
+        call assemble_internal_force(scene, x, length0, internal, tension, stretch, error)
         if (allocated(error)) return
         call scene%dofs%gather(internal - p_force * scene%external_force, residual)
     end subroutine assemble_residual
 
     !> Jacobian values P^T K P in the slots of `pattern` (values are overwritten).
-    subroutine assemble_jacobian(scene, pattern, x, values, error)
+    subroutine assemble_jacobian(scene, pattern, x, length0, values, error)
         type(scene_type), intent(in) :: scene
         type(pattern_type), intent(in) :: pattern
-        real(wp), intent(in) :: x(:, :)
+        real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         integer :: e, n1, n2, a, b, slot
@@ -70,10 +71,10 @@ contains
         do e = 1, scene%network%n_elements()
             n1 = scene%network%element_nodes(1, e)
             n2 = scene%network%element_nodes(2, e)
-            call check_length(scene, x, e, error)
+            call check_length(scene, x, length0, e, error)
             if (allocated(error)) return
             call get_truss_response(scene%laws(scene%network%element_material(e))%law, &
-                scene%solver%slack_stiffness, scene%network%length0(e), x(:, n1), x(:, n2), &
+                scene%solver%slack_stiffness, length0(e), x(:, n1), x(:, n2), &
                 tension, stretch, force, block)
             do b = 1, 6
                 do a = 1, 6
@@ -86,9 +87,9 @@ contains
         end do
     end subroutine assemble_jacobian
 
-    subroutine check_length(scene, x, e, error)
+    subroutine check_length(scene, x, length0, e, error)
         type(scene_type), intent(in) :: scene
-        real(wp), intent(in) :: x(:, :)
+        real(wp), intent(in) :: x(:, :), length0(:)
         integer, intent(in) :: e
         type(error_type), allocatable, intent(out) :: error
         real(wp) :: length
@@ -96,7 +97,7 @@ contains
 
         length = norm2(x(:, scene%network%element_nodes(2, e)) &
             - x(:, scene%network%element_nodes(1, e)))
-        if (.not. (length > degenerate_length_ratio * scene%network%length0(e))) then
+        if (.not. (length > degenerate_length_ratio * length0(e))) then
             write(buffer, '("element ", i0, " (nodes ", i0, ", ", i0, ") has length ", es10.3)') &
                 e, scene%network%element_nodes(:, e), length
             call fatal_error(error, trim(buffer))

@@ -1,7 +1,8 @@
 ! SPDX-License-Identifier: MIT
-!> Newton's method for the equilibrium of the network at given load factors, driven by
-!> SUNDIALS KINSOL (line search globalisation) with the analytic sparse Jacobian and a
-!> yarnfort linear solver behind a Fortran SUNLinearSolver.
+!> Newton's method for a nonlinear_problem_type (the network's equilibrium, with or
+!> without sliding), driven by SUNDIALS KINSOL (line search globalisation) with the
+!> analytic sparse Jacobian and a yarnfort linear solver behind a Fortran
+!> SUNLinearSolver.
 module yarnfort_solver_newton
     use, intrinsic :: iso_c_binding
     use fsundials_context_mod
@@ -13,9 +14,8 @@ module yarnfort_solver_newton
     use fsundials_linearsolver_mod
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_scene_scene, only: scene_type
-    use yarnfort_assembly_pattern, only: pattern_type, new_pattern
-    use yarnfort_assembly_assemble, only: assemble_residual, assemble_jacobian
+    use yarnfort_input_config, only: solver_config_type
+    use yarnfort_solver_problem, only: nonlinear_problem_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc
     use yarnfort_solver_timer, only: wall_time
@@ -46,12 +46,10 @@ module yarnfort_solver_newton
         integer :: flag = 0
     end type newton_stats_type
 
-    !> The problem KINSOL's callbacks see through their user-data pointer.
+    !> What KINSOL's callbacks see through their user-data pointer.
     type :: equilibrium_type
-        type(scene_type), pointer :: scene => null()
-        type(pattern_type) :: pattern
-        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
-        real(wp), allocatable :: x(:, :)
+        class(nonlinear_problem_type), pointer :: problem => null()
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
         real(wp), allocatable :: history(:)
         integer :: n_history = 0
         type(error_type), allocatable :: error
@@ -71,9 +69,10 @@ module yarnfort_solver_newton
         real(c_double), pointer :: f_scale_data(:) => null()
         type(equilibrium_type), pointer :: problem => null()
         type(adapter_type), pointer :: adapter => null()
+        type(solver_config_type) :: options
         class(linear_solver_type), pointer :: linear => null()
     contains
-        !> Solve for unknowns u (in: initial guess, out: solution) at the load factors.
+        !> Solve for unknowns u (in: initial guess, out: solution).
         procedure :: solve
         !> Timing and counters of assembly and linear algebra so far.
         procedure :: get_timings
@@ -83,23 +82,24 @@ module yarnfort_solver_newton
 
 contains
 
-    !> Set up KINSOL for `scene` (which must outlive the solver) with `linear` as the
-    !> linear solver (ownership passes to the Newton solver).
-    subroutine new_newton_solver(self, scene, linear, error)
+    !> Set up KINSOL for `problem` (which must outlive the solver) with `linear` as the
+    !> linear solver (ownership passes to the Newton solver) and the &solver options.
+    subroutine new_newton_solver(self, problem, linear, options, error)
         type(newton_solver_type), intent(out) :: self
-        type(scene_type), target, intent(in) :: scene
+        class(nonlinear_problem_type), target, intent(in) :: problem
         class(linear_solver_type), allocatable, intent(inout) :: linear
+        type(solver_config_type), intent(in) :: options
         type(error_type), allocatable, intent(out) :: error
         integer(c_int64_t) :: n, nnz
         integer(c_int) :: ierr
 
+        self%options = options
         allocate(self%problem)
-        self%problem%scene => scene
-        call new_pattern(self%problem%pattern, scene%network, scene%dofs)
-        allocate(self%problem%x(3, scene%network%n_nodes()))
-        allocate(self%problem%history(scene%solver%max_iterations + 2))
-        n = int(scene%dofs%n_unknowns, c_int64_t)
-        nnz = max(int(self%problem%pattern%nnz, c_int64_t), 1_c_int64_t)
+        self%problem%problem => problem
+        call problem%get_pattern(self%problem%col_ptr, self%problem%row_index)
+        allocate(self%problem%history(options%max_iterations + 2))
+        n = int(problem%get_size(), c_int64_t)
+        nnz = max(int(size(self%problem%row_index), c_int64_t), 1_c_int64_t)
         if (n == 0) then
             call fatal_error(error, 'the scene has no unknowns: every coordinate is prescribed')
             return
@@ -117,8 +117,8 @@ contains
         end if
         allocate(self%u(n), self%u_scale_data(n), self%f_scale_data(n))
         self%u = 0.0_wp
-        self%u_scale_data = 1.0_wp / scene%length_scale
-        self%f_scale_data = 1.0_wp / scene%force_scale
+        self%u_scale_data = 1.0_wp / problem%length_scale
+        self%f_scale_data = 1.0_wp / problem%force_scale
         self%u_vector => FN_VMake_Serial(n, self%u, self%sunctx)
         self%u_scale => FN_VMake_Serial(n, self%u_scale_data, self%sunctx)
         self%f_scale => FN_VMake_Serial(n, self%f_scale_data, self%sunctx)
@@ -146,16 +146,16 @@ contains
         if (allocated(error)) return
         call check(FKINSetJacFn(self%kinsol, c_funloc(jacobian_callback)), 'FKINSetJacFn', error)
         if (allocated(error)) return
-        call check(FKINSetMaxSetupCalls(self%kinsol, int(scene%solver%max_setup_calls, c_long)), &
+        call check(FKINSetMaxSetupCalls(self%kinsol, int(options%max_setup_calls, c_long)), &
             'FKINSetMaxSetupCalls', error)
         if (allocated(error)) return
-        call check(FKINSetNumMaxIters(self%kinsol, int(scene%solver%max_iterations, c_long)), &
+        call check(FKINSetNumMaxIters(self%kinsol, int(options%max_iterations, c_long)), &
             'FKINSetNumMaxIters', error)
         if (allocated(error)) return
-        call check(FKINSetFuncNormTol(self%kinsol, real(scene%solver%residual_tolerance, c_double)), &
+        call check(FKINSetFuncNormTol(self%kinsol, real(options%residual_tolerance, c_double)), &
             'FKINSetFuncNormTol', error)
         if (allocated(error)) return
-        call check(FKINSetScaledStepTol(self%kinsol, real(scene%solver%step_tolerance, c_double)), &
+        call check(FKINSetScaledStepTol(self%kinsol, real(options%step_tolerance, c_double)), &
             'FKINSetScaledStepTol', error)
         if (allocated(error)) return
         call check(FKINSetUserData(self%kinsol, c_loc(self%problem)), 'FKINSetUserData', error)
@@ -172,26 +172,21 @@ contains
         end if
     end subroutine check
 
-    subroutine solve(self, u, p_force, p_disp, stats, error)
+    subroutine solve(self, u, stats, error)
         class(newton_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: u(:)
-        real(wp), intent(in) :: p_force, p_disp
         type(newton_stats_type), intent(out) :: stats
         type(error_type), allocatable, intent(out) :: error
         integer(c_int) :: ierr, strategy
         integer(c_long) :: count(1)
         real(c_double) :: residual(size(u))
         character(len=200) :: buffer
-        type(scene_type), pointer :: scene
 
-        scene => self%problem%scene
-        self%problem%p_force = p_force
-        self%problem%p_disp = p_disp
         self%problem%n_history = 0
         if (allocated(self%problem%error)) deallocate(self%problem%error)
         if (allocated(self%problem%kinsol_message)) deallocate(self%problem%kinsol_message)
         self%u = u
-        strategy = merge(KIN_LINESEARCH, KIN_NONE, scene%solver%line_search)
+        strategy = merge(KIN_LINESEARCH, KIN_NONE, self%options%line_search)
         ierr = FKINSol(self%kinsol, self%u_vector, strategy, self%u_scale, self%f_scale)
         stats%flag = ierr
 
@@ -200,9 +195,9 @@ contains
         if (FKINGetNumJacEvals(self%kinsol, count) == 0) stats%jacobian_evaluations = int(count(1))
 
         ! Judge convergence by our own residual check on the final iterate.
-        call residual_at(self%problem, self%u, residual, error)
+        call self%problem%problem%evaluate_residual(self%u, residual, error)
         if (allocated(error)) return
-        stats%residual_norm = maxval(abs(residual)) / scene%force_scale
+        stats%residual_norm = maxval(abs(residual)) / self%problem%problem%force_scale
         self%problem%n_history = min(self%problem%n_history + 1, size(self%problem%history))
         self%problem%history(self%problem%n_history) = stats%residual_norm
         stats%residual_history = self%problem%history(1:self%problem%n_history)
@@ -216,10 +211,10 @@ contains
                 // self%adapter%error%message)
             return
         end if
-        if (ierr < 0 .or. .not. (stats%residual_norm <= scene%solver%residual_tolerance)) then
+        if (ierr < 0 .or. .not. (stats%residual_norm <= self%options%residual_tolerance)) then
             write(buffer, '("Newton did not converge: KINSOL flag ", i0, ", ", i0, &
                 & " iterations, scaled residual ", es10.3, " > tolerance ", es10.3)') &
-                ierr, stats%iterations, stats%residual_norm, scene%solver%residual_tolerance
+                ierr, stats%iterations, stats%residual_norm, self%options%residual_tolerance
             if (allocated(self%problem%kinsol_message)) then
                 call fatal_error(error, trim(buffer) // ' (' // self%problem%kinsol_message // ')')
             else
@@ -229,15 +224,6 @@ contains
         end if
         u = self%u
     end subroutine solve
-
-    subroutine residual_at(problem, u, residual, error)
-        type(equilibrium_type), intent(inout) :: problem
-        real(wp), intent(in) :: u(:)
-        real(wp), intent(out) :: residual(:)
-        type(error_type), allocatable, intent(out) :: error
-        call problem%scene%dofs%expand(u, problem%p_disp, problem%x)
-        call assemble_residual(problem%scene, problem%x, problem%p_force, residual, error)
-    end subroutine residual_at
 
     !> KINSOL residual callback F(u).
     integer(c_int) function residual_callback(sunvec_u, sunvec_f, user_data) &
@@ -252,7 +238,7 @@ contains
         u => FN_VGetArrayPointer(sunvec_u)
         f => FN_VGetArrayPointer(sunvec_f)
         start = wall_time()
-        call residual_at(problem, u, f, problem%error)
+        call problem%problem%evaluate_residual(u, f, problem%error)
         problem%residual_time = problem%residual_time + (wall_time() - start)
         ierr = 0
         if (allocated(problem%error)) ierr = -1
@@ -283,21 +269,20 @@ contains
         f => FN_VGetArrayPointer(sunvec_f)
         if (problem%n_history < size(problem%history)) then
             problem%n_history = problem%n_history + 1
-            problem%history(problem%n_history) = maxval(abs(f)) / problem%scene%force_scale
+            problem%history(problem%n_history) = maxval(abs(f)) / problem%problem%force_scale
         end if
         start = wall_time()
-        n = problem%pattern%n
-        nnz = problem%pattern%nnz
+        n = size(problem%col_ptr) - 1
+        nnz = size(problem%row_index)
         p => FSUNSparseMatrix_IndexPointers(sunmat_j)
         call c_f_pointer(c_loc(p(1)), col_ptr, [n + 1])
-        col_ptr = problem%pattern%col_ptr
+        col_ptr = problem%col_ptr
         p => FSUNSparseMatrix_IndexValues(sunmat_j)
         call c_f_pointer(c_loc(p(1)), row_index, [nnz])
-        row_index = problem%pattern%row_index
+        row_index = problem%row_index
         d => FSUNSparseMatrix_Data(sunmat_j)
         call c_f_pointer(c_loc(d(1)), values, [nnz])
-        call problem%scene%dofs%expand(u, problem%p_disp, problem%x)
-        call assemble_jacobian(problem%scene, problem%pattern, problem%x, values, problem%error)
+        call problem%problem%evaluate_jacobian(u, values, problem%error)
         problem%jacobian_time = problem%jacobian_time + (wall_time() - start)
         ierr = 0
         if (allocated(problem%error)) ierr = -1

@@ -202,7 +202,7 @@ contains
         call scene%dofs%restrict(scene%network%position, u)
         u = u + 0.03_wp * [(sin(real(3 * j, wp)), j = 1, n)]
         call scene%dofs%expand(u, p_disp, x)
-        call assemble_jacobian(scene, pattern, x, values, error)
+        call assemble_jacobian(scene, pattern, x, scene%network%length0, values, error)
         if (allocated(error)) return
         dense = 0.0_wp
         do j = 1, n
@@ -214,11 +214,11 @@ contains
             up = u
             up(j) = u(j) + fd_step
             call scene%dofs%expand(up, p_disp, x)
-            call assemble_residual(scene, x, p_force, rp, error)
+            call assemble_residual(scene, x, scene%network%length0, p_force, rp, error)
             if (allocated(error)) return
             up(j) = u(j) - fd_step
             call scene%dofs%expand(up, p_disp, x)
-            call assemble_residual(scene, x, p_force, rm, error)
+            call assemble_residual(scene, x, scene%network%length0, p_force, rm, error)
             if (allocated(error)) return
             call check_close(error, dense(:, j), (rp - rm) / (2 * fd_step), fd_tolerance, &
                 'Jacobian column', abs_tol=fd_tolerance * maxval(abs(dense)))
@@ -236,8 +236,8 @@ contains
 
         call make_scene(scene, error)
         if (allocated(error)) return
-        call assemble_internal_force(scene, scene%network%position * 1.2_wp, internal, &
-            tension, stretch, error)
+        call assemble_internal_force(scene, scene%network%position * 1.2_wp, &
+            scene%network%length0, internal, tension, stretch, error)
         if (allocated(error)) return
         total = [(sum(internal(k::3)), k = 1, 3)]
         call check(error, maxval(abs(total)) <= 100 * epsilon(1.0_wp) * maxval(abs(internal)), &

@@ -1,0 +1,75 @@
+! SPDX-License-Identifier: MIT
+!> Equilibrium of the network at given load factors with reference lengths held fixed
+!> (paper eqs. 51-52): the unknowns are the free coordinates.
+module yarnfort_solver_elastic_problem
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_assembly_pattern, only: pattern_type, new_pattern
+    use yarnfort_assembly_assemble, only: assemble_residual, assemble_jacobian
+    use yarnfort_solver_problem, only: nonlinear_problem_type
+    implicit none
+    private
+
+    public :: elastic_problem_type, new_elastic_problem
+
+    type, extends(nonlinear_problem_type) :: elastic_problem_type
+        type(scene_type), pointer :: scene => null()
+        type(pattern_type) :: pattern
+        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
+        !> Current reference lengths of the elements.
+        real(wp), allocatable :: length0(:)
+        real(wp), allocatable :: x(:, :)
+    contains
+        procedure :: get_size
+        procedure :: get_pattern
+        procedure :: evaluate_residual
+        procedure :: evaluate_jacobian
+    end type elastic_problem_type
+
+contains
+
+    !> The problem for `scene` (which must outlive it), reference lengths from the scene.
+    subroutine new_elastic_problem(self, scene)
+        type(elastic_problem_type), intent(out) :: self
+        type(scene_type), target, intent(in) :: scene
+
+        self%scene => scene
+        call new_pattern(self%pattern, scene%network, scene%dofs)
+        self%length0 = scene%network%length0
+        allocate(self%x(3, scene%network%n_nodes()))
+        self%force_scale = scene%force_scale
+        self%length_scale = scene%length_scale
+    end subroutine new_elastic_problem
+
+    pure integer function get_size(self)
+        class(elastic_problem_type), intent(in) :: self
+        get_size = self%scene%dofs%n_unknowns
+    end function get_size
+
+    subroutine get_pattern(self, col_ptr, row_index)
+        class(elastic_problem_type), intent(in) :: self
+        integer(ik), allocatable, intent(out) :: col_ptr(:), row_index(:)
+        col_ptr = self%pattern%col_ptr
+        row_index = self%pattern%row_index
+    end subroutine get_pattern
+
+    subroutine evaluate_residual(self, u, residual, error)
+        class(elastic_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: residual(:)
+        type(error_type), allocatable, intent(out) :: error
+        call self%scene%dofs%expand(u, self%p_disp, self%x)
+        call assemble_residual(self%scene, self%x, self%length0, self%p_force, residual, error)
+    end subroutine evaluate_residual
+
+    subroutine evaluate_jacobian(self, u, values, error)
+        class(elastic_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        call self%scene%dofs%expand(u, self%p_disp, self%x)
+        call assemble_jacobian(self%scene, self%pattern, self%x, self%length0, values, error)
+    end subroutine evaluate_jacobian
+
+end module yarnfort_solver_elastic_problem

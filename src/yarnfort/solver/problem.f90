@@ -1,0 +1,56 @@
+! SPDX-License-Identifier: MIT
+!> A square nonlinear system F(u) = 0 with a sparse Jacobian of fixed pattern: what the
+!> Newton solver (KINSOL) needs from the elastic and the frictional problems.
+module yarnfort_solver_problem
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type
+    implicit none
+    private
+
+    public :: nonlinear_problem_type
+
+    type, abstract :: nonlinear_problem_type
+        !> Scales: residual entries are compared with force_scale, unknowns with
+        !> length_scale (KINSOL's scaling vectors).
+        real(wp) :: force_scale = 1.0_wp
+        real(wp) :: length_scale = 1.0_wp
+    contains
+        !> Number of unknowns.
+        procedure(get_size_interface), deferred :: get_size
+        !> The Jacobian's CSC pattern (0-based), fixed for the problem's lifetime.
+        procedure(get_pattern_interface), deferred :: get_pattern
+        procedure(evaluate_residual_interface), deferred :: evaluate_residual
+        !> Jacobian values in the order of the pattern.
+        procedure(evaluate_jacobian_interface), deferred :: evaluate_jacobian
+    end type nonlinear_problem_type
+
+    abstract interface
+        pure integer function get_size_interface(self)
+            import :: nonlinear_problem_type
+            class(nonlinear_problem_type), intent(in) :: self
+        end function get_size_interface
+
+        subroutine get_pattern_interface(self, col_ptr, row_index)
+            import :: nonlinear_problem_type, ik
+            class(nonlinear_problem_type), intent(in) :: self
+            integer(ik), allocatable, intent(out) :: col_ptr(:), row_index(:)
+        end subroutine get_pattern_interface
+
+        subroutine evaluate_residual_interface(self, u, residual, error)
+            import :: nonlinear_problem_type, wp, error_type
+            class(nonlinear_problem_type), intent(inout) :: self
+            real(wp), intent(in) :: u(:)
+            real(wp), intent(out) :: residual(:)
+            type(error_type), allocatable, intent(out) :: error
+        end subroutine evaluate_residual_interface
+
+        subroutine evaluate_jacobian_interface(self, u, values, error)
+            import :: nonlinear_problem_type, wp, error_type
+            class(nonlinear_problem_type), intent(inout) :: self
+            real(wp), intent(in) :: u(:)
+            real(wp), intent(out) :: values(:)
+            type(error_type), allocatable, intent(out) :: error
+        end subroutine evaluate_jacobian_interface
+    end interface
+
+end module yarnfort_solver_problem

@@ -1,0 +1,51 @@
+! SPDX-License-Identifier: MIT
+!> Fill a step state (positions, tensions, reactions) from unknowns and reference lengths.
+module yarnfort_solver_state
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_assembly_assemble, only: assemble_internal_force
+    use yarnfort_solver_stepper, only: step_state_type
+    implicit none
+    private
+
+    public :: fill_step_state
+
+contains
+
+    !> The state of the net for position unknowns u (the first n_unknowns entries are
+    !> used), reference lengths length0 and load factors.
+    subroutine fill_step_state(scene, u, length0, p_force, p_disp, state, error)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: u(:), length0(:), p_force, p_disp
+        type(step_state_type), intent(inout) :: state
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: internal(:)
+        integer :: s, i, c, k, n_elements
+
+        n_elements = scene%network%n_elements()
+        state%p_force = p_force
+        state%p_disp = p_disp
+        if (.not. allocated(state%position)) then
+            allocate(state%position(3, scene%network%n_nodes()))
+            allocate(state%tension(n_elements), state%stretch(n_elements))
+        end if
+        state%length0 = length0
+        call scene%dofs%expand(u(1:scene%dofs%n_unknowns), p_disp, state%position)
+        allocate(internal(3 * scene%network%n_nodes()))
+        call assemble_internal_force(scene, state%position, length0, internal, state%tension, &
+            state%stretch, error)
+        if (allocated(error)) return
+        internal = internal - p_force * scene%external_force
+        if (allocated(state%reaction)) deallocate(state%reaction)
+        allocate(state%reaction(3, size(scene%supports)), source=0.0_wp)
+        do s = 1, size(scene%supports)
+            do i = 1, size(scene%supports(s)%coordinates)
+                c = scene%supports(s)%coordinates(i)
+                k = mod(c - 1, 3) + 1
+                state%reaction(k, s) = state%reaction(k, s) + internal(c)
+            end do
+        end do
+    end subroutine fill_step_state
+
+end module yarnfort_solver_state
