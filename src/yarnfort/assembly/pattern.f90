@@ -8,7 +8,7 @@ module yarnfort_assembly_pattern
     implicit none
     private
 
-    public :: pattern_type, new_pattern
+    public :: pattern_type, new_pattern, build_clique_pattern
 
     !> CSC pattern with 0-based int64 indices (the layout of a SUNSparseMatrix).
     type :: pattern_type
@@ -32,16 +32,11 @@ contains
         type(pattern_type), intent(out) :: self
         type(network_type), intent(in) :: network
         type(dof_map_type), intent(in) :: dofs
-        integer :: n, n_elements, e, a, b, i, j, col, pos, first, last
-        integer, allocatable :: element_unknowns(:, :), count(:), start(:), members(:)
-        integer, allocatable :: stamp(:), rows(:)
-        integer :: n_rows, k
+        integer, allocatable :: element_unknowns(:, :)
+        integer :: e, a, k
 
-        n = dofs%n_unknowns
-        n_elements = network%n_elements()
-        self%n = n
-        allocate(element_unknowns(6, n_elements))
-        do e = 1, n_elements
+        allocate(element_unknowns(6, network%n_elements()))
+        do e = 1, network%n_elements()
             do a = 1, 2
                 do k = 1, 3
                     element_unknowns(3 * (a - 1) + k, e) = &
@@ -49,12 +44,31 @@ contains
                 end do
             end do
         end do
+        call build_clique_pattern(dofs%n_unknowns, element_unknowns, self%col_ptr, &
+            self%row_index, self%element_slot)
+        self%n = dofs%n_unknowns
+        self%nnz = size(self%row_index)
+    end subroutine new_pattern
 
-        ! Elements touching each unknown (compressed lists).
+    !> CSC pattern (0-based, rows ascending) of n unknowns where the unknowns of each
+    !> clique (a column of `cliques`, entries 0 ignored) are all coupled; and the value
+    !> slot (1-based, 0 where an entry is 0) of every pair (a, b) of each clique.
+    subroutine build_clique_pattern(n, cliques, col_ptr, row_index, slots)
+        integer, intent(in) :: n, cliques(:, :)
+        integer(ik), allocatable, intent(out) :: col_ptr(:), row_index(:)
+        integer, allocatable, intent(out) :: slots(:, :, :)
+        integer :: n_cliques, width, c, a, b, i, j, col, pos, first, last, n_rows
+        integer, allocatable :: count(:), start(:), members(:), stamp(:), rows(:)
+        integer(ik), allocatable :: all_rows(:)
+        integer :: capacity, used
+
+        width = size(cliques, 1)
+        n_cliques = size(cliques, 2)
+        ! Cliques touching each unknown (compressed lists).
         allocate(count(n), source=0)
-        do e = 1, n_elements
-            do a = 1, 6
-                i = element_unknowns(a, e)
+        do c = 1, n_cliques
+            do a = 1, width
+                i = cliques(a, c)
                 if (i > 0) count(i) = count(i) + 1
             end do
         end do
@@ -65,69 +79,64 @@ contains
         end do
         allocate(members(start(n + 1) - 1))
         count = 0
-        do e = 1, n_elements
-            do a = 1, 6
-                i = element_unknowns(a, e)
+        do c = 1, n_cliques
+            do a = 1, width
+                i = cliques(a, c)
                 if (i > 0) then
-                    members(start(i) + count(i)) = e
+                    members(start(i) + count(i)) = c
                     count(i) = count(i) + 1
                 end if
             end do
         end do
 
-        ! Rows of each column: the unknowns of the elements touching it, deduplicated
+        ! Rows of each column: the unknowns of the cliques touching it, deduplicated
         ! with a stamp and sorted (short lists: insertion sort).
-        allocate(self%col_ptr(n + 1))
+        allocate(col_ptr(n + 1))
         allocate(stamp(n), source=0)
         allocate(rows(64))
-        self%col_ptr(1) = 0
-        allocate(self%row_index(0))
-        block
-            integer(ik), allocatable :: all_rows(:)
-            integer :: capacity, used
-            capacity = 27 * n + 16
-            allocate(all_rows(capacity))
-            used = 0
-            do col = 1, n
-                n_rows = 0
-                do pos = start(col), start(col + 1) - 1
-                    e = members(pos)
-                    do a = 1, 6
-                        i = element_unknowns(a, e)
-                        if (i > 0 .and. stamp(i) /= col) then
+        col_ptr(1) = 0
+        capacity = 9 * width * n + 16
+        allocate(all_rows(capacity))
+        used = 0
+        do col = 1, n
+            n_rows = 0
+            do pos = start(col), start(col + 1) - 1
+                c = members(pos)
+                do a = 1, width
+                    i = cliques(a, c)
+                    if (i > 0) then
+                        if (stamp(i) /= col) then
                             stamp(i) = col
                             n_rows = n_rows + 1
                             if (n_rows > size(rows)) call grow(rows)
                             rows(n_rows) = i
                         end if
-                    end do
+                    end if
                 end do
-                call insertion_sort(rows(1:n_rows))
-                if (used + n_rows > capacity) then
-                    capacity = max(2 * capacity, used + n_rows)
-                    call grow_ik(all_rows, capacity)
-                end if
-                all_rows(used + 1:used + n_rows) = int(rows(1:n_rows) - 1, ik)
-                used = used + n_rows
-                self%col_ptr(col + 1) = used
             end do
-            self%row_index = all_rows(1:used)
-            self%nnz = used
-        end block
+            call insertion_sort(rows(1:n_rows))
+            if (used + n_rows > capacity) then
+                capacity = max(2 * capacity, used + n_rows)
+                call grow_ik(all_rows, capacity)
+            end if
+            all_rows(used + 1:used + n_rows) = int(rows(1:n_rows) - 1, ik)
+            used = used + n_rows
+            col_ptr(col + 1) = used
+        end do
+        row_index = all_rows(1:used)
 
-        ! Slot of each element entry: search the row in its column.
-        allocate(self%element_slot(6, 6, n_elements), source=0)
-        do e = 1, n_elements
-            do b = 1, 6
-                j = element_unknowns(b, e)
+        ! Slot of each clique entry: search the row in its column.
+        allocate(slots(width, width, n_cliques), source=0)
+        do c = 1, n_cliques
+            do b = 1, width
+                j = cliques(b, c)
                 if (j == 0) cycle
-                first = int(self%col_ptr(j)) + 1
-                last = int(self%col_ptr(j + 1))
-                do a = 1, 6
-                    i = element_unknowns(a, e)
+                first = int(col_ptr(j)) + 1
+                last = int(col_ptr(j + 1))
+                do a = 1, width
+                    i = cliques(a, c)
                     if (i == 0) cycle
-                    self%element_slot(a, b, e) = find_row(self%row_index(first:last), i - 1) &
-                        + first - 1
+                    slots(a, b, c) = find_row(row_index(first:last), i - 1) + first - 1
                 end do
             end do
         end do
@@ -148,7 +157,7 @@ contains
             tmp(1:size(array)) = array
             call move_alloc(tmp, array)
         end subroutine grow_ik
-    end subroutine new_pattern
+    end subroutine build_clique_pattern
 
     pure subroutine insertion_sort(values)
         integer, intent(inout) :: values(:)

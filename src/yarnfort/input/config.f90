@@ -10,6 +10,7 @@ module yarnfort_input_config
     public :: config_type, control_config_type, solver_config_type, material_config_type
     public :: yarn_config_type, support_config_type, load_config_type, path_config_type
     public :: output_config_type, geometry_config_type, name_length, path_length
+    public :: contact_config_type
 
     integer, parameter :: name_length = 64
     integer, parameter :: path_length = 512
@@ -48,6 +49,18 @@ module yarnfort_input_config
         integer :: easy_iterations = 4
         !> Give up after this many consecutive step cuts.
         integer :: max_step_cuts = 30
+        !> Friction: 'monolithic' (positions and sliding solved together with a
+        !> stick/slip active set) or 'staggered' (the paper's two-step scheme).
+        character(len=16) :: scheme = 'monolithic'
+        !> Friction: most stick/slip active-set updates (monolithic) or elastic/sliding
+        !> alternations (staggered) per load step.
+        integer :: max_friction_iterations = 50
+        !> Friction: sliding never makes an element's reference length shorter than this
+        !> fraction of its initial length (the passage then locks in that direction).
+        real(wp) :: min_length_ratio = 1.0e-3_wp
+        !> Friction: relative slack in the stick test T_max <= T_crit (1 + tol) and
+        !> the staggered scheme's convergence test on the friction conditions.
+        real(wp) :: friction_tolerance = 1.0e-9_wp
     end type solver_config_type
 
     !> &material: one yarn type and its force law (one group per yarn type).
@@ -117,6 +130,24 @@ module yarnfort_input_config
     end type output_config_type
 
     !> The whole input.
+    !> &contact: the friction law where yarns of two types cross (one group per pair;
+    !> the pair is unordered and a type may pair with itself). Without any &contact
+    !> group every contact node is a plain shared node (no sliding).
+    type :: contact_config_type
+        !> The two yarn types (material names).
+        character(len=name_length) :: materials(2) = ''
+        !> 'bonded' (never slides), 'coulomb', 'adhesion' or 'decaying_adhesion'.
+        character(len=32) :: law = ''
+        !> Friction coefficient mu (1), for every law but 'bonded'.
+        real(wp) :: friction_coefficient = -1.0_wp
+        !> Adhesion beta (N), for 'adhesion' and 'decaying_adhesion'.
+        real(wp) :: adhesion = -1.0_wp
+        !> Decaying adhesion: tension w_d (N) where the adhesion starts to decay and s_d
+        !> (N) where it has vanished, 0 <= w_d < s_d.
+        real(wp) :: decay_start = -1.0_wp
+        real(wp) :: decay_end = -1.0_wp
+    end type contact_config_type
+
     type :: config_type
         type(control_config_type) :: control
         type(solver_config_type) :: solver
@@ -129,6 +160,7 @@ module yarnfort_input_config
         type(yarn_config_type), allocatable :: yarns(:)
         type(support_config_type), allocatable :: supports(:)
         type(load_config_type), allocatable :: loads(:)
+        type(contact_config_type), allocatable :: contacts(:)
         type(path_config_type) :: path
         type(output_config_type) :: output
         !> Not a namelist variable: the folder of the input file, against which relative

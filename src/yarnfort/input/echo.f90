@@ -28,7 +28,7 @@ contains
 
         call put('! yarnfort effective input: every namelist variable with its value, ' &
             // 'defaults included')
-        call put('! (-1 marks a material parameter that is not set).')
+        call put('! (-1 marks a material or contact parameter that is not set).')
         if (len_trim(config%input_folder) > 0) then
             call put('! Relative file names were resolved against the folder ' &
                 // quote_string(config%input_folder) // '.')
@@ -55,6 +55,11 @@ contains
             call put(indent // 'step_cut = ' // format_real(solver%step_cut))
             call put(indent // 'easy_iterations = ' // format_integer(solver%easy_iterations))
             call put(indent // 'max_step_cuts = ' // format_integer(solver%max_step_cuts))
+            call put(indent // 'scheme = ' // quote_string(solver%scheme))
+            call put(indent // 'max_friction_iterations = ' &
+                // format_integer(solver%max_friction_iterations))
+            call put(indent // 'min_length_ratio = ' // format_real(solver%min_length_ratio))
+            call put(indent // 'friction_tolerance = ' // format_real(solver%friction_tolerance))
             call put('/')
         end associate
 
@@ -68,6 +73,23 @@ contains
                     call put(indent // 'modulus = ' // format_real(material%modulus))
                     call put(indent // 'area = ' // format_real(material%area))
                     call put(indent // 'table_file = ' // quote_string(material%table_file))
+                    call put('/')
+                end associate
+            end do
+        end if
+
+        if (allocated(config%contacts)) then
+            do k = 1, size(config%contacts)
+                associate(contact => config%contacts(k))
+                    call put('&contact')
+                    call put(indent // 'materials = ' // quote_string(contact%materials(1)) &
+                        // ', ' // quote_string(contact%materials(2)))
+                    call put(indent // 'law = ' // quote_string(contact%law))
+                    call put(indent // 'friction_coefficient = ' &
+                        // format_real(contact%friction_coefficient))
+                    call put(indent // 'adhesion = ' // format_real(contact%adhesion))
+                    call put(indent // 'decay_start = ' // format_real(contact%decay_start))
+                    call put(indent // 'decay_end = ' // format_real(contact%decay_end))
                     call put('/')
                 end associate
             end do

@@ -2,8 +2,8 @@
 !> Reading the namelist input into a `config_type`. Groups may come in any order; each
 !> is read by its own `read_<group>` with a local namelist whose variables start from
 !> the defaults of the config types. Singletons (&control, &solver, &nodes, &geometry,
-!> &path, &output) may appear at most once; &material, &yarn, &support and &load once
-!> per item. A structural scan of the text first rejects unknown group names, text
+!> &path, &output) may appear at most once; &material, &contact, &yarn, &support and
+!> &load once per item. A structural scan of the text first rejects unknown group names, text
 !> outside groups, unclosed groups and variables set twice (see yarnfort_input_scan);
 !> the namelist reads then run on a scratch copy of the text without its comments.
 !> Lists are read into buffers of `max_list` (+1 guard) entries prefilled with a marker:
@@ -18,7 +18,7 @@ module yarnfort_input_namelist
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, control_config_type, solver_config_type, &
         material_config_type, yarn_config_type, support_config_type, load_config_type, &
-        output_config_type, geometry_config_type, path_length
+        output_config_type, geometry_config_type, contact_config_type, path_length
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist, explain_read_error
     use yarnfort_input_geometry, only: read_geometry_file
     use yarnfort_input_text, only: read_line, to_lower, format_integer, folder_of, &
@@ -37,8 +37,8 @@ module yarnfort_input_namelist
 
     !> All group names, in the order they are read and echoed.
     character(len=*), parameter :: group_names(*) = [character(len=8) :: 'control', &
-        'solver', 'material', 'nodes', 'geometry', 'yarn', 'support', 'load', 'path', &
-        'output']
+        'solver', 'material', 'contact', 'nodes', 'geometry', 'yarn', 'support', 'load', &
+        'path', 'output']
     !> Groups that may appear at most once.
     character(len=*), parameter :: singleton_names(*) = [character(len=8) :: 'control', &
         'solver', 'nodes', 'geometry', 'path', 'output']
@@ -129,6 +129,8 @@ contains
         call read_solver(unit, scan, config, error)
         if (allocated(error)) return
         call read_material(unit, scan, config, error)
+        if (allocated(error)) return
+        call read_contact(unit, scan, config, error)
         if (allocated(error)) return
         call read_nodes(unit, scan, config, error)
         if (allocated(error)) return
@@ -233,21 +235,23 @@ contains
         cfg%control%check_only = check_only
     end subroutine read_control
 
-    !> &solver: linear solver, Newton and continuation settings.
+    !> &solver: linear solver, Newton, continuation and friction settings.
     subroutine read_solver(unit, scan, cfg, error)
         integer, intent(in) :: unit
         type(namelist_scan_type), intent(in) :: scan
         type(config_type), intent(inout) :: cfg
         type(error_type), allocatable, intent(out) :: error
         type(solver_config_type) :: defaults
-        character(len=buffer_length) :: linear_solver
+        character(len=buffer_length) :: linear_solver, scheme
         real(wp) :: residual_tolerance, step_tolerance, slack_stiffness, initial_step, &
-            min_step, max_step, step_growth, step_cut
-        integer :: max_iterations, max_setup_calls, easy_iterations, max_step_cuts
+            min_step, max_step, step_growth, step_cut, min_length_ratio, friction_tolerance
+        integer :: max_iterations, max_setup_calls, easy_iterations, max_step_cuts, &
+            max_friction_iterations
         logical :: line_search
         namelist /solver/ linear_solver, residual_tolerance, step_tolerance, max_iterations, &
             max_setup_calls, line_search, slack_stiffness, initial_step, min_step, max_step, &
-            step_growth, step_cut, easy_iterations, max_step_cuts
+            step_growth, step_cut, easy_iterations, max_step_cuts, scheme, &
+            max_friction_iterations, min_length_ratio, friction_tolerance
         character(len=message_length) :: message
         integer :: stat
 
@@ -266,6 +270,10 @@ contains
         step_cut = defaults%step_cut
         easy_iterations = defaults%easy_iterations
         max_step_cuts = defaults%max_step_cuts
+        scheme = defaults%scheme
+        max_friction_iterations = defaults%max_friction_iterations
+        min_length_ratio = defaults%min_length_ratio
+        friction_tolerance = defaults%friction_tolerance
         rewind(unit)
         message = ''
         read(unit, nml=solver, iostat=stat, iomsg=message)
@@ -274,11 +282,15 @@ contains
                 [character(len=24) :: 'linear_solver', 'residual_tolerance', &
                 'step_tolerance', 'max_iterations', 'max_setup_calls', 'line_search', &
                 'slack_stiffness', 'initial_step', 'min_step', 'max_step', 'step_growth', &
-                'step_cut', 'easy_iterations', 'max_step_cuts'])
+                'step_cut', 'easy_iterations', 'max_step_cuts', 'scheme', &
+                'max_friction_iterations', 'min_length_ratio', 'friction_tolerance'])
             return
         end if
         call check_length(error, scan, 'solver', 0, 'linear_solver', linear_solver, &
             len(cfg%solver%linear_solver))
+        if (allocated(error)) return
+        call check_length(error, scan, 'solver', 0, 'scheme', adjustl(scheme), &
+            len(cfg%solver%scheme))
         if (allocated(error)) return
         linear_solver = to_lower(adjustl(linear_solver))
         cfg%solver%linear_solver = linear_solver(:len(cfg%solver%linear_solver))
@@ -295,6 +307,11 @@ contains
         cfg%solver%step_cut = step_cut
         cfg%solver%easy_iterations = easy_iterations
         cfg%solver%max_step_cuts = max_step_cuts
+        scheme = to_lower(adjustl(scheme))
+        cfg%solver%scheme = scheme(:len(cfg%solver%scheme))
+        cfg%solver%max_friction_iterations = max_friction_iterations
+        cfg%solver%min_length_ratio = min_length_ratio
+        cfg%solver%friction_tolerance = friction_tolerance
     end subroutine read_solver
 
     !> &material, once per yarn type.
@@ -359,6 +376,72 @@ contains
             call read_failed(error, scan, 'material', k + 1, stat, message, [character :: ])
         end if
     end subroutine read_material
+
+    !> &contact, once per pair of yarn types that touch.
+    subroutine read_contact(unit, scan, cfg, error)
+        integer, intent(in) :: unit
+        type(namelist_scan_type), intent(in) :: scan
+        type(config_type), intent(inout) :: cfg
+        type(error_type), allocatable, intent(out) :: error
+        type(contact_config_type) :: defaults
+        character(len=buffer_length) :: materials(2), law
+        real(wp) :: friction_coefficient, adhesion, decay_start, decay_end
+        namelist /contact/ materials, law, friction_coefficient, adhesion, decay_start, &
+            decay_end
+        character(len=message_length) :: message
+        integer :: stat, k, i, n_expected
+
+        n_expected = scan%count_group('contact')
+        allocate(cfg%contacts(n_expected))
+        rewind(unit)
+        k = 0
+        do
+            materials = defaults%materials
+            law = defaults%law
+            friction_coefficient = defaults%friction_coefficient
+            adhesion = defaults%adhesion
+            decay_start = defaults%decay_start
+            decay_end = defaults%decay_end
+            message = ''
+            read(unit, nml=contact, iostat=stat, iomsg=message)
+            if (is_iostat_end(stat)) exit
+            k = k + 1
+            if (k > n_expected) then
+                call too_many_found(error, 'contact', n_expected)
+                return
+            end if
+            if (stat /= 0) then
+                call read_failed(error, scan, 'contact', k, stat, message, &
+                    [character(len=24) :: 'materials', 'law', 'friction_coefficient', &
+                    'adhesion', 'decay_start', 'decay_end'])
+                return
+            end if
+            associate(contact => cfg%contacts(k))
+                do i = 1, size(materials)
+                    call check_length(error, scan, 'contact', k, 'materials(' &
+                        // format_integer(i) // ')', adjustl(materials(i)), &
+                        len(contact%materials(i)))
+                    if (allocated(error)) return
+                end do
+                call check_length(error, scan, 'contact', k, 'law', adjustl(law), &
+                    len(contact%law))
+                if (allocated(error)) return
+                do i = 1, size(materials)
+                    materials(i) = adjustl(materials(i))
+                    contact%materials(i) = materials(i)(:len(contact%materials(i)))
+                end do
+                law = to_lower(adjustl(law))
+                contact%law = law(:len(contact%law))
+                contact%friction_coefficient = friction_coefficient
+                contact%adhesion = adhesion
+                contact%decay_start = decay_start
+                contact%decay_end = decay_end
+            end associate
+        end do
+        if (k < n_expected) then
+            call read_failed(error, scan, 'contact', k + 1, stat, message, [character :: ])
+        end if
+    end subroutine read_contact
 
     !> &nodes: xyz = x1, y1, z1, x2, ... (node ids 1..n in this order).
     subroutine read_nodes(unit, scan, cfg, error)

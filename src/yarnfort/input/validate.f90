@@ -1,18 +1,21 @@
 ! SPDX-License-Identifier: MIT
 !> Checks of a read `config_type` that need no network: known names, positive and finite
 !> parameters, node ids in range, no zero-length segments or elements, consistent
-!> supports, loads and load path. Each message names the group, the variable and the value.
+!> supports, loads and load path, known friction laws with their parameters and, when
+!> any &contact is given, one for every pair of yarn types that meet. Each message names
+!> the group, the variable and the value.
 module yarnfort_input_validate
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, solver_config_type, output_config_type, &
-        material_config_type, path_config_type, name_length
+        material_config_type, path_config_type, contact_config_type, name_length
     use yarnfort_input_text, only: format_integer, format_real, join_names, closest_name
     implicit none
     private
 
     public :: check_config, coincidence_tolerance, known_laws, known_linear_solvers
+    public :: known_contact_laws, known_schemes
 
     !> A segment between consecutive yarn nodes is of zero length when it is not longer
     !> than this times the diagonal of the box around all nodes.
@@ -23,6 +26,12 @@ module yarnfort_input_validate
     !> Values of &solver linear_solver.
     character(len=*), parameter :: known_linear_solvers(*) = [character(len=7) :: 'auto', &
         'umfpack', 'klu', 'cholmod', 'dense']
+    !> Values of &contact law.
+    character(len=*), parameter :: known_contact_laws(*) = [character(len=17) :: 'bonded', &
+        'coulomb', 'adhesion', 'decaying_adhesion']
+    !> Values of &solver scheme.
+    character(len=*), parameter :: known_schemes(*) = [character(len=10) :: 'monolithic', &
+        'staggered']
     character(len=1), parameter :: axis(3) = ['x', 'y', 'z']
     !> Characters of material and support names.
     character(len=*), parameter :: name_characters = &
@@ -45,6 +54,8 @@ contains
         call check_nodes(config, error)
         if (allocated(error)) return
         call check_yarns(config, error)
+        if (allocated(error)) return
+        call check_contacts(config, error)
         if (allocated(error)) return
         call check_supports(config, owner, error)
         if (allocated(error)) return
@@ -119,6 +130,25 @@ contains
                 // ' must be >= 1')
             return
         end if
+        if (.not. any(known_schemes == solver%scheme)) then
+            call fatal_error(error, "&solver: scheme = '" // trim(solver%scheme) &
+                // "' is unknown (use " // join_names(known_schemes, '') // ')' &
+                // suggestion(solver%scheme, known_schemes))
+            return
+        end if
+        call require_at_least(error, '&solver', 'max_friction_iterations', &
+            solver%max_friction_iterations, 1)
+        if (allocated(error)) return
+        if (.not. ieee_is_finite(solver%min_length_ratio)) then
+            call not_finite(error, '&solver', 'min_length_ratio', solver%min_length_ratio)
+            return
+        end if
+        if (solver%min_length_ratio <= 0.0_wp .or. solver%min_length_ratio >= 1.0_wp) then
+            call fatal_error(error, '&solver: min_length_ratio = ' &
+                // format_real(solver%min_length_ratio) // ' must lie strictly between 0 and 1')
+            return
+        end if
+        call require_positive(error, '&solver', 'friction_tolerance', solver%friction_tolerance)
     end subroutine check_solver
 
     subroutine check_output(output, error)
@@ -213,6 +243,198 @@ contains
             end associate
         end do
     end subroutine check_materials
+
+    !> Contacts: two defined materials, one group per unordered pair, a known friction law
+    !> with exactly its parameters; and, when any &contact is given, one for every pair
+    !> of yarn types that meet at a node.
+    subroutine check_contacts(config, error)
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        character(len=name_length), allocatable :: material_names(:)
+        !> `pair(a, b)`: the &contact of materials a and b (symmetric), or 0.
+        integer, allocatable :: pair(:, :)
+        integer :: c, i, a, b
+        character(len=:), allocatable :: label
+
+        if (.not. allocated(config%contacts)) return
+        if (size(config%contacts) == 0) return
+        material_names = config%materials%name
+        allocate(pair(size(material_names), size(material_names)), source=0)
+        do c = 1, size(config%contacts)
+            associate(contact => config%contacts(c))
+                label = '&contact #' // format_integer(c)
+                do i = 1, 2
+                    call check_contact_material(error, label, i, contact%materials(i), &
+                        material_names)
+                    if (allocated(error)) return
+                end do
+                a = findloc(material_names, contact%materials(1), dim=1)
+                b = findloc(material_names, contact%materials(2), dim=1)
+                label = label // ' (' // pair_text(contact) // ')'
+                if (pair(a, b) /= 0) then
+                    call fatal_error(error, '&contact #' // format_integer(c) &
+                        // ': materials = ' // pair_text(contact) // ' is the same pair as ' &
+                        // '&contact #' // format_integer(pair(a, b)) // ' (materials = ' &
+                        // pair_text(config%contacts(pair(a, b))) // '; the order does not ' &
+                        // 'matter): give one &contact per pair of yarn types')
+                    return
+                end if
+                pair(a, b) = c
+                pair(b, a) = c
+                call check_contact_law(error, label, contact)
+                if (allocated(error)) return
+            end associate
+        end do
+        call check_contacts_complete(config, pair, error)
+    end subroutine check_contacts
+
+    !> 'a', 'b' of a contact, as in its materials variable.
+    pure function pair_text(contact) result(text)
+        type(contact_config_type), intent(in) :: contact
+        character(len=:), allocatable :: text
+
+        text = quoted_list(contact%materials)
+    end function pair_text
+
+    !> materials(i) of a &contact: set, and the name of a &material.
+    subroutine check_contact_material(error, label, i, name, material_names)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, name
+        integer, intent(in) :: i
+        character(len=*), intent(in) :: material_names(:)
+        character(len=:), allocatable :: variable
+
+        variable = 'materials(' // format_integer(i) // ')'
+        if (len_trim(name) == 0) then
+            call fatal_error(error, label // ': ' // variable // ' is not set (give the ' &
+                // "two yarn types, e.g. materials = '" // trim(material_names(1)) // "', '" &
+                // trim(material_names(size(material_names))) // "')")
+            return
+        end if
+        if (.not. any(material_names == name)) then
+            call fatal_error(error, label // ': ' // variable // " = '" // trim(name) &
+                // "' is not defined by any &material (defined: " &
+                // quoted_list(material_names) // ')' // suggestion(name, material_names))
+        end if
+    end subroutine check_contact_material
+
+    !> A known friction law with its own parameters only: all of them finite and >= 0,
+    !> and decay_start < decay_end.
+    subroutine check_contact_law(error, label, contact)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label
+        type(contact_config_type), intent(in) :: contact
+        type(contact_config_type) :: unset
+        character(len=*), parameter :: variables(4) = [character(len=20) :: &
+            'friction_coefficient', 'adhesion', 'decay_start', 'decay_end']
+        logical :: needed(4)
+        real(wp) :: values(4), unset_values(4)
+        integer :: i
+
+        select case (trim(contact%law))
+        case ('')
+            call fatal_error(error, label // ': law is not set (use ' &
+                // join_names(known_contact_laws, '') // ')')
+            return
+        case ('bonded')
+            needed = [.false., .false., .false., .false.]
+        case ('coulomb')
+            needed = [.true., .false., .false., .false.]
+        case ('adhesion')
+            needed = [.true., .true., .false., .false.]
+        case ('decaying_adhesion')
+            needed = [.true., .true., .true., .true.]
+        case default
+            call fatal_error(error, label // ": law = '" // trim(contact%law) &
+                // "' is unknown (use " // join_names(known_contact_laws, '') // ')' &
+                // suggestion(contact%law, known_contact_laws))
+            return
+        end select
+        values = [contact%friction_coefficient, contact%adhesion, contact%decay_start, &
+            contact%decay_end]
+        unset_values = [unset%friction_coefficient, unset%adhesion, unset%decay_start, &
+            unset%decay_end]
+        do i = 1, size(variables)
+            if (needed(i)) then
+                call require_nonnegative_parameter(error, label, trim(variables(i)), &
+                    values(i), unset_values(i), trim(contact%law))
+            else
+                call forbid_parameter(error, label, trim(variables(i)), values(i), &
+                    unset_values(i), trim(contact%law))
+            end if
+            if (allocated(error)) return
+        end do
+        if (needed(3) .and. needed(4)) then
+            if (.not. (contact%decay_start < contact%decay_end)) then
+                call fatal_error(error, label // ': decay_start = ' &
+                    // format_real(contact%decay_start) // ' must be less than decay_end = ' &
+                    // format_real(contact%decay_end) // ' (the adhesion decays from ' &
+                    // 'tension decay_start to decay_end)')
+                return
+            end if
+        end if
+    end subroutine check_contact_law
+
+    !> With any &contact, every pair of yarn types meeting at a node needs one. A node
+    !> meets when two different yarns list it (yarns of two types, or two of one type).
+    subroutine check_contacts_complete(config, pair, error)
+        type(config_type), intent(in) :: config
+        integer, intent(in) :: pair(:, :)
+        type(error_type), allocatable, intent(out) :: error
+        integer, allocatable :: material_of(:), first(:), yarns_at(:), last_yarn(:), filled(:)
+        integer :: n_nodes, y, i, node, j, k, a, b
+
+        n_nodes = size(config%node_positions, 2)
+        allocate(material_of(size(config%yarns)))
+        do y = 1, size(config%yarns)
+            material_of(y) = findloc(config%materials%name, config%yarns(y)%material, dim=1)
+        end do
+        ! Yarns through each node, each once (a yarn may list a node twice): the yarns
+        ! at node n are yarns_at(first(n):first(n + 1) - 1).
+        allocate(first(n_nodes + 1), source=0)
+        allocate(last_yarn(n_nodes), source=0)
+        do y = 1, size(config%yarns)
+            do i = 1, size(config%yarns(y)%nodes)
+                node = config%yarns(y)%nodes(i)
+                if (last_yarn(node) == y) cycle
+                last_yarn(node) = y
+                first(node + 1) = first(node + 1) + 1
+            end do
+        end do
+        first(1) = 1
+        do node = 1, n_nodes
+            first(node + 1) = first(node + 1) + first(node)
+        end do
+        allocate(yarns_at(first(n_nodes + 1) - 1))
+        allocate(filled(n_nodes), source=0)
+        last_yarn = 0
+        do y = 1, size(config%yarns)
+            do i = 1, size(config%yarns(y)%nodes)
+                node = config%yarns(y)%nodes(i)
+                if (last_yarn(node) == y) cycle
+                last_yarn(node) = y
+                yarns_at(first(node) + filled(node)) = y
+                filled(node) = filled(node) + 1
+            end do
+        end do
+        do node = 1, n_nodes
+            do j = first(node), first(node + 1) - 1
+                do k = j + 1, first(node + 1) - 1
+                    a = material_of(yarns_at(j))
+                    b = material_of(yarns_at(k))
+                    if (pair(a, b) /= 0) cycle
+                    call fatal_error(error, "no &contact for yarn types '" &
+                        // trim(config%materials(a)%name) // "' and '" &
+                        // trim(config%materials(b)%name) // "' (they meet at node " &
+                        // format_integer(node) // '); ' // yarn_label(config, yarns_at(j)) &
+                        // ' and ' // yarn_label(config, yarns_at(k)) // ' share it, and ' &
+                        // 'with any &contact group every pair of yarn types that meet ' &
+                        // 'needs one')
+                    return
+                end do
+            end do
+        end do
+    end subroutine check_contacts_complete
 
     !> Names are single words (the geometry file and the curve CSV header use them).
     subroutine check_name(error, label, name)
@@ -620,6 +842,33 @@ contains
             end if
         end do
     end subroutine check_path
+
+    !> A law parameter that must be set, finite and >= 0.
+    subroutine require_nonnegative_parameter(error, label, variable, value, unset, law)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, variable, law
+        real(wp), intent(in) :: value, unset
+
+        if (value == unset) then
+            call fatal_error(error, label // ': ' // variable // " is not set (law '" // law &
+                // "' needs it)")
+        else if (.not. ieee_is_finite(value)) then
+            call not_finite(error, label, variable, value)
+        else if (value < 0.0_wp) then
+            call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
+                // ' must be >= 0')
+        end if
+    end subroutine require_nonnegative_parameter
+
+    !> "; did you mean 'x'?" for the known name closest to `name`, or ''.
+    function suggestion(name, names) result(text)
+        character(len=*), intent(in) :: name
+        character(len=*), intent(in) :: names(:)
+        character(len=:), allocatable :: text
+
+        text = closest_name(trim(name), names)
+        if (len(text) > 0) text = "; did you mean '" // text // "'?"
+    end function suggestion
 
     subroutine require_positive(error, label, variable, value)
         type(error_type), allocatable, intent(out) :: error

@@ -1,6 +1,7 @@
 ! SPDX-License-Identifier: MIT
 !> Unit tests of the namelist input: reading a valid scene (values and defaults), groups
-!> in any order, the round trip read -> write_config -> read, the geometry file, and bad
+!> in any order, friction contacts, the round trip read -> write_config -> read, the
+!> geometry file, and bad
 !> inputs that must fail with a message naming what is wrong (tests/data/input/bad_*.nml).
 module test_input
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
@@ -33,6 +34,8 @@ contains
             new_unittest('any_order', test_any_order), &
             new_unittest('round_trip', test_round_trip), &
             new_unittest('round_trip_special_values', test_round_trip_special_values), &
+            new_unittest('valid_contact', test_valid_contact), &
+            new_unittest('contact_round_trip', test_contact_round_trip), &
             new_unittest('geometry_file', test_geometry_file), &
             new_unittest('geometry_round_trip', test_geometry_round_trip), &
             new_unittest('format_real', test_format_real), &
@@ -87,7 +90,19 @@ contains
             new_unittest('bad_geometry_keyword', test_bad_geometry_keyword), &
             new_unittest('bad_geometry_duplicate_node', test_bad_geometry_duplicate_node), &
             new_unittest('bad_geometry_dangling_node', test_bad_geometry_dangling_node), &
-            new_unittest('bad_geometry_missing_file', test_bad_geometry_missing_file) &
+            new_unittest('bad_geometry_missing_file', test_bad_geometry_missing_file), &
+            new_unittest('bad_contact_law', test_bad_contact_law), &
+            new_unittest('bad_contact_material', test_bad_contact_material), &
+            new_unittest('bad_contact_one_material', test_bad_contact_one_material), &
+            new_unittest('bad_contact_duplicate', test_bad_contact_duplicate), &
+            new_unittest('bad_contact_duplicate_reversed', test_bad_contact_duplicate_reversed), &
+            new_unittest('bad_contact_missing_friction', test_bad_contact_missing_friction), &
+            new_unittest('bad_contact_unused_adhesion', test_bad_contact_unused_adhesion), &
+            new_unittest('bad_contact_decay', test_bad_contact_decay), &
+            new_unittest('bad_contact_negative_friction', test_bad_contact_negative_friction), &
+            new_unittest('bad_contact_missing_pair', test_bad_contact_missing_pair), &
+            new_unittest('bad_scheme', test_bad_scheme), &
+            new_unittest('bad_min_length_ratio', test_bad_min_length_ratio) &
             ]
     end subroutine collect_input
 
@@ -221,6 +236,18 @@ contains
             .and. (config%solver%line_search .eqv. defaults%line_search), &
             'solver integer and logical defaults')
         if (allocated(error)) return
+        call check(error, config%solver%scheme == defaults%scheme &
+            .and. config%solver%max_friction_iterations == defaults%max_friction_iterations, &
+            'friction scheme and iteration defaults')
+        if (allocated(error)) return
+        call check_close(error, [config%solver%min_length_ratio, &
+            config%solver%friction_tolerance], [defaults%min_length_ratio, &
+            defaults%friction_tolerance], exact, 'friction solver defaults')
+        if (allocated(error)) return
+        call check(error, allocated(config%contacts), 'contacts allocated without &contact')
+        if (allocated(error)) return
+        call check(error, size(config%contacts) == 0, 'no contacts without &contact')
+        if (allocated(error)) return
         call check(error, config%geometry%file == '', 'no geometry file')
         if (allocated(error)) return
         call check_close(error, [config%materials(1)%modulus, config%materials(1)%area], &
@@ -285,6 +312,69 @@ contains
         config%path%p_disp = -config%path%time
         call round_trip(error, config)
     end subroutine test_round_trip_special_values
+
+    !> Two &contact groups (one with its pair in reversed order) and friction settings.
+    subroutine test_valid_contact(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(config_type) :: config
+        type(solver_config_type) :: defaults
+
+        call read_data('valid_contact.nml', config, error)
+        if (allocated(error)) return
+        call check_config(config, error)
+        if (allocated(error)) return
+        call check(error, config%solver%scheme == 'staggered', 'scheme (lower case)')
+        if (allocated(error)) return
+        call check(error, config%solver%max_friction_iterations == 20, &
+            'max_friction_iterations')
+        if (allocated(error)) return
+        call check_close(error, [config%solver%min_length_ratio, &
+            config%solver%friction_tolerance], [defaults%min_length_ratio, &
+            defaults%friction_tolerance], exact, 'friction solver defaults')
+        if (allocated(error)) return
+        call check(error, size(config%contacts) == 2, 'number of contacts')
+        if (allocated(error)) return
+        associate(contact => config%contacts(1))
+            call check(error, contact%materials(1) == 'wool' &
+                .and. contact%materials(2) == 'cotton', 'contact 1 materials')
+            if (allocated(error)) return
+            call check(error, contact%law == 'coulomb', 'contact 1 law (lower case)')
+            if (allocated(error)) return
+            call check_close(error, [contact%friction_coefficient, contact%adhesion, &
+                contact%decay_start, contact%decay_end], [0.3_wp, -1.0_wp, -1.0_wp, -1.0_wp], &
+                exact, 'contact 1 parameters (unset ones -1)')
+            if (allocated(error)) return
+        end associate
+        associate(contact => config%contacts(2))
+            call check(error, all(contact%materials == 'wool') &
+                .and. contact%law == 'decaying_adhesion', 'contact 2')
+            if (allocated(error)) return
+            call check_close(error, [contact%friction_coefficient, contact%adhesion, &
+                contact%decay_start, contact%decay_end], [0.2_wp, 0.05_wp, 1.0_wp, 2.5_wp], &
+                exact, 'contact 2 parameters')
+            if (allocated(error)) return
+        end associate
+        call check(error, size(config%yarns) == 3, 'number of yarns')
+    end subroutine test_valid_contact
+
+    !> Contacts and friction settings survive write_config -> read_config exactly.
+    subroutine test_contact_round_trip(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(config_type) :: config
+
+        call read_data('valid_contact.nml', config, error)
+        if (allocated(error)) return
+        call round_trip(error, config)
+        if (allocated(error)) return
+        config%contacts(1)%friction_coefficient = 0.1_wp + 0.2_wp
+        config%contacts(2)%adhesion = 1.0_wp / 3.0_wp
+        config%contacts(2)%decay_end = huge(1.0_wp)
+        config%contacts(2)%materials(2) = "it's"
+        config%solver%min_length_ratio = tiny(1.0_wp)
+        config%solver%friction_tolerance = 1.0_wp / 7.0_wp
+        config%solver%max_friction_iterations = 1
+        call round_trip(error, config)
+    end subroutine test_contact_round_trip
 
     subroutine test_geometry_file(error)
         type(error_type), allocatable, intent(out) :: error
@@ -418,14 +508,17 @@ contains
                 .or. a%max_setup_calls /= e%max_setup_calls &
                 .or. (a%line_search .neqv. e%line_search) &
                 .or. a%easy_iterations /= e%easy_iterations &
-                .or. a%max_step_cuts /= e%max_step_cuts) then
+                .or. a%max_step_cuts /= e%max_step_cuts .or. a%scheme /= e%scheme &
+                .or. a%max_friction_iterations /= e%max_friction_iterations) then
                 call fatal_error(error, '&solver differs (text, integer or logical)')
                 return
             end if
             call check_reals(error, [a%residual_tolerance, a%step_tolerance, &
                 a%slack_stiffness, a%initial_step, a%min_step, a%max_step, a%step_growth, &
-                a%step_cut], [e%residual_tolerance, e%step_tolerance, e%slack_stiffness, &
-                e%initial_step, e%min_step, e%max_step, e%step_growth, e%step_cut], '&solver')
+                a%step_cut, a%min_length_ratio, a%friction_tolerance], [e%residual_tolerance, &
+                e%step_tolerance, e%slack_stiffness, e%initial_step, e%min_step, e%max_step, &
+                e%step_growth, e%step_cut, e%min_length_ratio, e%friction_tolerance], &
+                '&solver')
             if (allocated(error)) return
         end associate
         if (size(actual%materials) /= size(expected%materials)) then
@@ -441,6 +534,23 @@ contains
                 end if
                 call check_reals(error, [a%stiffness, a%modulus, a%area], &
                     [e%stiffness, e%modulus, e%area], what)
+                if (allocated(error)) return
+            end associate
+        end do
+        if (size(actual%contacts) /= size(expected%contacts)) then
+            call fatal_error(error, 'number of contacts differs')
+            return
+        end if
+        do k = 1, size(expected%contacts)
+            associate(a => actual%contacts(k), e => expected%contacts(k))
+                what = '&contact #' // format_integer(k)
+                if (any(a%materials /= e%materials) .or. a%law /= e%law) then
+                    call fatal_error(error, what // ' differs (text)')
+                    return
+                end if
+                call check_reals(error, [a%friction_coefficient, a%adhesion, a%decay_start, &
+                    a%decay_end], [e%friction_coefficient, e%adhesion, e%decay_start, &
+                    e%decay_end], what)
                 if (allocated(error)) return
             end associate
         end do
@@ -899,5 +1009,103 @@ contains
             '&geometry: cannot open file', &
             'no_such_file.geo'])
     end subroutine test_bad_geometry_missing_file
+
+    subroutine test_bad_contact_law(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_law.nml', [character(len=78) :: &
+            '&contact #1 (''wool'', ''cotton''): law = ''colomb'' is unknown', &
+            '(use bonded, coulomb, adhesion, decaying_adhesion)', &
+            'did you mean ''coulomb''?'])
+    end subroutine test_bad_contact_law
+
+    subroutine test_bad_contact_material(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_material.nml', [character(len=64) :: &
+            '&contact #1: materials(2) = ''coton'' is not defined by any &material', &
+            '''cotton'', ''wool''', &
+            'did you mean ''cotton''?'])
+    end subroutine test_bad_contact_material
+
+    subroutine test_bad_contact_one_material(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_one_material.nml', [character(len=38) :: &
+            '&contact #1: materials(2) is not set'])
+    end subroutine test_bad_contact_one_material
+
+    subroutine test_bad_contact_duplicate(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_duplicate.nml', [character(len=64) :: &
+            '&contact #2: materials = ''wool'', ''cotton'' is the same pair as', &
+            '&contact #1 (materials = ''wool'', ''cotton''', &
+            'one &contact per pair'])
+    end subroutine test_bad_contact_duplicate
+
+    subroutine test_bad_contact_duplicate_reversed(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_duplicate_reversed.nml', &
+            [character(len=64) :: &
+            '&contact #2: materials = ''cotton'', ''wool'' is the same pair as', &
+            '&contact #1 (materials = ''wool'', ''cotton''', &
+            'the order does not matter'])
+    end subroutine test_bad_contact_duplicate_reversed
+
+    subroutine test_bad_contact_missing_friction(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_missing_friction.nml', [character(len=90) :: &
+            '&contact #1 (''wool'', ''cotton''): friction_coefficient is not set ' &
+            // '(law ''coulomb'' needs it)'])
+    end subroutine test_bad_contact_missing_friction
+
+    subroutine test_bad_contact_unused_adhesion(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_unused_adhesion.nml', [character(len=90) :: &
+            '&contact #1 (''wool'', ''cotton''): adhesion = 0.05 is not used by law ' &
+            // '''coulomb'' (remove it)'])
+    end subroutine test_bad_contact_unused_adhesion
+
+    subroutine test_bad_contact_decay(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_decay.nml', [character(len=90) :: &
+            '&contact #2 (''wool'', ''wool''): decay_start = 2.5 must be less than ' &
+            // 'decay_end = 2.5'])
+    end subroutine test_bad_contact_decay
+
+    subroutine test_bad_contact_negative_friction(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_negative_friction.nml', &
+            [character(len=90) :: &
+            '&contact #1 (''wool'', ''cotton''): friction_coefficient = -0.3 must be >= 0'])
+    end subroutine test_bad_contact_negative_friction
+
+    subroutine test_bad_contact_missing_pair(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_contact_missing_pair.nml', [character(len=80) :: &
+            'no &contact for yarn types ''cotton'' and ''wool'' (they meet at node 2)', &
+            '&yarn #1 and &yarn #2'])
+    end subroutine test_bad_contact_missing_pair
+
+    subroutine test_bad_scheme(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_scheme.nml', [character(len=72) :: &
+            '&solver: scheme = ''implicit'' is unknown (use monolithic, staggered)'])
+    end subroutine test_bad_scheme
+
+    subroutine test_bad_min_length_ratio(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_min_length_ratio.nml', [character(len=72) :: &
+            '&solver: min_length_ratio = 1.0 must lie strictly between 0 and 1'])
+    end subroutine test_bad_min_length_ratio
 
 end module test_input
