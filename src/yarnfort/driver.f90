@@ -7,6 +7,7 @@ module yarnfort_driver
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
     use yarnfort_solver_elastic_stepper, only: elastic_stepper_type, new_elastic_stepper
     use yarnfort_solver_continuation, only: step_observer_type, run_continuation
+    use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
     implicit none
     private
 
@@ -36,7 +37,15 @@ contains
         type(error_type), allocatable, intent(out) :: error
         class(linear_solver_type), allocatable :: linear
         type(elastic_stepper_type) :: stepper
+        type(friction_stepper_type) :: friction_stepper
 
+        ! Only a scene with sliding passages pays for the sliding machinery.
+        if (scene%passages%size() > 0) then
+            call new_friction_stepper(friction_stepper, scene, get_linear_solver_name(scene), error)
+            if (allocated(error)) return
+            call run_continuation(scene, friction_stepper, observer, error)
+            return
+        end if
         call new_linear_solver(linear, get_linear_solver_name(scene), error)
         if (allocated(error)) then
             call prefix_error(error, '&solver linear_solver')

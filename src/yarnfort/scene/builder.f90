@@ -9,6 +9,12 @@ module yarnfort_scene_builder
     use yarnfort_material_linear, only: linear_law_type, new_linear_law
     use yarnfort_material_neo_hookean, only: neo_hookean_law_type, new_neo_hookean_law
     use yarnfort_material_table, only: table_law_type, read_table_law
+    use yarnfort_input_config, only: contact_config_type
+    use yarnfort_friction_law, only: friction_law_type
+    use yarnfort_friction_coulomb, only: coulomb_law_type, new_coulomb_law
+    use yarnfort_friction_adhesion, only: adhesion_law_type, new_adhesion_law
+    use yarnfort_friction_decaying_adhesion, only: decaying_adhesion_law_type, &
+        new_decaying_adhesion_law
     implicit none
     private
 
@@ -42,6 +48,8 @@ contains
         call build_constraints(scene, config, error)
         if (allocated(error)) return
         call build_loads(scene, config)
+        call build_passages(scene, config, error)
+        if (allocated(error)) return
         scene%path%time = config%path%time
         scene%path%p_force = config%path%p_force
         scene%path%p_disp = config%path%p_disp
@@ -240,5 +248,132 @@ contains
             end do
         end do
     end subroutine build_loads
+
+    !> Friction laws from the &contact groups and the passages that use them: every
+    !> time a yarn passes (does not end) at a node that another yarn (or another pass of
+    !> the same yarn) also visits. Passages whose pair of yarn types is 'bonded' are
+    !> plain shared nodes and get no passage. The law of a passage is that of its yarn's
+    !> type paired with the type of the first other yarn at the node.
+    subroutine build_passages(scene, config, error)
+        type(scene_type), intent(inout) :: scene
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        integer :: c, y, e, node, n_nodes, n_passages, other, law, n_yarns, k
+        integer, allocatable :: visits(:), first_yarn(:), second_yarn(:), contact_of(:, :)
+        integer, allocatable :: yarn(:), at_node(:), before(:), after(:), laws(:)
+        character(len=200) :: buffer
+
+        n_yarns = size(config%yarns)
+        allocate(scene%friction(size(config%contacts)))
+        ! contact_of(type_a, type_b): index of the &contact group, 0 for none.
+        allocate(contact_of(size(config%materials), size(config%materials)), source=0)
+        do c = 1, size(config%contacts)
+            call new_friction_law(scene%friction(c)%law, config%contacts(c), error)
+            if (allocated(error)) then
+                write(buffer, '("&contact #", i0)') c
+                call prefix_error(error, trim(buffer))
+                return
+            end if
+            associate(a => find_material(config, config%contacts(c)%materials(1)), &
+                    b => find_material(config, config%contacts(c)%materials(2)))
+                contact_of(a, b) = c
+                contact_of(b, a) = c
+            end associate
+        end do
+        allocate(scene%passages%at_start(scene%network%n_elements()), source=0)
+        allocate(scene%passages%at_end(scene%network%n_elements()), source=0)
+        allocate(yarn(0), at_node(0), before(0), after(0), laws(0))
+        if (size(config%contacts) == 0) then
+            scene%passages%yarn = yarn
+            scene%passages%node = at_node
+            scene%passages%element_before = before
+            scene%passages%element_after = after
+            scene%passages%law = laws
+            return
+        end if
+
+        ! Yarns visiting each original node (the first two distinct visits suffice).
+        n_nodes = size(config%node_positions, 2)
+        allocate(visits(n_nodes), source=0)
+        allocate(first_yarn(n_nodes), source=0)
+        allocate(second_yarn(n_nodes), source=0)
+        do y = 1, n_yarns
+            do k = 1, size(config%yarns(y)%nodes)
+                node = config%yarns(y)%nodes(k)
+                visits(node) = visits(node) + 1
+                if (visits(node) == 1) then
+                    first_yarn(node) = y
+                else if (visits(node) == 2) then
+                    second_yarn(node) = y
+                end if
+            end do
+        end do
+        ! Passages: interior nodes of a yarn's list that are visited more than once.
+        n_passages = 0
+        do y = 1, n_yarns
+            do k = 2, size(config%yarns(y)%nodes) - 1
+                node = config%yarns(y)%nodes(k)
+                if (visits(node) < 2) cycle
+                other = first_yarn(node)
+                if (other == y) other = second_yarn(node)
+                c = contact_of(find_material(config, config%yarns(y)%material), &
+                    find_material(config, config%yarns(other)%material))
+                if (c == 0) cycle
+                if (trim(config%contacts(c)%law) == 'bonded') cycle
+                ! The elements before and after the node along the yarn.
+                e = scene%network%yarn_first_element(y) - 1 &
+                    + (k - 1) * config%yarns(y)%elements_per_segment
+                yarn = [yarn, y]
+                at_node = [at_node, node]
+                before = [before, e]
+                after = [after, e + 1]
+                laws = [laws, c]
+                n_passages = n_passages + 1
+                scene%passages%at_end(e) = n_passages
+                scene%passages%at_start(e + 1) = n_passages
+            end do
+        end do
+        scene%passages%yarn = yarn
+        scene%passages%node = at_node
+        scene%passages%element_before = before
+        scene%passages%element_after = after
+        scene%passages%law = laws
+    end subroutine build_passages
+
+    !> The friction law of a &contact group ('bonded' gets none: it never slides).
+    subroutine new_friction_law(law, contact, error)
+        class(friction_law_type), allocatable, intent(out) :: law
+        type(contact_config_type), intent(in) :: contact
+        type(error_type), allocatable, intent(out) :: error
+
+        select case (trim(contact%law))
+        case ('bonded')
+        case ('coulomb')
+            block
+                type(coulomb_law_type), allocatable :: coulomb
+                allocate(coulomb)
+                call new_coulomb_law(coulomb, contact%friction_coefficient, error)
+                call move_alloc(coulomb, law)
+            end block
+        case ('adhesion')
+            block
+                type(adhesion_law_type), allocatable :: adhesion
+                allocate(adhesion)
+                call new_adhesion_law(adhesion, contact%friction_coefficient, &
+                    contact%adhesion, error)
+                call move_alloc(adhesion, law)
+            end block
+        case ('decaying_adhesion')
+            block
+                type(decaying_adhesion_law_type), allocatable :: decaying
+                allocate(decaying)
+                call new_decaying_adhesion_law(decaying, contact%friction_coefficient, &
+                    contact%adhesion, contact%decay_start, contact%decay_end, error)
+                call move_alloc(decaying, law)
+            end block
+        case default
+            call fatal_error(error, "law '" // trim(contact%law) // "' is unknown")
+        end select
+    end subroutine new_friction_law
 
 end module yarnfort_scene_builder

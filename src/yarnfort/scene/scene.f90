@@ -5,6 +5,7 @@ module yarnfort_scene_scene
     use yarnfort_material_law, only: force_law_type
     use yarnfort_network_network, only: network_type
     use yarnfort_network_dof_map, only: dof_map_type
+    use yarnfort_contact_passages, only: passage_set_type, friction_holder_type
     use yarnfort_input_config, only: solver_config_type, output_config_type, name_length
     implicit none
     private
@@ -40,6 +41,9 @@ module yarnfort_scene_scene
         real(wp), allocatable :: external_force(:)
         type(support_set_type), allocatable :: supports(:)
         type(load_path_type) :: path
+        !> Sliding contact: passages and the friction laws they use (none: no sliding).
+        type(passage_set_type) :: passages
+        type(friction_holder_type), allocatable :: friction(:)
         type(solver_config_type) :: solver
         type(output_config_type) :: output
         !> Scales for the solver: a force (largest reference stiffness) and a length

@@ -1,0 +1,327 @@
+! SPDX-License-Identifier: MIT
+!> Equilibrium with sliding at contact nodes for a fixed stick/slip active set. The
+!> unknowns are the free coordinates and one flow s per passage (or the flows alone,
+!> with positions frozen, for the sliding step of the staggered scheme). Rows:
+!>   coordinates: P^T (internal force(x, L0(s)) - p_force * external force);
+!>   stick passage: k (s - s_target), k = force_scale / length_scale;
+!>   slip forward (T_after > T_before, s grows):    T_after - T_crit(T_before, alpha);
+!>   slip backward (T_before > T_after, s shrinks): T_before - T_crit(T_after, alpha).
+!> Tensions enter the friction conditions as max(T, 0) (a slack string pulls nothing).
+module yarnfort_contact_friction_problem
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_assembly_truss, only: get_truss_response, get_truss_tension
+    use yarnfort_assembly_pattern, only: build_clique_pattern
+    use yarnfort_assembly_assemble, only: assemble_internal_force
+    use yarnfort_contact_geometry, only: get_wrap_angle
+    use yarnfort_solver_problem, only: nonlinear_problem_type
+    implicit none
+    private
+
+    public :: friction_problem_type, new_friction_problem
+    public :: mode_stick, mode_forward, mode_backward
+
+    integer, parameter :: mode_stick = 0, mode_forward = 1, mode_backward = -1
+
+    !> Smallest sin(gamma) used in the derivative of the wrap angle (see get_wrap_angle).
+    real(wp), parameter :: min_sine = 1.0e-8_wp
+
+    type, extends(nonlinear_problem_type) :: friction_problem_type
+        type(scene_type), pointer :: scene => null()
+        !> Flows are the only unknowns; positions come from `u_frozen`.
+        logical :: positions_frozen = .false.
+        integer :: n_x = 0, n_p = 0
+        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
+        !> Active set: mode of each passage, and the flow a stick passage keeps.
+        integer, allocatable :: mode(:)
+        real(wp), allocatable :: flow_target(:)
+        !> Position unknowns used while positions are frozen.
+        real(wp), allocatable :: u_frozen(:)
+        real(wp) :: stick_scale = 1.0_wp
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        !> Cliques: element [6 coordinates, flow at start, flow at end]; passage
+        !> [coordinates of the node before, the node, the node after, own flow, flow at
+        !> the start of the element before, flow at the end of the element after].
+        integer, allocatable :: element_slot(:, :, :), passage_slot(:, :, :)
+        integer, allocatable :: element_clique(:, :), passage_clique(:, :)
+        !> Work arrays.
+        real(wp), allocatable :: x(:, :), length0(:), internal(:), tension(:), stretch(:)
+    contains
+        procedure :: get_size
+        procedure :: get_pattern
+        procedure :: evaluate_residual
+        procedure :: evaluate_jacobian
+        !> Split unknowns into position unknowns and flows; set the work arrays.
+        procedure :: update_state
+        !> Tensions (clipped at 0) on both sides and the wrap angle of passage p.
+        procedure :: get_passage_state
+    end type friction_problem_type
+
+contains
+
+    subroutine new_friction_problem(self, scene, positions_frozen)
+        type(friction_problem_type), intent(out) :: self
+        type(scene_type), target, intent(in) :: scene
+        logical, intent(in) :: positions_frozen
+        integer :: e, p, a, k, n_elements, node
+
+        self%scene => scene
+        self%positions_frozen = positions_frozen
+        self%n_x = scene%dofs%n_unknowns
+        self%n_p = scene%passages%size()
+        self%force_scale = scene%force_scale
+        self%length_scale = scene%length_scale
+        self%stick_scale = scene%force_scale / scene%length_scale
+        n_elements = scene%network%n_elements()
+        allocate(self%mode(self%n_p), source=mode_stick)
+        allocate(self%flow_target(self%n_p), source=0.0_wp)
+        allocate(self%u_frozen(self%n_x), source=0.0_wp)
+        allocate(self%x(3, scene%network%n_nodes()), self%length0(n_elements))
+        allocate(self%internal(3 * scene%network%n_nodes()))
+        allocate(self%tension(n_elements), self%stretch(n_elements))
+
+        allocate(self%element_clique(8, n_elements), source=0)
+        do e = 1, n_elements
+            do a = 1, 2
+                node = scene%network%element_nodes(a, e)
+                do k = 1, 3
+                    self%element_clique(3 * (a - 1) + k, e) = x_column(node, k)
+                end do
+            end do
+            self%element_clique(7, e) = s_column(scene%passages%at_start(e))
+            self%element_clique(8, e) = s_column(scene%passages%at_end(e))
+        end do
+        allocate(self%passage_clique(12, self%n_p), source=0)
+        do p = 1, self%n_p
+            associate(before => scene%passages%element_before(p), &
+                    after => scene%passages%element_after(p))
+                do k = 1, 3
+                    self%passage_clique(k, p) = x_column(scene%network%element_nodes(1, before), k)
+                    self%passage_clique(3 + k, p) = x_column(scene%passages%node(p), k)
+                    self%passage_clique(6 + k, p) = x_column(scene%network%element_nodes(2, after), k)
+                end do
+                self%passage_clique(10, p) = s_column(p)
+                self%passage_clique(11, p) = s_column(scene%passages%at_start(before))
+                self%passage_clique(12, p) = s_column(scene%passages%at_end(after))
+            end associate
+        end do
+        block
+            integer, allocatable :: cliques(:, :), slots(:, :, :)
+            allocate(cliques(12, n_elements + self%n_p), source=0)
+            cliques(1:8, 1:n_elements) = self%element_clique
+            cliques(:, n_elements + 1:) = self%passage_clique
+            call build_clique_pattern(self%get_size(), cliques, self%col_ptr, &
+                self%row_index, slots)
+            self%element_slot = slots(1:8, 1:8, 1:n_elements)
+            self%passage_slot = slots(:, :, n_elements + 1:)
+        end block
+    contains
+        integer function x_column(node, k)
+            integer, intent(in) :: node, k
+            x_column = 0
+            if (.not. positions_frozen) x_column = scene%dofs%unknown(3 * (node - 1) + k)
+        end function x_column
+
+        integer function s_column(passage)
+            integer, intent(in) :: passage
+            s_column = 0
+            if (passage == 0) return
+            s_column = passage
+            if (.not. positions_frozen) s_column = passage + scene%dofs%n_unknowns
+        end function s_column
+    end subroutine new_friction_problem
+
+    pure integer function get_size(self)
+        class(friction_problem_type), intent(in) :: self
+        get_size = self%n_p
+        if (.not. self%positions_frozen) get_size = self%n_x + self%n_p
+    end function get_size
+
+    subroutine get_pattern(self, col_ptr, row_index)
+        class(friction_problem_type), intent(in) :: self
+        integer(ik), allocatable, intent(out) :: col_ptr(:), row_index(:)
+        col_ptr = self%col_ptr
+        row_index = self%row_index
+    end subroutine get_pattern
+
+    !> Positions, reference lengths, internal forces and tensions for unknowns u.
+    subroutine update_state(self, u, error)
+        class(friction_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        type(error_type), allocatable, intent(out) :: error
+
+        associate(scene => self%scene)
+            if (self%positions_frozen) then
+                call scene%dofs%expand(self%u_frozen, self%p_disp, self%x)
+                call scene%passages%get_length0(scene%network%length0, u, self%length0)
+            else
+                call scene%dofs%expand(u(1:self%n_x), self%p_disp, self%x)
+                call scene%passages%get_length0(scene%network%length0, u(self%n_x + 1:), &
+                    self%length0)
+            end if
+            call assemble_internal_force(scene, self%x, self%length0, self%internal, &
+                self%tension, self%stretch, error)
+        end associate
+    end subroutine update_state
+
+    pure subroutine get_passage_state(self, p, tension_before, tension_after, angle, dangle)
+        class(friction_problem_type), intent(in) :: self
+        integer, intent(in) :: p
+        real(wp), intent(out) :: tension_before, tension_after, angle
+        real(wp), intent(out), optional :: dangle(3, 3)
+        real(wp) :: work(3, 3)
+
+        associate(net => self%scene%network, passages => self%scene%passages)
+            tension_before = max(self%tension(passages%element_before(p)), 0.0_wp)
+            tension_after = max(self%tension(passages%element_after(p)), 0.0_wp)
+            call get_wrap_angle(self%x(:, net%element_nodes(1, passages%element_before(p))), &
+                self%x(:, passages%node(p)), &
+                self%x(:, net%element_nodes(2, passages%element_after(p))), min_sine, &
+                angle, work)
+            if (present(dangle)) dangle = work
+        end associate
+    end subroutine get_passage_state
+
+    subroutine evaluate_residual(self, u, residual, error)
+        class(friction_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: residual(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: p, row
+        real(wp) :: t_before, t_after, angle, critical, dcrit_dt, dcrit_da, flow
+
+        call self%update_state(u, error)
+        if (allocated(error)) return
+        row = 0
+        if (.not. self%positions_frozen) then
+            call self%scene%dofs%gather(self%internal - self%p_force * self%scene%external_force, &
+                residual(1:self%n_x))
+            row = self%n_x
+        end if
+        do p = 1, self%n_p
+            flow = u(row + p)
+            select case (self%mode(p))
+            case (mode_stick)
+                residual(row + p) = self%stick_scale * (flow - self%flow_target(p))
+            case (mode_forward)
+                call self%get_passage_state(p, t_before, t_after, angle)
+                call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
+                    t_before, angle, critical, dcrit_dt, dcrit_da)
+                residual(row + p) = t_after - critical
+            case (mode_backward)
+                call self%get_passage_state(p, t_before, t_after, angle)
+                call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
+                    t_after, angle, critical, dcrit_dt, dcrit_da)
+                residual(row + p) = t_before - critical
+            end select
+        end do
+    end subroutine evaluate_residual
+
+    subroutine evaluate_jacobian(self, u, values, error)
+        class(friction_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: e, p, n1, n2, a, b, slot
+        real(wp) :: force(3), block(3, 3), tension, stretch, dtension, c(3), length
+        real(wp) :: dforce_dl0(3), sign_ab
+
+        call self%update_state(u, error)
+        if (allocated(error)) return
+        values = 0.0_wp
+        associate(scene => self%scene, net => self%scene%network)
+            if (.not. self%positions_frozen) then
+                do e = 1, net%n_elements()
+                    n1 = net%element_nodes(1, e)
+                    n2 = net%element_nodes(2, e)
+                    call get_truss_response(scene%laws(net%element_material(e))%law, &
+                        scene%solver%slack_stiffness, self%length0(e), self%x(:, n1), &
+                        self%x(:, n2), tension, stretch, force, block)
+                    do b = 1, 6
+                        do a = 1, 6
+                            slot = self%element_slot(a, b, e)
+                            if (slot == 0) cycle
+                            sign_ab = merge(1.0_wp, -1.0_wp, (a <= 3) .eqv. (b <= 3))
+                            values(slot) = values(slot) + sign_ab &
+                                * block(mod(a - 1, 3) + 1, mod(b - 1, 3) + 1)
+                        end do
+                    end do
+                    ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2.
+                    call get_truss_tension(scene%laws(net%element_material(e))%law, &
+                        scene%solver%slack_stiffness, stretch, tension, dtension)
+                    length = norm2(self%x(:, n2) - self%x(:, n1))
+                    c = (self%x(:, n2) - self%x(:, n1)) / length
+                    dforce_dl0 = -c * dtension * stretch / self%length0(e)
+                    do b = 7, 8
+                        do a = 1, 6
+                            slot = self%element_slot(a, b, e)
+                            if (slot == 0) cycle
+                            ! L0 grows with the flow at its start, shrinks with the one at its end.
+                            values(slot) = values(slot) + merge(1.0_wp, -1.0_wp, b == 7) &
+                                * merge(-1.0_wp, 1.0_wp, a <= 3) * dforce_dl0(mod(a - 1, 3) + 1)
+                        end do
+                    end do
+                end do
+            end if
+            do p = 1, self%n_p
+                call add_passage_row(p)
+            end do
+        end associate
+    contains
+        !> Derivatives of passage p's row with respect to its clique's unknowns.
+        subroutine add_passage_row(p)
+            integer, intent(in) :: p
+            real(wp) :: t_before, t_after, angle, dangle(3, 3), critical, dcrit_dt, dcrit_da
+            real(wp) :: row(12), d_before(12), d_after(12)
+            integer :: k
+
+            if (self%mode(p) == mode_stick) then
+                slot = self%passage_slot(10, 10, p)
+                values(slot) = values(slot) + self%stick_scale
+                return
+            end if
+            call self%get_passage_state(p, t_before, t_after, angle, dangle)
+            call tension_derivative(self%scene%passages%element_before(p), 1, 11, 10, d_before)
+            call tension_derivative(self%scene%passages%element_after(p), 4, 10, 12, d_after)
+            associate(law => self%scene%friction(self%scene%passages%law(p))%law)
+                if (self%mode(p) == mode_forward) then
+                    call law%get_critical_tension(t_before, angle, critical, dcrit_dt, dcrit_da)
+                    row = d_after - dcrit_dt * d_before
+                else
+                    call law%get_critical_tension(t_after, angle, critical, dcrit_dt, dcrit_da)
+                    row = d_before - dcrit_dt * d_after
+                end if
+            end associate
+            row(1:9) = row(1:9) - dcrit_da * reshape(dangle, [9])
+            do k = 1, 12
+                slot = self%passage_slot(10, k, p)
+                if (slot /= 0) values(slot) = values(slot) + row(k)
+            end do
+        end subroutine add_passage_row
+
+        !> Gradient of max(T_e, 0) over the passage clique: element e's first node sits at
+        !> clique coordinates first..first+2 and its second node at first+3..first+5; the
+        !> flows at its start and end sit at members start_slot and end_slot.
+        subroutine tension_derivative(e, first, start_slot, end_slot, gradient)
+            integer, intent(in) :: e, first, start_slot, end_slot
+            real(wp), intent(out) :: gradient(12)
+            real(wp) :: t, dt, c(3), length, lambda
+
+            gradient = 0.0_wp
+            associate(net => self%scene%network)
+                if (self%tension(e) <= 0.0_wp) return
+                length = norm2(self%x(:, net%element_nodes(2, e)) - self%x(:, net%element_nodes(1, e)))
+                c = (self%x(:, net%element_nodes(2, e)) - self%x(:, net%element_nodes(1, e))) / length
+                lambda = length / self%length0(e)
+                call get_truss_tension(self%scene%laws(net%element_material(e))%law, &
+                    self%scene%solver%slack_stiffness, lambda, t, dt)
+                gradient(first:first + 2) = -dt / self%length0(e) * c
+                gradient(first + 3:first + 5) = dt / self%length0(e) * c
+                gradient(start_slot) = gradient(start_slot) - dt * lambda / self%length0(e)
+                gradient(end_slot) = gradient(end_slot) + dt * lambda / self%length0(e)
+            end associate
+        end subroutine tension_derivative
+    end subroutine evaluate_jacobian
+
+end module yarnfort_contact_friction_problem

@@ -1,0 +1,346 @@
+! SPDX-License-Identifier: MIT
+!> Load steps with sliding at contact nodes, by either scheme:
+!> - monolithic: positions and flows solved together (friction_problem_type) for a
+!>   stick/slip active set, which is updated like a return mapping until it settles;
+!> - staggered (the paper's two-step method, Fig. 4): an elastic solve with reference
+!>   lengths frozen, then a sliding solve with positions frozen, repeated until the
+!>   equilibrium residual is small and the active set no longer changes.
+!> Active-set rules, per passage, after each solve:
+!>   stick -> slip forward  if T_after  > T_crit(T_before, alpha) (beyond tolerance);
+!>   stick -> slip backward if T_before > T_crit(T_after, alpha);
+!>   slip -> stick if the flow increment of the step has the wrong sign.
+!> A passage whose element would become shorter than min_length_ratio times its initial
+!> reference length locks at that length (stick), and may not slip that way again in
+!> the step. A passage that flips more than max_flips times in one step is held in
+!> stick for the rest of the step (chatter damping); the count is reported.
+module yarnfort_contact_friction_stepper
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_factory, only: new_linear_solver
+    use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
+    use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
+    use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
+    use yarnfort_solver_state, only: fill_step_state
+    use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
+        mode_stick, mode_forward, mode_backward
+    implicit none
+    private
+
+    public :: friction_stepper_type, new_friction_stepper
+
+    !> Flips of one passage's mode in a step before it is held in stick.
+    integer, parameter :: max_flips = 6
+
+    type, extends(load_stepper_type) :: friction_stepper_type
+        type(scene_type), pointer :: scene => null()
+        logical :: staggered = .false.
+        type(friction_problem_type), pointer :: full => null(), sliding => null()
+        type(elastic_problem_type), pointer :: elastic => null()
+        type(newton_solver_type) :: newton_full, newton_elastic, newton_sliding
+        !> Accepted state: position unknowns, flows, active set, load factors.
+        real(wp), allocatable :: u(:), flow(:)
+        integer, allocatable :: mode(:)
+        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
+        !> Trial state of the last successful try_step.
+        real(wp), allocatable :: u_trial(:), flow_trial(:)
+        integer, allocatable :: mode_trial(:)
+        real(wp) :: p_force_trial = 0.0_wp, p_disp_trial = 0.0_wp
+        !> Passages held in stick by chatter damping in the last step.
+        integer :: n_damped = 0
+        !> Factorisations so far (for benchmarks).
+        integer :: n_solves = 0
+    contains
+        procedure :: try_step
+        procedure :: accept
+        procedure :: get_state
+        final :: finalize
+    end type friction_stepper_type
+
+contains
+
+    !> Set up the chosen scheme; `linear_name` is the linear solver for the elastic
+    !> solves (the unsymmetric sliding systems use UMFPACK unless KLU or dense is chosen).
+    subroutine new_friction_stepper(self, scene, linear_name, error)
+        type(friction_stepper_type), intent(out) :: self
+        type(scene_type), target, intent(in) :: scene
+        character(len=*), intent(in) :: linear_name
+        type(error_type), allocatable, intent(out) :: error
+        class(linear_solver_type), allocatable :: linear
+        character(len=:), allocatable :: general_name
+        integer :: n_p
+
+        self%scene => scene
+        self%staggered = trim(scene%solver%scheme) == 'staggered'
+        general_name = linear_name
+        if (linear_name == 'cholmod') general_name = 'umfpack'
+        n_p = scene%passages%size()
+        if (self%staggered) then
+            allocate(self%elastic, self%sliding)
+            call new_elastic_problem(self%elastic, scene)
+            if (scene%dofs%n_unknowns > 0) then
+                call new_linear_solver(linear, linear_name, error)
+                if (allocated(error)) return
+                call new_newton_solver(self%newton_elastic, self%elastic, linear, scene%solver, &
+                    error)
+                if (allocated(error)) return
+            end if
+            call new_friction_problem(self%sliding, scene, positions_frozen=.true.)
+            call new_linear_solver(linear, general_name, error)
+            if (allocated(error)) return
+            call new_newton_solver(self%newton_sliding, self%sliding, linear, scene%solver, error)
+            if (allocated(error)) return
+        else
+            allocate(self%full)
+            call new_friction_problem(self%full, scene, positions_frozen=.false.)
+            call new_linear_solver(linear, general_name, error)
+            if (allocated(error)) return
+            call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)
+            if (allocated(error)) return
+        end if
+        allocate(self%u(scene%dofs%n_unknowns))
+        call scene%dofs%restrict(scene%network%position, self%u)
+        allocate(self%flow(n_p), source=0.0_wp)
+        allocate(self%mode(n_p), source=mode_stick)
+        self%u_trial = self%u
+        self%flow_trial = self%flow
+        self%mode_trial = self%mode
+    end subroutine new_friction_stepper
+
+    subroutine try_step(self, p_force, p_disp, stats, iterations, error)
+        class(friction_stepper_type), intent(inout) :: self
+        real(wp), intent(in) :: p_force, p_disp
+        type(newton_stats_type), intent(out) :: stats
+        integer, intent(out) :: iterations
+        type(error_type), allocatable, intent(out) :: error
+
+        self%p_force_trial = p_force
+        self%p_disp_trial = p_disp
+        self%u_trial = self%u
+        self%flow_trial = self%flow
+        self%mode_trial = self%mode
+        if (self%staggered) then
+            call try_staggered(self, stats, iterations, error)
+        else
+            call try_monolithic(self, stats, iterations, error)
+        end if
+    end subroutine try_step
+
+    subroutine try_monolithic(self, stats, iterations, error)
+        type(friction_stepper_type), intent(inout) :: self
+        type(newton_stats_type), intent(out) :: stats
+        integer, intent(out) :: iterations
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: unknowns(:)
+        integer, allocatable :: flips(:)
+        logical, allocatable :: locked_forward(:), locked_backward(:)
+        integer :: round, n_x, changed
+
+        associate(problem => self%full, scene => self%scene)
+            n_x = scene%dofs%n_unknowns
+            problem%p_force = self%p_force_trial
+            problem%p_disp = self%p_disp_trial
+            problem%flow_target = self%flow
+            unknowns = [self%u, self%flow]
+            allocate(flips(size(self%flow)), source=0)
+            allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
+                source=.false.)
+            iterations = 0
+            do round = 1, scene%solver%max_friction_iterations
+                problem%mode = self%mode_trial
+                call self%newton_full%solve(unknowns, stats, error)
+                iterations = iterations + stats%iterations
+                if (allocated(error)) return
+                call problem%update_state(unknowns, error)
+                if (allocated(error)) return
+                call update_active_set(problem, unknowns(n_x + 1:), self%flow, self%mode_trial, &
+                    flips, locked_forward, locked_backward, changed)
+                if (changed == 0) then
+                    self%u_trial = unknowns(1:n_x)
+                    self%flow_trial = unknowns(n_x + 1:)
+                    self%n_damped = count(flips > max_flips)
+                    return
+                end if
+            end do
+            call not_settled(error, scene%solver%max_friction_iterations, flips)
+        end associate
+    end subroutine try_monolithic
+
+    subroutine try_staggered(self, stats, iterations, error)
+        type(friction_stepper_type), intent(inout) :: self
+        type(newton_stats_type), intent(out) :: stats
+        integer, intent(out) :: iterations
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: residual(:)
+        integer, allocatable :: flips(:), mode_before(:)
+        logical, allocatable :: locked_forward(:), locked_backward(:)
+        integer :: round, inner, changed
+        real(wp) :: residual_norm
+
+        associate(scene => self%scene, elastic => self%elastic, sliding => self%sliding)
+            elastic%p_force = self%p_force_trial
+            elastic%p_disp = self%p_disp_trial
+            sliding%p_force = self%p_force_trial
+            sliding%p_disp = self%p_disp_trial
+            sliding%flow_target = self%flow
+            allocate(flips(size(self%flow)), source=0)
+            allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
+                source=.false.)
+            allocate(residual(scene%dofs%n_unknowns))
+            iterations = 0
+            do round = 1, scene%solver%max_friction_iterations
+                ! (1) Elastic step: reference lengths frozen.
+                call scene%passages%get_length0(scene%network%length0, self%flow_trial, &
+                    elastic%length0)
+                if (scene%dofs%n_unknowns > 0) then
+                    call self%newton_elastic%solve(self%u_trial, stats, error)
+                    iterations = iterations + stats%iterations
+                    if (allocated(error)) return
+                end if
+                ! (2) Sliding step: positions frozen; its own active set settles first.
+                sliding%u_frozen = self%u_trial
+                mode_before = self%mode_trial
+                do inner = 1, scene%solver%max_friction_iterations
+                    sliding%mode = self%mode_trial
+                    call self%newton_sliding%solve(self%flow_trial, stats, error)
+                    iterations = iterations + stats%iterations
+                    if (allocated(error)) return
+                    call sliding%update_state(self%flow_trial, error)
+                    if (allocated(error)) return
+                    call update_active_set(sliding, self%flow_trial, self%flow, &
+                        self%mode_trial, flips, locked_forward, locked_backward, changed)
+                    if (changed == 0) exit
+                end do
+                if (changed /= 0) then
+                    call not_settled(error, scene%solver%max_friction_iterations, flips)
+                    return
+                end if
+                ! (3) Done when the equilibrium holds with the new reference lengths.
+                call scene%passages%get_length0(scene%network%length0, self%flow_trial, &
+                    elastic%length0)
+                call elastic%evaluate_residual(self%u_trial, residual, error)
+                if (allocated(error)) return
+                residual_norm = maxval(abs(residual), mask=.true.) / scene%force_scale
+                if (size(residual) == 0) residual_norm = 0.0_wp
+                if (residual_norm <= scene%solver%residual_tolerance &
+                        .and. all(self%mode_trial == mode_before)) then
+                    self%n_damped = count(flips > max_flips)
+                    return
+                end if
+            end do
+            call fatal_error(error, 'staggered scheme: elastic and sliding steps did not agree &
+                &within max_friction_iterations rounds')
+        end associate
+    end subroutine try_staggered
+
+    !> Update the active set from the solved state held in `problem` (its update_state
+    !> was called at the solution). `flow` are the solved flows, `accepted` those at the
+    !> start of the step. Returns the number of passages whose mode changed.
+    subroutine update_active_set(problem, flow, accepted, mode, flips, locked_forward, &
+            locked_backward, changed)
+        type(friction_problem_type), intent(inout) :: problem
+        real(wp), intent(in) :: flow(:), accepted(:)
+        integer, intent(inout) :: mode(:), flips(:)
+        logical, intent(inout) :: locked_forward(:), locked_backward(:)
+        integer, intent(out) :: changed
+        integer :: p, new_mode, before, after
+        real(wp) :: t_before, t_after, angle, critical, d1, d2, slack, tol, min_before, min_after
+        real(wp) :: increment
+
+        associate(scene => problem%scene, passages => problem%scene%passages)
+            tol = scene%solver%friction_tolerance
+            ! Absolute slack: the equilibrium residual's noise level.
+            slack = 10 * scene%solver%residual_tolerance * scene%force_scale
+            changed = 0
+            do p = 1, size(mode)
+                if (flips(p) > max_flips) cycle
+                before = passages%element_before(p)
+                after = passages%element_after(p)
+                min_before = scene%solver%min_length_ratio * scene%network%length0(before)
+                min_after = scene%solver%min_length_ratio * scene%network%length0(after)
+                new_mode = mode(p)
+                increment = flow(p) - accepted(p)
+                select case (mode(p))
+                case (mode_stick)
+                    call problem%get_passage_state(p, t_before, t_after, angle)
+                    associate(law => scene%friction(passages%law(p))%law)
+                        call law%get_critical_tension(t_before, angle, critical, d1, d2)
+                        if (t_after > critical * (1 + tol) + slack .and. &
+                                .not. locked_forward(p)) then
+                            new_mode = mode_forward
+                        else
+                            call law%get_critical_tension(t_after, angle, critical, d1, d2)
+                            if (t_before > critical * (1 + tol) + slack .and. &
+                                    .not. locked_backward(p)) new_mode = mode_backward
+                        end if
+                    end associate
+                case (mode_forward)
+                    if (increment < 0.0_wp) new_mode = mode_stick
+                    ! Forward flow shortens the element before the node.
+                    if (problem%length0(before) < min_before) then
+                        new_mode = mode_stick
+                        locked_forward(p) = .true.
+                        problem%flow_target(p) = flow(p) + (problem%length0(before) - min_before)
+                    end if
+                case (mode_backward)
+                    if (increment > 0.0_wp) new_mode = mode_stick
+                    if (problem%length0(after) < min_after) then
+                        new_mode = mode_stick
+                        locked_backward(p) = .true.
+                        problem%flow_target(p) = flow(p) - (problem%length0(after) - min_after)
+                    end if
+                end select
+                if (new_mode /= mode(p)) then
+                    mode(p) = new_mode
+                    flips(p) = flips(p) + 1
+                    changed = changed + 1
+                    if (flips(p) > max_flips) mode(p) = mode_stick
+                end if
+            end do
+        end associate
+    end subroutine update_active_set
+
+    subroutine not_settled(error, rounds, flips)
+        type(error_type), allocatable, intent(out) :: error
+        integer, intent(in) :: rounds, flips(:)
+        character(len=200) :: buffer
+        write(buffer, '("stick/slip active set did not settle in ", i0, &
+            & " rounds (max_friction_iterations); most flips of one passage: ", i0)') &
+            rounds, maxval([0, flips])
+        call fatal_error(error, trim(buffer))
+    end subroutine not_settled
+
+    subroutine accept(self)
+        class(friction_stepper_type), intent(inout) :: self
+        self%u = self%u_trial
+        self%flow = self%flow_trial
+        self%mode = self%mode_trial
+        self%p_force = self%p_force_trial
+        self%p_disp = self%p_disp_trial
+    end subroutine accept
+
+    subroutine get_state(self, state, error)
+        class(friction_stepper_type), intent(inout) :: self
+        type(step_state_type), intent(inout) :: state
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: length0(:)
+
+        allocate(length0(self%scene%network%n_elements()))
+        call self%scene%passages%get_length0(self%scene%network%length0, self%flow, length0)
+        call fill_step_state(self%scene, self%u, length0, self%p_force, self%p_disp, state, error)
+        state%n_passages = size(self%mode)
+        state%n_slipping = count(self%mode /= mode_stick)
+    end subroutine get_state
+
+    subroutine finalize(self)
+        type(friction_stepper_type), intent(inout) :: self
+        call self%newton_full%destroy()
+        call self%newton_elastic%destroy()
+        call self%newton_sliding%destroy()
+        if (associated(self%full)) deallocate(self%full)
+        if (associated(self%sliding)) deallocate(self%sliding)
+        if (associated(self%elastic)) deallocate(self%elastic)
+    end subroutine finalize
+
+end module yarnfort_contact_friction_stepper
