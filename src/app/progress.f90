@@ -31,9 +31,14 @@ contains
         call self%output_writer_type%on_step(scene, state, error)
         if (allocated(error) .or. .not. self%progress) return
         write(error_unit, '("step ", i5, "  t = ", f9.5, "  p_force = ", f8.4, "  p_disp = ", &
-            & f8.4, "  newton ", i3, "  residual ", es9.2, "  ", f8.3, " s")') &
-            state%step, state%time, state%p_force, state%p_disp, state%newton%iterations, &
+            & f8.4, "  newton ", i3, "  residual ", es9.2, "  ", f8.3, " s")', advance='no') &
+            state%step, state%time, state%p_force, state%p_disp, state%newton_iterations, &
             state%newton%residual_norm, state%wall_time
+        if (state%n_passages > 0) then
+            write(error_unit, '("  slipping ", i0, "/", i0)') state%n_slipping, state%n_passages
+        else
+            write(error_unit, '()')
+        end if
         if (self%residual_history) write(error_unit, '("  residuals", *(1x, es9.2))') &
             state%newton%residual_history
     end subroutine on_step

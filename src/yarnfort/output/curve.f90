@@ -24,8 +24,10 @@ contains
 
     !> Create folder/curve.csv and write its header. Columns: step, time, p_force,
     !> p_disp, then rx, ry, rz (N, force applied by the support on the net) for each
-    !> support set, then Newton iterations, final scaled residual, step cuts and wall
-    !> time (s) of the step.
+    !> support set, then direction (1 loading, -1 unloading, 0 neither: sign of the
+    !> change of p_force + p_disp), passages slipping and sliding passages in all,
+    !> Newton iterations of the step (all solves), final scaled residual, step cuts and
+    !> wall time (s) of the step.
     subroutine open_curve(self, folder, scene, error)
         class(curve_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: folder
@@ -45,7 +47,7 @@ contains
             name = trim(scene%supports(s)%name)
             header = header // ',' // name // '_rx,' // name // '_ry,' // name // '_rz'
         end do
-        header = header // ',newton_iterations,residual,step_cuts,wall_time'
+        header = header // ',direction,slipping,passages,newton_iterations,residual,step_cuts,wall_time'
         write(self%unit, '(a)') header
         flush(self%unit)
     end subroutine open_curve
@@ -67,7 +69,8 @@ contains
                 call append(state%reaction(k, s))
             end do
         end do
-        write(field, '(i0)') state%newton%iterations
+        write(field, '(i0, ",", i0, ",", i0, ",", i0)') state%direction, state%n_slipping, &
+            state%n_passages, state%newton_iterations
         row = row // ',' // trim(field)
         call append(state%newton%residual_norm)
         write(field, '(i0)') state%step_cuts

@@ -1,0 +1,219 @@
+! SPDX-License-Identifier: MIT
+!> Sliding contact: passages, conservation of reference length, and the Jacobian of the
+!> frictional problem against finite differences.
+module test_contact
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type
+    use yarnfort_testing, only: unittest_type, new_unittest, check, check_close
+    use yarnfort_input_config, only: config_type
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_builder, only: new_scene
+    use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
+        mode_stick, mode_forward, mode_backward
+    use yarnfort_contact_geometry, only: get_wrap_angle
+    implicit none
+    private
+
+    public :: collect_contact
+
+    real(wp), parameter :: fd_step = 1.0e-7_wp
+    real(wp), parameter :: fd_tolerance = 1.0e-6_wp
+    real(wp), parameter :: pi = acos(-1.0_wp)
+
+contains
+
+    subroutine collect_contact(testsuite)
+        type(unittest_type), allocatable, intent(out) :: testsuite(:)
+        testsuite = [ &
+            new_unittest('passages_found', test_passages), &
+            new_unittest('flows_conserve_yarn_length', test_conservation), &
+            new_unittest('wrap_angle_and_gradient', test_wrap_angle), &
+            new_unittest('jacobian_matches_fd_monolithic', test_jacobian_full), &
+            new_unittest('jacobian_matches_fd_positions_frozen', test_jacobian_frozen) ]
+    end subroutine collect_contact
+
+    !> A yarn A-C-E-B (two elements per segment) passing two contact nodes C and E, each
+    !> also the end of a peg yarn anchored at D1, D2. A, B, D1, D2 are fixed.
+    subroutine make_scene(scene, error)
+        type(scene_type), intent(out) :: scene
+        type(error_type), allocatable, intent(out) :: error
+        type(config_type) :: config
+
+        config%node_positions = reshape([-1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, -0.3_wp, 0.1_wp, &
+            0.8_wp, -0.2_wp, -0.1_wp, 1.5_wp, 0.2_wp, 0.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, &
+            0.8_wp, -1.0_wp, 0.3_wp], [3, 6])
+        allocate(config%materials(2))
+        config%materials(1)%name = 'yarn'
+        config%materials(1)%law = 'neo_hookean'
+        config%materials(1)%modulus = 1.0e6_wp
+        config%materials(1)%area = 1.0e-5_wp
+        config%materials(2)%name = 'peg'
+        config%materials(2)%law = 'linear'
+        config%materials(2)%stiffness = 20.0_wp
+        allocate(config%yarns(3))
+        config%yarns(1)%material = 'yarn'
+        config%yarns(1)%nodes = [1, 2, 3, 4]
+        config%yarns(1)%elements_per_segment = 2
+        config%yarns(2)%material = 'peg'
+        config%yarns(2)%nodes = [2, 5]
+        config%yarns(3)%material = 'peg'
+        config%yarns(3)%nodes = [3, 6]
+        allocate(config%supports(1))
+        config%supports(1)%name = 'fixed'
+        config%supports(1)%nodes = [1, 4, 5, 6]
+        config%supports(1)%displacement = [0.1_wp, 0.0_wp, 0.0_wp]
+        allocate(config%loads(0))
+        allocate(config%contacts(1))
+        config%contacts(1)%materials = [character(len=64) :: 'yarn', 'peg']
+        config%contacts(1)%law = 'adhesion'
+        config%contacts(1)%friction_coefficient = 0.3_wp
+        config%contacts(1)%adhesion = 0.05_wp
+        config%path%time = [0.0_wp, 1.0_wp]
+        config%path%p_force = [0.0_wp, 0.0_wp]
+        config%path%p_disp = [0.0_wp, 1.0_wp]
+        call new_scene(scene, config, error)
+    end subroutine make_scene
+
+    subroutine test_passages(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(scene_type) :: scene
+
+        call make_scene(scene, error)
+        if (allocated(error)) return
+        call check(error, scene%passages%size() == 2, 'two passages (C and E)')
+        if (allocated(error)) return
+        call check(error, all(scene%passages%node == [2, 3]) .and. &
+            all(scene%passages%element_before == [2, 4]) .and. &
+            all(scene%passages%element_after == [3, 5]), 'passage nodes and elements')
+        if (allocated(error)) return
+        call check(error, scene%passages%at_end(2) == 1 .and. scene%passages%at_start(3) == 1 &
+            .and. scene%passages%at_start(1) == 0, 'element-passage links')
+    end subroutine test_passages
+
+    subroutine test_conservation(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(scene_type) :: scene
+        real(wp) :: length0(8)
+        integer :: y, first, last
+
+        call make_scene(scene, error)
+        if (allocated(error)) return
+        call scene%passages%get_length0(scene%network%length0, [0.123_wp, -0.0456_wp], length0)
+        do y = 1, 3
+            first = scene%network%yarn_first_element(y)
+            last = scene%network%yarn_first_element(y + 1) - 1
+            call check_close(error, sum(length0(first:last)), &
+                sum(scene%network%length0(first:last)), 10 * epsilon(1.0_wp), 'yarn length')
+            if (allocated(error)) return
+        end do
+    end subroutine test_conservation
+
+    subroutine test_wrap_angle(error)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: angle, dangle(3, 3), xb(3), xn(3), xa(3), xp(3), xm(3), ap, am, g(3, 3)
+        integer :: node, k
+
+        ! A right angle bend: alpha = pi/2; straight: alpha = 0; folded back: alpha = pi.
+        call get_wrap_angle([1.0_wp, 0.0_wp, 0.0_wp], [0.0_wp, 0.0_wp, 0.0_wp], &
+            [0.0_wp, 2.0_wp, 0.0_wp], 1.0e-8_wp, angle, dangle)
+        call check_close(error, angle, pi / 2, 1.0e-15_wp, 'right angle')
+        if (allocated(error)) return
+        call get_wrap_angle([-1.0_wp, 0.0_wp, 0.0_wp], [0.0_wp, 0.0_wp, 0.0_wp], &
+            [3.0_wp, 0.0_wp, 0.0_wp], 1.0e-8_wp, angle, dangle)
+        call check_close(error, angle, 0.0_wp, 0.0_wp, 'straight', abs_tol=1.0e-15_wp)
+        if (allocated(error)) return
+        xb = [0.3_wp, 0.9_wp, -0.2_wp]
+        xn = [0.0_wp, 0.1_wp, 0.0_wp]
+        xa = [1.1_wp, 0.4_wp, 0.5_wp]
+        call get_wrap_angle(xb, xn, xa, 1.0e-8_wp, angle, dangle)
+        do node = 1, 3
+            do k = 1, 3
+                xp = 0.0_wp
+                xp(k) = fd_step
+                xm = -xp
+                select case (node)
+                case (1)
+                    call get_wrap_angle(xb + xp, xn, xa, 1.0e-8_wp, ap, g)
+                    call get_wrap_angle(xb + xm, xn, xa, 1.0e-8_wp, am, g)
+                case (2)
+                    call get_wrap_angle(xb, xn + xp, xa, 1.0e-8_wp, ap, g)
+                    call get_wrap_angle(xb, xn + xm, xa, 1.0e-8_wp, am, g)
+                case (3)
+                    call get_wrap_angle(xb, xn, xa + xp, 1.0e-8_wp, ap, g)
+                    call get_wrap_angle(xb, xn, xa + xm, 1.0e-8_wp, am, g)
+                end select
+                call check_close(error, dangle(k, node), (ap - am) / (2 * fd_step), &
+                    fd_tolerance, 'd alpha / d x', abs_tol=fd_tolerance)
+                if (allocated(error)) return
+            end do
+        end do
+    end subroutine test_wrap_angle
+
+    subroutine test_jacobian_full(error)
+        type(error_type), allocatable, intent(out) :: error
+        call check_jacobian(.false., error)
+    end subroutine test_jacobian_full
+
+    subroutine test_jacobian_frozen(error)
+        type(error_type), allocatable, intent(out) :: error
+        call check_jacobian(.true., error)
+    end subroutine test_jacobian_frozen
+
+    !> Every column of the assembled Jacobian against central differences of the
+    !> residual, for each combination of modes of the two passages.
+    subroutine check_jacobian(frozen, error)
+        logical, intent(in) :: frozen
+        type(error_type), allocatable, intent(out) :: error
+        type(scene_type), target :: scene
+        type(friction_problem_type) :: problem
+        real(wp), allocatable :: u(:), up(:), rp(:), rm(:), values(:), dense(:, :), x0(:)
+        integer :: n, j, p, m1, m2
+        integer, parameter :: modes(3) = [mode_stick, mode_forward, mode_backward]
+
+        call make_scene(scene, error)
+        if (allocated(error)) return
+        ! The exact tension-only law: the slack regularisation's transverse floor is a
+        ! deliberate Jacobian approximation (see yarnfort_assembly_truss).
+        scene%solver%slack_stiffness = 0.0_wp
+        call new_friction_problem(problem, scene, frozen)
+        problem%p_disp = 0.6_wp
+        problem%flow_target = [0.01_wp, -0.02_wp]
+        allocate(x0(scene%dofs%n_unknowns))
+        call scene%dofs%restrict(scene%network%position, x0)
+        x0 = x0 + 0.02_wp * [(cos(real(5 * j, wp)), j = 1, size(x0))]
+        if (frozen) then
+            problem%u_frozen = x0
+            u = [0.03_wp, -0.01_wp]
+        else
+            u = [x0, 0.03_wp, -0.01_wp]
+        end if
+        n = problem%get_size()
+        allocate(rp(n), rm(n), values(size(problem%row_index)), dense(n, n))
+        do m1 = 1, 3
+            do m2 = 1, 3
+                problem%mode = [modes(m1), modes(m2)]
+                call problem%evaluate_jacobian(u, values, error)
+                if (allocated(error)) return
+                dense = 0.0_wp
+                do j = 1, n
+                    do p = int(problem%col_ptr(j)) + 1, int(problem%col_ptr(j + 1))
+                        dense(problem%row_index(p) + 1, j) = values(p)
+                    end do
+                end do
+                do j = 1, n
+                    up = u
+                    up(j) = u(j) + fd_step
+                    call problem%evaluate_residual(up, rp, error)
+                    if (allocated(error)) return
+                    up(j) = u(j) - fd_step
+                    call problem%evaluate_residual(up, rm, error)
+                    if (allocated(error)) return
+                    call check_close(error, dense(:, j), (rp - rm) / (2 * fd_step), &
+                        fd_tolerance, 'Jacobian column', abs_tol=fd_tolerance * maxval(abs(dense)))
+                    if (allocated(error)) return
+                end do
+            end do
+        end do
+    end subroutine check_jacobian
+
+end module test_contact
