@@ -10,7 +10,9 @@ from yarnfort import read_curve, read_states
 
 #: Agreement required with closed forms at convergence (issue: rel. error <= 1e-8).
 CLOSED_FORM_RTOL = 1e-8
-TIGHT = dict(residual_tolerance=1e-13)
+#: Tight Newton tolerance; a slack regularisation far below the closed-form tolerance
+#: (it adds slack_stiffness * EA * stretch to every tension: here ~1e-12 relative).
+TIGHT = dict(residual_tolerance=1e-13, slack_stiffness=1e-12)
 
 
 def v_scene(law: dict, load: float, depth0: float = 0.2, solver=None, **extra):

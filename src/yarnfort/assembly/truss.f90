@@ -10,11 +10,13 @@ module yarnfort_assembly_truss
 
 contains
 
-    !> Tension and stretch of an element, with the slack regularisation: for stretch <= 1
-    !> the tension is slack_stiffness * k_ref * (stretch - 1) (a tiny compression
-    !> stiffness, k_ref the law's reference stiffness) instead of exactly zero, which
-    !> keeps a net of slack strings from having a singular tangent; slack_stiffness = 0
-    !> gives the exact tension-only law.
+    !> Tension of an element at `stretch`, with the slack regularisation: the law's
+    !> tension plus that of a weak zero-rest-length spring, slack_stiffness * k_ref *
+    !> stretch (k_ref the law's reference stiffness). A string then never has exactly
+    !> zero tension, so a slack or straight string keeps a small positive transverse
+    !> stiffness and the tangent stays regular and exact (paper 2.6's x^4 degeneracy);
+    !> the price is a relative change of order slack_stiffness / strain in taut strings.
+    !> slack_stiffness = 0 gives the exact tension-only law.
     pure subroutine get_truss_tension(law, slack_stiffness, stretch, tension, dtension)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: slack_stiffness, stretch
@@ -24,17 +26,17 @@ contains
         if (stretch > 1.0_wp) then
             call law%get_force(stretch, tension, dtension)
         else
-            k_slack = slack_stiffness * law%get_reference_stiffness()
-            tension = k_slack * (stretch - 1.0_wp)
-            dtension = k_slack
+            tension = 0.0_wp
+            dtension = 0.0_wp
         end if
+        k_slack = slack_stiffness * law%get_reference_stiffness()
+        tension = tension + k_slack * stretch
+        dtension = dtension + k_slack
     end subroutine get_truss_tension
 
     !> Force on node 2 (node 1 gets its negative) and the 3x3 block Z of the element
-    !> tangent K = [Z -Z; -Z Z] (eq. 12) for nodes at x1, x2 and reference length L0.
-    !> The transverse (geometric) part of Z uses max(tension, slack_stiffness * k_ref)
-    !> so a straight string at zero tension still has a small transverse stiffness: this
-    !> changes only the Jacobian (Newton's path), never the residual or the solution.
+    !> tangent K = [Z -Z; -Z Z] (eq. 12) for nodes at x1, x2 and reference length L0:
+    !> Z = T/l (I - c c^T) + (dT/dlambda)/L0 c c^T, the exact derivative of the force.
     pure subroutine get_truss_response(law, slack_stiffness, length0, x1, x2, &
             tension, stretch, force, block)
         class(force_law_type), intent(in) :: law
@@ -55,7 +57,7 @@ contains
         end if
         force = tension * c
         if (present(block)) then
-            transverse = max(tension, slack_stiffness * law%get_reference_stiffness()) / length
+            transverse = tension / length
             do k = 1, 3
                 block(:, k) = (dtension / length0 - transverse) * c * c(k)
                 block(k, k) = block(k, k) + transverse

@@ -27,7 +27,7 @@ module yarnfort_input_config
         !> 'auto', 'umfpack', 'klu', 'cholmod' or 'dense'.
         character(len=16) :: linear_solver = 'auto'
         !> Newton stops when max |residual| <= residual_tolerance * force_scale.
-        real(wp) :: residual_tolerance = 1.0e-12_wp
+        real(wp) :: residual_tolerance = 1.0e-10_wp
         !> Newton also stops when the scaled step is below this (then checked against
         !> the residual tolerance, never accepted alone).
         real(wp) :: step_tolerance = 1.0e-14_wp
@@ -35,8 +35,10 @@ module yarnfort_input_config
         !> Newton iterations between Jacobian updates (1 = full Newton).
         integer :: max_setup_calls = 1
         logical :: line_search = .true.
-        !> Stiffness of a slack (compressed) element as a fraction of its law's reference
-        !> stiffness (regularisation of the tension-only law; 0 switches it off).
+        !> Regularisation of the tension-only law: every string also carries
+        !> slack_stiffness * k_ref * stretch (a weak zero-rest-length spring; k_ref the
+        !> law's reference stiffness), so slack strings keep a regular tangent.
+        !> 0 switches it off (exact tension-only law).
         real(wp) :: slack_stiffness = 1.0e-6_wp
         !> Continuation: first, smallest and largest pseudo-time step.
         real(wp) :: initial_step = 0.1_wp

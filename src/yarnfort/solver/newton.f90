@@ -310,6 +310,15 @@ contains
         real(wp), intent(out) :: residual_time, jacobian_time, analyse_time, factor_time
         real(wp), intent(out) :: solve_time
         integer, intent(out) :: n_factorisations
+        if (.not. associated(self%problem)) then
+            residual_time = 0.0_wp
+            jacobian_time = 0.0_wp
+            analyse_time = 0.0_wp
+            factor_time = 0.0_wp
+            solve_time = 0.0_wp
+            n_factorisations = 0
+            return
+        end if
         residual_time = self%problem%residual_time
         jacobian_time = self%problem%jacobian_time
         analyse_time = self%adapter%analyse_time

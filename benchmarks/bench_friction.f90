@@ -1,0 +1,231 @@
+! SPDX-License-Identifier: MIT
+!> Counts steps, Newton iterations and slipping passages of a run.
+module bench_friction_counter
+    use, intrinsic :: iso_fortran_env, only: error_unit
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_solver_continuation, only: step_observer_type, step_state_type
+    implicit none
+    private
+    public :: counter_type
+
+    type, extends(step_observer_type) :: counter_type
+        integer :: steps = 0, newton = 0, max_slipping = 0
+    contains
+        procedure :: on_step
+        procedure :: on_cut
+    end type counter_type
+
+contains
+
+    subroutine on_step(self, scene, state, error)
+        class(counter_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        type(error_type), allocatable, intent(out) :: error
+        if (state%step == 0) return
+        self%steps = self%steps + 1
+        self%newton = self%newton + state%newton_iterations
+        self%max_slipping = max(self%max_slipping, state%n_slipping)
+    end subroutine on_step
+
+    subroutine on_cut(self, time, step, reason)
+        class(counter_type), intent(inout) :: self
+        real(wp), intent(in) :: time, step
+        character(len=*), intent(in) :: reason
+        write(error_unit, '(a, g0.4, a)') 'bench_friction: cut at t = ', time, ': ' // reason
+    end subroutine on_cut
+
+end module bench_friction_counter
+
+!> Benchmark of a load/unload cycle with sliding on a generated crimped woven net.
+!>     bench_friction <crossings per side> <monolithic|staggered> [elements per segment]
+!> Prints, for the whole cycle: unknowns, passages, load steps, Newton iterations and
+!> sparse factorisations per step, time per step, and the split of time between
+!> assembly, factorisation, solves and the rest; peak resident memory.
+program bench_friction
+    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type
+    use yarnfort_input_config, only: config_type
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_builder, only: new_scene
+    use yarnfort_driver, only: get_linear_solver_name
+    use yarnfort_solver_continuation, only: step_observer_type, step_state_type, &
+        run_continuation
+    use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
+    use yarnfort_solver_timer, only: wall_time
+    use bench_friction_counter, only: counter_type
+    implicit none
+
+    type(config_type) :: config
+    type(scene_type), target :: scene
+    type(friction_stepper_type) :: stepper
+    type(counter_type) :: counter
+    type(error_type), allocatable :: error
+    real(wp) :: total, start, times(3, 5)
+    integer :: side, per_segment, factorisations(3), k
+    character(len=32) :: argument, scheme
+
+    call get_command_argument(1, argument)
+    if (trim(argument) == '--header') then
+        write(output_unit, '(a)') '    scheme  unknowns  passages  steps  newton/step' // &
+            '  factor/step  ms/step  assembly_%  factor_%  solve_%  other_%  max_slipping' // &
+            '  peak_MiB'
+        stop
+    end if
+    read(argument, *) side
+    call get_command_argument(2, scheme)
+    per_segment = 2
+    if (command_argument_count() >= 3) then
+        call get_command_argument(3, argument)
+        read(argument, *) per_segment
+    end if
+    call make_woven_net(config, side, per_segment, scheme)
+    call new_scene(scene, config, error)
+    if (allocated(error)) call fail(error)
+    call new_friction_stepper(stepper, scene, get_linear_solver_name(scene), error)
+    if (allocated(error)) call fail(error)
+    start = wall_time()
+    call run_continuation(scene, stepper, counter, error)
+    total = wall_time() - start
+    if (allocated(error)) call fail(error)
+    times = 0.0_wp
+    factorisations = 0
+    call stepper%newton_full%get_timings(times(1, 1), times(1, 2), times(1, 3), times(1, 4), &
+        times(1, 5), factorisations(1))
+    call stepper%newton_elastic%get_timings(times(2, 1), times(2, 2), times(2, 3), &
+        times(2, 4), times(2, 5), factorisations(2))
+    call stepper%newton_sliding%get_timings(times(3, 1), times(3, 2), times(3, 3), &
+        times(3, 4), times(3, 5), factorisations(3))
+    associate(assembly => sum(times(:, 1:2)), factor => sum(times(:, 3:4)), &
+            solve => sum(times(:, 5)))
+        write(output_unit, '(a10, i10, i10, i7, f13.2, f13.2, f9.2, 4f10.1, i14, f10.1)') &
+            trim(scheme), scene%dofs%n_unknowns, scene%passages%size(), counter%steps, &
+            real(counter%newton, wp) / counter%steps, &
+            real(sum(factorisations), wp) / counter%steps, 1e3_wp * total / counter%steps, &
+            100 * assembly / total, 100 * factor / total, 100 * solve / total, &
+            100 * (total - assembly - factor - solve) / total, counter%max_slipping, &
+            peak_memory_mib()
+    end associate
+
+contains
+
+    !> side x side crossings of warp (along x) and weft (along y) yarns at unit
+    !> spacing; crossing (i, j) sits at z = +-h in a checkerboard (crimp), so both yarns
+    !> bend at every crossing. Yarn ends: west ends fixed, east ends pulled by 20 % in x
+    !> while weft ends are pulled by 5 % in y (held in z); crossings keep their height;
+    !> unload to half and reload.
+    !> Capstan with adhesion at every crossing.
+    subroutine make_woven_net(config, side, per_segment, scheme)
+        type(config_type), intent(out) :: config
+        integer, intent(in) :: side, per_segment
+        character(len=*), intent(in) :: scheme
+        integer :: i, j, n, y
+        integer, allocatable :: id(:, :)
+        real(wp), parameter :: crimp = 0.15_wp
+
+        allocate(id(0:side + 1, 0:side + 1), source=0)
+        n = 0
+        do j = 0, side + 1
+            do i = 0, side + 1
+                if ((i == 0 .or. i == side + 1) .and. (j == 0 .or. j == side + 1)) cycle
+                n = n + 1
+                id(i, j) = n
+            end do
+        end do
+        allocate(config%node_positions(3, n))
+        do j = 0, side + 1
+            do i = 0, side + 1
+                if (id(i, j) == 0) cycle
+                config%node_positions(:, id(i, j)) = [real(i, wp), real(j, wp), &
+                    crimp * merge(1.0_wp, -1.0_wp, mod(i + j, 2) == 0)]
+                if (i == 0 .or. j == 0 .or. i == side + 1 .or. j == side + 1) &
+                    config%node_positions(3, id(i, j)) = 0.0_wp
+            end do
+        end do
+        allocate(config%materials(2))
+        config%materials(1)%name = 'warp'
+        config%materials(1)%law = 'linear'
+        config%materials(1)%stiffness = 10.0_wp
+        config%materials(2)%name = 'weft'
+        config%materials(2)%law = 'linear'
+        config%materials(2)%stiffness = 5.0_wp
+        allocate(config%yarns(2 * side))
+        y = 0
+        do j = 1, side
+            y = y + 1
+            config%yarns(y)%material = 'warp'
+            config%yarns(y)%nodes = id(0:side + 1, j)
+            config%yarns(y)%elements_per_segment = per_segment
+        end do
+        do i = 1, side
+            y = y + 1
+            config%yarns(y)%material = 'weft'
+            config%yarns(y)%nodes = id(i, 0:side + 1)
+            config%yarns(y)%elements_per_segment = per_segment
+        end do
+        allocate(config%supports(5))
+        config%supports(1)%name = 'west'
+        config%supports(1)%nodes = id(0, 1:side)
+        config%supports(2)%name = 'east'
+        config%supports(2)%nodes = id(side + 1, 1:side)
+        config%supports(2)%displacement = [0.2_wp * (side + 1), 0.0_wp, 0.0_wp]
+        config%supports(3)%name = 'south'
+        config%supports(3)%nodes = id(1:side, 0)
+        config%supports(3)%fix = 'yz'
+        config%supports(3)%displacement = [0.0_wp, -0.025_wp * (side + 1), 0.0_wp]
+        config%supports(4)%name = 'north'
+        config%supports(4)%nodes = id(1:side, side + 1)
+        config%supports(4)%fix = 'yz'
+        config%supports(4)%displacement = [0.0_wp, 0.025_wp * (side + 1), 0.0_wp]
+        ! Shared crossing nodes cannot keep warp over weft by themselves (both yarns
+        ! would pull a crossing flat); holding the crossings' height keeps the crimp.
+        config%supports(5)%name = 'crimp'
+        config%supports(5)%nodes = pack(id(1:side, 1:side), .true.)
+        config%supports(5)%fix = 'z'
+        allocate(config%loads(0))
+        allocate(config%contacts(merge(1, 0, scheme /= "none")))
+        if (size(config%contacts) > 0) then
+        config%contacts(1)%materials = [character(len=64) :: "warp", "weft"]
+        config%contacts(1)%law = 'adhesion'
+        config%contacts(1)%friction_coefficient = 0.3_wp
+        config%contacts(1)%adhesion = 0.01_wp
+        end if
+        ! Biaxial stretch (warp 20 %, weft 5 %), then unload to half and reload: the net
+        ! stays taut while the friction cycle runs.
+        config%path%time = [0.0_wp, 1.0_wp, 2.0_wp, 3.0_wp]
+        config%path%p_force = [0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+        config%path%p_disp = [0.0_wp, 1.0_wp, 0.5_wp, 1.0_wp]
+        config%solver%scheme = scheme
+        config%solver%initial_step = 0.05_wp
+        config%solver%max_step = 0.05_wp
+        config%solver%max_iterations = 100
+        config%solver%max_friction_iterations = 1000
+    end subroutine make_woven_net
+
+    real(wp) function peak_memory_mib()
+        character(len=256) :: line
+        integer :: unit, status, kib
+        peak_memory_mib = -1.0_wp
+        open(newunit=unit, file='/proc/self/status', action='read', iostat=status)
+        if (status /= 0) return
+        do
+            read(unit, '(a)', iostat=status) line
+            if (status /= 0) exit
+            if (line(1:6) == 'VmHWM:') then
+                read(line(7:), *) kib
+                peak_memory_mib = kib / 1024.0_wp
+            end if
+        end do
+        close(unit)
+    end function peak_memory_mib
+
+    subroutine fail(error)
+        type(error_type), intent(in) :: error
+        write(error_unit, '(a)') 'bench_friction: ' // error%message
+        error stop 1
+    end subroutine fail
+
+end program bench_friction
