@@ -1,6 +1,7 @@
 ! SPDX-License-Identifier: MIT
 !> Run a scene: choose the linear solver, set up Newton (KINSOL) and follow the load path.
 module yarnfort_driver
+    use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, prefix_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
@@ -15,16 +16,18 @@ module yarnfort_driver
 
 contains
 
-    !> The linear solver a scene uses: its &solver linear_solver, or for 'auto' the
-    !> measured default for its size. The elastic tangent is symmetric but not always
-    !> positive definite (slack regularisation, compressed strings), so 'auto' does not
-    !> pick the Cholesky solver.
+    !> The linear solver for the scene's elastic solves: its &solver linear_solver, or
+    !> for 'auto' the measured default for its size. With the slack regularisation every
+    !> string has positive tension and stiffness, so the elastic tangent is symmetric
+    !> positive definite (CHOLMOD, with a KLU fallback should a factorisation say
+    !> otherwise); without it, it may be singular or indefinite.
     function get_linear_solver_name(scene) result(name)
         type(scene_type), intent(in) :: scene
         character(len=:), allocatable :: name
 
         if (trim(scene%solver%linear_solver) == 'auto') then
-            name = default_linear_solver_name(int(scene%dofs%n_unknowns, 8), .false.)
+            name = default_linear_solver_name(int(scene%dofs%n_unknowns, 8), &
+                scene%solver%slack_stiffness > 0.0_wp)
         else
             name = trim(scene%solver%linear_solver)
         end if

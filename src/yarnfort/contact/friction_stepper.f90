@@ -18,7 +18,7 @@ module yarnfort_contact_friction_stepper
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_factory, only: new_linear_solver
+    use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
@@ -61,7 +61,8 @@ module yarnfort_contact_friction_stepper
 contains
 
     !> Set up the chosen scheme; `linear_name` is the linear solver for the elastic
-    !> solves (the unsymmetric sliding systems use UMFPACK unless KLU or dense is chosen).
+    !> solves. The sliding systems are unsymmetric: they use the measured default for
+    !> unsymmetric systems when `linear_name` is a Cholesky solver, else `linear_name`.
     subroutine new_friction_stepper(self, scene, linear_name, error)
         type(friction_stepper_type), intent(out) :: self
         type(scene_type), target, intent(in) :: scene
@@ -73,9 +74,10 @@ contains
 
         self%scene => scene
         self%staggered = trim(scene%solver%scheme) == 'staggered'
-        general_name = linear_name
-        if (linear_name == 'cholmod') general_name = 'umfpack'
         n_p = scene%passages%size()
+        general_name = linear_name
+        if (linear_name == 'cholmod' .or. linear_name == 'cholmod+klu') general_name = &
+            default_linear_solver_name(int(scene%dofs%n_unknowns + n_p, 8), .false.)
         if (self%staggered) then
             allocate(self%elastic, self%sliding)
             call new_elastic_problem(self%elastic, scene)

@@ -24,8 +24,8 @@ module yarnfort_input_validate
     character(len=*), parameter :: known_laws(*) = [character(len=11) :: 'linear', &
         'neo_hookean', 'table']
     !> Values of &solver linear_solver.
-    character(len=*), parameter :: known_linear_solvers(*) = [character(len=7) :: 'auto', &
-        'umfpack', 'klu', 'cholmod', 'dense']
+    character(len=*), parameter :: known_linear_solvers(*) = [character(len=11) :: 'auto', &
+        'umfpack', 'klu', 'cholmod', 'cholmod+klu', 'dense']
     !> Values of &contact law.
     character(len=*), parameter :: known_contact_laws(*) = [character(len=17) :: 'bonded', &
         'coulomb', 'adhesion', 'decaying_adhesion']

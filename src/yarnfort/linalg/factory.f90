@@ -9,6 +9,7 @@ module yarnfort_linalg_factory
     use yarnfort_linalg_klu, only: klu_solver_type
     use yarnfort_linalg_cholmod, only: cholmod_solver_type
     use yarnfort_linalg_dense, only: dense_solver_type
+    use yarnfort_linalg_fallback, only: fallback_solver_type
     implicit none
     private
 
@@ -16,13 +17,15 @@ module yarnfort_linalg_factory
     public :: linear_solver_names, klu_max_order
 
     !> Names accepted by `new_linear_solver`.
-    character(len=*), parameter :: linear_solver_names = "'umfpack', 'klu', 'cholmod', 'dense'"
+    character(len=*), parameter :: linear_solver_names = &
+        "'umfpack', 'klu', 'cholmod', 'cholmod+klu', 'dense'"
 
-    !> Largest order for which KLU is the default. Source: design.md section 5 (numeric
-    !> refactorisation + one solve, woven-net tangents, 2 cores). At 1e3 DOFs KLU is the
-    !> fastest (0.09 ms vs 0.1-0.36 ms CHOLMOD, 0.58 ms UMFPACK); at 1e4 it is 4x faster
-    !> than UMFPACK and within 20 % of CHOLMOD (1.9 vs 1.6 ms), which covers unit cells.
-    integer(ik), parameter :: klu_max_order = 10000_ik
+    !> Largest order for which KLU is the default for unsymmetric or indefinite
+    !> systems. Measured on cable-net tangents (benchmarks/run, 2 cores, one Newton
+    !> solve, numeric factorisation per iteration): KLU 1.2 / 52 / 2650 ms against
+    !> UMFPACK 3.7 / 108 / 3035 ms at 1e3 / 1e4 / 1e5 unknowns; design.md section 5 has
+    !> UMFPACK 2.6x faster than KLU at 1e6, so the switch sits between 1e5 and 1e6.
+    integer(ik), parameter :: klu_max_order = 200000_ik
 
 contains
 
@@ -42,27 +45,34 @@ contains
             allocate(cholmod_solver_type :: solver)
         case ('dense')
             allocate(dense_solver_type :: solver)
+        case ('cholmod+klu')
+            block
+                type(fallback_solver_type), allocatable :: fallback
+                allocate(fallback)
+                allocate(cholmod_solver_type :: fallback%primary)
+                allocate(klu_solver_type :: fallback%secondary)
+                call move_alloc(fallback, solver)
+            end block
         case default
             call fatal_error(error, "unknown linear solver '" // trim(adjustl(name)) &
                 // "'; valid names are " // linear_solver_names)
         end select
     end subroutine new_linear_solver
 
-    !> Default solver for a system of order n (design.md section 5):
-    !> n <= klu_max_order: 'klu' (fastest for unit cells, SPD or not);
-    !> larger and symmetric positive definite: 'cholmod' (fastest at 1e5 and 1e6 DOFs:
-    !> 45 ms and 0.86 s against KLU's 68 ms and 3.95 s, UMFPACK's 99 ms and 1.49 s);
-    !> larger otherwise: 'umfpack', the general solver for unsymmetric or indefinite
-    !> Jacobians (2.6x faster than KLU at 1e6).
+    !> Default solver for a system of order n, from the measurements above:
+    !> symmetric positive definite: 'cholmod+klu' (CHOLMOD, fastest at every size
+    !> measured: 0.9 / 39 / 1134 ms at 1e3 / 1e4 / 1e5, falling back to KLU for good if a
+    !> factorisation turns out not positive definite);
+    !> otherwise 'klu' up to klu_max_order unknowns, 'umfpack' above.
     pure function default_linear_solver_name(n, symmetric_positive_definite) result(name)
         integer(ik), intent(in) :: n
         logical, intent(in) :: symmetric_positive_definite
         character(len=:), allocatable :: name
 
-        if (n <= klu_max_order) then
+        if (symmetric_positive_definite) then
+            name = 'cholmod+klu'
+        else if (n <= klu_max_order) then
             name = 'klu'
-        else if (symmetric_positive_definite) then
-            name = 'cholmod'
         else
             name = 'umfpack'
         end if

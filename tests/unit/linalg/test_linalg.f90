@@ -456,9 +456,15 @@ contains
         call check_factor_fails('cholmod', 'shifted Laplacian', a, 'not positive definite', &
             error)
         if (allocated(error)) return
-        ! The same matrix is fine for UMFPACK (the fallback).
+        ! The same matrix is fine for UMFPACK, and for CHOLMOD with its KLU fallback.
         call check_known_solution('umfpack', 'shifted Laplacian', a, &
             random_vector(a%n, random_seed + 5), error)
+        if (allocated(error)) return
+        call check_known_solution('cholmod+klu', 'shifted Laplacian', a, &
+            random_vector(a%n, random_seed + 6), error)
+        if (allocated(error)) return
+        ! And the fallback solver uses CHOLMOD itself while the matrix is SPD.
+        call check_small_known('cholmod+klu', error)
     end subroutine test_cholmod_indefinite
 
     !> CHOLMOD ignores entries below the diagonal: garbage there must not change x.
@@ -656,7 +662,7 @@ contains
         call expect_error('factory unknown name', "unknown linear solver 'superlu'", error)
         if (allocated(error)) return
         call new_linear_solver(solver, 'superlu', error)
-        call expect_error('factory unknown name', "'umfpack', 'klu', 'cholmod', 'dense'", &
+        call expect_error('factory unknown name', "'umfpack', 'klu', 'cholmod', 'cholmod+klu', 'dense'", &
             error)
     end subroutine test_factory_unknown
 
@@ -667,11 +673,14 @@ contains
         call check(error, default_linear_solver_name(1000_ik, .false.) == 'klu', &
             'default for 1e3 general should be klu')
         if (allocated(error)) return
-        call check(error, default_linear_solver_name(klu_max_order, .true.) == 'klu', &
-            'default for klu_max_order SPD should be klu')
+        call check(error, default_linear_solver_name(klu_max_order, .false.) == 'klu', &
+            'default for klu_max_order general should be klu')
         if (allocated(error)) return
-        call check(error, default_linear_solver_name(klu_max_order + 1, .true.) == 'cholmod', &
-            'default above klu_max_order SPD should be cholmod')
+        call check(error, default_linear_solver_name(10_ik, .true.) == 'cholmod+klu', &
+            'default for SPD should be cholmod+klu')
+        if (allocated(error)) return
+        call check(error, default_linear_solver_name(1000000_ik, .true.) == 'cholmod+klu', &
+            'default for 1e6 SPD should be cholmod+klu')
         if (allocated(error)) return
         call check(error, default_linear_solver_name(1000000_ik, .false.) == 'umfpack', &
             'default for 1e6 general should be umfpack')

@@ -1,0 +1,91 @@
+! SPDX-License-Identifier: MIT
+!> A linear solver that tries a fast specialised solver first (CHOLMOD: symmetric
+!> positive definite only) and switches for good to a general one (KLU) the first time
+!> the specialised factorisation fails (e.g. "not positive definite").
+module yarnfort_linalg_fallback
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    implicit none
+    private
+
+    public :: fallback_solver_type
+
+    type, extends(linear_solver_type) :: fallback_solver_type
+        class(linear_solver_type), allocatable :: primary, secondary
+        logical :: switched = .false.
+        !> The pattern, kept to analyse the secondary solver when switching.
+        integer(ik) :: n = 0
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+    contains
+        procedure :: analyse
+        procedure :: factor
+        procedure :: solve
+        procedure :: destroy
+        procedure :: get_name
+    end type fallback_solver_type
+
+contains
+
+    subroutine analyse(self, n, col_ptr, row_index, error)
+        class(fallback_solver_type), intent(inout) :: self
+        integer(ik), intent(in) :: n
+        integer(ik), intent(in) :: col_ptr(:), row_index(:)
+        type(error_type), allocatable, intent(out) :: error
+
+        self%n = n
+        self%col_ptr = col_ptr(1:n + 1)
+        self%row_index = row_index(1:col_ptr(n + 1))
+        if (self%switched) then
+            call self%secondary%analyse(n, col_ptr, row_index, error)
+        else
+            call self%primary%analyse(n, col_ptr, row_index, error)
+        end if
+    end subroutine analyse
+
+    subroutine factor(self, values, error)
+        class(fallback_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+
+        if (.not. self%switched) then
+            call self%primary%factor(values, error)
+            if (.not. allocated(error)) return
+            deallocate(error)
+            self%switched = .true.
+            call self%primary%destroy()
+            call self%secondary%analyse(self%n, self%col_ptr, self%row_index, error)
+            if (allocated(error)) return
+        end if
+        call self%secondary%factor(values, error)
+    end subroutine factor
+
+    subroutine solve(self, rhs, error)
+        class(fallback_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:)
+        type(error_type), allocatable, intent(out) :: error
+        if (self%switched) then
+            call self%secondary%solve(rhs, error)
+        else
+            call self%primary%solve(rhs, error)
+        end if
+    end subroutine solve
+
+    subroutine destroy(self)
+        class(fallback_solver_type), intent(inout) :: self
+        if (allocated(self%primary)) call self%primary%destroy()
+        if (allocated(self%secondary)) call self%secondary%destroy()
+    end subroutine destroy
+
+    pure function get_name(self) result(name)
+        class(fallback_solver_type), intent(in) :: self
+        character(len=:), allocatable :: name
+        if (self%switched) then
+            name = self%secondary%get_name()
+        else
+            name = self%primary%get_name() // ' (falls back to ' // self%secondary%get_name() &
+                // ')'
+        end if
+    end function get_name
+
+end module yarnfort_linalg_fallback
