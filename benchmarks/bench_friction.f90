@@ -40,7 +40,8 @@ contains
 end module bench_friction_counter
 
 !> Benchmark of a load/unload cycle with sliding on a generated crimped woven net.
-!>     bench_friction <crossings per side> <monolithic|staggered> [elements per segment]
+!>     bench_friction <crossings per side> <monolithic|staggered> [elements per segment
+!>                    [linear solver]]
 !> Prints, for the whole cycle: unknowns, passages, load steps, Newton iterations and
 !> sparse factorisations per step, time per step, and the split of time between
 !> assembly, factorisation, solves and the rest; peak resident memory.
@@ -83,6 +84,7 @@ program bench_friction
         read(argument, *) per_segment
     end if
     call make_woven_net(config, side, per_segment, scheme)
+    if (command_argument_count() >= 4) call get_command_argument(4, config%solver%linear_solver)
     call new_scene(scene, config, error)
     if (allocated(error)) call fail(error)
     call new_friction_stepper(stepper, scene, get_linear_solver_name(scene), error)

@@ -47,6 +47,10 @@ module yarnfort_contact_friction_stepper
         real(wp), allocatable :: u_trial(:), flow_trial(:)
         integer, allocatable :: mode_trial(:)
         real(wp) :: p_force_trial = 0.0_wp, p_disp_trial = 0.0_wp
+        !> The accepted state before the current one, for a secant predictor.
+        real(wp), allocatable :: u_old(:), flow_old(:)
+        real(wp) :: load_old = 0.0_wp
+        logical :: have_old = .false.
         !> Passages held in stick by chatter damping in the last step.
         integer :: n_damped = 0
         !> Factorisations so far (for benchmarks).
@@ -145,6 +149,7 @@ contains
             problem%p_disp = self%p_disp_trial
             problem%flow_target = self%flow
             unknowns = [self%u, self%flow]
+            call predict(self, unknowns)
             allocate(flips(size(self%flow)), source=0)
             allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
                 source=.false.)
@@ -313,8 +318,33 @@ contains
         call fatal_error(error, trim(buffer))
     end subroutine not_settled
 
+    !> Secant predictor for the monolithic unknowns: extrapolate positions and the flows
+    !> of slipping passages along the last accepted increment, scaled by the ratio of
+    !> load increments, while the loading keeps its direction.
+    subroutine predict(self, unknowns)
+        type(friction_stepper_type), intent(in) :: self
+        real(wp), intent(inout) :: unknowns(:)
+        real(wp) :: ratio, load, load_now
+        integer :: n_x
+
+        if (.not. self%have_old) return
+        load = self%p_force_trial + self%p_disp_trial
+        load_now = self%p_force + self%p_disp
+        if (load_now == self%load_old) return
+        ratio = (load - load_now) / (load_now - self%load_old)
+        if (.not. (ratio > 0.0_wp .and. ratio <= 2.0_wp)) return
+        n_x = size(self%u)
+        unknowns(1:n_x) = self%u + ratio * (self%u - self%u_old)
+        where (self%mode /= mode_stick) unknowns(n_x + 1:) = self%flow &
+            + ratio * (self%flow - self%flow_old)
+    end subroutine predict
+
     subroutine accept(self)
         class(friction_stepper_type), intent(inout) :: self
+        self%u_old = self%u
+        self%flow_old = self%flow
+        self%load_old = self%p_force + self%p_disp
+        self%have_old = .true.
         self%u = self%u_trial
         self%flow = self%flow_trial
         self%mode = self%mode_trial
