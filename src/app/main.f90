@@ -73,7 +73,7 @@ contains
             case default
                 write(error_unit, '(a)') "yarnfort: error: unknown argument '" // trim(argument) &
                     // "' (try --help)"
-                error stop 2, quiet=.true.
+                stop 2, quiet=.true.
             end select
         end do
     end subroutine handle_arguments
@@ -100,8 +100,8 @@ contains
         type(error_type), intent(in) :: error
         integer, intent(in) :: code
         write(error_unit, '(a)') 'yarnfort: error (' // stage // '): ' // error%message
-        if (code == 1) error stop 1, quiet=.true.
-        error stop 2, quiet=.true.
+        if (code == 1) stop 1, quiet=.true.
+        stop 2, quiet=.true.
     end subroutine fail
 
 end program yarnfort_main

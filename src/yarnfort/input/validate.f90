@@ -105,11 +105,11 @@ contains
                 // ' is larger than max_step = ' // format_real(solver%max_step))
             return
         end if
-        if (solver%initial_step < solver%min_step .or. solver%initial_step > solver%max_step) then
+        ! An initial_step above max_step is simply capped at max_step by the continuation.
+        if (solver%initial_step < solver%min_step) then
             call fatal_error(error, '&solver: initial_step = ' &
-                // format_real(solver%initial_step) // ' must lie between min_step = ' &
-                // format_real(solver%min_step) // ' and max_step = ' &
-                // format_real(solver%max_step))
+                // format_real(solver%initial_step) // ' is smaller than min_step = ' &
+                // format_real(solver%min_step))
             return
         end if
         if (.not. ieee_is_finite(solver%step_cut)) then
