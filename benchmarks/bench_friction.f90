@@ -205,6 +205,7 @@ contains
         config%solver%max_step = 0.05_wp
         config%solver%max_iterations = 100
         config%solver%max_friction_iterations = 1000
+        if (command_argument_count() >= 5) config%solver%line_search = .false.
     end subroutine make_woven_net
 
     real(wp) function peak_memory_mib()

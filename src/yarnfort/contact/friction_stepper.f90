@@ -24,7 +24,7 @@ module yarnfort_contact_friction_stepper
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
     use yarnfort_solver_state, only: fill_step_state
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
-        mode_stick, mode_forward, mode_backward
+        mode_stick, mode_forward, mode_backward, locked_both
     implicit none
     private
 
@@ -154,6 +154,7 @@ contains
             allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
                 source=.false.)
             iterations = 0
+            problem%locked = 0
             do round = 1, scene%solver%max_friction_iterations
                 problem%mode = self%mode_trial
                 call self%newton_full%solve(unknowns, stats, error)
@@ -161,6 +162,10 @@ contains
                 if (allocated(error)) return
                 call problem%update_state(unknowns, error)
                 if (allocated(error)) return
+                if (problem%semismooth) then
+                    call problem%choose_modes(unknowns(n_x + 1:))
+                    self%mode_trial = problem%mode
+                end if
                 call update_active_set(problem, unknowns(n_x + 1:), self%flow, self%mode_trial, &
                     flips, locked_forward, locked_backward, changed)
                 if (changed == 0) then
@@ -191,6 +196,7 @@ contains
             sliding%p_force = self%p_force_trial
             sliding%p_disp = self%p_disp_trial
             sliding%flow_target = self%flow
+            sliding%locked = 0
             allocate(flips(size(self%flow)), source=0)
             allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
                 source=.false.)
@@ -215,6 +221,10 @@ contains
                     if (allocated(error)) return
                     call sliding%update_state(self%flow_trial, error)
                     if (allocated(error)) return
+                    if (sliding%semismooth) then
+                        call sliding%choose_modes(self%flow_trial)
+                        self%mode_trial = sliding%mode
+                    end if
                     call update_active_set(sliding, self%flow_trial, self%flow, &
                         self%mode_trial, flips, locked_forward, locked_backward, changed)
                     if (changed == 0) exit
@@ -288,6 +298,7 @@ contains
                     if (problem%length0(before) < min_before) then
                         new_mode = mode_stick
                         locked_forward(p) = .true.
+                        problem%locked(p) = mode_forward
                         problem%flow_target(p) = flow(p) + (problem%length0(before) - min_before)
                     end if
                 case (mode_backward)
@@ -295,6 +306,7 @@ contains
                     if (problem%length0(after) < min_after) then
                         new_mode = mode_stick
                         locked_backward(p) = .true.
+                        problem%locked(p) = mode_backward
                         problem%flow_target(p) = flow(p) - (problem%length0(after) - min_after)
                     end if
                 end select
@@ -302,7 +314,10 @@ contains
                     mode(p) = new_mode
                     flips(p) = flips(p) + 1
                     changed = changed + 1
-                    if (flips(p) > max_flips) mode(p) = mode_stick
+                    if (flips(p) > max_flips) then
+                        mode(p) = mode_stick
+                        problem%locked(p) = locked_both
+                    end if
                 end if
             end do
         end associate

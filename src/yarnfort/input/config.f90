@@ -56,7 +56,7 @@ module yarnfort_input_config
         character(len=16) :: scheme = 'monolithic'
         !> Friction: most stick/slip active-set updates (monolithic) or elastic/sliding
         !> alternations (staggered) per load step.
-        integer :: max_friction_iterations = 50
+        integer :: max_friction_iterations = 200
         !> Friction: sliding never makes an element's reference length shorter than this
         !> fraction of its initial length (the passage then locks in that direction).
         real(wp) :: min_length_ratio = 1.0e-3_wp

@@ -176,6 +176,8 @@ contains
         ! deliberate Jacobian approximation (see yarnfort_assembly_truss).
         scene%solver%slack_stiffness = 0.0_wp
         call new_friction_problem(problem, scene, frozen)
+        ! Every mode combination in turn (not chosen from the iterate).
+        problem%semismooth = .false.
         problem%p_disp = 0.6_wp
         problem%flow_target = [0.01_wp, -0.02_wp]
         allocate(x0(scene%dofs%n_unknowns))
