@@ -70,8 +70,14 @@ def read_state(path: str | Path) -> State:
 
 
 def read_states(folder: str | Path) -> list[State]:
-    """All VTK states of an output folder, in step order."""
-    return [read_state(p) for p in sorted(Path(folder).glob("state_*.vtu"))]
+    """The VTK states of an output folder, in step order, as listed in its states.pvd
+    (the files of this run only)."""
+    folder = Path(folder)
+    collection = folder / "states.pvd"
+    if collection.exists():
+        root = ET.parse(collection).getroot()
+        return [read_state(folder / d.get("file")) for d in root.iter("DataSet")]
+    return [read_state(p) for p in sorted(folder.glob("state_*.vtu"))]
 
 
 def read_run(folder: str | Path) -> tuple[Curve, list[State]]:

@@ -90,3 +90,14 @@ def test_example_run_writes_curve_vtk_and_echo(run_yarnfort, tmp_path):
     assert (tmp_path / "again" / "curve.csv").read_text().count("\n") == \
         (out / "curve.csv").read_text().count("\n")
     assert "step    20" in run.stderr
+
+
+def test_rerun_into_same_folder_leaves_no_stale_states(run_yarnfort, tmp_path):
+    """A second, shorter run into the same folder removes the first run's states."""
+    assert run_yarnfort(VNET, cwd=tmp_path).returncode == 0
+    short = VNET.replace("initial_step = 0.1", "initial_step = 1.0").replace(
+        "max_step = 0.1", "max_step = 1.0")
+    assert run_yarnfort(short, cwd=tmp_path).returncode == 0
+    out = tmp_path / "out" / "vnet"
+    states = sorted(p.name for p in out.glob("state_*.vtu"))
+    assert states == ["state_00000.vtu", "state_00001.vtu", "state_00002.vtu"]

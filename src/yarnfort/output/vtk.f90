@@ -18,6 +18,8 @@ module yarnfort_output_vtk
         real(wp), allocatable :: times(:)
     contains
         procedure :: write_state
+        !> Delete the states a previous run listed in folder/states.pvd.
+        procedure :: remove_previous
     end type vtk_writer_type
 
     integer, parameter :: vtk_line = 3
@@ -79,6 +81,31 @@ contains
             write(unit, '(a)') '</DataArray>'
         end subroutine write_cell_array
     end subroutine write_state
+
+    subroutine remove_previous(self)
+        class(vtk_writer_type), intent(in) :: self
+        character(len=1024) :: line
+        integer :: unit, status, first, last, old
+
+        open(newunit=unit, file=self%folder // '/states.pvd', status='old', action='read', &
+            iostat=status)
+        if (status /= 0) return
+        do
+            read(unit, '(a)', iostat=status) line
+            if (status /= 0) exit
+            first = index(line, 'file="')
+            if (first == 0) cycle
+            first = first + len('file="')
+            last = index(line(first:), '"') + first - 2
+            if (last < first) cycle
+            ! Only plain file names written by this writer (no paths).
+            if (index(line(first:last), '/') > 0) cycle
+            open(newunit=old, file=self%folder // '/' // line(first:last), status='old', &
+                iostat=status)
+            if (status == 0) close(old, status='delete')
+        end do
+        close(unit, status='delete')
+    end subroutine remove_previous
 
     subroutine write_collection(self, error)
         type(vtk_writer_type), intent(in) :: self

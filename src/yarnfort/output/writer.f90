@@ -42,6 +42,8 @@ contains
         call make_folder(self%folder, error)
         if (allocated(error)) return
         self%vtk%folder = self%folder
+        ! A rerun into the same folder must not leave states of the earlier run behind.
+        call self%vtk%remove_previous()
         call self%curve%open(self%folder, scene, error)
     end subroutine open_writer
 
