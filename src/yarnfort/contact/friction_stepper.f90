@@ -10,9 +10,10 @@
 !>   stick -> slip backward if T_before > T_crit(T_after, alpha);
 !>   slip -> stick if the flow increment of the step has the wrong sign.
 !> A passage whose element would become shorter than min_length_ratio times its initial
-!> reference length locks at that length (stick), and may not slip that way again in
-!> the step. A passage that flips more than max_flips times in one step is held in
-!> stick for the rest of the step (chatter damping); the count is reported.
+!> reference length locks at that length (stick), and may not slip that way again while
+!> the element keeps that length, in this step and the next ones. A passage that flips
+!> more than max_flips times in one step is held in stick for the rest of the step
+!> (chatter damping); the count is reported.
 module yarnfort_contact_friction_stepper
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
@@ -32,6 +33,10 @@ module yarnfort_contact_friction_stepper
 
     !> Flips of one passage's mode in a step before it is held in stick.
     integer, parameter :: max_flips = 6
+
+    !> Round-off of a reference length locked at its minimum, relative to its initial
+    !> length (the lock sets L0 = initial length - flow to the minimum).
+    real(wp), parameter :: length_round_off = 64 * epsilon(1.0_wp)
 
     type, extends(load_stepper_type) :: friction_stepper_type
         type(scene_type), pointer :: scene => null()
@@ -280,6 +285,13 @@ contains
                 increment = flow(p) - accepted(p)
                 select case (mode(p))
                 case (mode_stick)
+                    ! An element locked at its minimum length in an earlier step stays so.
+                    if (problem%length0(before) <= min_before &
+                            + length_round_off * scene%network%length0(before)) &
+                        locked_forward(p) = .true.
+                    if (problem%length0(after) <= min_after &
+                            + length_round_off * scene%network%length0(after)) &
+                        locked_backward(p) = .true.
                     call problem%get_passage_state(p, t_before, t_after, angle)
                     associate(law => scene%friction(passages%law(p))%law)
                         call law%get_critical_tension(t_before, angle, critical, d1, d2)

@@ -29,8 +29,12 @@ contains
         l_b = norm2(c_b)
         c_b = c_b / l_b
         cos_gamma = max(-1.0_wp, min(1.0_wp, dot_product(c_a, c_b)))
-        angle = pi - acos(cos_gamma)
-        sine = max(sqrt(max(0.0_wp, 1.0_wp - cos_gamma**2)), min_sine)
+        ! sin(gamma) = |c_a x c_b| and atan2: acos(cos_gamma) would lose half the digits
+        ! where the yarn is nearly straight or folded back (an error of ~1e-8 in alpha).
+        sine = norm2([c_a(2) * c_b(3) - c_a(3) * c_b(2), c_a(3) * c_b(1) - c_a(1) * c_b(3), &
+            c_a(1) * c_b(2) - c_a(2) * c_b(1)])
+        angle = pi - atan2(sine, cos_gamma)
+        sine = max(sine, min_sine)
         dcos_a = (c_b - cos_gamma * c_a) / l_a
         dcos_b = (c_a - cos_gamma * c_b) / l_b
         ! d alpha = d(cos gamma) / sin(gamma)
