@@ -6,17 +6,22 @@ module yarnfort_assembly_truss
     implicit none
     private
 
-    public :: get_truss_tension, get_truss_response
+    public :: get_truss_tension, get_truss_response, slack_rest_stretch
+
+    !> Rest stretch of the regularising spring (see get_truss_tension).
+    real(wp), parameter :: slack_rest_stretch = 0.5_wp
 
 contains
 
     !> Tension of an element at `stretch`, with the slack regularisation: the law's
-    !> tension plus that of a weak zero-rest-length spring, slack_stiffness * k_ref *
-    !> stretch (k_ref the law's reference stiffness). A string then never has exactly
-    !> zero tension, so a slack or straight string keeps a small positive transverse
-    !> stiffness and the tangent stays regular and exact (paper 2.6's x^4 degeneracy);
-    !> the price is a relative change of order slack_stiffness / strain in taut strings.
-    !> slack_stiffness = 0 gives the exact tension-only law.
+    !> tension plus that of a weak spring of rest length L0/2, slack_stiffness * k_ref *
+    !> (stretch - 1/2) (k_ref the law's reference stiffness). A string at its reference
+    !> length then still carries slack_stiffness * k_ref / 2, so a slack or straight
+    !> string keeps a small positive transverse stiffness and the tangent stays regular
+    !> and exact (paper 2.6's x^4 degeneracy); an unloaded dangling end rests at half its
+    !> reference length instead of being undetermined. The price is a relative change
+    !> of order slack_stiffness / strain in taut strings. slack_stiffness = 0 gives the
+    !> exact tension-only law.
     pure subroutine get_truss_tension(law, slack_stiffness, stretch, tension, dtension)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: slack_stiffness, stretch
@@ -30,7 +35,7 @@ contains
             dtension = 0.0_wp
         end if
         k_slack = slack_stiffness * law%get_reference_stiffness()
-        tension = tension + k_slack * stretch
+        tension = tension + k_slack * (stretch - slack_rest_stretch)
         dtension = dtension + k_slack
     end subroutine get_truss_tension
 

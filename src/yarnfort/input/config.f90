@@ -36,8 +36,8 @@ module yarnfort_input_config
         integer :: max_setup_calls = 1
         logical :: line_search = .true.
         !> Regularisation of the tension-only law: every string also carries
-        !> slack_stiffness * k_ref * stretch (a weak zero-rest-length spring; k_ref the
-        !> law's reference stiffness), so slack strings keep a regular tangent.
+        !> slack_stiffness * k_ref * (stretch - 1/2) (a weak spring of rest length L0/2;
+        !> k_ref the law's reference stiffness), so slack strings keep a regular tangent.
         !> 0 switches it off (exact tension-only law).
         real(wp) :: slack_stiffness = 1.0e-6_wp
         !> Continuation: first, smallest and largest pseudo-time step.
