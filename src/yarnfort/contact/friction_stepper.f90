@@ -143,10 +143,11 @@ contains
         type(newton_stats_type), intent(out) :: stats
         integer, intent(out) :: iterations
         type(error_type), allocatable, intent(out) :: error
-        real(wp), allocatable :: unknowns(:)
-        integer, allocatable :: flips(:)
+        real(wp), allocatable :: unknowns(:), good_unknowns(:)
+        integer, allocatable :: flips(:), good_mode(:), good_flips(:)
         logical, allocatable :: locked_forward(:), locked_backward(:)
-        integer :: round, n_x, changed
+        integer :: round, n_x, changed, cap, new_slips
+        logical :: have_good
 
         associate(problem => self%full, scene => self%scene)
             n_x = scene%dofs%n_unknowns
@@ -160,19 +161,49 @@ contains
                 source=.false.)
             iterations = 0
             problem%locked = 0
+            cap = huge(1)
+            have_good = .false.
             do round = 1, scene%solver%max_friction_iterations
                 problem%mode = self%mode_trial
                 call self%newton_full%solve(unknowns, stats, error)
                 iterations = iterations + stats%iterations
-                if (allocated(error)) return
+                if (allocated(error)) then
+                    ! A fixed active set may have no solution nearby. Go back to the last
+                    ! solved state and let fewer passages start slipping at once (half as
+                    ! many, most violated first); without such a state, restart from
+                    ! all-stick (the elastic problem, which has a solution).
+                    if (have_good) then
+                        if (new_slips <= 1) return
+                        cap = max(1, new_slips / 2)
+                        deallocate(error)
+                        unknowns = good_unknowns
+                        self%mode_trial = good_mode
+                        flips = good_flips
+                        call problem%update_state(unknowns, error)
+                        if (allocated(error)) return
+                        call update_active_set(problem, unknowns(n_x + 1:), self%flow, &
+                            self%mode_trial, flips, locked_forward, locked_backward, changed, &
+                            cap, new_slips)
+                        cycle
+                    end if
+                    if (all(self%mode_trial == mode_stick)) return
+                    deallocate(error)
+                    self%mode_trial = mode_stick
+                    unknowns = [self%u, self%flow]
+                    cycle
+                end if
                 call problem%update_state(unknowns, error)
                 if (allocated(error)) return
                 if (problem%semismooth) then
                     call problem%choose_modes(unknowns(n_x + 1:))
                     self%mode_trial = problem%mode
                 end if
+                have_good = .true.
+                good_unknowns = unknowns
+                good_mode = self%mode_trial
+                good_flips = flips
                 call update_active_set(problem, unknowns(n_x + 1:), self%flow, self%mode_trial, &
-                    flips, locked_forward, locked_backward, changed)
+                    flips, locked_forward, locked_backward, changed, cap, new_slips)
                 if (changed == 0) then
                     self%u_trial = unknowns(1:n_x)
                     self%flow_trial = unknowns(n_x + 1:)
@@ -192,7 +223,7 @@ contains
         real(wp), allocatable :: residual(:)
         integer, allocatable :: flips(:), mode_before(:)
         logical, allocatable :: locked_forward(:), locked_backward(:)
-        integer :: round, inner, changed
+        integer :: round, inner, changed, new_slips
         real(wp) :: residual_norm
 
         associate(scene => self%scene, elastic => self%elastic, sliding => self%sliding)
@@ -231,7 +262,8 @@ contains
                         self%mode_trial = sliding%mode
                     end if
                     call update_active_set(sliding, self%flow_trial, self%flow, &
-                        self%mode_trial, flips, locked_forward, locked_backward, changed)
+                        self%mode_trial, flips, locked_forward, locked_backward, changed, &
+                        huge(1), new_slips)
                     if (changed == 0) exit
                 end do
                 if (changed /= 0) then
@@ -260,21 +292,33 @@ contains
     !> was called at the solution). `flow` are the solved flows, `accepted` those at the
     !> start of the step. Returns the number of passages whose mode changed.
     subroutine update_active_set(problem, flow, accepted, mode, flips, locked_forward, &
-            locked_backward, changed)
+            locked_backward, changed, max_new_slips, new_slips)
         type(friction_problem_type), intent(inout) :: problem
         real(wp), intent(in) :: flow(:), accepted(:)
         integer, intent(inout) :: mode(:), flips(:)
         logical, intent(inout) :: locked_forward(:), locked_backward(:)
         integer, intent(out) :: changed
-        integer :: p, new_mode, before, after
+        !> At most this many stick passages start to slip (the most violated first).
+        integer, intent(in) :: max_new_slips
+        !> How many did.
+        integer, intent(out) :: new_slips
+        integer :: p, new_mode, before, after, n_candidates, k
         real(wp) :: t_before, t_after, angle, critical, d1, d2, slack, tol, min_before, min_after
         real(wp) :: increment
+        integer, allocatable :: candidate(:), direction(:)
+        real(wp), allocatable :: violation(:)
 
         associate(scene => problem%scene, passages => problem%scene%passages)
             tol = scene%solver%friction_tolerance
-            ! Absolute slack: the equilibrium residual's noise level.
-            slack = 10 * scene%solver%residual_tolerance * scene%force_scale
+            ! Absolute slack: the equilibrium residual's noise level, and the tension of
+            ! slack strings (regularisation spring): a passage whose higher tension is
+            ! below that has nothing to slide it, and its sliding would be undetermined.
+            slack = max(10 * scene%solver%residual_tolerance, &
+                10 * scene%solver%slack_stiffness) * scene%force_scale
             changed = 0
+            new_slips = 0
+            n_candidates = 0
+            allocate(candidate(size(mode)), direction(size(mode)), violation(size(mode)))
             do p = 1, size(mode)
                 if (flips(p) > max_flips) cycle
                 before = passages%element_before(p)
@@ -297,11 +341,13 @@ contains
                         call law%get_critical_tension(t_before, angle, critical, d1, d2)
                         if (t_after > critical * (1 + tol) + slack .and. &
                                 .not. locked_forward(p)) then
-                            new_mode = mode_forward
+                            call add_candidate(mode_forward, (t_after - critical) &
+                                / (critical + slack))
                         else
                             call law%get_critical_tension(t_after, angle, critical, d1, d2)
                             if (t_before > critical * (1 + tol) + slack .and. &
-                                    .not. locked_backward(p)) new_mode = mode_backward
+                                    .not. locked_backward(p)) call add_candidate( &
+                                mode_backward, (t_before - critical) / (critical + slack))
                         end if
                     end associate
                 case (mode_forward)
@@ -322,17 +368,37 @@ contains
                         problem%flow_target(p) = flow(p) - (problem%length0(after) - min_after)
                     end if
                 end select
-                if (new_mode /= mode(p)) then
-                    mode(p) = new_mode
-                    flips(p) = flips(p) + 1
-                    changed = changed + 1
-                    if (flips(p) > max_flips) then
-                        mode(p) = mode_stick
-                        problem%locked(p) = locked_both
-                    end if
-                end if
+                call set_mode(p, new_mode)
+            end do
+            ! Stick passages that start to slip: the most violated first, up to the cap.
+            do k = 1, min(n_candidates, max_new_slips)
+                p = maxloc(violation(1:n_candidates), dim=1)
+                call set_mode(candidate(p), direction(p))
+                violation(p) = -huge(1.0_wp)
+                new_slips = new_slips + 1
             end do
         end associate
+    contains
+        subroutine add_candidate(new_direction, measure)
+            integer, intent(in) :: new_direction
+            real(wp), intent(in) :: measure
+            n_candidates = n_candidates + 1
+            candidate(n_candidates) = p
+            direction(n_candidates) = new_direction
+            violation(n_candidates) = measure
+        end subroutine add_candidate
+
+        subroutine set_mode(passage, new_mode)
+            integer, intent(in) :: passage, new_mode
+            if (new_mode == mode(passage)) return
+            mode(passage) = new_mode
+            flips(passage) = flips(passage) + 1
+            changed = changed + 1
+            if (flips(passage) > max_flips) then
+                mode(passage) = mode_stick
+                problem%locked(passage) = locked_both
+            end if
+        end subroutine set_mode
     end subroutine update_active_set
 
     subroutine not_settled(error, rounds, flips)
