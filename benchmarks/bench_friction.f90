@@ -58,6 +58,7 @@ program bench_friction
     use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
     use yarnfort_solver_timer, only: wall_time
     use bench_friction_counter, only: counter_type
+    use bench_common, only: peak_memory_mib, fail
     implicit none
 
     type(config_type) :: config
@@ -86,13 +87,13 @@ program bench_friction
     call make_woven_net(config, side, per_segment, scheme)
     if (command_argument_count() >= 4) call get_command_argument(4, config%solver%linear_solver)
     call new_scene(scene, config, error)
-    if (allocated(error)) call fail(error)
+    if (allocated(error)) call fail('bench_friction', error)
     call new_friction_stepper(stepper, scene, get_linear_solver_name(scene), error)
-    if (allocated(error)) call fail(error)
+    if (allocated(error)) call fail('bench_friction', error)
     start = wall_time()
     call run_continuation(scene, stepper, counter, error)
     total = wall_time() - start
-    if (allocated(error)) call fail(error)
+    if (allocated(error)) call fail('bench_friction', error)
     times = 0.0_wp
     factorisations = 0
     call stepper%newton_full%get_timings(times(1, 1), times(1, 2), times(1, 3), times(1, 4), &
@@ -208,27 +209,5 @@ contains
         if (command_argument_count() >= 5) config%solver%line_search = .false.
     end subroutine make_woven_net
 
-    real(wp) function peak_memory_mib()
-        character(len=256) :: line
-        integer :: unit, status, kib
-        peak_memory_mib = -1.0_wp
-        open(newunit=unit, file='/proc/self/status', action='read', iostat=status)
-        if (status /= 0) return
-        do
-            read(unit, '(a)', iostat=status) line
-            if (status /= 0) exit
-            if (line(1:6) == 'VmHWM:') then
-                read(line(7:), *) kib
-                peak_memory_mib = kib / 1024.0_wp
-            end if
-        end do
-        close(unit)
-    end function peak_memory_mib
-
-    subroutine fail(error)
-        type(error_type), intent(in) :: error
-        write(error_unit, '(a)') 'bench_friction: ' // error%message
-        error stop 1
-    end subroutine fail
 
 end program bench_friction

@@ -17,6 +17,7 @@ program bench_newton
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_timer, only: wall_time
+    use bench_common, only: peak_memory_mib, fail
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
@@ -47,21 +48,21 @@ program bench_newton
 
     call make_cable_net(config, side, setup_calls, solver_name)
     call new_scene(scene, config, error)
-    if (allocated(error)) call fail(error)
+    if (allocated(error)) call fail('bench_newton', error)
     call new_linear_solver(linear, trim(solver_name), error)
-    if (allocated(error)) call fail(error)
+    if (allocated(error)) call fail('bench_newton', error)
     call new_elastic_problem(problem, scene)
     problem%p_force = 1.0_wp
     problem%p_disp = 1.0_wp
     call new_newton_solver(newton, problem, linear, scene%solver, error)
-    if (allocated(error)) call fail(error)
+    if (allocated(error)) call fail('bench_newton', error)
     allocate(u(scene%dofs%n_unknowns))
     call scene%dofs%restrict(scene%network%position, u)
 
     start = wall_time()
     call newton%solve(u, stats, error)
     total = wall_time() - start
-    if (allocated(error)) call fail(error)
+    if (allocated(error)) call fail('bench_newton', error)
     call newton%get_timings(t_residual, t_jacobian, t_analyse, t_factor, t_solve, n_factor)
     iterations = max(stats%iterations, 1)
     other = total - (t_residual + t_jacobian + t_analyse + t_factor + t_solve)
@@ -144,27 +145,5 @@ contains
         config%solver%max_iterations = 200
     end subroutine make_cable_net
 
-    real(wp) function peak_memory_mib()
-        character(len=256) :: line
-        integer :: unit, status, kib
-        peak_memory_mib = -1.0_wp
-        open(newunit=unit, file='/proc/self/status', action='read', iostat=status)
-        if (status /= 0) return
-        do
-            read(unit, '(a)', iostat=status) line
-            if (status /= 0) exit
-            if (line(1:6) == 'VmHWM:') then
-                read(line(7:), *) kib
-                peak_memory_mib = kib / 1024.0_wp
-            end if
-        end do
-        close(unit)
-    end function peak_memory_mib
-
-    subroutine fail(error)
-        type(error_type), intent(in) :: error
-        write(error_unit, '(a)') 'bench_newton: ' // error%message
-        error stop 1
-    end subroutine fail
 
 end program bench_newton
