@@ -31,6 +31,8 @@ module yarnfort_contact_friction_stepper
 
     public :: friction_stepper_type, new_friction_stepper
 
+    !> Bounds of the staggered scheme's Aitken relaxation factor.
+    real(wp), parameter :: min_relaxation = 0.1_wp, max_relaxation = 100.0_wp
     !> Flips of one passage's mode in a step before it is held in stick.
     integer, parameter :: max_flips = 6
 
@@ -224,7 +226,9 @@ contains
         integer, allocatable :: flips(:), mode_before(:)
         logical, allocatable :: locked_forward(:), locked_backward(:)
         integer :: round, inner, changed, new_slips
-        real(wp) :: residual_norm
+        real(wp) :: residual_norm, omega, denominator
+        real(wp), allocatable :: flow_in(:), update(:), update_previous(:)
+        logical :: relax
 
         associate(scene => self%scene, elastic => self%elastic, sliding => self%sliding)
             elastic%p_force = self%p_force_trial
@@ -238,8 +242,11 @@ contains
                 source=.false.)
             allocate(residual(scene%dofs%n_unknowns))
             iterations = 0
+            omega = 1.0_wp
+            relax = .false.
             do round = 1, scene%solver%max_friction_iterations
                 ! (1) Elastic step: reference lengths frozen.
+                flow_in = self%flow_trial
                 call scene%passages%get_length0(scene%network%length0, self%flow_trial, &
                     elastic%length0)
                 if (scene%dofs%n_unknowns > 0) then
@@ -282,6 +289,30 @@ contains
                     self%n_damped = count(flips > max_flips)
                     return
                 end if
+                ! (4) Aitken relaxation of the flow update while the active set holds: the
+                ! plain alternation contracts by a factor close to 1 when contact nodes
+                ! are free (the elastic step moves them along the yarn and undoes most of
+                ! the sliding), and Aitken's secant estimate of that factor removes most
+                ! of it. Reset to the plain update whenever the active set changes.
+                update = self%flow_trial - flow_in
+                if (relax .and. all(self%mode_trial == mode_before)) then
+                    denominator = sum((update - update_previous)**2)
+                    if (denominator > 0.0_wp) omega = -omega &
+                        * sum(update_previous * (update - update_previous)) / denominator
+                    omega = max(min_relaxation, min(max_relaxation, omega))
+                else
+                    omega = 1.0_wp
+                end if
+                relax = all(self%mode_trial == mode_before)
+                update_previous = update
+                if (omega /= 1.0_wp) then
+                    ! Never relax an element below its minimum reference length.
+                    call scene%passages%get_length0(scene%network%length0, &
+                        flow_in + omega * update, elastic%length0)
+                    if (any(elastic%length0 < scene%solver%min_length_ratio &
+                            * scene%network%length0)) omega = 1.0_wp
+                end if
+                self%flow_trial = flow_in + omega * update
             end do
             call fatal_error(error, 'staggered scheme: elastic and sliding steps did not agree &
                 &within max_friction_iterations rounds')
