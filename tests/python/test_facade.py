@@ -193,8 +193,11 @@ def test_run_scene_bad_input_raises(tmp_path):
 
 def test_failed_solve_raises_and_keeps_the_converged_steps(tmp_path):
     folder = tmp_path / "out"
-    # One Newton iteration cannot reach the default tolerance on a loaded step.
-    path = scene_in(tmp_path, folder, "    max_iterations = 1\n    max_step_cuts = 0\n")
+    # One Newton iteration cannot reach the default tolerance on a loaded step. The
+    # exact tension-only law (slack_stiffness = 0) keeps the unloaded state 0 exactly in
+    # equilibrium, so the first step converges and the second fails.
+    path = scene_in(tmp_path, folder,
+                    "    max_iterations = 1\n    max_step_cuts = 0\n    slack_stiffness = 0.0\n")
     with pytest.raises(YarnfortError, match="^solve: ") as info:
         yarnfort.run_scene(path)
     assert info.value.status == 1
