@@ -11,6 +11,7 @@ module yarnfort_assembly_assemble
     private
 
     public :: assemble_internal_force, assemble_residual, assemble_jacobian
+    public :: add_element_tangents
 
     !> Elements shorter than this fraction of their reference length are degenerate.
     real(wp), parameter :: degenerate_length_ratio = 1.0e-12_wp
@@ -64,10 +65,22 @@ contains
         real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
+
+        values = 0.0_wp
+        call add_element_tangents(scene, pattern%element_slot, x, length0, values, error)
+    end subroutine assemble_jacobian
+
+    !> Add every element's 6x6 tangent to `values` at element_slot(a, b, e) (entries
+    !> a, b <= 6 of each element's slot table: node 1 xyz, node 2 xyz; 0 = skip).
+    subroutine add_element_tangents(scene, element_slot, x, length0, values, error)
+        type(scene_type), intent(in) :: scene
+        integer, intent(in) :: element_slot(:, :, :)
+        real(wp), intent(in) :: x(:, :), length0(:)
+        real(wp), intent(inout) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
         integer :: e, n1, n2, a, b, slot
         real(wp) :: force(3), block(3, 3), tension, stretch, sign_ab
 
-        values = 0.0_wp
         do e = 1, scene%network%n_elements()
             n1 = scene%network%element_nodes(1, e)
             n2 = scene%network%element_nodes(2, e)
@@ -78,14 +91,14 @@ contains
                 tension, stretch, force, block)
             do b = 1, 6
                 do a = 1, 6
-                    slot = pattern%element_slot(a, b, e)
+                    slot = element_slot(a, b, e)
                     if (slot == 0) cycle
                     sign_ab = merge(1.0_wp, -1.0_wp, (a <= 3) .eqv. (b <= 3))
                     values(slot) = values(slot) + sign_ab * block(mod(a - 1, 3) + 1, mod(b - 1, 3) + 1)
                 end do
             end do
         end do
-    end subroutine assemble_jacobian
+    end subroutine add_element_tangents
 
     subroutine check_length(scene, x, length0, e, error)
         type(scene_type), intent(in) :: scene

@@ -25,9 +25,9 @@ module yarnfort_contact_friction_problem
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_scene_scene, only: scene_type
-    use yarnfort_assembly_truss, only: get_truss_response, get_truss_tension
+    use yarnfort_assembly_truss, only: get_truss_tension
     use yarnfort_assembly_pattern, only: build_clique_pattern
-    use yarnfort_assembly_assemble, only: assemble_internal_force
+    use yarnfort_assembly_assemble, only: assemble_internal_force, add_element_tangents
     use yarnfort_contact_geometry, only: get_wrap_angle
     use yarnfort_solver_problem, only: nonlinear_problem_type
     implicit none
@@ -278,8 +278,8 @@ contains
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         integer :: e, p, n1, n2, a, b, slot
-        real(wp) :: force(3), block(3, 3), tension, stretch, dtension, c(3), length
-        real(wp) :: dforce_dl0(3), sign_ab
+        real(wp) :: tension, stretch, dtension, c(3), length
+        real(wp) :: dforce_dl0(3)
 
         call self%update_state(u, error)
         if (allocated(error)) return
@@ -293,25 +293,17 @@ contains
         values = 0.0_wp
         associate(scene => self%scene, net => self%scene%network)
             if (.not. self%positions_frozen) then
+                call add_element_tangents(scene, self%element_slot, self%x, self%length0, &
+                    values, error)
+                if (allocated(error)) return
                 do e = 1, net%n_elements()
                     n1 = net%element_nodes(1, e)
                     n2 = net%element_nodes(2, e)
-                    call get_truss_response(scene%laws(net%element_material(e))%law, &
-                        scene%solver%slack_stiffness, self%length0(e), self%x(:, n1), &
-                        self%x(:, n2), tension, stretch, force, block)
-                    do b = 1, 6
-                        do a = 1, 6
-                            slot = self%element_slot(a, b, e)
-                            if (slot == 0) cycle
-                            sign_ab = merge(1.0_wp, -1.0_wp, (a <= 3) .eqv. (b <= 3))
-                            values(slot) = values(slot) + sign_ab &
-                                * block(mod(a - 1, 3) + 1, mod(b - 1, 3) + 1)
-                        end do
-                    end do
                     ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2.
+                    length = norm2(self%x(:, n2) - self%x(:, n1))
+                    stretch = length / self%length0(e)
                     call get_truss_tension(scene%laws(net%element_material(e))%law, &
                         scene%solver%slack_stiffness, stretch, tension, dtension)
-                    length = norm2(self%x(:, n2) - self%x(:, n1))
                     c = (self%x(:, n2) - self%x(:, n1)) / length
                     dforce_dl0 = -c * dtension * stretch / self%length0(e)
                     do b = 7, 8
