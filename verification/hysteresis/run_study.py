@@ -7,7 +7,8 @@ coefficients and both the Coulomb and the adhesion law, with both friction schem
 and compares every converged step with the piecewise closed form derived there.
 Writes ``hysteresis.png`` next to this script and prints the error table.
 
-    YARNFORT_EXE=/work/main/build-hyst/yarnfort python verification/hysteresis/run_study.py
+    .venv/bin/python verification/hysteresis/run_study.py   (after ./yarnfort has built once;
+    YARNFORT_EXE picks another binary)
 """
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ TOP = HERE.parents[1]
 sys.path[:0] = [str(TOP / "tests" / "verification"), str(TOP / "python")]
 from test_hysteresis import Case, ClosedForm, compare, hysteresis_scene  # noqa: E402
 
-EXECUTABLE = Path(os.environ.get("YARNFORT_EXE", TOP / "build-hyst" / "yarnfort"))
+EXECUTABLE = Path(os.environ.get("YARNFORT_EXE", TOP / "build" / "yarnfort"))
 MUS = (0.1, 0.3, 0.6)
 BETA = 0.1                       #: adhesion (N) of the 'adhesion' runs
 MAX_STEP = 0.05                  #: 20 steps per half cycle
