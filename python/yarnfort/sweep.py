@@ -1,0 +1,393 @@
+# SPDX-License-Identifier: MIT
+"""Parameter sweeps: run one scene for many parameter values, in parallel.
+
+How runs are made
+-----------------
+Each run is the program ``build/yarnfort`` started as a subprocess (not the in-process
+f2py facade): one process per run keeps runs independent (no shared Fortran module
+state), lets a run that crashes or hangs fail alone (a row with its error, or a
+timeout), and parallelises the same way on local worker processes and on Dask workers.
+A run costs a process start (milliseconds) on top of the solve. Each run gets
+``OMP_NUM_THREADS=1`` unless the environment sets it (runs, not threads, share the cores).
+
+For every run the scene is read with f90nml, patched (the swept parameters, an own
+``&output`` folder, no progress lines) and written as ``input.nml`` into its own folder;
+the program reads it on standard input with the scene's folder as working directory, so
+relative file names of the scene (``table_file``, ``&geometry``) still resolve.
+
+Parameter addresses
+-------------------
+``'group.variable'`` for a group that appears once (``'solver.max_step'``) and
+``'group[i].variable'`` for the i-th (from 0) of a repeated group, in file order
+(``'contact[0].friction_coefficient'``). A group or variable missing from the scene is
+added. Addresses are checked before any run starts (:class:`ValueError`); a value the
+program rejects gives a row with status ``'bad_input'`` and its message.
+
+Dask
+----
+With ``scheduler='tcp://host:port'`` the tasks go through
+``distributed.Client(scheduler).get_executor()``. Workers must import this package
+(``yarnfort`` on their path) and see the program and the scene at the same paths.
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import itertools
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import f90nml
+import numpy as np
+
+from ._native import YarnfortError
+from .results import Curve, read_curve
+
+__all__ = ["run_sweep", "run_patched", "set_parameter", "executable", "parameter_grid"]
+
+#: Environment variable naming the yarnfort program (as in the test suite).
+EXECUTABLE_ENV = "YARNFORT_EXE"
+#: Seconds a single run may take before it is stopped and reported as failed.
+DEFAULT_TIMEOUT = 600.0
+#: Status of a row: success, failed solve (exit 1), bad input (exit 2), anything else.
+STATUS = {0: "ok", 1: "solve_failed", 2: "bad_input"}
+
+_TOP = Path(__file__).resolve().parents[2]
+_ADDRESS = re.compile(r"^\s*(\w+)\s*(?:\[\s*(\d+)\s*\])?\s*\.\s*(\w+)\s*$")
+_COMPONENTS = {"x": 0, "y": 1, "z": 2}
+
+
+def executable() -> Path:
+    """The yarnfort program: ``$YARNFORT_EXE``, else ``<top>/build/yarnfort``.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the program is not built.
+    """
+    path = Path(os.environ.get(EXECUTABLE_ENV, _TOP / "build" / "yarnfort"))
+    if not path.is_file():
+        raise FileNotFoundError(f"{path} is missing: build first (./yarnfort --version)")
+    return path.resolve()
+
+
+def set_parameter(scene: f90nml.Namelist, address: str, value: Any) -> None:
+    """Set one variable of a namelist in place.
+
+    Parameters
+    ----------
+    scene : f90nml.Namelist
+        The scene, as read by ``f90nml.read``.
+    address : str
+        ``'group.variable'`` or ``'group[i].variable'`` (i from 0, file order).
+    value
+        The new value (a number, string, bool or list).
+
+    Raises
+    ------
+    ValueError
+        For a malformed address, an index past the groups in the scene, or a repeated
+        group addressed without an index.
+    """
+    match = _ADDRESS.match(address)
+    if not match:
+        raise ValueError(f"parameter {address!r}: expected 'group.variable' or "
+                         "'group[i].variable'")
+    group, index, variable = match[1].lower(), match[2], match[3].lower()
+    if group not in scene:
+        if index not in (None, "0"):
+            raise ValueError(f"parameter {address!r}: the scene has no &{group}")
+        scene[group] = f90nml.Namelist()
+    groups = scene[group]
+    if isinstance(groups, f90nml.Namelist):
+        groups = [groups]
+    elif index is None:
+        raise ValueError(f"parameter {address!r}: &{group} appears {len(groups)} times; "
+                         f"name one as '{group}[i].{variable}'")
+    i = int(index or 0)
+    if i >= len(groups):
+        raise ValueError(f"parameter {address!r}: the scene has {len(groups)} &{group}")
+    groups[i][variable] = value.item() if isinstance(value, np.generic) else value
+
+
+def _patched_text(scene: f90nml.Namelist, values: Mapping[str, Any], folder: Path,
+                  vtk: bool) -> str:
+    """The scene with ``values`` set and its output sent to ``folder``, as text."""
+    patched = f90nml.reads(str(scene))  # an independent copy
+    for address, value in values.items():
+        set_parameter(patched, address, value)
+    set_parameter(patched, "output.folder", str(folder))
+    set_parameter(patched, "output.progress", False)
+    if not vtk:
+        set_parameter(patched, "output.vtk_every", 0)
+    return str(patched) + "\n"
+
+
+@dataclass(frozen=True)
+class _Task:
+    """One run, self-contained and picklable (sent to worker processes)."""
+
+    program: str
+    cwd: str
+    text: str
+    folder: str | None
+    support: str
+    component: int | None
+    timeout: float | None
+
+
+def _summary(curve: Curve, support: str, component: int | None) -> tuple[float, float]:
+    force = curve.reaction(support)
+    value = np.linalg.norm(force, axis=1) if component is None else force[:, component]
+    return float(value[-1]), float(value[np.argmax(np.abs(value))])
+
+
+def _execute(task: _Task) -> dict[str, Any]:
+    """Run one task and summarise it; never raises (errors become the row's message)."""
+    start = time.perf_counter()
+    row: dict[str, Any] = {"status": "error", "error": "", "n_steps": 0,
+                           "final_reaction": np.nan, "max_reaction": np.nan}
+    owned = task.folder is None
+    folder = Path(tempfile.mkdtemp(prefix="yarnfort-run-")) if owned else Path(task.folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        text = task.text.replace("@FOLDER@", str(folder / "out"))
+        (folder / "input.nml").write_text(text)
+        env = dict(os.environ)
+        env.setdefault("OMP_NUM_THREADS", "1")  # one core per run: runs are the parallelism
+        proc = subprocess.run([task.program], input=text, capture_output=True, text=True,
+                              cwd=task.cwd, timeout=task.timeout, env=env)
+        row["status"] = STATUS.get(proc.returncode, "error")
+        if proc.returncode != 0:
+            lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
+            row["error"] = lines[-1] if lines else f"exit code {proc.returncode}"
+        curve_file = folder / "out" / "curve.csv"
+        if curve_file.is_file():
+            curve = read_curve(curve_file)
+            row["n_steps"] = len(curve["step"])
+            if proc.returncode == 0:
+                row["final_reaction"], row["max_reaction"] = _summary(
+                    curve, task.support, task.component)
+    except subprocess.TimeoutExpired:
+        row["status"], row["error"] = "error", f"timed out after {task.timeout} s"
+    except Exception as error:  # noqa: BLE001 - a row reports any failure of its run
+        row["status"], row["error"] = "error", f"{type(error).__name__}: {error}"
+    finally:
+        if owned:
+            shutil.rmtree(folder, ignore_errors=True)
+    row["wall_time"] = time.perf_counter() - start
+    return row
+
+
+def run_patched(scene_path: str | os.PathLike, values: Mapping[str, Any],
+                folder: str | os.PathLike, *, timeout: float | None = DEFAULT_TIMEOUT,
+                vtk: bool = False) -> Curve:
+    """Run the scene once with some parameters changed and return its curve.
+
+    Parameters
+    ----------
+    scene_path : path
+        The namelist file of the scene.
+    values : mapping
+        Parameter address -> value (see the module notes).
+    folder : path
+        Folder for ``input.nml`` and the output folder ``out/``.
+    timeout : float or None
+        Seconds before the run is stopped.
+    vtk : bool
+        Also write the VTK states.
+
+    Returns
+    -------
+    Curve
+        The run's ``curve.csv``.
+
+    Raises
+    ------
+    YarnfortError
+        If the program fails (status 1 failed solve, 2 bad input); the message is the
+        program's.
+    """
+    scene_path = Path(scene_path).resolve()
+    scene = f90nml.read(scene_path)
+    folder = Path(folder).resolve()
+    text = _patched_text(scene, values, folder / "out", vtk)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "input.nml").write_text(text)
+    try:
+        proc = subprocess.run([str(executable())], input=text, capture_output=True,
+                              text=True, cwd=scene_path.parent, timeout=timeout)
+    except subprocess.TimeoutExpired as error:
+        raise YarnfortError(f"timed out after {timeout} s", 1) from error
+    if proc.returncode != 0:
+        lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
+        raise YarnfortError(lines[-1] if lines else f"exit code {proc.returncode}",
+                            proc.returncode)
+    return read_curve(folder / "out")
+
+
+def parameter_grid(parameters: Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]]
+                   ) -> list[dict[str, Any]]:
+    """The runs of a sweep: the Cartesian product of a dict of lists (first key varies
+    slowest), or an explicit list of dicts, as a list of dicts."""
+    if isinstance(parameters, Mapping):
+        names = list(parameters)
+        return [dict(zip(names, combo))
+                for combo in itertools.product(*(list(parameters[n]) for n in names))]
+    return [dict(values) for values in parameters]
+
+
+def _column(values: list[Any]) -> np.ndarray:
+    try:
+        column = np.array(values)
+    except ValueError:
+        column = np.empty(len(values), dtype=object)
+        column[:] = values
+    return column if column.ndim == 1 else np.array(values, dtype=object)
+
+
+def _first_support(scene: f90nml.Namelist) -> str:
+    groups = scene.get("support")
+    if groups is None:
+        raise ValueError("the scene has no &support: name the reaction's support")
+    first = groups if isinstance(groups, f90nml.Namelist) else groups[0]
+    return str(first["name"])
+
+
+class _Progress:
+    """tqdm on stderr when installed, else a plain counter line."""
+
+    def __init__(self, total: int, enabled: bool) -> None:
+        self.total, self.done, self.enabled, self.bar = total, 0, enabled, None
+        if enabled:
+            try:
+                from tqdm import tqdm
+                self.bar = tqdm(total=total, desc="yarnfort sweep", unit="run",
+                                file=sys.stderr)
+            except ImportError:
+                pass
+
+    def update(self) -> None:
+        self.done += 1
+        if self.bar is not None:
+            self.bar.update(1)
+        elif self.enabled:
+            end = "\n" if self.done == self.total else ""
+            print(f"\ryarnfort sweep: {self.done}/{self.total} runs", end=end,
+                  file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _run_tasks(tasks: list[_Task], executor: cf.Executor, progress: _Progress
+               ) -> list[dict[str, Any]]:
+    futures = {executor.submit(_execute, task): i for i, task in enumerate(tasks)}
+    rows: list[dict[str, Any]] = [{} for _ in tasks]
+    for future in cf.as_completed(futures):
+        i = futures[future]
+        try:
+            rows[i] = future.result()
+        except Exception as error:  # noqa: BLE001 - e.g. a lost worker
+            rows[i] = {"status": "error", "error": f"{type(error).__name__}: {error}",
+                       "n_steps": 0, "final_reaction": np.nan, "max_reaction": np.nan,
+                       "wall_time": np.nan}
+        progress.update()
+    return rows
+
+
+def run_sweep(scene_path: str | os.PathLike,
+              parameters: Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]], *,
+              workers: int | None = None, scheduler: str | None = None,
+              progress: bool = True, support: str | None = None,
+              component: str | int | None = None, work_dir: str | os.PathLike | None = None,
+              timeout: float | None = DEFAULT_TIMEOUT, vtk: bool = False
+              ) -> dict[str, np.ndarray]:
+    """Run a scene for each parameter combination and tabulate the outcomes.
+
+    Parameters
+    ----------
+    scene_path : path
+        The namelist file of the scene.
+    parameters : dict of lists, or list of dicts
+        Address -> values: every combination is run (grid, first key slowest). Or an
+        explicit list of runs, each a dict address -> value (same keys in each).
+    workers : int, optional
+        Local worker processes (default: the CPU count). Ignored with ``scheduler``.
+    scheduler : str, optional
+        Address of a Dask distributed scheduler (``'tcp://host:port'``): run there.
+    progress : bool
+        Show a progress bar on stderr.
+    support : str, optional
+        Support set whose reaction is summarised (default: the scene's first &support).
+    component : {'x', 'y', 'z', 0, 1, 2}, optional
+        Reaction component summarised; default the magnitude |R|.
+    work_dir : path, optional
+        Keep each run's ``input.nml`` and ``out/`` in ``work_dir/run_NNNNN``; by default
+        each run uses a temporary folder removed afterwards.
+    timeout : float or None
+        Seconds a run may take before it is stopped and reported as failed.
+    vtk : bool
+        Write the VTK states too (off by default: the table needs only the curve).
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        One entry per run, in the order of the runs: a column per parameter address, and
+        ``status`` (``'ok'``, ``'solve_failed'``, ``'bad_input'`` or ``'error'``),
+        ``error`` (the program's message, ``''`` when ok), ``n_steps`` (converged steps
+        written, initial state included), ``final_reaction`` and ``max_reaction`` (the
+        summarised reaction at the last step and the one of largest magnitude, N; NaN for
+        a failed run), ``wall_time`` (s, per run, process start included).
+
+    Raises
+    ------
+    ValueError
+        For a malformed parameter address or an unknown component; the program's
+        failures do not raise (they are rows).
+    FileNotFoundError
+        If the program is not built.
+    """
+    scene_path = Path(scene_path).resolve()
+    scene = f90nml.read(scene_path)
+    runs = parameter_grid(parameters)
+    names = list(dict.fromkeys(name for run in runs for name in run))
+    support = support or _first_support(scene)
+    if isinstance(component, str):
+        if component.lower() not in _COMPONENTS:
+            raise ValueError(f"component {component!r}: expected 'x', 'y' or 'z'")
+        component = _COMPONENTS[component.lower()]
+    elif component is not None and component not in (0, 1, 2):
+        raise ValueError(f"component {component!r}: expected 0, 1 or 2")
+    program = str(executable())
+    tasks = []
+    for i, run in enumerate(runs):
+        folder = None if work_dir is None else str(Path(work_dir).resolve() / f"run_{i:05d}")
+        text = _patched_text(scene, run, Path("@FOLDER@"), vtk)
+        tasks.append(_Task(program, str(scene_path.parent), text, folder, support,
+                           component, timeout))
+    bar = _Progress(len(tasks), progress)
+    try:
+        if scheduler is not None:
+            from distributed import Client
+            with Client(scheduler) as client:
+                rows = _run_tasks(tasks, client.get_executor(), bar)
+        else:
+            with cf.ProcessPoolExecutor(max_workers=workers) as executor:
+                rows = _run_tasks(tasks, executor, bar)
+    finally:
+        bar.close()
+    table = {name: _column([run.get(name) for run in runs]) for name in names}
+    for key in ("status", "error", "n_steps", "final_reaction", "max_reaction",
+                "wall_time"):
+        table[key] = np.array([row[key] for row in rows])
+    return table

@@ -1,0 +1,102 @@
+# SPDX-License-Identifier: MIT
+"""Tests of yarnfort.sweep: parameter grids over the capstan scene, on local worker
+processes, serially, and on a real local Dask cluster."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from yarnfort.sweep import executable, parameter_grid, run_sweep
+
+TOP = Path(__file__).resolve().parents[2]
+CAPSTAN = TOP / "inputs" / "capstan.nml"
+MU = "contact[0].friction_coefficient"
+BETA = "contact[0].adhesion"
+#: A 2x2 grid; coarse steps keep every run to a few milliseconds.
+GRID = {MU: [0.1, 0.5], BETA: [0.02, 0.08], "solver.max_step": [0.1]}
+#: Columns that must agree between two executions of one sweep (wall time does not).
+SAME = ("status", "error", "n_steps", "final_reaction", "max_reaction")
+#: The same program on the same input is deterministic: only I/O rounding may differ.
+IDENTITY = 100 * np.finfo(float).eps
+
+
+@pytest.fixture(scope="module", autouse=True)
+def program() -> Path:
+    try:
+        return executable()
+    except FileNotFoundError as error:
+        pytest.fail(str(error))
+
+
+@pytest.fixture(scope="module")
+def local_table() -> dict[str, np.ndarray]:
+    return run_sweep(CAPSTAN, GRID, workers=2, progress=False, support="pull",
+                     component="y")
+
+
+def assert_same_table(actual: dict, expected: dict) -> None:
+    assert list(actual) == list(expected)
+    for key in [*parameter_grid(GRID)[0], *SAME]:
+        if actual[key].dtype.kind == "f":
+            np.testing.assert_allclose(actual[key], expected[key], rtol=IDENTITY)
+        else:
+            np.testing.assert_array_equal(actual[key], expected[key])
+
+
+def test_grid_gives_one_ok_row_per_combination(local_table):
+    assert len(local_table["status"]) == 4
+    assert list(local_table["status"]) == ["ok"] * 4
+    np.testing.assert_array_equal(local_table[MU], [0.1, 0.1, 0.5, 0.5])
+    np.testing.assert_array_equal(local_table[BETA], [0.02, 0.08, 0.02, 0.08])
+    assert np.all(local_table["n_steps"] > 10)
+    assert np.all(local_table["wall_time"] > 0)
+
+
+def test_larger_friction_needs_a_larger_pull_force(local_table):
+    # The pull acts downwards (-y): compare magnitudes at each adhesion.
+    peak = np.abs(local_table["max_reaction"])
+    for beta in GRID[BETA]:
+        rows = local_table[BETA] == beta
+        order = np.argsort(local_table[MU][rows])
+        assert np.all(np.diff(peak[rows][order]) > 0)
+
+
+def test_parallel_sweep_equals_serial_sweep(local_table):
+    serial = run_sweep(CAPSTAN, GRID, workers=1, progress=False, support="pull",
+                       component="y")
+    assert_same_table(local_table, serial)
+
+
+def test_bad_value_gives_an_error_row_and_the_other_runs_still_finish():
+    runs = [{MU: 0.3}, {MU: -1.0}, {MU: 0.3, "solver.max_step": "fast"}, {MU: 0.6}]
+    table = run_sweep(CAPSTAN, runs, workers=2, progress=False, support="pull")
+    assert list(table["status"]) == ["ok", "bad_input", "bad_input", "ok"]
+    assert "friction_coefficient" in table["error"][1]
+    assert "max_step" in table["error"][2]
+    assert table["error"][0] == "" and np.isnan(table["max_reaction"][1])
+    assert table["solver.max_step"][0] is None  # not set in that run
+
+
+def test_malformed_address_is_rejected_before_any_run():
+    with pytest.raises(ValueError, match="contact"):
+        run_sweep(CAPSTAN, {"contact[3].adhesion": [0.1]}, progress=False)
+    with pytest.raises(ValueError, match="appears 3 times"):
+        run_sweep(CAPSTAN, {"support.nodes": [1]}, progress=False)
+
+
+def test_kept_run_folders_hold_the_patched_input(tmp_path):
+    run_sweep(CAPSTAN, {MU: [0.25]}, workers=1, progress=False, work_dir=tmp_path)
+    text = (tmp_path / "run_00000" / "input.nml").read_text()
+    assert "friction_coefficient = 0.25" in text
+    assert (tmp_path / "run_00000" / "out" / "curve.csv").is_file()
+
+
+def test_dask_cluster_gives_the_same_table(local_table):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
+                                  dashboard_address=None) as cluster:
+        table = run_sweep(CAPSTAN, GRID, scheduler=cluster.scheduler_address,
+                          progress=False, support="pull", component="y")
+    assert_same_table(table, local_table)
