@@ -1,0 +1,142 @@
+# SPDX-License-Identifier: MIT
+"""Command line: ``python -m yarnfort plot <output folder> [--support NAME] [--out FILE]``.
+
+Writes a PNG with the force–displacement (hysteresis) plot of one support set and the
+final deformed network coloured by tension. Exit codes: 0 success, 2 bad arguments, a
+missing or unreadable output folder, or an unknown support set.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .namelist import read_scene
+from .results import Curve, read_curve, read_states
+
+# matplotlib (through .plots) is imported only once a plot is to be made, so that
+# --help and argument errors answer quickly.
+
+#: Exit code for bad arguments or unusable inputs (as the Fortran program).
+EXIT_BAD_INPUT = 2
+#: File name of the default plot inside the output folder.
+DEFAULT_PLOT = "plot.png"
+
+
+class CommandError(Exception):
+    """A problem reported as a message on stderr and exit code 2."""
+
+
+def _moving_supports(folder: Path) -> list[str]:
+    """Support sets with a non-zero prescribed displacement in the effective input."""
+    scene_file = folder / "input.nml"
+    if not scene_file.is_file():
+        return []
+    try:
+        scene = read_scene(scene_file)
+    except Exception:  # an unreadable input.nml only loses the hint
+        return []
+    found = scene.get("support", [])
+    groups = list(found) if isinstance(found, list) else [found]
+    return [str(group["name"]) for group in groups
+            if "name" in group and np.any(np.asarray(group.get("displacement", 0.0)) != 0)]
+
+
+def choose_support(curve: Curve, folder: Path, name: str | None = None) -> str:
+    """``name`` if given (it must exist), else the first support set that moves, else
+    the first with a non-zero reaction, else the first."""
+    from .plots import supports
+
+    known = supports(curve)
+    if not known:
+        raise CommandError(f"{folder / 'curve.csv'} has no support reaction columns")
+    if name is not None:
+        if name not in known:
+            raise CommandError(f"unknown support {name!r}; the supports are: "
+                               + ", ".join(known))
+        return name
+    for moving in _moving_supports(folder):
+        if moving in known:
+            return moving
+    for support in known:
+        if np.any(curve.reaction(support) != 0):
+            return support
+    return known[0]
+
+
+def _dominant_component(curve: Curve, support: str) -> str:
+    reaction = np.abs(curve.reaction(support))
+    return "xyz"[int(np.argmax(reaction.max(axis=0)))] if reaction.size else "y"
+
+
+def _dominant_projection(position: np.ndarray) -> str:
+    extent = np.ptp(position, axis=0)
+    keep = sorted(np.argsort(extent)[1:])
+    return "xyz"[keep[0]] + "xyz"[keep[1]]
+
+
+def plot_folder(folder: Path, support: str | None = None, out: Path | None = None) -> Path:
+    """Write the summary plot of an output folder; returns the PNG path."""
+    if not folder.is_dir():
+        raise CommandError(f"no output folder {str(folder)!r}")
+    if not (folder / "curve.csv").is_file():
+        raise CommandError(f"{str(folder)!r} holds no curve.csv: not a yarnfort output"
+                           " folder")
+    from matplotlib.figure import Figure
+
+    from .plots import plot_hysteresis, plot_network, save_figure
+
+    curve = read_curve(folder)
+    name = choose_support(curve, folder, support)
+    component = _dominant_component(curve, name)
+    x = "p_disp" if np.ptp(curve["p_disp"]) > 0 else "p_force"
+    states = read_states(folder)
+
+    figure = Figure(figsize=(11, 4.5), layout="constrained")
+    left, right = figure.subplots(1, 2)
+    plot_hysteresis(curve, name, component=component, x=x, ax=left)
+    left.set_title(f"reaction of '{name}'")
+    if states:
+        final = states[-1]
+        plot_network(final, ax=right, projection=_dominant_projection(final.position))
+        right.set_title(f"final state (step {int(curve['step'][-1])})")
+    else:
+        right.set_axis_off()
+        right.text(0.5, 0.5, "no states written", ha="center", va="center")
+    return save_figure(figure, out if out is not None else folder / DEFAULT_PLOT)
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m yarnfort",
+        description="yarnfort result tools: plot a run's output folder.")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    plot = commands.add_parser(
+        "plot", help="write a PNG: force-displacement loop and final network",
+        description="Write a PNG with the force-displacement (hysteresis) plot of a"
+        " support set and the final deformed network coloured by tension.")
+    plot.add_argument("folder", type=Path, help="output folder of a run (holds curve.csv)")
+    plot.add_argument("--support", metavar="NAME",
+                      help="support set to plot (default: the first that moves)")
+    plot.add_argument("--out", type=Path, metavar="FILE",
+                      help=f"PNG to write (default: <folder>/{DEFAULT_PLOT})")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "plot":
+            path = plot_folder(args.folder, args.support, args.out)
+            print(f"yarnfort: wrote {path}")
+    except (CommandError, OSError, ValueError) as error:
+        print(f"yarnfort {args.command}: error: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
