@@ -10,7 +10,7 @@ module yarnfort_input_config
     public :: config_type, control_config_type, solver_config_type, material_config_type
     public :: yarn_config_type, support_config_type, load_config_type, path_config_type
     public :: output_config_type, geometry_config_type, name_length, path_length
-    public :: contact_config_type
+    public :: contact_config_type, fabric_config_type, link_config_type
 
     integer, parameter :: name_length = 64
     integer, parameter :: path_length = 512
@@ -20,6 +20,12 @@ module yarnfort_input_config
         character(len=256) :: title = ''
         !> Stop after reading and checking the input (no solve, no output).
         logical :: check_only = .false.
+        !> Continue from the restart file of the &output folder (its last converged step)
+        !> instead of starting at the first knot.
+        logical :: restart = .false.
+        !> Stop after this many converged load steps of this run (0: no limit); a later
+        !> run with restart = .true. goes on from there.
+        integer :: max_steps = 0
     end type control_config_type
 
     !> &solver: nonlinear and linear solver settings, continuation step control.
@@ -80,6 +86,9 @@ module yarnfort_input_config
         !> table: CSV file of (strain, force in N), relative to the input file's folder
         !> or the working directory.
         character(len=path_length) :: table_file = ''
+        !> Pre-stress (N): the tension every element of this yarn type carries in the
+        !> initial geometry; its reference length L0 is chosen so (0: stress-free).
+        real(wp) :: prestress = 0.0_wp
     end type material_config_type
 
     !> &yarn: one yarn, a polyline through node ids, split into elements.
@@ -133,6 +142,62 @@ module yarnfort_input_config
         logical :: residual_history = .false.
     end type output_config_type
 
+    !> &fabric: a generated fabric (knitted with inlay, or woven) instead of &nodes,
+    !> &yarn and &support groups. Geometry and parameters: inputs/REFERENCE.md.
+    type :: fabric_config_type
+        !> 'knit' (weft-knitted jersey, optional inlay), 'plain' or 'twill' (woven).
+        character(len=16) :: kind = ''
+        !> Repeats along x and y: wales x courses (knit); weft x warp yarns (woven).
+        integer :: cells(2) = [4, 4]
+        !> Repeat spacing along x and y (m): wale and course spacing; weft and warp
+        !> yarn spacing.
+        real(wp) :: spacing(2) = -1.0_wp
+        !> 'periodic' (a unit cell, eq. 53, with a macroscopic stretch) or 'clamped' (a
+        !> finite sample: left edge fixed, right edge pulled).
+        character(len=16) :: boundary = 'periodic'
+        !> Engineering strain along x at p_disp = 1 (1.0 stretches to twice the length).
+        real(wp) :: strain = 1.0_wp
+        !> Periodic: engineering strain of the y period at p_disp = 1 (prescribed).
+        real(wp) :: lateral_strain = 0.0_wp
+        !> Clamped: 'free' side edges, or 'rollers' (side-edge yarn ends held in y).
+        character(len=16) :: sides = 'free'
+        !> Elements per yarn segment between generated nodes.
+        integer :: elements_per_segment = 1
+        !> Knit: yarn type of the loops and of the inlay ('' = no inlay).
+        character(len=name_length) :: knit_material = ''
+        character(len=name_length) :: inlay_material = ''
+        !> Knit: width of a loop's head between its two contacts, as a fraction of the
+        !> wale spacing (the sinker between loops takes the rest). In this polygon model
+        !> a loop is 2*spacing(2) + spacing(1) long.
+        real(wp) :: head_width = 0.5_wp
+        !> Knit: an inlay yarn in every inlay_every-th course, crossing the loop legs at
+        !> inlay_offset * spacing(2) above the course line and the sinkers on it.
+        integer :: inlay_every = 1
+        real(wp) :: inlay_offset = 0.5_wp
+        !> Woven: yarn types along x (warp, the loaded direction) and y (weft).
+        character(len=name_length) :: warp_material = ''
+        character(len=name_length) :: weft_material = ''
+        !> Woven: distance between warp and weft axes at a crossing (m), kept by a
+        !> gap-holder (paper Fig. 12).
+        real(wp) :: gap = -1.0_wp
+        !> Woven: gap factor (multiplies gap) as a piecewise-linear function of the
+        !> displacement factor p_disp (paper Fig. 13b). Empty: factor 1.
+        real(wp), allocatable :: gap_factor_p_disp(:)
+        real(wp), allocatable :: gap_factor(:)
+    end type fabric_config_type
+
+    !> A node that follows another one: a periodic image (eq. 53) or the other side of
+    !> a gap-holder. Made by the fabric generators.
+    type :: link_config_type
+        integer :: follower = 0
+        integer :: leader = 0
+        !> follower = leader + offset + p_disp * strain * offset (componentwise), with
+        !> offset the initial difference of their positions; a gap link scales the
+        !> offset by the gap factor instead.
+        real(wp) :: strain(3) = 0.0_wp
+        logical :: gap = .false.
+    end type link_config_type
+
     !> The whole input.
     !> &contact: the friction law where yarns of two types cross (one group per pair;
     !> the pair is unordered and a type may pair with itself). Without any &contact
@@ -165,6 +230,13 @@ module yarnfort_input_config
         type(support_config_type), allocatable :: supports(:)
         type(load_config_type), allocatable :: loads(:)
         type(contact_config_type), allocatable :: contacts(:)
+        !> &fabric group (kind = '': none) and the links its generator made.
+        type(fabric_config_type) :: fabric
+        type(link_config_type), allocatable :: links(:)
+        !> Generated fabrics: width (m) across which the x force is carried, and the
+        !> support whose x reaction is the fabric's force (0: not a fabric).
+        real(wp) :: fabric_width = 0.0_wp
+        integer :: fabric_support = 0
         type(path_config_type) :: path
         type(output_config_type) :: output
         !> Not a namelist variable: the folder of the input file, against which relative

@@ -37,6 +37,8 @@ contains
         call put('&control')
         call put(indent // 'title = ' // quote_string(config%control%title))
         call put(indent // 'check_only = ' // format_logical(config%control%check_only))
+        call put(indent // 'restart = ' // format_logical(config%control%restart))
+        call put(indent // 'max_steps = ' // format_integer(config%control%max_steps))
         call put('/')
 
         associate(solver => config%solver)
@@ -73,6 +75,7 @@ contains
                     call put(indent // 'modulus = ' // format_real(material%modulus))
                     call put(indent // 'area = ' // format_real(material%area))
                     call put(indent // 'table_file = ' // quote_string(material%table_file))
+                    call put(indent // 'prestress = ' // format_real(material%prestress))
                     call put('/')
                 end associate
             end do
@@ -95,6 +98,64 @@ contains
             end do
         end if
 
+        if (len_trim(config%fabric%kind) > 0) then
+            call put_fabric()
+        else
+            call put_network()
+        end if
+
+        if (allocated(config%path%time)) then
+            call put('&path')
+            call put_reals('time', config%path%time)
+            if (allocated(config%path%p_force)) call put_reals('p_force', config%path%p_force)
+            if (allocated(config%path%p_disp)) call put_reals('p_disp', config%path%p_disp)
+            call put('/')
+        end if
+
+        associate(output => config%output)
+            call put('&output')
+            call put(indent // 'folder = ' // quote_string(output%folder))
+            call put(indent // 'vtk_every = ' // format_integer(output%vtk_every))
+            call put(indent // 'progress = ' // format_logical(output%progress))
+            call put(indent // 'residual_history = ' // format_logical(output%residual_history))
+            call put('/')
+        end associate
+
+    contains
+
+
+        !> The &fabric group (its generator makes the nodes, yarns and supports).
+        subroutine put_fabric()
+            associate(fabric => config%fabric)
+                call put('&fabric')
+                call put(indent // 'kind = ' // quote_string(fabric%kind))
+                call put(indent // 'cells = ' // format_integer(fabric%cells(1)) // ', ' &
+                    // format_integer(fabric%cells(2)))
+                call put(indent // 'spacing = ' // reals(fabric%spacing))
+                call put(indent // 'boundary = ' // quote_string(fabric%boundary))
+                call put(indent // 'strain = ' // format_real(fabric%strain))
+                call put(indent // 'lateral_strain = ' // format_real(fabric%lateral_strain))
+                call put(indent // 'sides = ' // quote_string(fabric%sides))
+                call put(indent // 'elements_per_segment = ' &
+                    // format_integer(fabric%elements_per_segment))
+                call put(indent // 'knit_material = ' // quote_string(fabric%knit_material))
+                call put(indent // 'inlay_material = ' // quote_string(fabric%inlay_material))
+                call put(indent // 'head_width = ' // format_real(fabric%head_width))
+                call put(indent // 'inlay_offset = ' // format_real(fabric%inlay_offset))
+                call put(indent // 'inlay_every = ' // format_integer(fabric%inlay_every))
+                call put(indent // 'warp_material = ' // quote_string(fabric%warp_material))
+                call put(indent // 'weft_material = ' // quote_string(fabric%weft_material))
+                call put(indent // 'gap = ' // format_real(fabric%gap))
+                if (size(fabric%gap_factor) > 0) then
+                    call put_reals('gap_factor_p_disp', fabric%gap_factor_p_disp)
+                    call put_reals('gap_factor', fabric%gap_factor)
+                end if
+                call put('/')
+            end associate
+        end subroutine put_fabric
+
+        !> &geometry or &nodes and &yarn, then &support and &load.
+        subroutine put_network()
         from_file = len_trim(config%geometry%file) > 0
         call put('&geometry')
         call put(indent // 'file = ' // quote_string(config%geometry%file))
@@ -151,25 +212,8 @@ contains
                 end associate
             end do
         end if
+        end subroutine put_network
 
-        if (allocated(config%path%time)) then
-            call put('&path')
-            call put_reals('time', config%path%time)
-            if (allocated(config%path%p_force)) call put_reals('p_force', config%path%p_force)
-            if (allocated(config%path%p_disp)) call put_reals('p_disp', config%path%p_disp)
-            call put('/')
-        end if
-
-        associate(output => config%output)
-            call put('&output')
-            call put(indent // 'folder = ' // quote_string(output%folder))
-            call put(indent // 'vtk_every = ' // format_integer(output%vtk_every))
-            call put(indent // 'progress = ' // format_logical(output%progress))
-            call put(indent // 'residual_history = ' // format_logical(output%residual_history))
-            call put('/')
-        end associate
-
-    contains
 
         subroutine put(line)
             character(len=*), intent(in) :: line

@@ -18,12 +18,14 @@ module yarnfort_input_namelist
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, control_config_type, solver_config_type, &
         material_config_type, yarn_config_type, support_config_type, load_config_type, &
-        output_config_type, geometry_config_type, contact_config_type, path_length
+        output_config_type, geometry_config_type, contact_config_type, path_length, &
+        fabric_config_type
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist, explain_read_error
     use yarnfort_input_geometry, only: read_geometry_file
     use yarnfort_input_text, only: read_line, to_lower, format_integer, folder_of, &
         resolve_path
     use yarnfort_input_validate, only: check_config
+    use yarnfort_generate_fabric, only: generate_fabric
     implicit none
     private
 
@@ -37,11 +39,14 @@ module yarnfort_input_namelist
 
     !> All group names, in the order they are read and echoed.
     character(len=*), parameter :: group_names(*) = [character(len=8) :: 'control', &
-        'solver', 'material', 'contact', 'nodes', 'geometry', 'yarn', 'support', 'load', &
-        'path', 'output']
+        'solver', 'material', 'contact', 'fabric', 'nodes', 'geometry', 'yarn', 'support', &
+        'load', 'path', 'output']
     !> Groups that may appear at most once.
     character(len=*), parameter :: singleton_names(*) = [character(len=8) :: 'control', &
-        'solver', 'nodes', 'geometry', 'path', 'output']
+        'solver', 'fabric', 'nodes', 'geometry', 'path', 'output']
+    !> Groups a generated fabric replaces.
+    character(len=*), parameter :: generated_names(*) = [character(len=8) :: 'nodes', &
+        'geometry', 'yarn', 'support', 'load']
 
     !> Marks list entries the input did not set.
     integer, parameter :: unset_integer = -huge(1)
@@ -115,6 +120,19 @@ contains
                 config%node_positions, config%yarns, error)
             if (allocated(error)) return
         end if
+        if (len_trim(config%fabric%kind) > 0) then
+            do k = 1, size(generated_names)
+                name = trim(generated_names(k))
+                if (scan%count_group(name) > 0) then
+                    call fatal_error(error, '&' // name // ': not allowed together with ' &
+                        // '&fabric (the fabric generator makes the nodes, yarns and supports)')
+                    return
+                end if
+            end do
+            call generate_fabric(config, error)
+            if (allocated(error)) return
+        end if
+        if (.not. allocated(config%links)) allocate(config%links(0))
     end subroutine read_config
 
     !> Each group from the comment-free text, in a fixed order.
@@ -131,6 +149,8 @@ contains
         call read_material(unit, scan, config, error)
         if (allocated(error)) return
         call read_contact(unit, scan, config, error)
+        if (allocated(error)) return
+        call read_fabric(unit, scan, config, error)
         if (allocated(error)) return
         call read_nodes(unit, scan, config, error)
         if (allocated(error)) return
@@ -205,7 +225,7 @@ contains
         close(scratch)
     end subroutine read_config_from_stdin
 
-    !> &control: title, check_only.
+    !> &control: title, check_only, restart, max_steps.
     subroutine read_control(unit, scan, cfg, error)
         integer, intent(in) :: unit
         type(namelist_scan_type), intent(in) :: scan
@@ -213,26 +233,31 @@ contains
         type(error_type), allocatable, intent(out) :: error
         type(control_config_type) :: defaults
         character(len=buffer_length) :: title
-        logical :: check_only
-        namelist /control/ title, check_only
+        logical :: check_only, restart
+        integer :: max_steps
+        namelist /control/ title, check_only, restart, max_steps
         character(len=message_length) :: message
         integer :: stat
 
         if (scan%count_group('control') == 0) return
         title = defaults%title
         check_only = defaults%check_only
+        restart = defaults%restart
+        max_steps = defaults%max_steps
         rewind(unit)
         message = ''
         read(unit, nml=control, iostat=stat, iomsg=message)
         if (stat /= 0) then
             call read_failed(error, scan, 'control', 0, stat, message, &
-                [character(len=16) :: 'title', 'check_only'])
+                [character(len=16) :: 'title', 'check_only', 'restart', 'max_steps'])
             return
         end if
         call check_length(error, scan, 'control', 0, 'title', title, len(cfg%control%title))
         if (allocated(error)) return
         cfg%control%title = title(:len(cfg%control%title))
         cfg%control%check_only = check_only
+        cfg%control%restart = restart
+        cfg%control%max_steps = max_steps
     end subroutine read_control
 
     !> &solver: linear solver, Newton, continuation and friction settings.
@@ -322,8 +347,8 @@ contains
         type(error_type), allocatable, intent(out) :: error
         type(material_config_type) :: defaults
         character(len=buffer_length) :: name, law, table_file
-        real(wp) :: stiffness, modulus, area
-        namelist /material/ name, law, stiffness, modulus, area, table_file
+        real(wp) :: stiffness, modulus, area, prestress
+        namelist /material/ name, law, stiffness, modulus, area, table_file, prestress
         character(len=message_length) :: message
         integer :: stat, k, n_expected
 
@@ -338,6 +363,7 @@ contains
             modulus = defaults%modulus
             area = defaults%area
             table_file = defaults%table_file
+            prestress = defaults%prestress
             message = ''
             read(unit, nml=material, iostat=stat, iomsg=message)
             if (is_iostat_end(stat)) exit
@@ -349,7 +375,7 @@ contains
             if (stat /= 0) then
                 call read_failed(error, scan, 'material', k, stat, message, &
                     [character(len=16) :: 'name', 'law', 'stiffness', 'modulus', 'area', &
-                    'table_file'])
+                    'table_file', 'prestress'])
                 return
             end if
             associate(material => cfg%materials(k))
@@ -370,6 +396,7 @@ contains
                 material%modulus = modulus
                 material%area = area
                 material%table_file = table_file(:len(material%table_file))
+                material%prestress = prestress
             end associate
         end do
         if (k < n_expected) then
@@ -696,6 +723,106 @@ contains
         end if
     end subroutine read_path
 
+    !> &fabric: a generated knitted or woven fabric (see yarnfort_generate_fabric).
+    subroutine read_fabric(unit, scan, cfg, error)
+        integer, intent(in) :: unit
+        type(namelist_scan_type), intent(in) :: scan
+        type(config_type), intent(inout) :: cfg
+        type(error_type), allocatable, intent(out) :: error
+        type(fabric_config_type) :: defaults
+        character(len=buffer_length) :: kind, boundary, sides, knit_material, inlay_material, &
+            warp_material, weft_material
+        integer :: cells(2), elements_per_segment, inlay_every, n_p, n_f
+        real(wp) :: spacing(2), strain, lateral_strain, head_width, inlay_offset, gap
+        real(wp), allocatable :: gap_factor_p_disp(:), gap_factor(:)
+        namelist /fabric/ kind, cells, spacing, boundary, strain, lateral_strain, sides, &
+            elements_per_segment, knit_material, inlay_material, head_width, inlay_offset, &
+            inlay_every, warp_material, weft_material, gap, &
+            gap_factor_p_disp, gap_factor
+        character(len=message_length) :: message
+        integer :: stat
+
+        allocate(cfg%fabric%gap_factor_p_disp(0), cfg%fabric%gap_factor(0))
+        if (scan%count_group('fabric') == 0) return
+        kind = defaults%kind
+        cells = defaults%cells
+        spacing = defaults%spacing
+        boundary = defaults%boundary
+        strain = defaults%strain
+        lateral_strain = defaults%lateral_strain
+        sides = defaults%sides
+        elements_per_segment = defaults%elements_per_segment
+        knit_material = defaults%knit_material
+        inlay_material = defaults%inlay_material
+        head_width = defaults%head_width
+        inlay_offset = defaults%inlay_offset
+        inlay_every = defaults%inlay_every
+        warp_material = defaults%warp_material
+        weft_material = defaults%weft_material
+        gap = defaults%gap
+        allocate(gap_factor_p_disp(max_list + 1), gap_factor(max_list + 1))
+        gap_factor_p_disp = unset_real
+        gap_factor = unset_real
+        rewind(unit)
+        message = ''
+        read(unit, nml=fabric, iostat=stat, iomsg=message)
+        if (stat /= 0) then
+            call read_failed(error, scan, 'fabric', 0, stat, message, &
+                [character(len=20) :: 'kind', 'cells', 'spacing', 'boundary', 'strain', &
+                'lateral_strain', 'sides', 'elements_per_segment', 'knit_material', &
+                'inlay_material', 'head_width', 'inlay_offset', 'inlay_every', &
+                'warp_material', 'weft_material', 'gap', 'gap_factor_p_disp', 'gap_factor'])
+            return
+        end if
+        call get_real_list_length(error, scan, 'fabric', 0, 'gap_factor_p_disp', &
+            gap_factor_p_disp, n_p)
+        if (allocated(error)) return
+        call get_real_list_length(error, scan, 'fabric', 0, 'gap_factor', gap_factor, n_f)
+        if (allocated(error)) return
+        call take_name(kind, 'kind', cfg%fabric%kind, .true.)
+        if (allocated(error)) return
+        call take_name(boundary, 'boundary', cfg%fabric%boundary, .true.)
+        if (allocated(error)) return
+        call take_name(sides, 'sides', cfg%fabric%sides, .true.)
+        if (allocated(error)) return
+        call take_name(knit_material, 'knit_material', cfg%fabric%knit_material, .false.)
+        if (allocated(error)) return
+        call take_name(inlay_material, 'inlay_material', cfg%fabric%inlay_material, .false.)
+        if (allocated(error)) return
+        call take_name(warp_material, 'warp_material', cfg%fabric%warp_material, .false.)
+        if (allocated(error)) return
+        call take_name(weft_material, 'weft_material', cfg%fabric%weft_material, .false.)
+        if (allocated(error)) return
+        if (len_trim(cfg%fabric%kind) == 0) then
+            call post_read_error(error, scan, 'fabric', 0, &
+                "kind is required (knit, plain or twill)")
+            return
+        end if
+        cfg%fabric%cells = cells
+        cfg%fabric%spacing = spacing
+        cfg%fabric%strain = strain
+        cfg%fabric%lateral_strain = lateral_strain
+        cfg%fabric%elements_per_segment = elements_per_segment
+        cfg%fabric%head_width = head_width
+        cfg%fabric%inlay_offset = inlay_offset
+        cfg%fabric%inlay_every = inlay_every
+        cfg%fabric%gap = gap
+        cfg%fabric%gap_factor_p_disp = gap_factor_p_disp(:n_p)
+        cfg%fabric%gap_factor = gap_factor(:n_f)
+    contains
+        subroutine take_name(buffer, variable, field, lower)
+            character(len=*), intent(inout) :: buffer
+            character(len=*), intent(in) :: variable
+            character(len=*), intent(out) :: field
+            logical, intent(in) :: lower
+            call check_length(error, scan, 'fabric', 0, variable, adjustl(buffer), len(field))
+            if (allocated(error)) return
+            buffer = adjustl(buffer)
+            if (lower) buffer = to_lower(buffer)
+            field = buffer(:len(field))
+        end subroutine take_name
+    end subroutine read_fabric
+
     !> &output: folder, vtk_every, progress, residual_history.
     subroutine read_output(unit, scan, cfg, error)
         integer, intent(in) :: unit
@@ -760,7 +887,7 @@ contains
                 // 'earlier on that line? (it hides the rest of the line)')
             return
         end if
-        call fatal_error(error, group_label(name, occurrence) // ': ' // trim(message) &
+        call fatal_error(error, group_label(name, occurrence) // ': ' &
             // explain_read_error(scan, name, max(occurrence, 1), trim(message), variables))
     end subroutine read_failed
 

@@ -1,9 +1,9 @@
 ! SPDX-License-Identifier: MIT
 !> Checks of a read `config_type` that need no network: known names, positive and finite
-!> parameters, node ids in range, no zero-length segments or elements, consistent
-!> supports, loads and load path, known friction laws with their parameters and, when
-!> any &contact is given, one for every pair of yarn types that meet. Each message names
-!> the group, the variable and the value.
+!> parameters, node ids in range, no zero-length segments or elements, no two segments
+!> joining the same two nodes, consistent supports, loads and load path, known friction
+!> laws with their parameters and, when any &contact is given, one for every pair of
+!> yarn types that meet. Each message names the group, the variable and the value.
 module yarnfort_input_validate
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
@@ -20,6 +20,9 @@ module yarnfort_input_validate
     !> A segment between consecutive yarn nodes is of zero length when it is not longer
     !> than this times the diagonal of the box around all nodes.
     real(wp), parameter :: coincidence_tolerance = 100 * epsilon(1.0_wp)
+    !> Smallest &solver min_step as a fraction of the largest |&path time|: a shorter
+    !> step would not (or barely) change the pseudo-time, and the continuation would stall.
+    real(wp), parameter :: time_resolution = 100 * epsilon(1.0_wp)
     !> Values of &material law.
     character(len=*), parameter :: known_laws(*) = [character(len=11) :: 'linear', &
         'neo_hookean', 'table']
@@ -45,6 +48,8 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer, allocatable :: owner(:, :)
 
+        call require_at_least(error, '&control', 'max_steps', config%control%max_steps, 0)
+        if (allocated(error)) return
         call check_solver(config%solver, error)
         if (allocated(error)) return
         call check_output(config%output, error)
@@ -55,6 +60,8 @@ contains
         if (allocated(error)) return
         call check_yarns(config, error)
         if (allocated(error)) return
+        call check_duplicate_segments(config, error)
+        if (allocated(error)) return
         call check_contacts(config, error)
         if (allocated(error)) return
         call check_supports(config, owner, error)
@@ -62,6 +69,8 @@ contains
         call check_loads(config, owner, error)
         if (allocated(error)) return
         call check_path(config%path, error)
+        if (allocated(error)) return
+        call check_step_resolution(config%solver, config%path, error)
     end subroutine check_config
 
     subroutine check_solver(solver, error)
@@ -240,6 +249,13 @@ contains
                         // "' is unknown (use " // join_names(known_laws, '') // ')')
                 end select
                 if (allocated(error)) return
+                if (.not. (material%prestress >= 0.0_wp .and. &
+                        material%prestress < huge(1.0_wp))) then
+                    call fatal_error(error, label // ': prestress = ' &
+                        // format_real(material%prestress) &
+                        // ' must be a tension >= 0 (N)')
+                    return
+                end if
             end associate
         end do
     end subroutine check_materials
@@ -614,6 +630,85 @@ contains
         end do
     end subroutine check_yarns
 
+    !> No two segments, of one yarn or of two, join the same two nodes: their elements
+    !> would lie on top of each other (a yarn doubling back, or a yarn listed twice).
+    !> Segments are bucketed by their lower node id, so the check is linear in their number.
+    subroutine check_duplicate_segments(config, error)
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        !> The segments whose lower node is `a` are slots first(a):first(a + 1) - 1, each
+        !> with its yarn and its position i in the yarn (nodes(i), nodes(i + 1)).
+        integer, allocatable :: first(:), filled(:), yarn_of(:), position_of(:)
+        !> `seen(b)`: the last slot met with upper node b (a slot of the current lower
+        !> node when it is >= first(a)).
+        integer, allocatable :: seen(:)
+        integer :: n_nodes, y, i, a, b, k, slot
+
+        n_nodes = size(config%node_positions, 2)
+        allocate(first(n_nodes + 1), source=0)
+        do y = 1, size(config%yarns)
+            associate(nodes => config%yarns(y)%nodes)
+                do i = 1, size(nodes) - 1
+                    a = min(nodes(i), nodes(i + 1))
+                    first(a + 1) = first(a + 1) + 1
+                end do
+            end associate
+        end do
+        first(1) = 1
+        do a = 1, n_nodes
+            first(a + 1) = first(a + 1) + first(a)
+        end do
+        allocate(yarn_of(first(n_nodes + 1) - 1), position_of(first(n_nodes + 1) - 1))
+        allocate(filled(n_nodes), source=0)
+        do y = 1, size(config%yarns)
+            associate(nodes => config%yarns(y)%nodes)
+                do i = 1, size(nodes) - 1
+                    a = min(nodes(i), nodes(i + 1))
+                    slot = first(a) + filled(a)
+                    yarn_of(slot) = y
+                    position_of(slot) = i
+                    filled(a) = filled(a) + 1
+                end do
+            end associate
+        end do
+        allocate(seen(n_nodes), source=0)
+        do a = 1, n_nodes
+            do k = first(a), first(a + 1) - 1
+                b = upper_node(k)
+                if (seen(b) >= first(a)) then
+                    call fatal_error(error, segment_text(k) // ' join the same two nodes as ' &
+                        // segment_text(seen(b)) // ': duplicate segment (two strings ' &
+                        // 'between one pair of nodes would lie on top of each other)')
+                    return
+                end if
+                seen(b) = k
+            end do
+        end do
+
+    contains
+
+        integer function upper_node(slot)
+            integer, intent(in) :: slot
+
+            associate(nodes => config%yarns(yarn_of(slot))%nodes, i => position_of(slot))
+                upper_node = max(nodes(i), nodes(i + 1))
+            end associate
+        end function upper_node
+
+        !> "&yarn #2: nodes(3), nodes(4) = 5, 2"
+        function segment_text(slot) result(text)
+            integer, intent(in) :: slot
+            character(len=:), allocatable :: text
+
+            associate(nodes => config%yarns(yarn_of(slot))%nodes, i => position_of(slot))
+                text = yarn_label(config, yarn_of(slot)) // ': nodes(' // format_integer(i) &
+                    // '), nodes(' // format_integer(i + 1) // ') = ' &
+                    // format_integer(nodes(i)) // ', ' // format_integer(nodes(i + 1))
+            end associate
+        end function segment_text
+
+    end subroutine check_duplicate_segments
+
     !> Where the nodes come from, for messages.
     function node_source(config) result(source)
         type(config_type), intent(in) :: config
@@ -842,6 +937,26 @@ contains
             end if
         end do
     end subroutine check_path
+
+    !> Every continuation step (at least min_step) must advance the pseudo-time: min_step
+    !> must not be below the floating-point resolution of the path's times.
+    subroutine check_step_resolution(solver, path, error)
+        type(solver_config_type), intent(in) :: solver
+        type(path_config_type), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: largest
+        character(len=16) :: shortest
+
+        largest = maxval(abs(path%time))
+        if (solver%min_step < time_resolution * largest) then
+            write(shortest, '(es9.2)') time_resolution * largest
+            call fatal_error(error, '&solver: min_step = ' // format_real(solver%min_step) &
+                // ' is below the resolution of &path time (up to ' // format_real(largest) &
+                // ' in magnitude): a step shorter than ' // trim(adjustl(shortest)) &
+                // ' would not advance the pseudo-time; raise min_step (and max_step) or ' &
+                // 'move the path times closer to 0')
+        end if
+    end subroutine check_step_resolution
 
     !> A law parameter that must be set, finite and >= 0.
     subroutine require_nonnegative_parameter(error, label, variable, value, unset, law)

@@ -19,6 +19,8 @@ module yarnfort_material_law
         procedure(get_energy_interface), deferred :: get_energy
         !> A positive scale of df/dlambda near lambda = 1 (used to size regularisations).
         procedure(get_reference_stiffness_interface), deferred :: get_reference_stiffness
+        !> The stretch at which the yarn carries a given tension (the law's inverse).
+        procedure :: get_stretch_at_force
     end type force_law_type
 
     abstract interface
@@ -42,5 +44,53 @@ module yarnfort_material_law
             real(wp) :: stiffness
         end function get_reference_stiffness_interface
     end interface
+
+contains
+
+    !> Stretch lambda > 1 with f(lambda) = force > 0, by Newton's method safeguarded by
+    !> bisection on a bracket grown from [1, 2]. `found` is false if no stretch up to
+    !> 2**max_doublings carries the force or the iteration does not converge.
+    pure subroutine get_stretch_at_force(self, force, stretch, found)
+        class(force_law_type), intent(in) :: self
+        real(wp), intent(in) :: force
+        real(wp), intent(out) :: stretch
+        logical, intent(out) :: found
+        integer, parameter :: max_doublings = 60, max_iterations = 200
+        real(wp), parameter :: tolerance = 8.0_wp * epsilon(1.0_wp)
+        real(wp) :: low, high, f, df
+        integer :: k
+
+        found = .false.
+        stretch = 1.0_wp
+        if (.not. (force > 0.0_wp)) then
+            found = force == 0.0_wp
+            return
+        end if
+        low = 1.0_wp
+        high = 2.0_wp
+        do k = 1, max_doublings
+            call self%get_force(high, f, df)
+            if (f >= force) exit
+            low = high
+            high = 2.0_wp * high
+        end do
+        if (f < force) return
+        stretch = 0.5_wp * (low + high)
+        do k = 1, max_iterations
+            call self%get_force(stretch, f, df)
+            if (f > force) then
+                high = stretch
+            else
+                low = stretch
+            end if
+            if (abs(f - force) <= tolerance * force .or. high - low <= tolerance * high) then
+                found = .true.
+                return
+            end if
+            ! Newton when it stays inside the bracket, bisection otherwise.
+            if (df > 0.0_wp) stretch = stretch - (f - force) / df
+            if (.not. (stretch > low .and. stretch < high)) stretch = 0.5_wp * (low + high)
+        end do
+    end subroutine get_stretch_at_force
 
 end module yarnfort_material_law

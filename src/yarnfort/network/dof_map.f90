@@ -1,10 +1,12 @@
 ! SPDX-License-Identifier: MIT
 !> Map between the solver's unknowns u and the nodal coordinates x of the network.
 !> Constrained coordinates are eliminated, not penalised: every coordinate is
-!>     x(i) = u(unknown(i)) + base(i) + p_disp * delta(i),
+!>     x(i) = u(unknown(i)) + base(i) + p_disp * delta(i) + (g(p_disp) - 1) * gap(i),
 !> with unknown(i) = 0 for a prescribed coordinate (then base is its initial value and
 !> delta its prescribed displacement at p_disp = 1). A free coordinate has base = delta = 0.
-!> Several coordinates may share one unknown (periodic pairs, with base as the offset).
+!> Several coordinates may share one unknown: a periodic image (eq. 53; base is the
+!> offset, delta the macroscopic stretch) or the far side of a gap-holder (gap is the
+!> holder's offset, scaled by the gap factor g, a piecewise-linear function of p_disp).
 module yarnfort_network_dof_map
     use yarnfort_kinds, only: wp
     implicit none
@@ -18,7 +20,12 @@ module yarnfort_network_dof_map
         integer, allocatable :: unknown(:)
         real(wp), allocatable :: base(:)
         real(wp), allocatable :: delta(:)
+        !> Gap-holder offsets (zero where there is none) and the gap factor's knots.
+        real(wp), allocatable :: gap(:)
+        real(wp), allocatable :: gap_p_disp(:), gap_factor(:)
     contains
+        !> The gap factor g(p_disp) (1 without knots; constant beyond the end knots).
+        procedure :: get_gap_factor
         !> Coordinates x (3, n_nodes) from unknowns u at displacement factor p_disp.
         procedure :: expand
         !> Unknowns u from coordinates x (the inverse on free coordinates).
@@ -34,15 +41,43 @@ contains
         real(wp), intent(in) :: u(:), p_disp
         real(wp), intent(out) :: x(:, :)
         integer :: i, node, k
+        real(wp) :: gap_change
 
+        gap_change = self%get_gap_factor(p_disp) - 1.0_wp
         do i = 1, size(self%unknown)
             node = (i - 1) / 3 + 1
             k = i - 3 * (node - 1)
             x(k, node) = self%base(i) + p_disp * self%delta(i)
+            if (allocated(self%gap)) x(k, node) = x(k, node) + gap_change * self%gap(i)
             if (self%unknown(i) > 0) x(k, node) = x(k, node) + u(self%unknown(i))
         end do
     end subroutine expand
 
+    pure real(wp) function get_gap_factor(self, p_disp) result(factor)
+        class(dof_map_type), intent(in) :: self
+        real(wp), intent(in) :: p_disp
+        integer :: i, n
+        real(wp) :: w
+
+        factor = 1.0_wp
+        if (.not. allocated(self%gap_factor)) return
+        n = size(self%gap_factor)
+        if (n == 0) return
+        if (p_disp <= self%gap_p_disp(1)) then
+            factor = self%gap_factor(1)
+        else if (p_disp >= self%gap_p_disp(n)) then
+            factor = self%gap_factor(n)
+        else
+            do i = 1, n - 1
+                if (p_disp <= self%gap_p_disp(i + 1)) exit
+            end do
+            w = (p_disp - self%gap_p_disp(i)) / (self%gap_p_disp(i + 1) - self%gap_p_disp(i))
+            factor = (1.0_wp - w) * self%gap_factor(i) + w * self%gap_factor(i + 1)
+        end if
+    end function get_gap_factor
+
+    !> The inverse of expand at p_disp = 0 with gap factor 1 (base offsets only): for
+    !> initial positions, where followers sit at their leaders' offsets.
     pure subroutine restrict(self, x, u)
         class(dof_map_type), intent(in) :: self
         real(wp), intent(in) :: x(:, :)

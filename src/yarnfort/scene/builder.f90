@@ -4,7 +4,8 @@ module yarnfort_scene_builder
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
     use yarnfort_input_config, only: config_type, material_config_type
-    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_scene, only: scene_type, support_set_type
+    use yarnfort_input_text, only: format_real
     use yarnfort_material_law, only: force_law_type
     use yarnfort_material_linear, only: linear_law_type, new_linear_law
     use yarnfort_material_neo_hookean, only: neo_hookean_law_type, new_neo_hookean_law
@@ -45,11 +46,20 @@ contains
         end do
         call build_network(scene, config, error)
         if (allocated(error)) return
+        call apply_prestress(scene, config, error)
+        if (allocated(error)) return
         call build_constraints(scene, config, error)
+        if (allocated(error)) return
+        call build_links(scene, config, error)
         if (allocated(error)) return
         call build_loads(scene, config)
         call build_passages(scene, config, error)
         if (allocated(error)) return
+        if (config%fabric_width > 0.0_wp) then
+            scene%fabric_width = config%fabric_width
+            scene%fabric_strain = config%fabric%strain
+            if (config%fabric_support > 0) scene%fabric_set = config%fabric_support
+        end if
         scene%path%time = config%path%time
         scene%path%p_force = config%path%p_force
         scene%path%p_disp = config%path%p_disp
@@ -234,6 +244,144 @@ contains
         scene%dofs%n_unknowns = count
     end subroutine build_constraints
 
+    !> Pre-stress: elements of a yarn type with prestress > 0 get the reference length
+    !> at which they carry that tension in the initial geometry.
+    subroutine apply_prestress(scene, config, error)
+        type(scene_type), intent(inout) :: scene
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        integer :: m, e
+        real(wp) :: stretch
+        logical :: found
+
+        do m = 1, size(config%materials)
+            if (.not. (config%materials(m)%prestress > 0.0_wp)) cycle
+            call scene%laws(m)%law%get_stretch_at_force(config%materials(m)%prestress, &
+                stretch, found)
+            if (.not. found) then
+                call fatal_error(error, "&material '" // trim(config%materials(m)%name) &
+                    // "': prestress = " // format_real(config%materials(m)%prestress) &
+                    // ' N is more than the force law reaches')
+                return
+            end if
+            do e = 1, scene%network%n_elements()
+                if (scene%network%element_material(e) == m) then
+                    scene%network%length0(e) = scene%network%length0(e) / stretch
+                end if
+            end do
+        end do
+    end subroutine apply_prestress
+
+    !> Links (periodic images, eq. 53, and gap-holders): a follower node's coordinates
+    !> share the unknowns of its leader (followed to the end of a chain), offset by their
+    !> initial difference, plus the macroscopic stretch (periodic) or scaled by the gap
+    !> factor (gap-holder). Periodic followers that move with the x stretch form the
+    !> force set 'stretch': its x reaction is the force carried across the cell.
+    subroutine build_links(scene, config, error)
+        type(scene_type), intent(inout) :: scene
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        integer :: n_nodes, l, n, r, k, c, cr, hops
+        integer, allocatable :: leader(:), link_of(:), stretch_coordinates(:)
+        real(wp) :: offset(3), macro(3), gap(3), step(3)
+        character(len=200) :: buffer
+
+        n_nodes = scene%network%n_nodes()
+        allocate(scene%dofs%gap(3 * n_nodes), source=0.0_wp)
+        scene%dofs%gap_p_disp = config%fabric%gap_factor_p_disp
+        scene%dofs%gap_factor = config%fabric%gap_factor
+        if (size(config%links) == 0) return
+        allocate(leader(n_nodes), link_of(n_nodes), source=0)
+        do l = 1, size(config%links)
+            n = config%links(l)%follower
+            if (leader(n) /= 0) then
+                write(buffer, '("node ", i0, " follows both node ", i0, " and node ", i0)') &
+                    n, leader(n), config%links(l)%leader
+                call fatal_error(error, trim(buffer))
+                return
+            end if
+            if (any(scene%dofs%unknown(3 * n - 2:3 * n) == 0)) then
+                write(buffer, '("node ", i0, " follows node ", i0, &
+                    & " and cannot also be supported")') n, config%links(l)%leader
+                call fatal_error(error, trim(buffer))
+                return
+            end if
+            leader(n) = config%links(l)%leader
+            link_of(n) = l
+        end do
+        allocate(stretch_coordinates(0))
+        do n = 1, n_nodes
+            if (leader(n) == 0) cycle
+            ! Walk to the root, summing the offsets of every hop.
+            offset = 0.0_wp
+            macro = 0.0_wp
+            gap = 0.0_wp
+            r = n
+            hops = 0
+            do while (leader(r) /= 0)
+                hops = hops + 1
+                if (hops > n_nodes) then
+                    write(buffer, '("node ", i0, " is in a cycle of links")') n
+                    call fatal_error(error, trim(buffer))
+                    return
+                end if
+                associate(link => config%links(link_of(r)))
+                    step = scene%network%position(:, r) - scene%network%position(:, leader(r))
+                    offset = offset + step
+                    if (link%gap) then
+                        gap = gap + step
+                    else
+                        macro = macro + link%strain * step
+                    end if
+                end associate
+                r = leader(r)
+            end do
+            do k = 1, 3
+                c = 3 * (n - 1) + k
+                cr = 3 * (r - 1) + k
+                scene%dofs%unknown(c) = scene%dofs%unknown(cr)
+                if (scene%dofs%unknown(cr) == 0) then
+                    scene%dofs%base(c) = scene%dofs%base(cr) + offset(k)
+                    scene%dofs%delta(c) = scene%dofs%delta(cr) + macro(k)
+                else
+                    scene%dofs%base(c) = offset(k)
+                    scene%dofs%delta(c) = macro(k)
+                end if
+                scene%dofs%gap(c) = gap(k)
+            end do
+            if (macro(1) /= 0.0_wp) stretch_coordinates = [stretch_coordinates, 3 * n - 2]
+        end do
+        call renumber_unknowns(scene%dofs%unknown, scene%dofs%n_unknowns)
+        if (size(stretch_coordinates) > 0) then
+            block
+                type(support_set_type) :: stretch
+                stretch%name = 'stretch'
+                stretch%coordinates = stretch_coordinates
+                scene%supports = [scene%supports, stretch]
+                if (config%fabric_width > 0.0_wp) scene%fabric_set = size(scene%supports)
+            end block
+        end if
+    end subroutine build_links
+
+    !> Renumber the unknowns 1..n in order of first use (followers leave gaps).
+    subroutine renumber_unknowns(unknown, n)
+        integer, intent(inout) :: unknown(:)
+        integer, intent(out) :: n
+        integer, allocatable :: new(:)
+        integer :: c
+
+        allocate(new(maxval([0, unknown])), source=0)
+        n = 0
+        do c = 1, size(unknown)
+            if (unknown(c) == 0) cycle
+            if (new(unknown(c)) == 0) then
+                n = n + 1
+                new(unknown(c)) = n
+            end if
+            unknown(c) = new(unknown(c))
+        end do
+    end subroutine renumber_unknowns
+
     subroutine build_loads(scene, config)
         type(scene_type), intent(inout) :: scene
         type(config_type), intent(in) :: config
@@ -260,6 +408,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer :: c, y, e, node, n_nodes, n_passages, other, law, n_yarns, k
         integer, allocatable :: visits(:), first_yarn(:), second_yarn(:), contact_of(:, :)
+        integer, allocatable :: root(:)
         integer, allocatable :: yarn(:), at_node(:), before(:), after(:), laws(:)
         character(len=200) :: buffer
 
@@ -292,14 +441,27 @@ contains
             return
         end if
 
-        ! Yarns visiting each original node (the first two distinct visits suffice).
+        ! Yarns visiting each original node (the first two distinct visits suffice). Nodes
+        ! joined by links (gap-holders, periodic images) count as one contact: visits are
+        ! counted at the root of each node's chain of links.
         n_nodes = size(config%node_positions, 2)
         allocate(visits(n_nodes), source=0)
         allocate(first_yarn(n_nodes), source=0)
         allocate(second_yarn(n_nodes), source=0)
+        allocate(root(n_nodes))
+        root = [(node, node = 1, n_nodes)]
+        do k = 1, size(config%links)
+            root(config%links(k)%follower) = config%links(k)%leader
+        end do
+        do node = 1, n_nodes
+            do k = 1, n_nodes
+                if (root(root(node)) == root(node)) exit
+                root(node) = root(root(node))
+            end do
+        end do
         do y = 1, n_yarns
             do k = 1, size(config%yarns(y)%nodes)
-                node = config%yarns(y)%nodes(k)
+                node = root(config%yarns(y)%nodes(k))
                 visits(node) = visits(node) + 1
                 if (visits(node) == 1) then
                     first_yarn(node) = y
@@ -313,9 +475,9 @@ contains
         do y = 1, n_yarns
             do k = 2, size(config%yarns(y)%nodes) - 1
                 node = config%yarns(y)%nodes(k)
-                if (visits(node) < 2) cycle
-                other = first_yarn(node)
-                if (other == y) other = second_yarn(node)
+                if (visits(root(node)) < 2) cycle
+                other = first_yarn(root(node))
+                if (other == y) other = second_yarn(root(node))
                 c = contact_of(find_material(config, config%yarns(y)%material), &
                     find_material(config, config%yarns(other)%material))
                 if (c == 0) cycle

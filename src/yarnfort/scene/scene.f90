@@ -50,6 +50,12 @@ module yarnfort_scene_scene
         !> (mean element length).
         real(wp) :: force_scale = 1.0_wp
         real(wp) :: length_scale = 1.0_wp
+        !> Generated fabrics (&fabric): the width (m) across which the fabric carries its
+        !> x force, the macroscopic strain at p_disp = 1, and the set of `supports` whose
+        !> x reaction is that force (fabric_set = 0: not a fabric).
+        real(wp) :: fabric_width = 0.0_wp
+        real(wp) :: fabric_strain = 0.0_wp
+        integer :: fabric_set = 0
     end type scene_type
 
 contains

@@ -1,0 +1,233 @@
+! SPDX-License-Identifier: MIT
+!> The &fabric group: check its parameters and generate the fabric's nodes, yarns,
+!> supports and links into the configuration (knitted: yarnfort_generate_knit; woven:
+!> yarnfort_generate_woven).
+module yarnfort_generate_fabric
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_input_config, only: config_type, fabric_config_type
+    use yarnfort_generate_net_builder, only: net_builder_type
+    use yarnfort_generate_knit, only: generate_knit
+    use yarnfort_generate_woven, only: generate_woven
+    implicit none
+    private
+
+    public :: generate_fabric
+
+    !> Most generated nodes (a guard against a typo such as cells = 40000, 40000).
+    integer, parameter :: max_generated_cells = 1000000
+
+contains
+
+    subroutine generate_fabric(config, error)
+        type(config_type), intent(inout) :: config
+        type(error_type), allocatable, intent(out) :: error
+        type(net_builder_type) :: net
+        real(wp) :: width
+        integer :: pulled
+
+        call check_fabric(config, error)
+        if (allocated(error)) return
+        select case (trim(config%fabric%kind))
+        case ('knit')
+            call generate_knit(config%fabric, net, width, pulled)
+        case default
+            call generate_woven(config%fabric, net, width, pulled)
+        end select
+        call net%hand_over(config)
+        config%fabric_width = width
+        config%fabric_support = pulled
+    end subroutine generate_fabric
+
+    subroutine check_fabric(config, error)
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), parameter :: label = '&fabric: '
+        character(len=200) :: buffer
+        integer :: k
+
+        associate(fabric => config%fabric)
+            select case (trim(fabric%kind))
+            case ('knit', 'plain', 'twill')
+            case default
+                call fatal_error(error, label // "kind = '" // trim(fabric%kind) &
+                    // "' is unknown (use knit, plain or twill)")
+                return
+            end select
+            select case (trim(fabric%boundary))
+            case ('periodic', 'clamped')
+            case default
+                call fatal_error(error, label // "boundary = '" // trim(fabric%boundary) &
+                    // "' is unknown (use periodic or clamped)")
+                return
+            end select
+            select case (trim(fabric%sides))
+            case ('free', 'rollers')
+            case default
+                call fatal_error(error, label // "sides = '" // trim(fabric%sides) &
+                    // "' is unknown (use free or rollers)")
+                return
+            end select
+            if (any(fabric%cells < 1) .or. &
+                    real(fabric%cells(1), wp) * fabric%cells(2) > max_generated_cells) then
+                write(buffer, '(a, "cells = ", i0, ", ", i0, " must be at least 1 and at most ", &
+                    & i0, " in all")') label, fabric%cells, max_generated_cells
+                call fatal_error(error, trim(buffer))
+                return
+            end if
+            if (.not. all(fabric%spacing > 0.0_wp .and. fabric%spacing < huge(1.0_wp))) then
+                write(buffer, '(a, "spacing = ", g0, ", ", g0, " must be two positive lengths (m)")') &
+                    label, fabric%spacing
+                call fatal_error(error, trim(buffer))
+                return
+            end if
+            call require_range(error, 'strain', fabric%strain, -0.9_wp, 100.0_wp)
+            if (allocated(error)) return
+            call require_range(error, 'lateral_strain', fabric%lateral_strain, -0.9_wp, 100.0_wp)
+            if (allocated(error)) return
+            if (fabric%elements_per_segment < 1) then
+                write(buffer, '(a, "elements_per_segment = ", i0, " must be at least 1")') &
+                    label, fabric%elements_per_segment
+                call fatal_error(error, trim(buffer))
+                return
+            end if
+
+            if (fabric%kind == 'knit') then
+                call require_material(error, 'knit_material', fabric%knit_material, .true.)
+                if (allocated(error)) return
+                call require_material(error, 'inlay_material', fabric%inlay_material, .false.)
+                if (allocated(error)) return
+                call require_range(error, 'head_width', fabric%head_width, 0.05_wp, 0.95_wp)
+                if (allocated(error)) return
+                if (len_trim(fabric%inlay_material) > 0) then
+                    call require_range(error, 'inlay_offset', fabric%inlay_offset, 0.05_wp, &
+                        0.95_wp)
+                    if (allocated(error)) return
+                    if (fabric%inlay_every < 1) then
+                        write(buffer, '(a, "inlay_every = ", i0, " must be at least 1")') &
+                            label, fabric%inlay_every
+                        call fatal_error(error, trim(buffer))
+                        return
+                    end if
+                end if
+                call forbid_name(error, 'warp_material', fabric%warp_material)
+                if (allocated(error)) return
+                call forbid_name(error, 'weft_material', fabric%weft_material)
+                if (allocated(error)) return
+                if (len_trim(fabric%inlay_material) > 0) then
+                    call check_gap(error)
+                    if (allocated(error)) return
+                else if (fabric%gap /= -1.0_wp .or. size(fabric%gap_factor) > 0) then
+                    call fatal_error(error, label // 'gap and gap_factor apply to woven ' &
+                        // 'fabrics and to the inlay of a knit; this knit has no inlay_material')
+                    return
+                end if
+            else
+                call require_material(error, 'warp_material', fabric%warp_material, .true.)
+                if (allocated(error)) return
+                call require_material(error, 'weft_material', fabric%weft_material, .true.)
+                if (allocated(error)) return
+                call forbid_name(error, 'knit_material', fabric%knit_material)
+                if (allocated(error)) return
+                call forbid_name(error, 'inlay_material', fabric%inlay_material)
+                if (allocated(error)) return
+                call check_gap(error)
+                if (allocated(error)) return
+                if (fabric%boundary == 'periodic') call check_repeat(error)
+                if (allocated(error)) return
+            end if
+        end associate
+    contains
+        subroutine require_range(error, variable, value, low, high)
+            type(error_type), allocatable, intent(out) :: error
+            character(len=*), intent(in) :: variable
+            real(wp), intent(in) :: value, low, high
+            if (value >= low .and. value <= high) return
+            write(buffer, '(a, a, " = ", g0, " must lie in [", g0, ", ", g0, "]")') &
+                label, variable, value, low, high
+            call fatal_error(error, trim(buffer))
+        end subroutine require_range
+
+        subroutine require_material(error, variable, name, required)
+            type(error_type), allocatable, intent(out) :: error
+            character(len=*), intent(in) :: variable, name
+            logical, intent(in) :: required
+            if (len_trim(name) == 0) then
+                if (required) call fatal_error(error, label // variable // ' is required for ' &
+                    // "kind = '" // trim(config%fabric%kind) // "'")
+                return
+            end if
+            do k = 1, size(config%materials)
+                if (trim(config%materials(k)%name) == trim(name)) return
+            end do
+            call fatal_error(error, label // variable // " = '" // trim(name) &
+                // "' is not the name of any &material")
+        end subroutine require_material
+
+        subroutine forbid_name(error, variable, name)
+            type(error_type), allocatable, intent(out) :: error
+            character(len=*), intent(in) :: variable, name
+            if (len_trim(name) == 0) return
+            call fatal_error(error, label // variable // " does not apply to kind = '" &
+                // trim(config%fabric%kind) // "'")
+        end subroutine forbid_name
+
+        subroutine check_gap(error)
+            type(error_type), allocatable, intent(out) :: error
+            if (.not. (config%fabric%gap > 0.0_wp .and. &
+                    config%fabric%gap < minval(config%fabric%spacing))) then
+                write(buffer, '(a, "gap = ", g0, " must be positive and smaller than the ", &
+                    & "yarn spacing (m)")') label, config%fabric%gap
+                call fatal_error(error, trim(buffer))
+                return
+            end if
+            call check_gap_table(error)
+        end subroutine check_gap
+
+        !> A periodic weave must hold whole repeats of its pattern.
+        subroutine check_repeat(error)
+            type(error_type), allocatable, intent(out) :: error
+            integer :: repeat
+            repeat = merge(4, 2, config%fabric%kind == 'twill')
+            if (all(mod(config%fabric%cells, repeat) == 0)) return
+            write(buffer, '(a, "cells = ", i0, ", ", i0, " must be multiples of ", i0, &
+                & " for a periodic ", a, " cell")') label, config%fabric%cells, repeat, &
+                trim(config%fabric%kind)
+            call fatal_error(error, trim(buffer))
+        end subroutine check_repeat
+
+        subroutine check_gap_table(error)
+            type(error_type), allocatable, intent(out) :: error
+            associate(p => config%fabric%gap_factor_p_disp, f => config%fabric%gap_factor)
+                if (size(p) /= size(f)) then
+                    write(buffer, '(a, "gap_factor_p_disp has ", i0, " values but gap_factor ", &
+                        & "has ", i0)') label, size(p), size(f)
+                    call fatal_error(error, trim(buffer))
+                    return
+                end if
+                do k = 2, size(p)
+                    if (.not. (p(k) > p(k - 1))) then
+                        write(buffer, '(a, "gap_factor_p_disp must increase strictly: value ", &
+                            & i0, " (", g0, ") follows ", g0)') label, k, p(k), p(k - 1)
+                        call fatal_error(error, trim(buffer))
+                        return
+                    end if
+                end do
+                do k = 1, size(f)
+                    if (.not. (f(k) > 0.0_wp .and. f(k) * config%fabric%gap &
+                            < minval(config%fabric%spacing))) then
+                        write(buffer, '(a, "gap_factor value ", i0, " (", g0, ") must be ", &
+                            & "positive and keep the gap below the yarn spacing")') &
+                            label, k, f(k)
+                        call fatal_error(error, trim(buffer))
+                        return
+                    end if
+                end do
+                if (any(p /= p) .or. any(abs(p) > huge(1.0_wp))) then
+                    call fatal_error(error, label // 'gap_factor_p_disp must be finite')
+                end if
+            end associate
+        end subroutine check_gap_table
+    end subroutine check_fabric
+
+end module yarnfort_generate_fabric
