@@ -4,7 +4,12 @@
 !> Prints one line of figures per run (see the header printed with --header): unknowns,
 !> nonzeros, Newton iterations, factorisations, and per-iteration wall times of residual
 !> assembly, Jacobian assembly, numeric factorisation, solve, and everything else;
-!> total time and peak resident memory (VmHWM) of the process.
+!> total time and peak resident memory (VmHWM) of the process. Then memory per unknown
+!> (bytes): the growth of the peak resident memory from before the net is built
+!> (`grow_B/dof`), and for UMFPACK its own figures of the last factorisation: the
+!> Numeric object, i.e. the LU factors (`umf_LU_B/dof`), and its peak during symbolic
+!> analysis and numeric factorisation (`umf_peak_B/dof`), with the ratios of the growth
+!> to each (`x_LU`, `x_peak`).
 program bench_newton
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use yarnfort_kinds, only: wp
@@ -14,6 +19,7 @@ program bench_newton
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
+    use yarnfort_linalg_umfpack, only: umfpack_solver_type, umfpack_memory_type
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_timer, only: wall_time
@@ -28,6 +34,9 @@ program bench_newton
     type(error_type), allocatable :: error
     real(wp), allocatable :: u(:)
     real(wp) :: t_residual, t_jacobian, t_analyse, t_factor, t_solve, total, start, other
+    real(wp) :: baseline_mib, growth
+    type(umfpack_memory_type) :: umfpack_memory
+    logical :: have_umfpack
     integer :: side, setup_calls, n_factor, iterations
     character(len=32) :: argument, solver_name
 
@@ -35,7 +44,8 @@ program bench_newton
     if (trim(argument) == '--header') then
         write(output_unit, '(a)') 'solver  setup  unknowns       nnz  iters  facts' // &
             '  residual_ms  jacobian_ms  factor_ms  solve_ms  other_ms  other_%' // &
-            '  analyse_ms  total_s  peak_MiB'
+            '  analyse_ms  total_s  peak_MiB  grow_B/dof  umf_LU_B/dof  umf_peak_B/dof' // &
+            '  x_LU  x_peak'
         stop
     end if
     read(argument, *) side
@@ -46,6 +56,7 @@ program bench_newton
         read(argument, *) setup_calls
     end if
 
+    baseline_mib = peak_memory_mib()
     call make_cable_net(config, side, setup_calls, solver_name)
     call new_scene(scene, config, error)
     if (allocated(error)) call fail('bench_newton', error)
@@ -66,10 +77,27 @@ program bench_newton
     call newton%get_timings(t_residual, t_jacobian, t_analyse, t_factor, t_solve, n_factor)
     iterations = max(stats%iterations, 1)
     other = total - (t_residual + t_jacobian + t_analyse + t_factor + t_solve)
-    write(output_unit, '(a7, i6, i10, i10, i7, i7, 5f11.3, f9.1, f12.3, f9.3, f10.1)') &
-        trim(solver_name), setup_calls, scene%dofs%n_unknowns, newton_nnz(), iterations, &
-        n_factor, 1e3_wp * [t_residual, t_jacobian, t_factor, t_solve, other] / iterations, &
-        100 * other / total, 1e3_wp * t_analyse, total, peak_memory_mib()
+    growth = (peak_memory_mib() - baseline_mib) * 1024.0_wp**2 / scene%dofs%n_unknowns
+    have_umfpack = .false.
+    select type (solver => newton%linear)
+    type is (umfpack_solver_type)
+        umfpack_memory = solver%get_memory()
+        have_umfpack = .true.
+    end select
+    write(output_unit, '(a7, i6, i10, i10, i7, i7, 5f11.3, f9.1, f12.3, f9.3, f10.1, f12.0)', &
+        advance='no') trim(solver_name), setup_calls, scene%dofs%n_unknowns, newton_nnz(), &
+        iterations, n_factor, &
+        1e3_wp * [t_residual, t_jacobian, t_factor, t_solve, other] / iterations, &
+        100 * other / total, 1e3_wp * t_analyse, total, peak_memory_mib(), growth
+    if (have_umfpack) then
+        associate(lu => umfpack_memory%numeric_bytes / scene%dofs%n_unknowns, &
+                peak => umfpack_memory%peak_bytes / scene%dofs%n_unknowns)
+            write(output_unit, '(f14.0, f16.0, f6.2, f8.2)') lu, peak, growth / lu, &
+                growth / peak
+        end associate
+    else
+        write(output_unit, '(a14, a16, a6, a8)') '-', '-', '-', '-'
+    end if
 
 contains
 

@@ -13,13 +13,17 @@ program yarnfort_main
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_driver, only: run_scene, get_linear_solver_name
     use yarnfort_app_progress, only: progress_writer_type
+    use yarnfort_solver_restart, only: restart_type
+    use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
     type(progress_writer_type) :: writer
     type(error_type), allocatable :: error
     type(error_type), allocatable :: finish_error
+    type(restart_type) :: restart
     integer :: unit, status
+    logical :: stopped
 
     call handle_arguments()
 
@@ -42,7 +46,19 @@ program yarnfort_main
 
     writer%progress = config%output%progress
     writer%residual_history = config%output%residual_history
-    call writer%open(scene, error)
+    writer%input_hash = get_input_hash(config, scene)
+    if (config%control%restart) then
+        ! Check the restart file before touching anything in the folder.
+        call read_restart(trim(config%output%folder), restart, error)
+        if (.not. allocated(error)) call check_restart(restart, scene, writer%input_hash, &
+            trim(config%output%folder), error)
+        if (allocated(error)) call fail('restart', error, 2)
+        write(error_unit, '(a, i0, a, g0.6)') 'yarnfort: restarting after step ', restart%step, &
+            ' at t = ', restart%time
+        call writer%open(scene, error, resume_step=restart%step)
+    else
+        call writer%open(scene, error)
+    end if
     if (allocated(error)) call fail('output', error, 2)
     open(newunit=unit, file=trim(config%output%folder) // '/input.nml', status='replace', &
         action='write', iostat=status)
@@ -51,11 +67,22 @@ program yarnfort_main
         close(unit)
     end if
 
-    call run_scene(scene, writer, error)
+    if (config%control%restart) then
+        call run_scene(scene, writer, error, restart=restart, &
+            max_steps=config%control%max_steps, stopped=stopped)
+    else
+        call run_scene(scene, writer, error, max_steps=config%control%max_steps, stopped=stopped)
+    end if
     call writer%finish(scene, finish_error)
     if (allocated(error)) call fail('solve', error, 1)
     if (allocated(finish_error)) call fail('output', finish_error, 1)
-    write(error_unit, '(a)') 'yarnfort: done; results in ' // trim(config%output%folder)
+    if (stopped) then
+        write(error_unit, '(a, i0, a)') 'yarnfort: stopped after max_steps = ', &
+            config%control%max_steps, ' load steps; results so far in ' &
+            // trim(config%output%folder) // ' (continue with &control restart = .true.)'
+    else
+        write(error_unit, '(a)') 'yarnfort: done; results in ' // trim(config%output%folder)
+    end if
 
 contains
 
@@ -94,7 +121,9 @@ contains
             'Writes to the &output folder: curve.csv (one row per converged step),', &
             'state_NNNNN.vtu + states.pvd (ParaView) and input.nml (the effective input).', &
             'Progress lines go to stderr. Exit code 0 on success, 1 if the solve failed', &
-            '(converged steps are kept), 2 for bad input or an unwritable output folder.'
+            '(converged steps are kept), 2 for bad input or an unwritable output folder.', &
+            'After every converged step it also writes restart.dat; &control restart =', &
+            '.true. continues a stopped or failed run from its last converged step.'
     end subroutine print_help
 
     subroutine fail(stage, error, code)

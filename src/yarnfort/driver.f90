@@ -9,6 +9,7 @@ module yarnfort_driver
     use yarnfort_solver_elastic_stepper, only: elastic_stepper_type, new_elastic_stepper
     use yarnfort_solver_continuation, only: step_observer_type, run_continuation
     use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
+    use yarnfort_solver_restart, only: restart_type
     implicit none
     private
 
@@ -33,20 +34,28 @@ contains
         end if
     end function get_linear_solver_name
 
-    !> Follow the scene's load path; `observer` receives every converged step.
-    subroutine run_scene(scene, observer, error)
+    !> Follow the scene's load path; `observer` receives every converged step and its
+    !> restart snapshot. With `restart`, go on from that snapshot instead of starting at
+    !> the first knot; with `max_steps` > 0, stop after that many converged load steps
+    !> (`stopped` then tells whether the path's end was not reached).
+    subroutine run_scene(scene, observer, error, restart, max_steps, stopped)
         type(scene_type), target, intent(in) :: scene
         class(step_observer_type), intent(inout) :: observer
         type(error_type), allocatable, intent(out) :: error
+        type(restart_type), intent(in), optional :: restart
+        integer, intent(in), optional :: max_steps
+        logical, intent(out), optional :: stopped
         class(linear_solver_type), allocatable :: linear
         type(elastic_stepper_type) :: stepper
         type(friction_stepper_type) :: friction_stepper
 
+        if (present(stopped)) stopped = .false.
         ! Only a scene with sliding passages pays for the sliding machinery.
         if (scene%passages%size() > 0) then
             call new_friction_stepper(friction_stepper, scene, get_linear_solver_name(scene), error)
             if (allocated(error)) return
-            call run_continuation(scene, friction_stepper, observer, error)
+            call run_continuation(scene, friction_stepper, observer, error, restart, max_steps, &
+                stopped)
             return
         end if
         call new_linear_solver(linear, get_linear_solver_name(scene), error)
@@ -56,7 +65,7 @@ contains
         end if
         call new_elastic_stepper(stepper, scene, linear, error)
         if (allocated(error)) return
-        call run_continuation(scene, stepper, observer, error)
+        call run_continuation(scene, stepper, observer, error, restart, max_steps, stopped)
     end subroutine run_scene
 
 end module yarnfort_driver

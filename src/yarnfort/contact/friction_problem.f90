@@ -8,6 +8,14 @@
 !>   slip backward (T_before > T_after, s shrinks): T_before - T_crit(T_after, alpha).
 !> (The signs make the residual continuous where the semismooth choice below switches
 !> a passage between stick and slip: there k ds = -g_f, resp. k ds = g_b.)
+!> Each slip row is divided by a weight w = max(1, dT_crit/dT_min), fixed for a Newton
+!> solve from its initial guess (`prepare_solve`), so that it measures the change of the
+!> low-side tension that would satisfy it. Unweighted, the row cannot reach the residual
+!> tolerance once exp(mu alpha) is large: T_min carries a rounding error of about
+!> EA*epsilon (from lambda - 1 near lambda = 1), which T_crit multiplies by
+!> dT_crit/dT_min (measured: mu alpha = 20 stalled at 5e-8 * force_scale). Weighted, the
+!> tolerance asks for the flow to about residual_tolerance * length_scale. With
+!> `semismooth` the weights stay 1 (the modes change within a solve).
 !> Tensions enter the friction conditions as max(T, 0) (a slack string pulls nothing).
 !> With `semismooth` (off by default) the mode of each passage is not fixed from outside
 !> but chosen at every evaluation from the current iterate, as in a primal-dual active
@@ -42,6 +50,9 @@ module yarnfort_contact_friction_problem
 
     !> Smallest sin(gamma) used in the derivative of the wrap angle (see get_wrap_angle).
     real(wp), parameter :: min_sine = 1.0e-8_wp
+    !> A slack string within this of stretch 1 sits at the kink of max(T, 0) (round-off
+    !> of length / L0 for a string at its reference length).
+    real(wp), parameter :: kink_round_off = 8 * epsilon(1.0_wp)
 
     type, extends(nonlinear_problem_type) :: friction_problem_type
         type(scene_type), pointer :: scene => null()
@@ -52,6 +63,8 @@ module yarnfort_contact_friction_problem
         !> Active set: mode of each passage, and the flow a stick passage keeps.
         integer, allocatable :: mode(:)
         real(wp), allocatable :: flow_target(:)
+        !> Divisor of each slip row, fixed per Newton solve (module notes).
+        real(wp), allocatable :: slip_weight(:)
         !> Choose modes from the iterate (semismooth Newton) instead of keeping `mode`.
         logical :: semismooth = .false.
         !> Direction a passage may not slip in (mode_forward or mode_backward), both
@@ -73,6 +86,7 @@ module yarnfort_contact_friction_problem
         procedure :: get_pattern
         procedure :: evaluate_residual
         procedure :: evaluate_jacobian
+        procedure :: prepare_solve
         !> Split unknowns into position unknowns and flows; set the work arrays.
         procedure :: update_state
         !> Tensions (clipped at 0) on both sides and the wrap angle of passage p.
@@ -100,6 +114,7 @@ contains
         allocate(self%mode(self%n_p), source=mode_stick)
         allocate(self%locked(self%n_p), source=0)
         allocate(self%flow_target(self%n_p), source=0.0_wp)
+        allocate(self%slip_weight(self%n_p), source=1.0_wp)
         allocate(self%u_frozen(self%n_x), source=0.0_wp)
         allocate(self%x(3, scene%network%n_nodes()), self%length0(n_elements))
         allocate(self%internal(3 * scene%network%n_nodes()))
@@ -234,6 +249,28 @@ contains
         end do
     end subroutine choose_modes
 
+    !> Fix the slip rows' weights w = max(1, dT_crit/dT_min) at the initial guess u.
+    subroutine prepare_solve(self, u, error)
+        class(friction_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: p
+        real(wp) :: t_before, t_after, angle, t_min, critical, dcrit_dt, dcrit_da
+
+        self%slip_weight = 1.0_wp
+        if (self%semismooth .or. all(self%mode == mode_stick)) return
+        call self%update_state(u, error)
+        if (allocated(error)) return
+        do p = 1, self%n_p
+            if (self%mode(p) == mode_stick) cycle
+            call self%get_passage_state(p, t_before, t_after, angle)
+            t_min = merge(t_before, t_after, self%mode(p) == mode_forward)
+            call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
+                t_min, angle, critical, dcrit_dt, dcrit_da)
+            self%slip_weight(p) = max(1.0_wp, dcrit_dt)
+        end do
+    end subroutine prepare_solve
+
     subroutine evaluate_residual(self, u, residual, error)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
@@ -262,12 +299,12 @@ contains
                 call self%get_passage_state(p, t_before, t_after, angle)
                 call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
                     t_before, angle, critical, dcrit_dt, dcrit_da)
-                residual(row + p) = critical - t_after
+                residual(row + p) = (critical - t_after) / self%slip_weight(p)
             case (mode_backward)
                 call self%get_passage_state(p, t_before, t_after, angle)
                 call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
                     t_after, angle, critical, dcrit_dt, dcrit_da)
-                residual(row + p) = t_before - critical
+                residual(row + p) = (t_before - critical) / self%slip_weight(p)
             end select
         end do
     end subroutine evaluate_residual
@@ -348,6 +385,7 @@ contains
                     row(1:9) = row(1:9) - dcrit_da * reshape(dangle, [9])
                 end if
             end associate
+            row = row / self%slip_weight(p)
             do k = 1, 12
                 slot = self%passage_slot(10, k, p)
                 if (slot /= 0) values(slot) = values(slot) + row(k)
@@ -364,12 +402,24 @@ contains
 
             gradient = 0.0_wp
             associate(net => self%scene%network)
-                if (self%tension(e) <= 0.0_wp) return
                 length = norm2(self%x(:, net%element_nodes(2, e)) - self%x(:, net%element_nodes(1, e)))
                 c = (self%x(:, net%element_nodes(2, e)) - self%x(:, net%element_nodes(1, e))) / length
                 lambda = length / self%length0(e)
-                call get_truss_tension(self%scene%laws(net%element_material(e))%law, &
-                    self%scene%solver%slack_stiffness, lambda, t, dt)
+                if (self%tension(e) <= 0.0_wp) then
+                    ! Slack: max(T, 0) is flat, except at its kink lambda = 1 (a string at
+                    ! its reference length with slack_stiffness = 0, e.g. every string of
+                    ! the stress-free start). There the taut side's slope is taken: the
+                    ! low-tension side of a slipping passage is pulled taut by the flow,
+                    ! and the flat side's 0 drops T_crit's dependence on it from the
+                    ! Jacobian (with a large mu the first Newton step then overshoots the
+                    ! flow by the factor exp(mu alpha), and the line search fails).
+                    if (abs(lambda - 1.0_wp) > kink_round_off) return
+                    t = 0.0_wp
+                    dt = self%scene%laws(net%element_material(e))%law%get_reference_stiffness()
+                else
+                    call get_truss_tension(self%scene%laws(net%element_material(e))%law, &
+                        self%scene%solver%slack_stiffness, lambda, t, dt)
+                end if
                 gradient(first:first + 2) = -dt / self%length0(e) * c
                 gradient(first + 3:first + 5) = dt / self%length0(e) * c
                 gradient(start_slot) = gradient(start_slot) - dt * lambda / self%length0(e)

@@ -24,6 +24,7 @@ module yarnfort_contact_friction_stepper
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
     use yarnfort_solver_state, only: fill_step_state
+    use yarnfort_solver_restart, only: restart_type, stepper_friction
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
         mode_stick, mode_forward, mode_backward, locked_both
     implicit none
@@ -66,6 +67,8 @@ module yarnfort_contact_friction_stepper
         procedure :: try_step
         procedure :: accept
         procedure :: get_state
+        procedure :: save_state
+        procedure :: restore_state
         final :: finalize
     end type friction_stepper_type
 
@@ -488,6 +491,76 @@ contains
         state%n_passages = size(self%mode)
         state%n_slipping = count(self%mode /= mode_stick)
     end subroutine get_state
+
+    !> Everything a step depends on besides the scene: the accepted state (whose flows
+    !> give the reference lengths and the locks at the minimum length) and the one before
+    !> it for the secant predictor.
+    subroutine save_state(self, snapshot)
+        class(friction_stepper_type), intent(in) :: self
+        type(restart_type), intent(inout) :: snapshot
+
+        snapshot%stepper = stepper_friction
+        snapshot%p_force = self%p_force
+        snapshot%p_disp = self%p_disp
+        snapshot%u = self%u
+        snapshot%flow = self%flow
+        snapshot%mode = self%mode
+        snapshot%have_old = self%have_old
+        snapshot%load_old = self%load_old
+        if (self%have_old) then
+            snapshot%u_old = self%u_old
+            snapshot%flow_old = self%flow_old
+        else
+            snapshot%u_old = self%u
+            snapshot%flow_old = self%flow
+        end if
+        if (.not. allocated(snapshot%length0)) &
+            allocate(snapshot%length0(self%scene%network%n_elements()))
+        call self%scene%passages%get_length0(self%scene%network%length0, self%flow, &
+            snapshot%length0)
+    end subroutine save_state
+
+    !> The reference lengths follow from the flows: the snapshot's must be those, bit
+    !> for bit (else it was written for another scene).
+    subroutine restore_state(self, snapshot, error)
+        class(friction_stepper_type), intent(inout) :: self
+        type(restart_type), intent(in) :: snapshot
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: length0(:)
+
+        if (snapshot%stepper /= stepper_friction) then
+            call fatal_error(error, 'the restart file was written by a run without sliding ' &
+                // 'passages, this scene has some')
+            return
+        end if
+        if (size(snapshot%u) /= size(self%u) .or. size(snapshot%flow) /= size(self%flow) &
+                .or. size(snapshot%length0) /= self%scene%network%n_elements()) then
+            call fatal_error(error, 'the restart file does not match the scene: other sizes')
+            return
+        end if
+        allocate(length0(self%scene%network%n_elements()))
+        call self%scene%passages%get_length0(self%scene%network%length0, snapshot%flow, &
+            length0)
+        if (any(length0 /= snapshot%length0)) then
+            call fatal_error(error, 'the restart file does not match the scene: other ' &
+                // 'element reference lengths')
+            return
+        end if
+        self%p_force = snapshot%p_force
+        self%p_disp = snapshot%p_disp
+        self%u = snapshot%u
+        self%flow = snapshot%flow
+        self%mode = snapshot%mode
+        self%have_old = snapshot%have_old
+        self%load_old = snapshot%load_old
+        self%u_old = snapshot%u_old
+        self%flow_old = snapshot%flow_old
+        self%p_force_trial = self%p_force
+        self%p_disp_trial = self%p_disp
+        self%u_trial = self%u
+        self%flow_trial = self%flow
+        self%mode_trial = self%mode
+    end subroutine restore_state
 
     subroutine finalize(self)
         type(friction_stepper_type), intent(inout) :: self

@@ -236,7 +236,7 @@ contains
                     ! the input needs that, a forgotten quote is far more likely.
                     call fatal_error(error, 'line ' // format_integer(iline) &
                         // ': character value not closed with ' // quote &
-                        // ' on its line')
+                        // ' on its line: ' // open_value())
                     return
                 end if
             end associate
@@ -334,8 +334,28 @@ contains
         subroutine string_group_error()
             call fatal_error(error, 'line ' // format_integer(iline) // ": '&" // name &
                 // "' inside a character value would be read as the start of group &" &
-                // name // "; remove the '&'")
+                // name // "; remove the '&': " // open_value())
         end subroutine string_group_error
+
+        !> The group, the variable and the start of the character value being read:
+        !> "&control title = 'see &yarn..." (the variable is the last name before it).
+        function open_value() result(text)
+            character(len=:), allocatable :: text
+            integer :: k
+
+            associate(group => scan%groups(scan%n_groups))
+                text = '&' // group%name
+                do k = group%n_tokens - 1, 1, -1
+                    if (group%tokens(k)%is_name) then
+                        text = text // ' ' // scan%token_text(group%tokens(k)) // ' ='
+                        exit
+                    end if
+                end do
+                associate(value => group%tokens(group%n_tokens))
+                    text = text // ' ' // shorten(scan%lines(value%line)%text(value%first:))
+                end associate
+            end associate
+        end function open_value
 
     end subroutine find_groups
 
@@ -463,10 +483,11 @@ contains
         text = self%lines(token%line)%text(token%first:token%last)
     end function token_text
 
-    !> Words to append to the namelist reader's iomsg for the `occurrence`-th group `name`
-    !> (known variables `variables`): the line, and for "Cannot match namelist object
-    !> name X" whether X is an unknown variable (with a suggestion) or a bad value of the
-    !> variable before it.
+    !> The namelist reader's iomsg `message` for the `occurrence`-th group `name` (known
+    !> variables `variables`), explained: with the line, and for "Cannot match namelist
+    !> object name X" whether X is an unknown variable (with a suggestion) or a bad value
+    !> of the variable before it. A bad value leads the text ("'soft' is not a valid
+    !> value of stiffness (line 9: ...)"), with the reader's own words at the end.
     function explain_read_error(scan, name, occurrence, message, variables) result(hint)
         type(namelist_scan_type), intent(in) :: scan
         character(len=*), intent(in) :: name
@@ -476,17 +497,38 @@ contains
         character(len=:), allocatable :: hint
         character(len=*), parameter :: no_match = 'Cannot match namelist object name '
         character(len=:), allocatable :: object, text, guess, variable
-        integer :: g, k, pass
+        integer :: g, k, pass, found, found_subscripted
 
         g = scan%find_group(name, occurrence)
         if (g == 0) then
-            hint = ''
+            hint = message
             return
         end if
         associate(group => scan%groups(g))
-            hint = ' (group on line ' // format_integer(group%first_line) // ')'
-            if (index(message, no_match) /= 1) return
+            hint = message // ' (group on line ' // format_integer(group%first_line) // ')'
+            if (index(message, no_match) /= 1) then
+                ! "Bad data for namelist object nodes" and the like: show that assignment
+                ! (for an index or substring message, the first one with a subscript).
+                variable = named_variable(message)
+                if (len(variable) == 0) return
+                found = 0
+                found_subscripted = 0
+                do k = 1, group%n_tokens
+                    if (.not. group%tokens(k)%is_name) cycle
+                    text = scan%token_text(group%tokens(k))
+                    if (base_name(text) /= variable) cycle
+                    if (found == 0) found = k
+                    if (found_subscripted == 0 .and. index(text, '(') > 0) found_subscripted = k
+                end do
+                if (found_subscripted > 0 .and. is_subscript_message()) found = found_subscripted
+                if (found > 0) hint = message // ' (line ' &
+                    // format_integer(group%tokens(found)%line) // ': ' &
+                    // assignment_text(found) // ')'
+                return
+            end if
             object = to_lower(trim(message(len(no_match) + 1:)))
+            ! The reader may run on into the next group ("'stiff'&material", "true.&yarn").
+            if (index(object, '&') > 1) object = object(:index(object, '&') - 1)
             ! Pass 1: the reader names a whole token (or a string and what followed it);
             ! pass 2: the end of a token it read in part (the '.5' of '2.5' for an integer).
             do pass = 1, 2
@@ -497,8 +539,8 @@ contains
                         if (pass == 1 .and. (to_lower(text) == object &
                             .or. base_name(text) == object)) then
                             guess = closest_name(base_name(text), variables)
-                            hint = ' (line ' // format_integer(group%tokens(k)%line) &
-                                // ': unknown variable'
+                            hint = message // ' (line ' &
+                                // format_integer(group%tokens(k)%line) // ': unknown variable'
                             if (len(guess) > 0) then
                                 hint = hint // ', did you mean ' // guess // '?)'
                             else
@@ -509,10 +551,10 @@ contains
                         end if
                         variable = base_name(text)
                     else if (len(variable) > 0 .and. matches(to_lower(text), pass)) then
-                        hint = ' (line ' // format_integer(group%tokens(k)%line) // ': ' &
-                            // text // ' is not a valid value of ' // variable &
-                            // ': wrong type, text without quotes, or more values than ' &
-                            // variable // ' holds)'
+                        hint = text // ' is not a valid value of ' // variable // ' (line ' &
+                            // format_integer(group%tokens(k)%line) // ': wrong type, text ' &
+                            // 'without quotes, or more values than ' // variable &
+                            // ' holds; the namelist reader says: ' // message // ')'
                         return
                     end if
                 end do
@@ -520,6 +562,28 @@ contains
         end associate
 
     contains
+
+        logical function is_subscript_message()
+            is_subscript_message = index(message, 'ndex') > 0 .or. index(message, 'ubstring') > 0 &
+                .or. index(message, 'ualifier') > 0
+        end function is_subscript_message
+
+        !> "name = value value ..." of the name token k of the group, at most 60 characters.
+        function assignment_text(k) result(text)
+            integer, intent(in) :: k
+            character(len=:), allocatable :: text
+            integer, parameter :: max_length = 60
+            integer :: j
+
+            associate(group => scan%groups(g))
+                text = scan%token_text(group%tokens(k)) // ' ='
+                do j = k + 1, group%n_tokens
+                    if (group%tokens(j)%is_name .or. len(text) > max_length) exit
+                    text = text // ' ' // scan%token_text(group%tokens(j))
+                end do
+            end associate
+            if (len(text) > max_length) text = text(:max_length) // '...'
+        end function assignment_text
 
         logical function matches(token, pass)
             character(len=*), intent(in) :: token
@@ -534,6 +598,26 @@ contains
         end function matches
 
     end function explain_read_error
+
+    !> The variable a namelist reader's message names at its end ("Bad data for namelist
+    !> object nodes", "Index 1 out of range for namelist variable time"), lower case; ''
+    !> for messages that name none.
+    pure function named_variable(message) result(variable)
+        character(len=*), intent(in) :: message
+        character(len=:), allocatable :: variable
+        character(len=*), parameter :: markers(2) = [character(len=18) :: &
+            'namelist object ', 'namelist variable ']
+        integer :: i, at
+
+        variable = ''
+        do i = 1, size(markers)
+            at = index(message, trim(markers(i)) // ' ', back=.true.)
+            if (at == 0) cycle
+            variable = base_name(adjustl(message(at + len_trim(markers(i)) + 1:)))
+            if (variable == 'name' .or. index(variable, ' ') > 0) variable = ''
+            return
+        end do
+    end function named_variable
 
     !> A quoted character value (the namelist reader may print more after it).
     pure logical function is_string(text)

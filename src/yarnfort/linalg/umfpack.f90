@@ -18,16 +18,26 @@ module yarnfort_linalg_umfpack
         umfpack_error_invalid_system, umfpack_error_invalid_permutation, &
         umfpack_error_internal_error, umfpack_error_ordering_failed, umfpack_dl_defaults, &
         umfpack_dl_symbolic, umfpack_dl_numeric, umfpack_dl_wsolve, &
-        umfpack_dl_free_symbolic, umfpack_dl_free_numeric
+        umfpack_dl_free_symbolic, umfpack_dl_free_numeric, umfpack_size_of_unit, &
+        umfpack_numeric_size, umfpack_peak_memory, umfpack_lnz, umfpack_unz
     implicit none
     private
 
-    public :: umfpack_solver_type, umfpack_refinement_steps
+    public :: umfpack_solver_type, umfpack_refinement_steps, umfpack_memory_type
 
     !> Iterative refinement steps per solve (Control(UMFPACK_IRSTEP)); see design.md sec. 5.
     integer, parameter :: umfpack_refinement_steps = 0
     !> UMFPACK print level (Control(UMFPACK_PRL)): library code never prints.
     integer, parameter :: umfpack_print_level = 0
+
+    !> UMFPACK's own account of its memory at the last numeric factorisation.
+    type :: umfpack_memory_type
+        !> Bytes of the Numeric object (the LU factors and their indices), and peak bytes
+        !> UMFPACK held during symbolic analysis and numeric factorisation.
+        real(wp) :: numeric_bytes = 0.0_wp, peak_bytes = 0.0_wp
+        !> Nonzeros of L and U, diagonal included.
+        real(wp) :: l_nonzeros = 0.0_wp, u_nonzeros = 0.0_wp
+    end type umfpack_memory_type
 
     !> UMFPACK solver. Owns C handles: never copy an analysed object by assignment.
     type, extends(linear_solver_type) :: umfpack_solver_type
@@ -43,7 +53,10 @@ module yarnfort_linalg_umfpack
         !> Solve workspace (umfpack_dl_wsolve) and a copy of the right-hand side.
         integer(c_long), allocatable :: int_work(:)
         real(c_double), allocatable :: real_work(:), rhs_copy(:)
+        type(umfpack_memory_type) :: memory
     contains
+        !> UMFPACK's memory figures of the last numeric factorisation (benchmarks).
+        procedure :: get_memory
         procedure :: analyse
         procedure :: factor
         procedure :: solve
@@ -102,7 +115,15 @@ contains
         call umfpack_dl_free_numeric(self%numeric)
         status = umfpack_dl_numeric(self%col_ptr, self%row_index, values, self%symbolic, &
             self%numeric, self%control, self%info)
-        if (status == umfpack_ok) return
+        if (status == umfpack_ok) then
+            associate(unit => self%info(umfpack_size_of_unit))
+                self%memory%numeric_bytes = self%info(umfpack_numeric_size) * unit
+                self%memory%peak_bytes = self%info(umfpack_peak_memory) * unit
+            end associate
+            self%memory%l_nonzeros = self%info(umfpack_lnz)
+            self%memory%u_nonzeros = self%info(umfpack_unz)
+            return
+        end if
 
         call umfpack_dl_free_numeric(self%numeric)
         if (status == umfpack_warning_singular_matrix) then
@@ -153,6 +174,13 @@ contains
         if (allocated(self%real_work)) deallocate(self%real_work)
         if (allocated(self%rhs_copy)) deallocate(self%rhs_copy)
     end subroutine destroy
+
+    pure function get_memory(self) result(memory)
+        class(umfpack_solver_type), intent(in) :: self
+        type(umfpack_memory_type) :: memory
+
+        memory = self%memory
+    end function get_memory
 
     pure function get_name(self) result(name)
         class(umfpack_solver_type), intent(in) :: self

@@ -8,6 +8,8 @@ module yarnfort_linalg_umfpack_binding
     private
 
     public :: umfpack_control, umfpack_info
+    public :: umfpack_size_of_unit, umfpack_numeric_size, umfpack_peak_memory, umfpack_lnz, &
+        umfpack_unz
     public :: umfpack_prl, umfpack_irstep, umfpack_status, umfpack_rcond
     public :: umfpack_a
     public :: umfpack_ok, umfpack_warning_singular_matrix, umfpack_error_out_of_memory
@@ -26,6 +28,11 @@ module yarnfort_linalg_umfpack_binding
     integer, parameter :: umfpack_prl = 0, umfpack_irstep = 7
     !> 0-based indices into Info: status, reciprocal condition estimate.
     integer, parameter :: umfpack_status = 0, umfpack_rcond = 67
+    !> 0-based indices into Info: bytes per Unit; size of the Numeric object and peak
+    !> memory of symbolic analysis and numeric factorisation, in Units; nonzeros of L
+    !> and U (diagonal included).
+    integer, parameter :: umfpack_size_of_unit = 3, umfpack_numeric_size = 40, &
+        umfpack_peak_memory = 41, umfpack_lnz = 43, umfpack_unz = 44
 
     !> System to solve: A x = b.
     integer(c_long), parameter :: umfpack_a = 0

@@ -1,12 +1,13 @@
 ! SPDX-License-Identifier: MIT
-!> Folder creation through the C library (Fortran has no portable mkdir).
+!> Folder creation and file renaming through the C library (Fortran has no portable
+!> mkdir or rename).
 module yarnfort_output_filesystem
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
     use yarnfort_error, only: error_type, fatal_error
     implicit none
     private
 
-    public :: make_folder
+    public :: make_folder, rename_file
 
     interface
         function c_mkdir(path, mode) result(status) bind(C, name='mkdir')
@@ -15,6 +16,12 @@ module yarnfort_output_filesystem
             integer(c_int), value :: mode
             integer(c_int) :: status
         end function c_mkdir
+
+        function c_rename(old, new) result(status) bind(C, name='rename')
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: old(*), new(*)
+            integer(c_int) :: status
+        end function c_rename
     end interface
 
     !> Permissions of new folders (rwxr-xr-x before the umask).
@@ -44,5 +51,15 @@ contains
         end if
         close(unit, status='delete')
     end subroutine make_folder
+
+    !> Rename `old` to `new`, replacing `new` if it exists. On POSIX systems this is
+    !> atomic: `new` is always either the old file or the complete new one.
+    subroutine rename_file(old, new, error)
+        character(len=*), intent(in) :: old, new
+        type(error_type), allocatable, intent(out) :: error
+
+        if (c_rename(old // c_null_char, new // c_null_char) /= 0) &
+            call fatal_error(error, "cannot rename '" // old // "' to '" // new // "'")
+    end subroutine rename_file
 
 end module yarnfort_output_filesystem

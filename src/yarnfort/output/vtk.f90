@@ -20,6 +20,8 @@ module yarnfort_output_vtk
         procedure :: write_state
         !> Delete the states a previous run listed in folder/states.pvd.
         procedure :: remove_previous
+        !> Keep the states of folder/states.pvd up to a step, delete the later ones.
+        procedure :: resume => resume_states
     end type vtk_writer_type
 
     integer, parameter :: vtk_line = 3
@@ -106,6 +108,54 @@ contains
         end do
         close(unit, status='delete')
     end subroutine remove_previous
+
+    !> Continue the states of folder/states.pvd after `step` (a restart): keep the
+    !> listed states of steps up to `step`, delete the files of later ones, and rewrite
+    !> the collection with the kept ones. No states.pvd: no states to keep.
+    subroutine resume_states(self, step, error)
+        class(vtk_writer_type), intent(inout) :: self
+        integer, intent(in) :: step
+        type(error_type), allocatable, intent(out) :: error
+        character(len=1024) :: line
+        character(len=:), allocatable :: name
+        integer :: unit, status, first, last, old, state_step
+        real(wp) :: time
+
+        allocate(self%files(0), self%times(0))
+        open(newunit=unit, file=self%folder // '/states.pvd', status='old', action='read', &
+            iostat=status)
+        if (status /= 0) return
+        do
+            read(unit, '(a)', iostat=status) line
+            if (status /= 0) exit
+            first = index(line, 'file="')
+            if (first == 0) cycle
+            first = first + len('file="')
+            last = index(line(first:), '"') + first - 2
+            if (last < first) cycle
+            name = line(first:last)
+            ! Only the plain state_NNNNN.vtu names written by this writer.
+            if (len(name) /= len('state_00000.vtu') .or. name(1:6) /= 'state_' .or. &
+                    name(12:) /= '.vtu') cycle
+            read(name(7:11), '(i5)', iostat=status) state_step
+            if (status /= 0) cycle
+            if (state_step <= step) then
+                first = index(line, 'timestep="')
+                if (first == 0) cycle
+                first = first + len('timestep="')
+                last = index(line(first:), '"') + first - 2
+                read(line(first:last), *, iostat=status) time
+                if (status /= 0) cycle
+                self%files = [self%files, [character(len=32) :: name]]
+                self%times = [self%times, time]
+            else
+                open(newunit=old, file=self%folder // '/' // name, status='old', iostat=status)
+                if (status == 0) close(old, status='delete')
+            end if
+        end do
+        close(unit)
+        call write_collection(self, error)
+    end subroutine resume_states
 
     subroutine write_collection(self, error)
         type(vtk_writer_type), intent(in) :: self

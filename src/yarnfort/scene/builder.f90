@@ -288,8 +288,11 @@ contains
 
         n_nodes = scene%network%n_nodes()
         allocate(scene%dofs%gap(3 * n_nodes), source=0.0_wp)
-        scene%dofs%gap_p_disp = config%fabric%gap_factor_p_disp
-        scene%dofs%gap_factor = config%fabric%gap_factor
+        if (allocated(config%fabric%gap_factor)) then
+            scene%dofs%gap_p_disp = config%fabric%gap_factor_p_disp
+            scene%dofs%gap_factor = config%fabric%gap_factor
+        end if
+        if (.not. allocated(config%links)) return
         if (size(config%links) == 0) return
         allocate(leader(n_nodes), link_of(n_nodes), source=0)
         do l = 1, size(config%links)
@@ -450,9 +453,11 @@ contains
         allocate(second_yarn(n_nodes), source=0)
         allocate(root(n_nodes))
         root = [(node, node = 1, n_nodes)]
-        do k = 1, size(config%links)
-            root(config%links(k)%follower) = config%links(k)%leader
-        end do
+        if (allocated(config%links)) then
+            do k = 1, size(config%links)
+                root(config%links(k)%follower) = config%links(k)%leader
+            end do
+        end if
         do node = 1, n_nodes
             do k = 1, n_nodes
                 if (root(root(node)) == root(node)) exit

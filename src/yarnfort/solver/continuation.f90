@@ -2,13 +2,15 @@
 !> Continuation along the load path (paper section 2.6): steps in pseudo-time from knot
 !> to knot, each solved from the previous converged state; a failed step is cut, an
 !> easy one lets the next step grow. Every converged step goes to the observer before
-!> the next one starts.
+!> the next one starts, then a restart snapshot of it (on_checkpoint): a run started
+!> from that snapshot takes the same steps as one that never stopped.
 module yarnfort_solver_continuation
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_newton, only: newton_stats_type
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
+    use yarnfort_solver_restart, only: restart_type
     use yarnfort_solver_timer, only: wall_time
     implicit none
     private
@@ -20,6 +22,8 @@ module yarnfort_solver_continuation
     contains
         procedure(on_step_interface), deferred :: on_step
         procedure(on_cut_interface), deferred :: on_cut
+        !> Receives the restart snapshot of every converged step, after on_step.
+        procedure :: on_checkpoint
     end type step_observer_type
 
     abstract interface
@@ -44,43 +48,86 @@ module yarnfort_solver_continuation
 
 contains
 
-    !> Follow the scene's load path from its first knot to its last.
-    subroutine run_continuation(scene, stepper, observer, error)
+    !> The default: snapshots are not kept.
+    subroutine on_checkpoint(self, scene, snapshot, error)
+        class(step_observer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        type(restart_type), intent(in) :: snapshot
+        type(error_type), allocatable, intent(out) :: error
+    end subroutine on_checkpoint
+
+    !> Follow the scene's load path from its first knot to its last, or from the step
+    !> of a `restart` snapshot on; stop early after `max_steps` converged load steps
+    !> (> 0) and then set `stopped`.
+    subroutine run_continuation(scene, stepper, observer, error, restart, max_steps, stopped)
         type(scene_type), intent(in) :: scene
         class(load_stepper_type), intent(inout) :: stepper
         class(step_observer_type), intent(inout) :: observer
         type(error_type), allocatable, intent(out) :: error
+        type(restart_type), intent(in), optional :: restart
+        integer, intent(in), optional :: max_steps
+        logical, intent(out), optional :: stopped
         real(wp) :: t, t_end, dt, t_next, p_force, p_disp, span, start, previous_load
-        integer :: step, cuts, knot, iterations
+        integer :: step, cuts, knot, iterations, first_step
         type(newton_stats_type) :: stats
         type(step_state_type) :: state
+        type(restart_type) :: snapshot
         type(error_type), allocatable :: step_error
         character(len=200) :: buffer
 
+        if (present(stopped)) stopped = .false.
         associate(path => scene%path)
             t = path%time(1)
             t_end = path%time(size(path%time))
             span = t_end - t
 
-            ! Step 0: equilibrium at the first knot.
-            start = wall_time()
-            call path%get_factors(t, p_force, p_disp)
-            call stepper%try_step(p_force, p_disp, stats, iterations, error)
-            if (allocated(error)) then
-                call prefix_error(error, 'initial state (time 0)')
-                return
+            if (present(restart)) then
+                ! Go on from the snapshot's converged step, as the run that wrote it would.
+                if (restart%knot < 2 .or. restart%knot > size(path%time) .or. &
+                        .not. (restart%time >= t .and. restart%time <= t_end)) then
+                    call fatal_error(error, 'restart file: its time or knot is not on ' &
+                        // 'the load path')
+                    return
+                end if
+                call stepper%restore_state(restart, error)
+                if (allocated(error)) return
+                t = restart%time
+                dt = restart%next_step
+                knot = restart%knot
+                step = restart%step
+                previous_load = restart%previous_load
+                p_force = restart%p_force
+                p_disp = restart%p_disp
+            else
+                ! Step 0: equilibrium at the first knot.
+                start = wall_time()
+                call path%get_factors(t, p_force, p_disp)
+                call stepper%try_step(p_force, p_disp, stats, iterations, error)
+                if (allocated(error)) then
+                    call prefix_error(error, 'initial state (time 0)')
+                    return
+                end if
+                call stepper%accept()
+                step = 0
+                dt = min(scene%solver%initial_step, scene%solver%max_step)
+                knot = 2
+                call report(0)
+                if (allocated(error)) return
+                previous_load = p_force + p_disp
+                call checkpoint(t)
+                if (allocated(error)) return
             end if
-            call stepper%accept()
-            step = 0
-            call report(0)
-            if (allocated(error)) return
-            previous_load = p_force + p_disp
 
-            dt = min(scene%solver%initial_step, scene%solver%max_step)
-            knot = 2
+            first_step = step
             cuts = 0
             start = wall_time()
             do while (t < t_end - knot_tolerance * span)
+                if (present(max_steps)) then
+                    if (max_steps > 0 .and. step - first_step >= max_steps) then
+                        if (present(stopped)) stopped = .true.
+                        return
+                    end if
+                end if
                 do while (path%time(knot) <= t + knot_tolerance * span)
                     knot = knot + 1
                 end do
@@ -106,13 +153,15 @@ contains
                 call stepper%accept()
                 step = step + 1
                 state%time = t_next
-                call report(cuts)
-                if (allocated(error)) return
                 if (iterations <= scene%solver%easy_iterations .and. cuts == 0) then
                     dt = min((t_next - t) * scene%solver%step_growth, scene%solver%max_step)
                 else
                     dt = min(max(dt, t_next - t), scene%solver%max_step)
                 end if
+                call report(cuts)
+                if (allocated(error)) return
+                call checkpoint(t_next)
+                if (allocated(error)) return
                 t = t_next
                 cuts = 0
                 start = wall_time()
@@ -138,6 +187,22 @@ contains
             previous_load = p_force + p_disp
             call observer%on_step(scene, state, error)
         end subroutine report
+
+        !> Hand the accepted state at `time` to the observer as a restart snapshot.
+        subroutine checkpoint(time)
+            real(wp), intent(in) :: time
+            call stepper%save_state(snapshot)
+            snapshot%step = step
+            snapshot%time = time
+            snapshot%next_step = dt
+            snapshot%knot = knot
+            snapshot%previous_load = previous_load
+            snapshot%n_nodes = scene%network%n_nodes()
+            snapshot%n_elements = scene%network%n_elements()
+            snapshot%n_unknowns = scene%dofs%n_unknowns
+            snapshot%n_passages = scene%passages%size()
+            call observer%on_checkpoint(scene, snapshot, error)
+        end subroutine checkpoint
     end subroutine run_continuation
 
 end module yarnfort_solver_continuation

@@ -2,13 +2,14 @@
 !> Load steps without sliding: one Newton solve of the equilibrium per step.
 module yarnfort_solver_elastic_stepper
     use yarnfort_kinds, only: wp
-    use yarnfort_error, only: error_type
+    use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
     use yarnfort_solver_state, only: fill_step_state
+    use yarnfort_solver_restart, only: restart_type, stepper_elastic
     implicit none
     private
 
@@ -26,6 +27,8 @@ module yarnfort_solver_elastic_stepper
         procedure :: try_step
         procedure :: accept
         procedure :: get_state
+        procedure :: save_state
+        procedure :: restore_state
         final :: finalize
     end type elastic_stepper_type
 
@@ -77,6 +80,47 @@ contains
         call fill_step_state(self%scene, self%u, self%problem%length0, self%p_force, &
             self%p_disp, state, error)
     end subroutine get_state
+
+    subroutine save_state(self, snapshot)
+        class(elastic_stepper_type), intent(in) :: self
+        type(restart_type), intent(inout) :: snapshot
+
+        snapshot%stepper = stepper_elastic
+        snapshot%p_force = self%p_force
+        snapshot%p_disp = self%p_disp
+        snapshot%u = self%u
+        snapshot%length0 = self%problem%length0
+    end subroutine save_state
+
+    !> The reference lengths never change without sliding: the snapshot's must be the
+    !> scene's, bit for bit.
+    subroutine restore_state(self, snapshot, error)
+        class(elastic_stepper_type), intent(inout) :: self
+        type(restart_type), intent(in) :: snapshot
+        type(error_type), allocatable, intent(out) :: error
+
+        if (snapshot%stepper /= stepper_elastic) then
+            call fatal_error(error, "the restart file was written by a run with sliding " &
+                // "passages, this scene has none")
+            return
+        end if
+        if (size(snapshot%u) /= size(self%u) .or. &
+                size(snapshot%length0) /= size(self%problem%length0)) then
+            call fatal_error(error, 'the restart file does not match the scene: other sizes')
+            return
+        end if
+        if (any(snapshot%length0 /= self%problem%length0)) then
+            call fatal_error(error, 'the restart file does not match the scene: other ' &
+                // 'element reference lengths')
+            return
+        end if
+        self%u = snapshot%u
+        self%u_trial = snapshot%u
+        self%p_force = snapshot%p_force
+        self%p_disp = snapshot%p_disp
+        self%p_force_trial = snapshot%p_force
+        self%p_disp_trial = snapshot%p_disp
+    end subroutine restore_state
 
     subroutine finalize(self)
         type(elastic_stepper_type), intent(inout) :: self

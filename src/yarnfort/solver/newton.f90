@@ -185,6 +185,8 @@ contains
         self%problem%n_history = 0
         if (allocated(self%problem%error)) deallocate(self%problem%error)
         if (allocated(self%problem%kinsol_message)) deallocate(self%problem%kinsol_message)
+        call self%problem%problem%prepare_solve(u, error)
+        if (allocated(error)) return
         self%u = u
         strategy = merge(KIN_LINESEARCH, KIN_NONE, self%options%line_search)
         ierr = FKINSol(self%kinsol, self%u_vector, strategy, self%u_scale, self%f_scale)

@@ -22,6 +22,9 @@ module yarnfort_solver_problem
         procedure(evaluate_residual_interface), deferred :: evaluate_residual
         !> Jacobian values in the order of the pattern.
         procedure(evaluate_jacobian_interface), deferred :: evaluate_jacobian
+        !> Called by the Newton solver before each solve with its initial guess: a problem
+        !> may fix there what must stay constant during one solve (default: nothing).
+        procedure :: prepare_solve
     end type nonlinear_problem_type
 
     abstract interface
@@ -52,5 +55,14 @@ module yarnfort_solver_problem
             type(error_type), allocatable, intent(out) :: error
         end subroutine evaluate_jacobian_interface
     end interface
+
+contains
+
+    !> Nothing to prepare.
+    subroutine prepare_solve(self, u, error)
+        class(nonlinear_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        type(error_type), allocatable, intent(out) :: error
+    end subroutine prepare_solve
 
 end module yarnfort_solver_problem

@@ -5,6 +5,7 @@ module yarnfort_solver_stepper
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     use yarnfort_solver_newton, only: newton_stats_type
+    use yarnfort_solver_restart, only: restart_type
     implicit none
     private
 
@@ -38,6 +39,10 @@ module yarnfort_solver_stepper
         procedure(accept_interface), deferred :: accept
         !> The accepted state (positions, tensions, reactions, friction counts).
         procedure(get_state_interface), deferred :: get_state
+        !> Put the accepted state in a restart snapshot (its stepper part).
+        procedure(save_state_interface), deferred :: save_state
+        !> Make a snapshot's stepper part the accepted state; fails if it does not fit.
+        procedure(restore_state_interface), deferred :: restore_state
     end type load_stepper_type
 
     abstract interface
@@ -61,6 +66,19 @@ module yarnfort_solver_stepper
             type(step_state_type), intent(inout) :: state
             type(error_type), allocatable, intent(out) :: error
         end subroutine get_state_interface
+
+        subroutine save_state_interface(self, snapshot)
+            import :: load_stepper_type, restart_type
+            class(load_stepper_type), intent(in) :: self
+            type(restart_type), intent(inout) :: snapshot
+        end subroutine save_state_interface
+
+        subroutine restore_state_interface(self, snapshot, error)
+            import :: load_stepper_type, restart_type, error_type
+            class(load_stepper_type), intent(inout) :: self
+            type(restart_type), intent(in) :: snapshot
+            type(error_type), allocatable, intent(out) :: error
+        end subroutine restore_state_interface
     end interface
 
 end module yarnfort_solver_stepper
