@@ -13,8 +13,8 @@
 !> Yarn ends lie half way between crossings. A periodic cell pairs the ends at x = 0
 !> with those at x = nx*sx (and the weft ends along y): points of symmetry of the weave,
 !> where no yarn slides through. A clamped sample holds the warp ends at x = 0 and
-!> pulls those at the right edge; its weft ends are free or held in y ('rollers',
-!> which stands for a selvedge that keeps the weft from pulling out).
+!> pulls those at the right edge; its weft ends are free or held in y and z ('rollers',
+!> which stands for a selvedge that keeps the weft from pulling out and from folding).
 module yarnfort_generate_woven
     use yarnfort_kinds, only: wp
     use yarnfort_input_config, only: fabric_config_type
@@ -108,7 +108,7 @@ contains
                 [fabric%strain * nx * sx, 0.0_wp, 0.0_wp])
             pulled = 2
             if (fabric%sides == 'rollers') then
-                call net%add_support('sides', [weft_ends(1, :), weft_ends(2, :)], 'y', &
+                call net%add_support('sides', [weft_ends(1, :), weft_ends(2, :)], 'yz', &
                     [0.0_wp, 0.0_wp, 0.0_wp])
             end if
         end if
