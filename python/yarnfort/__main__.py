@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: MIT
 """Command line: ``python -m yarnfort plot <output folder> [--support NAME] [--out FILE]``.
 
-Writes a PNG with the force–displacement (hysteresis) plot of one support set and the
-final deformed network coloured by tension. Exit codes: 0 success, 2 bad arguments, a
+Writes a PNG with the force–displacement (hysteresis) plot of one support set (for a
+generated fabric: force per unit width against strain) and the final deformed network
+coloured by tension. Exit codes: 0 success, 2 bad arguments, a
 missing or unreadable output folder, or an unknown support set.
 """
 from __future__ import annotations
@@ -86,18 +87,22 @@ def plot_folder(folder: Path, support: str | None = None, out: Path | None = Non
                            " folder")
     from matplotlib.figure import Figure
 
-    from .plots import plot_hysteresis, plot_network, save_figure
+    from .plots import plot_fabric_hysteresis, plot_hysteresis, plot_network, save_figure
 
     curve = read_curve(folder)
-    name = choose_support(curve, folder, support)
-    component = _dominant_component(curve, name)
-    x = "p_disp" if np.ptp(curve["p_disp"]) > 0 else "p_force"
     states = read_states(folder)
-
     figure = Figure(figsize=(11, 4.5), layout="constrained")
     left, right = figure.subplots(1, 2)
-    plot_hysteresis(curve, name, component=component, x=x, ax=left)
-    left.set_title(f"reaction of '{name}'")
+    if support is None and "force_per_width" in curve.names:
+        # A generated fabric: its effective curve.
+        plot_fabric_hysteresis(curve, ax=left)
+        left.set_title("effective curve of the fabric")
+    else:
+        name = choose_support(curve, folder, support)
+        component = _dominant_component(curve, name)
+        x = "p_disp" if np.ptp(curve["p_disp"]) > 0 else "p_force"
+        plot_hysteresis(curve, name, component=component, x=x, ax=left)
+        left.set_title(f"reaction of '{name}'")
     if states:
         final = states[-1]
         plot_network(final, ax=right, projection=_dominant_projection(final.position))

@@ -135,20 +135,44 @@ def plot_hysteresis(curve: Curve, support: str, component: str = "y", x: str = "
     Axes
     """
     ax = _axes(ax)
-    abscissa = curve[x]
-    force = reaction_component(curve, support, component)
-    direction = curve["direction"]
-    for branch, value in BRANCH_DIRECTIONS.items():
-        for number, (start, stop) in enumerate(_runs(direction == value)):
-            first = max(start - 1, 0)
-            line, = ax.plot(abscissa[first:stop], force[first:stop],
-                            label=branch if number == 0 else "_" + branch,
-                            **BRANCH_STYLES[branch])
-            line.set_gid(branch)
+    _plot_branches(ax, curve[x], reaction_component(curve, support, component),
+                   curve["direction"])
     _labels(ax, support, component, x)
     if ax.get_legend_handles_labels()[0]:
         ax.legend()
     return ax
+
+
+def plot_fabric_hysteresis(curve: Curve, ax: Axes | None = None) -> Axes:
+    """Effective curve of a generated fabric (``&fabric``): force per unit width
+    against macroscopic strain, loading and unloading drawn as in
+    :func:`plot_hysteresis`.
+
+    Returns
+    -------
+    Axes
+    """
+    ax = _axes(ax)
+    _plot_branches(ax, curve["strain"], curve["force_per_width"], curve["direction"])
+    ax.set_xlabel("macroscopic strain (1)")
+    ax.set_ylabel("force per unit width (N/m)")
+    ax.grid(True, alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend()
+    return ax
+
+
+def _plot_branches(ax: Axes, abscissa: np.ndarray, ordinate: np.ndarray,
+                   direction: np.ndarray) -> None:
+    """Loading and unloading runs of a curve, each segment starting at the step
+    before its first step so that the loop has no gaps."""
+    for branch, value in BRANCH_DIRECTIONS.items():
+        for number, (start, stop) in enumerate(_runs(direction == value)):
+            first = max(start - 1, 0)
+            line, = ax.plot(abscissa[first:stop], ordinate[first:stop],
+                            label=branch if number == 0 else "_" + branch,
+                            **BRANCH_STYLES[branch])
+            line.set_gid(branch)
 
 
 def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
