@@ -11,6 +11,7 @@ module test_contact
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
         mode_stick, mode_forward, mode_backward
     use yarnfort_contact_geometry, only: get_wrap_angle
+    use yarnfort_generate_fabric, only: generate_fabric
     implicit none
     private
 
@@ -29,7 +30,9 @@ contains
             new_unittest('flows_conserve_yarn_length', test_conservation), &
             new_unittest('wrap_angle_and_gradient', test_wrap_angle), &
             new_unittest('jacobian_matches_fd_monolithic', test_jacobian_full), &
-            new_unittest('jacobian_matches_fd_positions_frozen', test_jacobian_frozen) ]
+            new_unittest('jacobian_matches_fd_positions_frozen', test_jacobian_frozen), &
+            new_unittest('jacobian_matches_fd_periodic_gap_holders', test_jacobian_links), &
+            new_unittest('links_follow_leaders', test_links_follow) ]
     end subroutine collect_contact
 
     !> A yarn A-C-E-B (two elements per segment) passing two contact nodes C and E, each
@@ -73,6 +76,77 @@ contains
         config%path%p_disp = [0.0_wp, 1.0_wp]
         call new_scene(scene, config, error)
     end subroutine make_scene
+
+    !> A periodic 2 x 2 plain-weave cell from the generator: gap-holders at the crossings
+    !> (gap factor 1 -> 0.7 over p_disp 0 -> 1) and periodic yarn ends with a macroscopic
+    !> strain; warp and weft slide with adhesion.
+    subroutine make_woven_scene(scene, error)
+        type(scene_type), intent(out) :: scene
+        type(error_type), allocatable, intent(out) :: error
+        type(config_type) :: config
+
+        allocate(config%materials(2))
+        config%materials(1)%name = 'warp'
+        config%materials(1)%law = 'neo_hookean'
+        config%materials(1)%modulus = 1.0e6_wp
+        config%materials(1)%area = 1.0e-5_wp
+        config%materials(1)%prestress = 0.5_wp
+        config%materials(2)%name = 'weft'
+        config%materials(2)%law = 'linear'
+        config%materials(2)%stiffness = 20.0_wp
+        config%materials(2)%prestress = 0.3_wp
+        allocate(config%contacts(1))
+        config%contacts(1)%materials = [character(len=64) :: 'warp', 'weft']
+        config%contacts(1)%law = 'adhesion'
+        config%contacts(1)%friction_coefficient = 0.3_wp
+        config%contacts(1)%adhesion = 0.05_wp
+        config%fabric%kind = 'plain'
+        config%fabric%cells = [2, 2]
+        config%fabric%spacing = [1.0_wp, 0.8_wp]
+        config%fabric%strain = 0.2_wp
+        config%fabric%lateral_strain = -0.05_wp
+        config%fabric%warp_material = 'warp'
+        config%fabric%weft_material = 'weft'
+        config%fabric%gap = 0.3_wp
+        config%fabric%gap_factor_p_disp = [0.0_wp, 1.0_wp]
+        config%fabric%gap_factor = [1.0_wp, 0.7_wp]
+        config%path%time = [0.0_wp, 1.0_wp]
+        config%path%p_force = [0.0_wp, 0.0_wp]
+        config%path%p_disp = [0.0_wp, 1.0_wp]
+        allocate(config%loads(0))
+        call generate_fabric(config, error)
+        if (allocated(error)) return
+        call new_scene(scene, config, error)
+    end subroutine make_woven_scene
+
+    subroutine test_jacobian_links(error)
+        type(error_type), allocatable, intent(out) :: error
+        call check_jacobian(.false., error, woven=.true.)
+    end subroutine test_jacobian_links
+
+    !> Expanded positions: a gap-holder's far node sits at its leader plus the scaled gap,
+    !> a periodic image at its leader plus the stretched period.
+    subroutine test_links_follow(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(scene_type) :: scene
+        real(wp), allocatable :: u(:), x(:, :)
+        real(wp), parameter :: p_disp = 0.4_wp, factor = 1.0_wp - 0.3_wp * p_disp
+        integer :: j
+
+        call make_woven_scene(scene, error)
+        if (allocated(error)) return
+        allocate(u(scene%dofs%n_unknowns), x(3, scene%network%n_nodes()))
+        call scene%dofs%restrict(scene%network%position, u)
+        u = u + 0.01_wp * [(sin(real(3 * j, wp)), j = 1, size(u))]
+        call scene%dofs%expand(u, p_disp, x)
+        ! Generator order: warp node, weft node per crossing (crossing (0,0) first, warp
+        ! over, gap 0.3); then the warp ends at x = 0 and x = 2 of warp 0.
+        call check_close(error, x(:, 2) - x(:, 1), [0.0_wp, 0.0_wp, -0.3_wp * factor], &
+            1.0e-14_wp, 'gap-holder offset')
+        if (allocated(error)) return
+        call check_close(error, x(:, 10) - x(:, 9), [2.0_wp * (1.0_wp + 0.2_wp * p_disp), &
+            0.0_wp, 0.0_wp], 1.0e-14_wp, 'periodic image offset')
+    end subroutine test_links_follow
 
     subroutine test_passages(error)
         type(error_type), allocatable, intent(out) :: error
@@ -161,16 +235,22 @@ contains
 
     !> Every column of the assembled Jacobian against central differences of the
     !> residual, for each combination of modes of the two passages.
-    subroutine check_jacobian(frozen, error)
+    subroutine check_jacobian(frozen, error, woven)
         logical, intent(in) :: frozen
         type(error_type), allocatable, intent(out) :: error
+        !> The periodic woven cell (all passages in one mode per combination) instead.
+        logical, intent(in), optional :: woven
         type(scene_type), target :: scene
         type(friction_problem_type) :: problem
         real(wp), allocatable :: u(:), up(:), rp(:), rm(:), values(:), dense(:, :), x0(:)
         integer :: n, j, p, m1, m2
         integer, parameter :: modes(3) = [mode_stick, mode_forward, mode_backward]
 
-        call make_scene(scene, error)
+        if (present(woven)) then
+            call make_woven_scene(scene, error)
+        else
+            call make_scene(scene, error)
+        end if
         if (allocated(error)) return
         ! The exact tension-only law: the slack regularisation's transverse floor is a
         ! deliberate Jacobian approximation (see yarnfort_assembly_truss).
@@ -179,21 +259,22 @@ contains
         ! Every mode combination in turn (not chosen from the iterate).
         problem%semismooth = .false.
         problem%p_disp = 0.6_wp
-        problem%flow_target = [0.01_wp, -0.02_wp]
+        problem%flow_target = [(0.01_wp * cos(real(j, wp)), j = 1, problem%n_p)]
         allocate(x0(scene%dofs%n_unknowns))
         call scene%dofs%restrict(scene%network%position, x0)
         x0 = x0 + 0.02_wp * [(cos(real(5 * j, wp)), j = 1, size(x0))]
         if (frozen) then
             problem%u_frozen = x0
-            u = [0.03_wp, -0.01_wp]
+            u = [(0.02_wp * sin(real(j, wp)), j = 1, problem%n_p)]
         else
-            u = [x0, 0.03_wp, -0.01_wp]
+            u = [x0, [(0.02_wp * sin(real(j, wp)), j = 1, problem%n_p)]]
         end if
         n = problem%get_size()
         allocate(rp(n), rm(n), values(size(problem%row_index)), dense(n, n))
         do m1 = 1, 3
             do m2 = 1, 3
-                problem%mode = [modes(m1), modes(m2)]
+                ! Alternate the two modes over the passages.
+                problem%mode = [(merge(modes(m1), modes(m2), mod(p, 2) == 1), p = 1, problem%n_p)]
                 call problem%evaluate_jacobian(u, values, error)
                 if (allocated(error)) return
                 dense = 0.0_wp
