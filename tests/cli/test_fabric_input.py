@@ -1,0 +1,100 @@
+# SPDX-License-Identifier: MIT
+"""Bad &fabric input: each mistake gets exit code 2, a message naming the variable and
+value, and nothing written. The base input is a valid periodic plain-weave cell."""
+from __future__ import annotations
+
+import pytest
+
+BASE = """
+&material name = 'warp', law = 'linear', stiffness = 20.0, prestress = 0.02 /
+&material name = 'weft', law = 'linear', stiffness = 10.0 /
+&contact materials = 'warp', 'weft', law = 'coulomb', friction_coefficient = 0.3 /
+&fabric
+    kind = 'plain'
+    cells = 2, 2
+    spacing = 1.0e-3, 1.0e-3
+    warp_material = 'warp'
+    weft_material = 'weft'
+    gap = 0.2e-3
+    strain = 0.1
+/
+&path time = 0, 1, p_disp = 0, 1 /
+&output folder = 'out' /
+"""
+
+CASES = {
+    "unknown_kind": ("kind = 'plain'", "kind = 'satin'",
+                     "&fabric: kind = 'satin' is unknown (use knit, plain or twill)"),
+    "odd_periodic_plain": ("cells = 2, 2", "cells = 3, 2",
+                           "cells = 3, 2 must be multiples of 2 for a periodic plain cell"),
+    "twill_repeat": ("kind = 'plain'", "kind = 'twill'",
+                     "must be multiples of 4 for a periodic twill cell"),
+    "no_spacing": ("spacing = 1.0e-3, 1.0e-3", "",
+                   "&fabric: spacing = -1.0"),
+    "negative_spacing": ("spacing = 1.0e-3, 1.0e-3", "spacing = 1.0e-3, -1.0e-3",
+                         "must be two positive lengths"),
+    "no_gap": ("gap = 0.2e-3", "", "&fabric: gap = -1.0"),
+    "gap_too_wide": ("gap = 0.2e-3", "gap = 2.0e-3",
+                     "must be positive and smaller than the yarn spacing"),
+    "gap_table_lengths": ("gap = 0.2e-3", "gap = 0.2e-3\n gap_factor_p_disp = 0, 1\n"
+                          " gap_factor = 1.0", "gap_factor_p_disp has 2 values but gap_factor has 1"),
+    "gap_table_order": ("gap = 0.2e-3", "gap = 0.2e-3\n gap_factor_p_disp = 0, 1, 0.5\n"
+                        " gap_factor = 1.0, 0.9, 0.8", "gap_factor_p_disp must increase strictly"),
+    "gap_factor_negative": ("gap = 0.2e-3", "gap = 0.2e-3\n gap_factor_p_disp = 0, 1\n"
+                            " gap_factor = 1.0, -0.5", "gap_factor value 2"),
+    "unknown_material": ("weft_material = 'weft'", "weft_material = 'wool'",
+                         "&fabric: weft_material = 'wool' is not the name of any &material"),
+    "missing_material": ("weft_material = 'weft'", "",
+                         "&fabric: weft_material is required for kind = 'plain'"),
+    "knit_variable_on_weave": ("gap = 0.2e-3", "gap = 0.2e-3\n knit_material = 'warp'",
+                               "knit_material does not apply to kind = 'plain'"),
+    "unknown_boundary": ("strain = 0.1", "strain = 0.1\n boundary = 'open'",
+                         "boundary = 'open' is unknown"),
+    "huge_strain": ("strain = 0.1", "strain = 1e300", "&fabric: strain = "),
+    "zero_cells": ("cells = 2, 2", "cells = 0, 2", "must be at least 1"),
+    "elements_per_segment": ("strain = 0.1", "strain = 0.1\n elements_per_segment = 0",
+                             "elements_per_segment = 0 must be at least 1"),
+    "fabric_with_nodes": ("&path", "&nodes xyz = 0, 0, 0 /\n&path",
+                          "&nodes: not allowed together with &fabric"),
+    "fabric_with_support": ("&path", "&support name = 'x', nodes = 1 /\n&path",
+                            "&support: not allowed together with &fabric"),
+    "negative_prestress": ("prestress = 0.02", "prestress = -0.02",
+                           "&material 'warp': prestress = -0.02"),
+    "nan_prestress": ("prestress = 0.02", "prestress = NaN", "prestress = NaN"),
+    "fabric_twice": ("&path", "&fabric kind = 'plain' /\n&path",
+                     "&fabric appears more than once"),
+    "no_kind": ("kind = 'plain'", "", "kind is required"),
+    "knit_needs_knit_material": ("kind = 'plain'", "kind = 'knit'",
+                                 "&fabric: knit_material is required for kind = 'knit'"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_bad_fabric_input(run_yarnfort, tmp_path, name):
+    old, new, words = CASES[name]
+    assert old in BASE
+    run = run_yarnfort(BASE.replace(old, new, 1), cwd=tmp_path)
+    assert run.returncode == 2, run.stderr
+    assert words in run.stderr, run.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_base_input_is_valid(run_yarnfort, tmp_path):
+    run = run_yarnfort(BASE, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    header = (tmp_path / "out" / "curve.csv").read_text().splitlines()[0].split(",")
+    assert "force_per_width" in header and "strain" in header
+
+
+def test_knit_inlay_needs_gap(run_yarnfort, tmp_path):
+    text = """
+&material name = 'knit', law = 'linear', stiffness = 5.0 /
+&material name = 'inlay', law = 'linear', stiffness = 1.0 /
+&fabric kind = 'knit', spacing = 1e-3, 1e-3, knit_material = 'knit',
+        inlay_material = 'inlay' /
+&path time = 0, 1, p_disp = 0, 1 /
+"""
+    run = run_yarnfort(text, cwd=tmp_path)
+    assert run.returncode == 2
+    assert "&fabric: gap = -1.0" in run.stderr
+    assert list(tmp_path.iterdir()) == []
