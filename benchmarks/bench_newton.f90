@@ -162,6 +162,7 @@ contains
         config%supports(4)%name = 'north'
         config%supports(4)%nodes = id(1:side, side + 1)
         config%supports(4)%displacement = [0.0_wp, 0.02_wp * (side + 1), 0.0_wp]
+        allocate(config%contacts(0))
         allocate(config%loads(1))
         config%loads(1)%nodes = pack(id(1:side, 1:side), .true.)
         config%loads(1)%force = [0.0_wp, 0.0_wp, -0.01_wp]

@@ -3,13 +3,19 @@
 from __future__ import annotations
 
 import re
+import shutil
 from pathlib import Path
 
 import pytest
 
 TOP = Path(__file__).resolve().parents[2]
-BAD_INPUTS = sorted((TOP / "tests" / "data" / "input").glob("bad_*.nml"))
+DATA = TOP / "tests" / "data" / "input"
+BAD_INPUTS = sorted(DATA.glob("bad_*.nml"))
+#: Files a catalogued input may name (geometry files, tables), copied next to it.
+COMPANIONS = sorted([*DATA.glob("*.geo"), *DATA.glob("*.csv")])
 VNET = (TOP / "inputs" / "vnet.nml").read_text()
+#: First line of every catalogued bad input: the words its error message must contain.
+EXPECT = re.compile(r"! expect: (?P<words>.*\S)")
 
 
 def test_help(run_yarnfort):
@@ -39,11 +45,20 @@ def test_empty_input(run_yarnfort):
 
 @pytest.mark.parametrize("path", BAD_INPUTS, ids=lambda p: p.stem)
 def test_bad_input_fails_cleanly(run_yarnfort, tmp_path, path):
-    """Every catalogued bad input: exit code 2, one message, nothing written."""
-    run = run_yarnfort(path.read_text(), cwd=tmp_path)
+    """Every catalogued bad input: exit code 2, one message with the words of its
+    ``! expect:`` first line, nothing written. Relative file names in the input are
+    resolved against the working directory (input from stdin), so the geometry files and
+    tables of tests/data/input are copied into it first."""
+    text = path.read_text()
+    expect = EXPECT.fullmatch(text.splitlines()[0]) if text else None
+    assert expect, f"{path.name}: the first line must be '! expect: <words of the message>'"
+    for companion in COMPANIONS:
+        shutil.copy(companion, tmp_path)
+    run = run_yarnfort(text, cwd=tmp_path)
     assert run.returncode == 2, run.stderr
     assert run.stderr.count("yarnfort: error (input): ") == 1, run.stderr
-    assert list(tmp_path.iterdir()) == []
+    assert expect["words"] in run.stderr, run.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == [p.name for p in COMPANIONS]
 
 
 def test_unwritable_output_folder(run_yarnfort, tmp_path):

@@ -31,7 +31,7 @@
 !> reference length reached, or chatter damping).
 module yarnfort_contact_friction_problem
     use yarnfort_kinds, only: wp, ik
-    use yarnfort_error, only: error_type
+    use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_assembly_truss, only: get_truss_tension
     use yarnfort_assembly_pattern, only: build_clique_pattern
@@ -84,9 +84,11 @@ module yarnfort_contact_friction_problem
     contains
         procedure :: get_size
         procedure :: get_pattern
+        procedure :: copy_pattern
         procedure :: evaluate_residual
         procedure :: evaluate_jacobian
         procedure :: prepare_solve
+        procedure :: check_solution
         !> Split unknowns into position unknowns and flows; set the work arrays.
         procedure :: update_state
         !> Tensions (clipped at 0) on both sides and the wrap angle of passage p.
@@ -184,6 +186,13 @@ contains
         row_index = self%row_index
     end subroutine get_pattern
 
+    subroutine copy_pattern(self, col_ptr, row_index)
+        class(friction_problem_type), intent(in) :: self
+        integer(ik), intent(out) :: col_ptr(:), row_index(:)
+        col_ptr = self%col_ptr
+        row_index = self%row_index
+    end subroutine copy_pattern
+
     !> Positions, reference lengths, internal forces and tensions for unknowns u.
     subroutine update_state(self, u, error)
         class(friction_problem_type), intent(inout) :: self
@@ -248,6 +257,29 @@ contains
             end if
         end do
     end subroutine choose_modes
+
+    !> Reject a solution whose flows leave an element a reference length <= 0. Newton's
+    !> iterates may pass there (forbidding it made KINSOL's five step halvings too few on
+    !> test_friction's bollard), but a string with L0 <= 0 counts as slack, so such a
+    !> state can satisfy the equations spuriously (measured: a flow through a pin that
+    !> overshot to L0 = -7 m "converged" with zero tension on both sides instead of the
+    !> slip solution; the stepper then locked the passage at its minimum length). The
+    !> failed solve makes the step be retried (fewer new slips, or a shorter step).
+    subroutine check_solution(self, u, error)
+        class(friction_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: e
+        character(len=160) :: buffer
+
+        call self%update_state(u, error)
+        if (allocated(error)) return
+        if (all(self%length0 > 0.0_wp)) return
+        e = findloc(self%length0 > 0.0_wp, .false., dim=1)
+        write(buffer, '("Newton converged to a spurious state: sliding left element ", i0, &
+            &" a reference length of ", es10.3)') e, self%length0(e)
+        call fatal_error(error, trim(buffer))
+    end subroutine check_solution
 
     !> Fix the slip rows' weights w = max(1, dT_crit/dT_min) at the initial guess u.
     subroutine prepare_solve(self, u, error)

@@ -11,9 +11,16 @@ module yarnfort_input_config
     public :: yarn_config_type, support_config_type, load_config_type, path_config_type
     public :: output_config_type, geometry_config_type, name_length, path_length
     public :: contact_config_type, fabric_config_type, link_config_type
+    public :: solver_presets, get_solver_preset
 
     integer, parameter :: name_length = 64
     integer, parameter :: path_length = 512
+
+    !> Values of &solver preset: 'custom' keeps the defaults of solver_config_type, the
+    !> others set those of initial_step, max_step, residual_tolerance and scheme to values
+    !> chosen from the speed-accuracy study (verification/speed_accuracy; get_solver_preset).
+    character(len=*), parameter :: solver_presets(*) = [character(len=8) :: 'custom', &
+        'fast', 'balanced', 'accurate']
 
     !> &control: what the run is.
     type :: control_config_type
@@ -71,6 +78,9 @@ module yarnfort_input_config
         !> Friction: relative slack in the stick test T_max <= T_crit (1 + tol) and
         !> the staggered scheme's convergence test on the friction conditions.
         real(wp) :: friction_tolerance = 1.0e-9_wp
+        !> Named defaults of initial_step, max_step, residual_tolerance and scheme (one of
+        !> solver_presets); a variable set in &solver overrides its preset value.
+        character(len=16) :: preset = 'custom'
     end type solver_config_type
 
     !> &material: one yarn type and its force law (one group per yarn type).
@@ -243,5 +253,42 @@ module yarnfort_input_config
         !> file names in the input are resolved ('' = the working directory, as for stdin).
         character(len=path_length) :: input_folder = ''
     end type config_type
+
+contains
+
+    !> The &solver defaults of preset `name` (lower case, one of solver_presets): the type's
+    !> defaults with initial_step = max_step, residual_tolerance and scheme of the preset,
+    !> and preset = name. The values come from verification/speed_accuracy: the error of
+    !> the force curve is set by the step (pseudo-time; the example scenes have one unit
+    !> per stretch or release), the tolerance only has to stay well below it, and the
+    !> monolithic scheme was the faster one. `found` is false for an unknown name (then
+    !> the type's defaults).
+    pure subroutine get_solver_preset(name, solver, found)
+        character(len=*), intent(in) :: name
+        type(solver_config_type), intent(out) :: solver
+        logical, intent(out) :: found
+        real(wp) :: step, tolerance
+
+        found = .true.
+        solver%preset = name
+        select case (name)
+        case ('fast')           ! 4 steps per unit of pseudo-time
+            step = 0.25_wp
+            tolerance = 1.0e-6_wp
+        case ('balanced')       ! 20 steps per unit
+            step = 0.05_wp
+            tolerance = 1.0e-8_wp
+        case ('accurate')       ! 200 steps per unit
+            step = 0.005_wp
+            tolerance = 1.0e-10_wp
+        case default
+            found = name == 'custom'
+            return
+        end select
+        solver%initial_step = step
+        solver%max_step = step
+        solver%residual_tolerance = tolerance
+        solver%scheme = 'monolithic'
+    end subroutine get_solver_preset
 
 end module yarnfort_input_config

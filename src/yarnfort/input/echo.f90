@@ -43,6 +43,8 @@ contains
 
         associate(solver => config%solver)
             call put('&solver')
+            ! The preset and every value it gave: the explicit values read back the same.
+            call put(indent // 'preset = ' // quote_string(solver%preset))
             call put(indent // 'linear_solver = ' // quote_string(solver%linear_solver))
             call put(indent // 'residual_tolerance = ' // format_real(solver%residual_tolerance))
             call put(indent // 'step_tolerance = ' // format_real(solver%step_tolerance))

@@ -19,7 +19,7 @@ module yarnfort_input_namelist
     use yarnfort_input_config, only: config_type, control_config_type, solver_config_type, &
         material_config_type, yarn_config_type, support_config_type, load_config_type, &
         output_config_type, geometry_config_type, contact_config_type, path_length, &
-        fabric_config_type
+        fabric_config_type, get_solver_preset
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist, explain_read_error
     use yarnfort_input_geometry, only: read_geometry_file
     use yarnfort_input_text, only: read_line, to_lower, format_integer, folder_of, &
@@ -51,6 +51,8 @@ module yarnfort_input_namelist
     !> Marks list entries the input did not set.
     integer, parameter :: unset_integer = -huge(1)
     real(wp), parameter :: unset_real = -huge(1.0_wp)
+    !> Marks a character variable the input did not set (&solver: preset defaults).
+    character(len=*), parameter :: unset_character = achar(0)
     !> Length of the character buffers the namelists read into (longer than any config
     !> field, so that a value too long for its field is detected, not cut).
     integer, parameter :: buffer_length = 4 * path_length
@@ -260,14 +262,15 @@ contains
         cfg%control%max_steps = max_steps
     end subroutine read_control
 
-    !> &solver: linear solver, Newton, continuation and friction settings.
+    !> &solver: linear solver, Newton, continuation and friction settings. The variables a
+    !> preset sets start unset; those the input leaves unset take the preset's values.
     subroutine read_solver(unit, scan, cfg, error)
         integer, intent(in) :: unit
         type(namelist_scan_type), intent(in) :: scan
         type(config_type), intent(inout) :: cfg
         type(error_type), allocatable, intent(out) :: error
-        type(solver_config_type) :: defaults
-        character(len=buffer_length) :: linear_solver, scheme
+        type(solver_config_type) :: defaults, preset_defaults
+        character(len=buffer_length) :: linear_solver, scheme, preset
         real(wp) :: residual_tolerance, step_tolerance, slack_stiffness, initial_step, &
             min_step, max_step, step_growth, step_cut, min_length_ratio, friction_tolerance
         integer :: max_iterations, max_setup_calls, easy_iterations, max_step_cuts, &
@@ -276,26 +279,28 @@ contains
         namelist /solver/ linear_solver, residual_tolerance, step_tolerance, max_iterations, &
             max_setup_calls, line_search, slack_stiffness, initial_step, min_step, max_step, &
             step_growth, step_cut, easy_iterations, max_step_cuts, scheme, &
-            max_friction_iterations, min_length_ratio, friction_tolerance
+            max_friction_iterations, min_length_ratio, friction_tolerance, preset
         character(len=message_length) :: message
         integer :: stat
+        logical :: known_preset
 
         if (scan%count_group('solver') == 0) return
+        preset = defaults%preset
         linear_solver = defaults%linear_solver
-        residual_tolerance = defaults%residual_tolerance
+        residual_tolerance = unset_real
         step_tolerance = defaults%step_tolerance
         max_iterations = defaults%max_iterations
         max_setup_calls = defaults%max_setup_calls
         line_search = defaults%line_search
         slack_stiffness = defaults%slack_stiffness
-        initial_step = defaults%initial_step
+        initial_step = unset_real
         min_step = defaults%min_step
-        max_step = defaults%max_step
+        max_step = unset_real
         step_growth = defaults%step_growth
         step_cut = defaults%step_cut
         easy_iterations = defaults%easy_iterations
         max_step_cuts = defaults%max_step_cuts
-        scheme = defaults%scheme
+        scheme = unset_character
         max_friction_iterations = defaults%max_friction_iterations
         min_length_ratio = defaults%min_length_ratio
         friction_tolerance = defaults%friction_tolerance
@@ -308,9 +313,22 @@ contains
                 'step_tolerance', 'max_iterations', 'max_setup_calls', 'line_search', &
                 'slack_stiffness', 'initial_step', 'min_step', 'max_step', 'step_growth', &
                 'step_cut', 'easy_iterations', 'max_step_cuts', 'scheme', &
-                'max_friction_iterations', 'min_length_ratio', 'friction_tolerance'])
+                'max_friction_iterations', 'min_length_ratio', 'friction_tolerance', &
+                'preset'])
             return
         end if
+        call check_length(error, scan, 'solver', 0, 'preset', adjustl(preset), &
+            len(cfg%solver%preset))
+        if (allocated(error)) return
+        ! An unknown preset gives the plain defaults here; check_config rejects its name.
+        preset = to_lower(adjustl(preset))
+        call get_solver_preset(trim(preset), preset_defaults, known_preset)
+        if (residual_tolerance == unset_real) &
+            residual_tolerance = preset_defaults%residual_tolerance
+        if (initial_step == unset_real) initial_step = preset_defaults%initial_step
+        if (max_step == unset_real) max_step = preset_defaults%max_step
+        if (scheme == unset_character) scheme = preset_defaults%scheme
+        cfg%solver%preset = preset_defaults%preset
         call check_length(error, scan, 'solver', 0, 'linear_solver', linear_solver, &
             len(cfg%solver%linear_solver))
         if (allocated(error)) return

@@ -521,9 +521,19 @@ contains
                     if (found_subscripted == 0 .and. index(text, '(') > 0) found_subscripted = k
                 end do
                 if (found_subscripted > 0 .and. is_subscript_message()) found = found_subscripted
-                if (found > 0) hint = message // ' (line ' &
-                    // format_integer(group%tokens(found)%line) // ': ' &
-                    // assignment_text(found) // ')'
+                if (found > 0) then
+                    hint = message // ' (line ' // format_integer(group%tokens(found)%line) &
+                        // ': ' // assignment_text(found) // ')'
+                    return
+                end if
+                ! A name the reader took for a variable without '=' after it: show its line.
+                do k = 1, group%n_tokens
+                    if (to_lower(scan%token_text(group%tokens(k))) /= variable) cycle
+                    hint = message // ' (line ' // format_integer(group%tokens(k)%line) &
+                        // ': ' // shorten(adjustl(scan%lines(group%tokens(k)%line)%text)) &
+                        // ')'
+                    return
+                end do
                 return
             end if
             object = to_lower(trim(message(len(no_match) + 1:)))
@@ -600,13 +610,13 @@ contains
     end function explain_read_error
 
     !> The variable a namelist reader's message names at its end ("Bad data for namelist
-    !> object nodes", "Index 1 out of range for namelist variable time"), lower case; ''
-    !> for messages that name none.
+    !> object nodes", "Index 1 out of range for namelist variable time", "Equal sign must
+    !> follow namelist object name x"), lower case; '' for messages that name none.
     pure function named_variable(message) result(variable)
         character(len=*), intent(in) :: message
         character(len=:), allocatable :: variable
-        character(len=*), parameter :: markers(2) = [character(len=18) :: &
-            'namelist object ', 'namelist variable ']
+        character(len=*), parameter :: markers(3) = [character(len=21) :: &
+            'namelist object name', 'namelist object', 'namelist variable']
         integer :: i, at
 
         variable = ''
@@ -614,7 +624,7 @@ contains
             at = index(message, trim(markers(i)) // ' ', back=.true.)
             if (at == 0) cycle
             variable = base_name(adjustl(message(at + len_trim(markers(i)) + 1:)))
-            if (variable == 'name' .or. index(variable, ' ') > 0) variable = ''
+            if (index(variable, ' ') > 0) variable = ''
             return
         end do
     end function named_variable

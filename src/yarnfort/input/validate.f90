@@ -6,10 +6,12 @@
 !> yarn types that meet. Each message names the group, the variable and the value.
 module yarnfort_input_validate
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: iso_fortran_env, only: int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, solver_config_type, output_config_type, &
-        material_config_type, path_config_type, contact_config_type, name_length
+        material_config_type, path_config_type, contact_config_type, name_length, &
+        solver_presets
     use yarnfort_input_text, only: format_integer, format_real, join_names, closest_name
     implicit none
     private
@@ -23,6 +25,10 @@ module yarnfort_input_validate
     !> Smallest &solver min_step as a fraction of the largest |&path time|: a shorter
     !> step would not (or barely) change the pseudo-time, and the continuation would stall.
     real(wp), parameter :: time_resolution = 100 * epsilon(1.0_wp)
+    !> Largest network the solver indexes with default integers: 3 unknowns per node and
+    !> a 6 x 6 Jacobian block per element (elements_per_segment multiplies both).
+    integer, parameter :: max_network_nodes = huge(1) / 3
+    integer, parameter :: max_network_elements = huge(1) / 36
     !> Values of &material law.
     character(len=*), parameter :: known_laws(*) = [character(len=11) :: 'linear', &
         'neo_hookean', 'table']
@@ -77,6 +83,12 @@ contains
         type(solver_config_type), intent(in) :: solver
         type(error_type), allocatable, intent(out) :: error
 
+        if (.not. any(solver_presets == solver%preset)) then
+            call fatal_error(error, "&solver: preset = '" // trim(solver%preset) &
+                // "' is unknown (use " // join_names(solver_presets, '') // ')' &
+                // suggestion(solver%preset, solver_presets))
+            return
+        end if
         if (.not. any(known_linear_solvers == solver%linear_solver)) then
             call fatal_error(error, "&solver: linear_solver = '" // trim(solver%linear_solver) &
                 // "' is unknown (use " // join_names(known_linear_solvers, '') // ')')
@@ -550,10 +562,13 @@ contains
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
         integer :: y, i, n_nodes, a, b
+        !> Elements and new nodes of the yarns so far (elements_per_segment may be large).
+        integer(int64) :: n_elements, n_new_nodes
         logical, allocatable :: used(:)
         real(wp) :: scale, length
         character(len=:), allocatable :: label, guess
         character(len=name_length), allocatable :: material_names(:)
+        character(len=80) :: counts
 
         if (.not. allocated(config%yarns)) then
             call fatal_error(error, 'no yarns: give &yarn groups or yarn lines in the ' &
@@ -569,6 +584,8 @@ contains
         n_nodes = size(config%node_positions, 2)
         scale = norm2(maxval(config%node_positions, dim=2) - minval(config%node_positions, dim=2))
         allocate(used(n_nodes), source=.false.)
+        n_elements = 0
+        n_new_nodes = 0
         do y = 1, size(config%yarns)
             associate(yarn => config%yarns(y))
                 label = yarn_label(config, y)
@@ -593,6 +610,21 @@ contains
                     call fatal_error(error, label // ': nodes has ' &
                         // format_integer(size(yarn%nodes)) &
                         // ' node id(s); a yarn needs at least 2')
+                    return
+                end if
+                n_elements = n_elements + (size(yarn%nodes) - 1) &
+                    * int(yarn%elements_per_segment, int64)
+                n_new_nodes = n_new_nodes + (size(yarn%nodes) - 1) &
+                    * (int(yarn%elements_per_segment, int64) - 1)
+                if (n_elements > max_network_elements &
+                    .or. n_nodes + n_new_nodes > max_network_nodes) then
+                    write(counts, '(i0, " elements and ", i0, " nodes")') n_elements, &
+                        n_nodes + n_new_nodes
+                    call fatal_error(error, label // ': elements_per_segment = ' &
+                        // format_integer(yarn%elements_per_segment) // ' makes the network ' &
+                        // trim(counts) // ' (with the yarns before it); at most ' &
+                        // format_integer(max_network_elements) // ' elements and ' &
+                        // format_integer(max_network_nodes) // ' nodes fit the solver')
                     return
                 end if
                 do i = 1, size(yarn%nodes)

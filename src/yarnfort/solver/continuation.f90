@@ -132,8 +132,10 @@ contains
                     knot = knot + 1
                 end do
                 t_next = min(t + dt, path%time(knot))
-                ! Do not leave a sliver before the knot.
-                if (path%time(knot) - t_next < 0.25_wp * dt) t_next = path%time(knot)
+                ! Do not leave a sliver before the knot; but never after a cut, whose
+                ! shorter step that stretch would undo (step_cut > 0.8: no cut at all).
+                if (cuts == 0 .and. path%time(knot) - t_next < 0.25_wp * dt) &
+                    t_next = path%time(knot)
                 call path%get_factors(t_next, p_force, p_disp)
                 call stepper%try_step(p_force, p_disp, stats, iterations, step_error)
                 if (allocated(step_error)) then

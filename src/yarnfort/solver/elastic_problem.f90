@@ -23,6 +23,7 @@ module yarnfort_solver_elastic_problem
     contains
         procedure :: get_size
         procedure :: get_pattern
+        procedure :: copy_pattern
         procedure :: evaluate_residual
         procedure :: evaluate_jacobian
     end type elastic_problem_type
@@ -53,6 +54,13 @@ contains
         col_ptr = self%pattern%col_ptr
         row_index = self%pattern%row_index
     end subroutine get_pattern
+
+    subroutine copy_pattern(self, col_ptr, row_index)
+        class(elastic_problem_type), intent(in) :: self
+        integer(ik), intent(out) :: col_ptr(:), row_index(:)
+        col_ptr = self%pattern%col_ptr
+        row_index = self%pattern%row_index
+    end subroutine copy_pattern
 
     subroutine evaluate_residual(self, u, residual, error)
         class(elastic_problem_type), intent(inout) :: self

@@ -49,7 +49,8 @@ module yarnfort_solver_newton
     !> What KINSOL's callbacks see through their user-data pointer.
     type :: equilibrium_type
         class(nonlinear_problem_type), pointer :: problem => null()
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        !> Order and nonzeros of the Jacobian (its pattern stays with the problem).
+        integer(ik) :: n = 0, nnz = 0
         real(wp), allocatable :: history(:)
         integer :: n_history = 0
         type(error_type), allocatable :: error
@@ -92,14 +93,18 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_int64_t) :: n, nnz
         integer(c_int) :: ierr
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
 
         self%options = options
         allocate(self%problem)
         self%problem%problem => problem
-        call problem%get_pattern(self%problem%col_ptr, self%problem%row_index)
+        call problem%get_pattern(col_ptr, row_index)
+        self%problem%n = size(col_ptr, kind=ik) - 1
+        self%problem%nnz = size(row_index, kind=ik)
+        deallocate(col_ptr, row_index)
         allocate(self%problem%history(options%max_iterations + 2))
         n = int(problem%get_size(), c_int64_t)
-        nnz = max(int(size(self%problem%row_index), c_int64_t), 1_c_int64_t)
+        nnz = max(int(self%problem%nnz, c_int64_t), 1_c_int64_t)
         if (n == 0) then
             call fatal_error(error, 'the scene has no unknowns: every coordinate is prescribed')
             return
@@ -224,6 +229,8 @@ contains
             end if
             return
         end if
+        call self%problem%problem%check_solution(self%u, error)
+        if (allocated(error)) return
         u = self%u
     end subroutine solve
 
@@ -274,14 +281,13 @@ contains
             problem%history(problem%n_history) = maxval(abs(f)) / problem%problem%force_scale
         end if
         start = wall_time()
-        n = size(problem%col_ptr) - 1
-        nnz = size(problem%row_index)
+        n = problem%n
+        nnz = problem%nnz
         p => FSUNSparseMatrix_IndexPointers(sunmat_j)
         call c_f_pointer(c_loc(p(1)), col_ptr, [n + 1])
-        col_ptr = problem%col_ptr
         p => FSUNSparseMatrix_IndexValues(sunmat_j)
         call c_f_pointer(c_loc(p(1)), row_index, [nnz])
-        row_index = problem%row_index
+        call problem%problem%copy_pattern(col_ptr, row_index)
         d => FSUNSparseMatrix_Data(sunmat_j)
         call c_f_pointer(c_loc(d(1)), values, [nnz])
         call problem%problem%evaluate_jacobian(u, values, problem%error)

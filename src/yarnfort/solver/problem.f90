@@ -19,12 +19,19 @@ module yarnfort_solver_problem
         procedure(get_size_interface), deferred :: get_size
         !> The Jacobian's CSC pattern (0-based), fixed for the problem's lifetime.
         procedure(get_pattern_interface), deferred :: get_pattern
+        !> Write the pattern into arrays of its size (the Newton solver restores it in
+        !> KINSOL's matrix before each Jacobian, without a copy of its own). The default
+        !> goes through get_pattern; a problem that keeps its pattern copies it directly.
+        procedure :: copy_pattern
         procedure(evaluate_residual_interface), deferred :: evaluate_residual
         !> Jacobian values in the order of the pattern.
         procedure(evaluate_jacobian_interface), deferred :: evaluate_jacobian
         !> Called by the Newton solver before each solve with its initial guess: a problem
         !> may fix there what must stay constant during one solve (default: nothing).
         procedure :: prepare_solve
+        !> Called by the Newton solver on a converged solution: a problem may reject it
+        !> with an error (a spurious root outside its domain). Default: accept.
+        procedure :: check_solution
     end type nonlinear_problem_type
 
     abstract interface
@@ -58,11 +65,28 @@ module yarnfort_solver_problem
 
 contains
 
+    subroutine copy_pattern(self, col_ptr, row_index)
+        class(nonlinear_problem_type), intent(in) :: self
+        integer(ik), intent(out) :: col_ptr(:), row_index(:)
+        integer(ik), allocatable :: pattern_col_ptr(:), pattern_row_index(:)
+
+        call self%get_pattern(pattern_col_ptr, pattern_row_index)
+        col_ptr = pattern_col_ptr
+        row_index = pattern_row_index
+    end subroutine copy_pattern
+
     !> Nothing to prepare.
     subroutine prepare_solve(self, u, error)
         class(nonlinear_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
     end subroutine prepare_solve
+
+    !> Every solution is acceptable.
+    subroutine check_solution(self, u, error)
+        class(nonlinear_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        type(error_type), allocatable, intent(out) :: error
+    end subroutine check_solution
 
 end module yarnfort_solver_problem

@@ -102,7 +102,10 @@ contains
             new_unittest('bad_contact_negative_friction', test_bad_contact_negative_friction), &
             new_unittest('bad_contact_missing_pair', test_bad_contact_missing_pair), &
             new_unittest('bad_scheme', test_bad_scheme), &
-            new_unittest('bad_min_length_ratio', test_bad_min_length_ratio) &
+            new_unittest('bad_min_length_ratio', test_bad_min_length_ratio), &
+            new_unittest('bad_duplicate_segment', test_bad_duplicate_segment), &
+            new_unittest('bad_duplicate_segment_back', test_bad_duplicate_segment_back), &
+            new_unittest('bad_path_time_resolution', test_bad_path_time_resolution) &
             ]
     end subroutine collect_input
 
@@ -699,7 +702,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         call check_bad_input(error, 'bad_duplicate_singleton.nml', [character(len=47) :: &
-            '&solver appears more than once (lines 5 and 35)'])
+            '&solver appears more than once (lines 6 and 36)'])
     end subroutine test_bad_duplicate_singleton
 
     subroutine test_bad_missing_path(error)
@@ -829,35 +832,35 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         call check_bad_input(error, 'bad_unclosed_group.nml', [character(len=40) :: &
-            '&output (line 34) is not closed with ''/'''])
+            '&output (line 35) is not closed with ''/'''])
     end subroutine test_bad_unclosed_group
 
     subroutine test_bad_text_outside(error)
         type(error_type), allocatable, intent(out) :: error
 
         call check_bad_input(error, 'bad_text_outside.nml', [character(len=39) :: &
-            'line 2: text outside a group: ''control'''])
+            'line 3: text outside a group: ''control'''])
     end subroutine test_bad_text_outside
 
     subroutine test_bad_variable_twice(error)
         type(error_type), allocatable, intent(out) :: error
 
         call check_bad_input(error, 'bad_variable_twice.nml', [character(len=46) :: &
-            '&solver: max_step is set twice (lines 8 and 9)'])
+            '&solver: max_step is set twice (lines 9 and 10)'])
     end subroutine test_bad_variable_twice
 
     subroutine test_bad_group_in_string(error)
         type(error_type), allocatable, intent(out) :: error
 
         call check_bad_input(error, 'bad_group_in_string.nml', [character(len=40) :: &
-            'line 3: ''&yarn'' inside a character value'])
+            'line 4: ''&yarn'' inside a character value'])
     end subroutine test_bad_group_in_string
 
     subroutine test_bad_string_not_closed(error)
         type(error_type), allocatable, intent(out) :: error
 
         call check_bad_input(error, 'bad_string_not_closed.nml', [character(len=53) :: &
-            'line 3: character value not closed with '' on its line'])
+            'line 4: character value not closed with '' on its line'])
     end subroutine test_bad_string_not_closed
 
     subroutine test_bad_nodes_not_triplets(error)
@@ -964,7 +967,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         call check_bad_input(error, 'bad_group_not_closed.nml', [character(len=71) :: &
-            'line 14: &material starts before &material (line 10) is closed with ''/'''])
+            'line 15: &material starts before &material (line 11) is closed with ''/'''])
     end subroutine test_bad_group_not_closed
 
     subroutine test_bad_support_name(error)
@@ -1107,5 +1110,29 @@ contains
         call check_bad_input(error, 'bad_min_length_ratio.nml', [character(len=72) :: &
             '&solver: min_length_ratio = 1.0 must lie strictly between 0 and 1'])
     end subroutine test_bad_min_length_ratio
+
+    subroutine test_bad_duplicate_segment(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_duplicate_segment.nml', [character(len=72) :: &
+            '&yarn #2: nodes(2), nodes(3) = 2, 3 join the same two nodes as &yarn #1:', &
+            'duplicate segment'])
+    end subroutine test_bad_duplicate_segment
+
+    subroutine test_bad_duplicate_segment_back(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_duplicate_segment_back.nml', [character(len=72) :: &
+            '&yarn #2: nodes(3), nodes(4) = 5, 2 join the same two nodes as &yarn #2:', &
+            'nodes(2), nodes(3) = 2, 5: duplicate segment'])
+    end subroutine test_bad_duplicate_segment_back
+
+    subroutine test_bad_path_time_resolution(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_path_time_resolution.nml', [character(len=72) :: &
+            '&solver: min_step = 1.0e-6 is below the resolution of &path time', &
+            '(up to 2.0e20 in magnitude)'])
+    end subroutine test_bad_path_time_resolution
 
 end module test_input

@@ -1,0 +1,42 @@
+! SPDX-License-Identifier: MIT
+!> A restart snapshot: everything the continuation and the load stepper need to go on
+!> from a converged step exactly as an uninterrupted run would. Filled after every
+!> converged step (yarnfort_solver_continuation), written to and read from the output
+!> folder by yarnfort_output_restart.
+module yarnfort_solver_restart
+    use yarnfort_kinds, only: wp
+    implicit none
+    private
+
+    public :: restart_type, stepper_elastic, stepper_friction
+
+    !> Which stepper filled the snapshot.
+    character(len=*), parameter :: stepper_elastic = 'elastic'
+    character(len=*), parameter :: stepper_friction = 'friction'
+
+    type :: restart_type
+        !> Fingerprint of the input the run was made with ('': unknown), and the scene's
+        !> sizes: nodes, elements, position unknowns, sliding passages.
+        character(len=16) :: input_hash = ''
+        integer :: n_nodes = 0, n_elements = 0, n_unknowns = 0, n_passages = 0
+        !> Continuation: the converged step, its pseudo-time, the next step size to try,
+        !> the path knot the next step heads for, and the step's p_force + p_disp (for
+        !> the loading direction of the next step).
+        integer :: step = 0, knot = 2
+        real(wp) :: time = 0.0_wp, next_step = 0.0_wp, previous_load = 0.0_wp
+        !> Load stepper: `stepper_elastic` or `stepper_friction`.
+        character(len=16) :: stepper = ''
+        !> Accepted load factors, position unknowns and element reference lengths.
+        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
+        real(wp), allocatable :: u(:), length0(:)
+        !> Friction: flows and stick/slip mode of each passage; the accepted state before
+        !> (position unknowns, flows, p_force + p_disp) for the secant predictor, valid
+        !> when `have_old`.
+        real(wp), allocatable :: flow(:)
+        integer, allocatable :: mode(:)
+        logical :: have_old = .false.
+        real(wp) :: load_old = 0.0_wp
+        real(wp), allocatable :: u_old(:), flow_old(:)
+    end type restart_type
+
+end module yarnfort_solver_restart

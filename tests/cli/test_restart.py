@@ -1,0 +1,245 @@
+# SPDX-License-Identifier: MIT
+"""Restart: a run stopped after some step (by &control max_steps, or killed) and then
+continued with &control restart = .true. must give the curve of an uninterrupted run,
+keep curve.csv and the VTK states up to the restart step, and refuse a restart file
+that does not belong to the scene."""
+from __future__ import annotations
+
+import csv
+import os
+import signal
+import subprocess
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+TOP = Path(__file__).resolve().parents[2]
+EXECUTABLE = Path(os.environ.get("YARNFORT_EXE", TOP / "build" / "yarnfort"))
+CAPSTAN = (TOP / "inputs" / "capstan.nml").read_text()
+VNET = (TOP / "inputs" / "vnet.nml").read_text()
+
+#: Curve columns that are not part of the path: timing, and the final scaled Newton
+#: residual (below the tolerance, its digits are round-off).
+NOT_COMPARED = {"wall_time", "residual"}
+#: Counts that must agree exactly.
+INTEGER_COLUMNS = {"step", "direction", "slipping", "passages", "newton_iterations",
+                   "step_cuts"}
+#: Largest difference allowed between the restarted and the uninterrupted curve,
+#: relative to the largest magnitude in the column. The restarted run repeats every
+#: operation of the uninterrupted one from the same bits, except that the linear
+#: solvers fix their pivot order at their first factorisation (KLU refactorisation),
+#: which is a different matrix after a restart: differences are round-off, far below
+#: Newton's tolerance (measured: bitwise equal on the example scenes; on the
+#: elastic-peg scene stopped after step 50, 9e-14 of the column scale, 2e-15 N).
+RELATIVE_TOLERANCE = 1e-10
+
+
+def elastic_pegs() -> str:
+    """The capstan scene with the pegs free to move (each held by its elastic 'peg'
+    yarn to a fixed anchor) and three elements per yarn segment: positions and sliding
+    are solved together, the secant predictor and step cuts are used."""
+    text = CAPSTAN.replace("    name = 'pegs'\n    nodes = 2, 3, 4, 6, 7, 8\n/",
+                           "    name = 'anchors'\n    nodes = 6, 7, 8\n/\n"
+                           "&support\n    name = 'plane'\n    nodes = 2, 3, 4\n    fix = 'z'\n/")
+    text = text.replace("nodes = 1, 2, 3, 4, 5\n",
+                        "nodes = 1, 2, 3, 4, 5\n    elements_per_segment = 3\n")
+    assert "'anchors'" in text and "elements_per_segment" in text
+    return text
+
+
+SCENES = {
+    "capstan": CAPSTAN,
+    "capstan_staggered": CAPSTAN.replace("scheme = 'monolithic'", "scheme = 'staggered'"),
+    "capstan_growing_steps": CAPSTAN.replace("max_step = 0.05",
+                                             "max_step = 0.4\n    initial_step = 0.01"),
+    "vnet": VNET,
+    "elastic_pegs": elastic_pegs(),
+}
+
+
+def with_output(text: str, folder: str, *, control: str = "", output: str = "") -> str:
+    """The scene writing to `folder`, with extra &control and &output settings."""
+    lines = []
+    for line in text.splitlines():
+        if line.strip().startswith("folder ="):
+            line = f"    folder = '{folder}'" + (f"\n    {output}" if output else "")
+        lines.append(line)
+    text = "\n".join(lines) + "\n"
+    assert f"folder = '{folder}'" in text
+    if control:
+        if "&control" in text:
+            text = text.replace("&control", "&control\n    " + control, 1)
+        else:
+            text = f"&control {control} /\n" + text
+    return text
+
+
+def read_rows(folder: Path) -> list[dict[str, str]]:
+    with open(folder / "curve.csv", newline="") as stream:
+        return list(csv.DictReader(stream))
+
+
+def compare_curves(full: list[dict[str, str]], restarted: list[dict[str, str]]) -> float:
+    """Assert the curves agree; return the largest difference relative to the column
+    scale."""
+    assert len(restarted) == len(full)
+    assert list(restarted[0]) == list(full[0])
+    worst = 0.0
+    for name in full[0]:
+        if name in NOT_COMPARED:
+            continue
+        if name in INTEGER_COLUMNS:
+            assert [r[name] for r in restarted] == [r[name] for r in full], name
+            continue
+        a = [float(r[name]) for r in full]
+        b = [float(r[name]) for r in restarted]
+        scale = max(max(abs(v) for v in a), 1e-300)
+        difference = max(abs(x - y) for x, y in zip(a, b)) / scale
+        assert difference <= RELATIVE_TOLERANCE, (name, difference)
+        worst = max(worst, difference)
+    return worst
+
+
+def state_list(folder: Path) -> list[tuple[str, str]]:
+    root = ET.parse(folder / "states.pvd").getroot()
+    return [(d.get("file"), d.get("timestep")) for d in root.iter("DataSet")]
+
+
+def positions(path: Path) -> list[float]:
+    root = ET.parse(path).getroot()
+    return [float(v) for v in root.find("UnstructuredGrid/Piece/Points/DataArray").text.split()]
+
+
+@pytest.mark.parametrize("name, stop", [("capstan", 15), ("capstan", 1),
+                                        ("capstan_staggered", 9),
+                                        ("capstan_growing_steps", 4), ("vnet", 7),
+                                        ("elastic_pegs", 33), ("elastic_pegs", 50)])
+def test_restart_gives_the_uninterrupted_curve(run_yarnfort, tmp_path, name, stop):
+    text = SCENES[name]
+    full = run_yarnfort(with_output(text, "full"))
+    assert full.returncode == 0, full.stderr
+    first = run_yarnfort(with_output(text, "parts", control=f"max_steps = {stop}"))
+    assert first.returncode == 0, first.stderr
+    assert "stopped after max_steps" in first.stderr
+    parts = tmp_path / "parts"
+    assert [r["step"] for r in read_rows(parts)] == [str(k) for k in range(stop + 1)]
+    # Only &control and &output may change: here the title and the progress lines.
+    second = run_yarnfort(with_output(text.replace("title = '", "title = 'second part: "),
+                                      "parts", control="restart = .true.",
+                                      output="progress = .false."))
+    assert second.returncode == 0, second.stderr
+    assert f"restarting after step {stop}" in second.stderr
+    worst = compare_curves(read_rows(tmp_path / "full"), read_rows(parts))
+    print(f"{name}, stopped after step {stop}: restarted curve differs by {worst:.1e} "
+          f"of the column scale")
+    # The VTK states continue: the same list, the same files.
+    assert state_list(parts) == state_list(tmp_path / "full")
+    last = state_list(parts)[-1][0]
+    a, b = positions(tmp_path / "full" / last), positions(parts / last)
+    assert max(abs(x - y) for x, y in zip(a, b)) <= RELATIVE_TOLERANCE * max(map(abs, a))
+    assert not (parts / "restart.dat.tmp").exists()
+
+
+def test_restart_after_a_kill(run_yarnfort, tmp_path):
+    """Kill the run (SIGKILL) part way, then restart: the kill may come at any moment,
+    also while the restart file or a curve row is being written."""
+    text = CAPSTAN.replace("max_step = 0.05", "max_step = 0.002\n    initial_step = 0.002")
+    full = run_yarnfort(with_output(text, "full", output="vtk_every = 0"))
+    assert full.returncode == 0, full.stderr
+    n_steps = len(read_rows(tmp_path / "full")) - 1
+    kill_at = n_steps // 3
+    process = subprocess.Popen([str(EXECUTABLE)], cwd=tmp_path, text=True,
+                               stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.PIPE)
+    process.stdin.write(with_output(text, "parts", output="vtk_every = 0"))
+    process.stdin.close()
+    for line in process.stderr:
+        if line.startswith("step") and int(line.split()[1]) >= kill_at:
+            os.kill(process.pid, signal.SIGKILL)
+            break
+    process.stderr.close()
+    assert process.wait() == -signal.SIGKILL, "the run ended before it was killed"
+    kept = read_rows(tmp_path / "parts")
+    assert kill_at <= int(kept[-1]["step"]) < n_steps
+    again = run_yarnfort(with_output(text, "parts", control="restart = .true.",
+                                     output="vtk_every = 0"))
+    assert again.returncode == 0, again.stderr
+    compare_curves(read_rows(tmp_path / "full"), read_rows(tmp_path / "parts"))
+
+
+def test_rows_after_the_restart_step_are_dropped(run_yarnfort, tmp_path):
+    """Rows written after the last restart file (a kill between the curve row and the
+    restart file), and a row cut short, are replaced by the restarted run's."""
+    full = run_yarnfort(with_output(CAPSTAN, "full"))
+    assert full.returncode == 0, full.stderr
+    assert run_yarnfort(with_output(CAPSTAN, "parts", control="max_steps = 10")).returncode == 0
+    curve = tmp_path / "parts" / "curve.csv"
+    rows = curve.read_text().splitlines()
+    extra = "11" + rows[-1][len("10"):]
+    curve.write_text("\n".join(rows + [extra, extra[:40]]))
+    again = run_yarnfort(with_output(CAPSTAN, "parts", control="restart = .true."))
+    assert again.returncode == 0, again.stderr
+    compare_curves(read_rows(tmp_path / "full"), read_rows(tmp_path / "parts"))
+
+
+def test_restart_of_a_finished_run_does_nothing(run_yarnfort, tmp_path):
+    assert run_yarnfort(with_output(VNET, "out")).returncode == 0
+    before = read_rows(tmp_path / "out")
+    again = run_yarnfort(with_output(VNET, "out", control="restart = .true."))
+    assert again.returncode == 0, again.stderr
+    assert read_rows(tmp_path / "out") == before
+
+
+def test_restart_without_a_restart_file(run_yarnfort, tmp_path):
+    run = run_yarnfort(with_output(VNET, "out", control="restart = .true."))
+    assert run.returncode == 2
+    assert "error (restart): &control restart: no restart file 'out/restart.dat'" in run.stderr
+
+
+def test_restart_of_another_input_is_refused(run_yarnfort, tmp_path):
+    """Same sizes, another friction coefficient: refused, and nothing is changed."""
+    assert run_yarnfort(with_output(CAPSTAN, "out", control="max_steps = 5")).returncode == 0
+    before = {p.name: p.read_bytes() for p in (tmp_path / "out").iterdir()}
+    other = CAPSTAN.replace("friction_coefficient = 0.3", "friction_coefficient = 0.31")
+    run = run_yarnfort(with_output(other, "out", control="restart = .true."))
+    assert run.returncode == 2
+    assert "was written for another input" in run.stderr
+    assert "only &control and &output may change" in run.stderr
+    assert {p.name: p.read_bytes() for p in (tmp_path / "out").iterdir()} == before
+
+
+def test_restart_of_another_scene_is_refused(run_yarnfort, tmp_path):
+    assert run_yarnfort(with_output(VNET, "out", control="max_steps = 3")).returncode == 0
+    run = run_yarnfort(with_output(CAPSTAN, "out", control="restart = .true."))
+    assert run.returncode == 2
+    assert ("'out/restart.dat' does not match the scene: it has 3 nodes, 2 elements, "
+            "2 unknowns, 0 passages, the scene has 8 nodes, 7 elements") in run.stderr
+
+
+def test_cut_short_restart_file_is_refused(run_yarnfort, tmp_path):
+    assert run_yarnfort(with_output(VNET, "out", control="max_steps = 3")).returncode == 0
+    restart = tmp_path / "out" / "restart.dat"
+    restart.write_bytes(restart.read_bytes()[:-20])
+    run = run_yarnfort(with_output(VNET, "out", control="restart = .true."))
+    assert run.returncode == 2
+    assert "'out/restart.dat' is cut short or unreadable" in run.stderr
+
+
+def test_new_run_removes_an_old_restart_file(run_yarnfort, tmp_path):
+    """A run from the beginning replaces the folder's restart file; a failed step 0
+    leaves none (so no stale file can be continued)."""
+    assert run_yarnfort(with_output(VNET, "out", control="max_steps = 3")).returncode == 0
+    assert (tmp_path / "out" / "restart.dat").exists()
+    broken = VNET.replace("0.0, -0.2, 0.0,  ! node 2", "0.0, 0.0, 0.0,  ! node 2").replace(
+        "max_step = 0.1", "max_step = 0.1\n    slack_stiffness = 0.0\n    min_step = 1e-3")
+    broken = broken.replace("p_force = 0.0, 1.0, 0.0", "p_force = 0.1, 1.0, 0.0")
+    run = run_yarnfort(with_output(broken, "out"))
+    assert run.returncode == 1
+    assert not (tmp_path / "out" / "restart.dat").exists()
+
+
+def test_max_steps_must_not_be_negative(run_yarnfort, tmp_path):
+    run = run_yarnfort(with_output(VNET, "out", control="max_steps = -1"))
+    assert run.returncode == 2
+    assert "&control: max_steps = -1 must be >= 0" in run.stderr
