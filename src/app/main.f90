@@ -115,8 +115,10 @@ contains
             'by a Fortran namelist read from standard input, following its load path with', &
             "Newton's method (SUNDIALS KINSOL) and sparse direct linear solvers.", &
             '', &
-            'Namelist groups: &control &solver &material &nodes &geometry &yarn &support', &
-            '&load &path &output; every variable, default and unit: inputs/REFERENCE.md.', &
+            'Namelist groups: &control &solver &material &contact &nodes &geometry &yarn', &
+            '&support &load &path &output, or &fabric (a generated knitted or woven', &
+            'fabric) instead of &nodes ... &load; every variable, default and unit:', &
+            'inputs/REFERENCE.md. Examples: inputs/*.nml.', &
             '', &
             'Writes to the &output folder: curve.csv (one row per converged step),', &
             'state_NNNNN.vtu + states.pvd (ParaView) and input.nml (the effective input).', &
