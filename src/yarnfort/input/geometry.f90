@@ -146,13 +146,16 @@ contains
             end select
         end do read_lines
 
-        ! Node ids must be exactly 1..n.
+        ! Node ids must be exactly 1..n. An id above the number of node lines means that
+        ! some id up to it is missing (found below): nothing is allocated by such an id,
+        ! which may be huge.
         yarns = yarns(:n_yarns)
         id = 0
         if (n_nodes > 0) id = maxval(node_ids(:n_nodes))
-        allocate(node_positions(3, id), defined_on(id))
+        allocate(node_positions(3, min(id, n_nodes)), defined_on(min(id, n_nodes)))
         defined_on = 0
         do i = 1, n_nodes
+            if (node_ids(i) > size(defined_on)) cycle
             if (defined_on(node_ids(i)) /= 0) then
                 call fail(node_lines(i), 'node ' // format_integer(node_ids(i)) &
                     // ' is defined twice (lines ' // format_integer(defined_on(node_ids(i))) &
@@ -162,7 +165,7 @@ contains
             defined_on(node_ids(i)) = node_lines(i)
             node_positions(:, node_ids(i)) = node_xyz(:, i)
         end do
-        do i = 1, id
+        do i = 1, size(defined_on)
             if (defined_on(i) == 0) then
                 call fatal_error(error, "&geometry: file '" // path // "': node " &
                     // format_integer(i) // ' is missing (node ids must be 1..n, each ' &

@@ -50,6 +50,7 @@ module yarnfort_input_scan
     end type namelist_scan_type
 
     character(len=1), parameter :: tab = achar(9), carriage_return = achar(13)
+    character(len=*), parameter :: byte_order_mark = achar(239) // achar(187) // achar(191)
     character(len=*), parameter :: name_characters = &
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_'
     !> Characters that end a bare (unquoted) word inside a group.
@@ -88,6 +89,9 @@ contains
                 call move_alloc(grown, scan%lines)
             end if
             n_lines = n_lines + 1
+            ! Some editors start a UTF-8 file with a byte order mark: not text of the input.
+            if (n_lines == 1 .and. index(line, byte_order_mark) == 1) &
+                line = line(len(byte_order_mark) + 1:)
             call move_alloc(line, scan%lines(n_lines)%text)
         end do
         scan%lines = scan%lines(:n_lines)

@@ -105,7 +105,8 @@ contains
             new_unittest('bad_min_length_ratio', test_bad_min_length_ratio), &
             new_unittest('bad_duplicate_segment', test_bad_duplicate_segment), &
             new_unittest('bad_duplicate_segment_back', test_bad_duplicate_segment_back), &
-            new_unittest('bad_path_time_resolution', test_bad_path_time_resolution) &
+            new_unittest('bad_path_time_resolution', test_bad_path_time_resolution), &
+            new_unittest('bad_elements_per_segment_huge', test_bad_elements_per_segment_huge) &
             ]
     end subroutine collect_input
 
@@ -1134,5 +1135,13 @@ contains
             '&solver: min_step = 1.0e-6 is below the resolution of &path time', &
             '(up to 2.0e20 in magnitude)'])
     end subroutine test_bad_path_time_resolution
+
+    subroutine test_bad_elements_per_segment_huge(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_bad_input(error, 'bad_elements_per_segment_huge.nml', [character(len=72) :: &
+            '&yarn #1: elements_per_segment = 2147483647 makes the network 4294967294', &
+            'at most 59652323 elements and 715827882 nodes fit the solver'])
+    end subroutine test_bad_elements_per_segment_huge
 
 end module test_input
