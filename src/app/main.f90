@@ -41,7 +41,7 @@ program yarnfort_main
         scene%passages%size(), ' sliding passages, ', trim(scene%solver%scheme), ' scheme'
     if (config%control%check_only) then
         write(error_unit, '(a)') 'yarnfort: input checked (check_only = .true.), nothing solved'
-        stop
+        stop 0, quiet=.true.
     end if
 
     writer%progress = config%output%progress
@@ -95,10 +95,10 @@ contains
             select case (trim(argument))
             case ('--help', '-h')
                 call print_help()
-                stop
+                stop 0, quiet=.true.
             case ('--version', '-V')
                 write(output_unit, '(a)') 'yarnfort ' // yarnfort_version_string
-                stop
+                stop 0, quiet=.true.
             case default
                 write(error_unit, '(a)') "yarnfort: error: unknown argument '" // trim(argument) &
                     // "' (try --help)"

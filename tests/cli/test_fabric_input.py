@@ -52,6 +52,8 @@ CASES = {
                          "boundary = 'open' is unknown"),
     "huge_strain": ("strain = 0.1", "strain = 1e300", "&fabric: strain = "),
     "zero_cells": ("cells = 2, 2", "cells = 0, 2", "must be at least 1"),
+    "huge_network": ("strain = 0.1", "strain = 0.1\n elements_per_segment = 300000000",
+                     "elements_per_segment = 300000000 makes too large a network"),
     "elements_per_segment": ("strain = 0.1", "strain = 0.1\n elements_per_segment = 0",
                              "elements_per_segment = 0 must be at least 1"),
     "fabric_with_nodes": ("&path", "&nodes xyz = 0, 0, 0 /\n&path",

@@ -374,7 +374,9 @@ contains
                     call get_truss_tension(scene%laws(net%element_material(e))%law, &
                         scene%solver%slack_stiffness, stretch, tension, dtension)
                     c = (self%x(:, n2) - self%x(:, n1)) / length
-                    dforce_dl0 = -c * dtension * stretch / self%length0(e)
+                    ! L0 changes by share(e) times the flows bounding its segment.
+                    dforce_dl0 = -c * dtension * stretch / self%length0(e) &
+                        * scene%passages%share(e)
                     do b = 7, 8
                         do a = 1, 6
                             slot = self%element_slot(a, b, e)
@@ -454,8 +456,10 @@ contains
                 end if
                 gradient(first:first + 2) = -dt / self%length0(e) * c
                 gradient(first + 3:first + 5) = dt / self%length0(e) * c
-                gradient(start_slot) = gradient(start_slot) - dt * lambda / self%length0(e)
-                gradient(end_slot) = gradient(end_slot) + dt * lambda / self%length0(e)
+                gradient(start_slot) = gradient(start_slot) &
+                    - dt * lambda / self%length0(e) * self%scene%passages%share(e)
+                gradient(end_slot) = gradient(end_slot) &
+                    + dt * lambda / self%length0(e) * self%scene%passages%share(e)
             end associate
         end subroutine tension_derivative
     end subroutine evaluate_jacobian

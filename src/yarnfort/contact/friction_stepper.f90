@@ -391,7 +391,8 @@ contains
                         new_mode = mode_stick
                         locked_forward(p) = .true.
                         problem%locked(p) = mode_forward
-                        problem%flow_target(p) = flow(p) + (problem%length0(before) - min_before)
+                        problem%flow_target(p) = flow(p) + (problem%length0(before) &
+                            - min_before) / passages%share(before)
                     end if
                 case (mode_backward)
                     if (increment > 0.0_wp) new_mode = mode_stick
@@ -399,7 +400,8 @@ contains
                         new_mode = mode_stick
                         locked_backward(p) = .true.
                         problem%locked(p) = mode_backward
-                        problem%flow_target(p) = flow(p) - (problem%length0(after) - min_after)
+                        problem%flow_target(p) = flow(p) - (problem%length0(after) &
+                            - min_after) / passages%share(after)
                     end if
                 end select
                 call set_mode(p, new_mode)

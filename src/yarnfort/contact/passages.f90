@@ -1,9 +1,15 @@
 ! SPDX-License-Identifier: MIT
 !> Passages: a yarn passing through a contact node (a node it shares with another yarn
 !> or with another pass of itself). Each passage has one flow variable s: the reference
-!> length moved from the element before the node to the element after it (paper eq. 22),
-!>     L0(e) = L0_initial(e) + s(passage at the start of e) - s(passage at the end of e),
-!> so every yarn's total reference length is conserved exactly.
+!> length moved from the yarn segment before the node to the segment after it (paper
+!> eq. 22). A segment is the run of elements between two listed nodes of a yarn (split
+!> by elements_per_segment); material moves along it freely, so each of its elements
+!> takes its initial share of the change:
+!>     L0(e) = L0_initial(e) + share(e) * (s(passage at the segment's start)
+!>                                         - s(passage at the segment's end)),
+!> share(e) = L0_initial(e) / (segment's initial length). Every yarn's total reference
+!> length is conserved exactly, and a segment shortens evenly rather than draining the
+!> one element next to the node.
 module yarnfort_contact_passages
     use yarnfort_kinds, only: wp
     use yarnfort_friction_law, only: friction_law_type
@@ -22,8 +28,10 @@ module yarnfort_contact_passages
         !> the friction law (index into the scene's friction laws) of each passage.
         integer, allocatable :: yarn(:), node(:), element_before(:), element_after(:)
         integer, allocatable :: law(:)
-        !> Passage at the start and at the end of each element (0: none).
+        !> Passage at the start and at the end of each element's segment (0: none), and
+        !> the element's share of its segment's initial reference length.
         integer, allocatable :: at_start(:), at_end(:)
+        real(wp), allocatable :: share(:)
     contains
         procedure :: size => get_size
         !> Current reference lengths from initial ones and the flows.
@@ -42,12 +50,15 @@ contains
         class(passage_set_type), intent(in) :: self
         real(wp), intent(in) :: initial(:), flow(:)
         real(wp), intent(out) :: length0(:)
-        integer :: p
+        integer :: e
 
         length0 = initial
-        do p = 1, self%size()
-            length0(self%element_before(p)) = length0(self%element_before(p)) - flow(p)
-            length0(self%element_after(p)) = length0(self%element_after(p)) + flow(p)
+        if (self%size() == 0) return
+        do e = 1, size(initial)
+            if (self%at_start(e) > 0) length0(e) = length0(e) + self%share(e) &
+                * flow(self%at_start(e))
+            if (self%at_end(e) > 0) length0(e) = length0(e) - self%share(e) &
+                * flow(self%at_end(e))
         end do
     end subroutine get_length0
 

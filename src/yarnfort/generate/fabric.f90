@@ -85,6 +85,15 @@ contains
             if (allocated(error)) return
             call require_range(error, 'lateral_strain', fabric%lateral_strain, -0.9_wp, 100.0_wp)
             if (allocated(error)) return
+            if (real(fabric%cells(1), wp) * fabric%cells(2) * fabric%elements_per_segment &
+                    > max_generated_cells) then
+                write(buffer, '(a, "cells = ", i0, ", ", i0, " with elements_per_segment = ", &
+                    & i0, " makes too large a network (cells times elements_per_segment at ", &
+                    & "most ", i0, ")")') label, fabric%cells, fabric%elements_per_segment, &
+                    max_generated_cells
+                call fatal_error(error, trim(buffer))
+                return
+            end if
             if (fabric%elements_per_segment < 1) then
                 write(buffer, '(a, "elements_per_segment = ", i0, " must be at least 1")') &
                     label, fabric%elements_per_segment

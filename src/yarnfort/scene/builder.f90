@@ -119,7 +119,7 @@ contains
         type(scene_type), intent(inout) :: scene
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
-        integer :: n_nodes, n_elements, y, s, j, k, e, node, previous, material
+        integer :: n_nodes, n_elements, y, s, j, k, e, node, previous, material, status
         real(wp), allocatable :: position(:, :)
         logical, allocatable :: used(:)
         character(len=120) :: buffer
@@ -130,10 +130,16 @@ contains
             n_elements = n_elements + (size(config%yarns(y)%nodes) - 1) &
                 * config%yarns(y)%elements_per_segment
         end do
-        allocate(position(3, n_nodes + n_elements))
+        allocate(position(3, n_nodes + n_elements), scene%network%element_nodes(2, n_elements), &
+            scene%network%length0(n_elements), scene%network%element_material(n_elements), &
+            stat=status)
+        if (status /= 0) then
+            write(buffer, '("the network of ", i0, " elements does not fit in memory")') &
+                n_elements
+            call fatal_error(error, trim(buffer))
+            return
+        end if
         position(:, 1:n_nodes) = config%node_positions
-        allocate(scene%network%element_nodes(2, n_elements))
-        allocate(scene%network%length0(n_elements), scene%network%element_material(n_elements))
         allocate(scene%network%yarn_first_element(size(config%yarns) + 1))
         allocate(used(n_nodes), source=.false.)
         e = 0
@@ -412,6 +418,7 @@ contains
         integer :: c, y, e, node, n_nodes, n_passages, other, law, n_yarns, k
         integer, allocatable :: visits(:), first_yarn(:), second_yarn(:), contact_of(:, :)
         integer, allocatable :: root(:)
+        integer :: m
         integer, allocatable :: yarn(:), at_node(:), before(:), after(:), laws(:)
         character(len=200) :: buffer
 
@@ -434,6 +441,7 @@ contains
         end do
         allocate(scene%passages%at_start(scene%network%n_elements()), source=0)
         allocate(scene%passages%at_end(scene%network%n_elements()), source=0)
+        allocate(scene%passages%share(scene%network%n_elements()), source=1.0_wp)
         allocate(yarn(0), at_node(0), before(0), after(0), laws(0))
         if (size(config%contacts) == 0) then
             scene%passages%yarn = yarn
@@ -496,8 +504,19 @@ contains
                 after = [after, e + 1]
                 laws = [laws, c]
                 n_passages = n_passages + 1
-                scene%passages%at_end(e) = n_passages
-                scene%passages%at_start(e + 1) = n_passages
+                ! Every element of the segments before and after the node.
+                m = config%yarns(y)%elements_per_segment
+                scene%passages%at_end(e - m + 1:e) = n_passages
+                scene%passages%at_start(e + 1:e + m) = n_passages
+            end do
+        end do
+        ! Each element's share of its segment's initial reference length.
+        do y = 1, n_yarns
+            m = config%yarns(y)%elements_per_segment
+            do e = scene%network%yarn_first_element(y), scene%network%yarn_first_element(y + 1) &
+                    - 1, m
+                scene%passages%share(e:e + m - 1) = scene%network%length0(e:e + m - 1) &
+                    / sum(scene%network%length0(e:e + m - 1))
             end do
         end do
         scene%passages%yarn = yarn
