@@ -103,14 +103,14 @@ contains
                 if (allocated(error)) return
             end if
             call new_friction_problem(self%sliding, scene, positions_frozen=.true.)
-            call new_linear_solver(linear, general_name, error)
+            call new_linear_solver(linear, general_name, error, unsymmetric=.true.)
             if (allocated(error)) return
             call new_newton_solver(self%newton_sliding, self%sliding, linear, scene%solver, error)
             if (allocated(error)) return
         else
             allocate(self%full)
             call new_friction_problem(self%full, scene, positions_frozen=.false.)
-            call new_linear_solver(linear, general_name, error)
+            call new_linear_solver(linear, general_name, error, unsymmetric=.true.)
             if (allocated(error)) return
             call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)
             if (allocated(error)) return

@@ -31,16 +31,24 @@ contains
 
     !> Allocate `solver` as the solver called `name` ('umfpack', 'klu', 'cholmod' or
     !> 'dense'; case and surrounding blanks are ignored). Any old solver is destroyed.
-    subroutine new_linear_solver(solver, name, error)
+    subroutine new_linear_solver(solver, name, error, unsymmetric)
         class(linear_solver_type), allocatable, intent(out) :: solver
         character(len=*), intent(in) :: name
         type(error_type), allocatable, intent(out) :: error
+        !> The matrices have a strongly unsymmetric pattern (the friction Jacobian): KLU
+        !> then orders with COLAMD instead of AMD.
+        logical, intent(in), optional :: unsymmetric
 
         select case (to_lower(trim(adjustl(name))))
         case ('umfpack')
             allocate(umfpack_solver_type :: solver)
         case ('klu')
-            allocate(klu_solver_type :: solver)
+            block
+                type(klu_solver_type), allocatable :: klu
+                allocate(klu)
+                if (present(unsymmetric)) klu%unsymmetric_ordering = unsymmetric
+                call move_alloc(klu, solver)
+            end block
         case ('cholmod')
             allocate(cholmod_solver_type :: solver)
         case ('dense')
