@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 """Mutation fuzzing of the input: the example scenes with random damage must never crash.
 
-The example inputs ``inputs/vnet.nml`` and ``inputs/capstan.nml`` are mutated at random
+The example inputs ``inputs/vnet.nml``, ``inputs/capstan.nml`` and ``inputs/knit.nml`` (its
+table laws made linear) are mutated at random
 with a fixed seed: characters and lines deleted, inserted, duplicated or swapped, the text
 truncated, numbers replaced by extreme values (0, -1, 1e300, nan, huge integers, ...),
 small integers or scaled ones, names replaced by garbage, group names changed, '=', '/'
@@ -44,6 +45,17 @@ import pytest
 
 TOP = Path(__file__).resolve().parents[2]
 SEEDS = {name: (TOP / "inputs" / f"{name}.nml").read_text() for name in ("vnet", "capstan")}
+
+
+def _without_tables(text: str) -> str:
+    """The scene with its table laws made linear: its table files are relative to the
+    repository top, and each case runs in a folder of its own."""
+    text = re.sub(r"law = 'table'", "law = 'linear'", text)
+    return re.sub(r"table_file = '[^']*'", "stiffness = 5.0", text)
+
+
+#: The generated knitted fabric (&fabric) too: its reader, checks and generator.
+SEEDS["knit"] = _without_tables((TOP / "inputs" / "knit.nml").read_text())
 
 #: Fixed seed: the cases are the same on every run.
 SEED = 20250611

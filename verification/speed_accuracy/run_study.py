@@ -179,7 +179,7 @@ SCENES = [
     Scene(name="hysteresis", text=hysteresis_text, cwd=TOP, knots=[0.0, 1.0, 2.0, 3.0, 4.0],
           force=hysteresis_force, unit="N", default_elements=None, reference_elements=None),
     fabric_scene("knit", "N/m", default_elements=1, reference_elements=3),
-    fabric_scene("belt", "N/m", default_elements=2, reference_elements=4),
+    fabric_scene("belt", "N/m", default_elements=1, reference_elements=4),
 ]
 
 
