@@ -36,7 +36,7 @@ contains
         character(len=*), intent(in) :: name
         type(error_type), allocatable, intent(out) :: error
         !> The matrices have a strongly unsymmetric pattern (the friction Jacobian): KLU
-        !> then orders with COLAMD instead of AMD.
+        !> then keeps the sparser of its AMD and COLAMD orderings.
         logical, intent(in), optional :: unsymmetric
 
         select case (to_lower(trim(adjustl(name))))

@@ -7,7 +7,7 @@
 !> SUNLinSol_KLU).
 module yarnfort_linalg_klu
     use, intrinsic :: iso_c_binding, only: c_long, c_ptr, c_null_ptr, c_null_funptr, &
-        c_associated
+        c_associated, c_f_pointer
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
@@ -15,6 +15,7 @@ module yarnfort_linalg_klu
     use yarnfort_linalg_klu_binding, only: klu_l_common, klu_ok, klu_singular, &
         klu_out_of_memory, klu_invalid, klu_too_large, klu_l_defaults, klu_l_analyze, &
         klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_rcond, klu_l_free_symbolic, &
+        klu_l_numeric_sizes, &
         klu_l_free_numeric
     implicit none
     private
@@ -33,10 +34,12 @@ module yarnfort_linalg_klu
         private
         !> Refactorisations below this reciprocal condition estimate are redone with pivoting.
         real(wp), public :: refactor_rcond_min = default_refactor_rcond_min
-        !> Fill-reducing ordering: AMD on A + A^T (KLU's default), or COLAMD on A^T A for
-        !> strongly unsymmetric patterns. Measured on the friction Jacobian of a 32 x 16
-        !> twill strip (5840 unknowns, one element per segment): a whole run took 44 s
-        !> with AMD and 5.9 s with COLAMD.
+        !> Fill-reducing ordering: AMD on A + A^T (KLU's default), or, for unsymmetric
+        !> patterns, the sparser of AMD and COLAMD, chosen by factoring the first matrix
+        !> both ways. Neither wins everywhere on the friction Jacobian (whole runs, AMD /
+        !> COLAMD / this choice): 32 x 16 twill strip 44 / 5.9 / 10.5 s; 8 x 8 knit cell
+        !> 4.6 / 10.4 / 2.5 s; bench_friction woven nets 68 / 22 / 29 and 1480 / 374 /
+        !> 623 ms per load step. The choice is never the worst and at most 1.8x the best.
         logical, public :: unsymmetric_ordering = .false.
         !> Matrix order, 0 before `analyse`.
         integer(ik) :: n = 0
@@ -46,6 +49,8 @@ module yarnfort_linalg_klu
         logical :: common_ready = .false.
         type(c_ptr) :: symbolic = c_null_ptr
         type(c_ptr) :: numeric = c_null_ptr
+        !> The COLAMD analysis, until the first factorisation has chosen between the two.
+        type(c_ptr) :: symbolic_colamd = c_null_ptr
     contains
         procedure :: analyse
         procedure :: factor
@@ -75,7 +80,6 @@ contains
         self%common%user_order = c_null_funptr
         self%common%user_data = c_null_ptr
         self%common%halt_if_singular = c_true
-        if (self%unsymmetric_ordering) self%common%ordering = 1
         self%common_ready = .true.
 
         self%col_ptr = col_ptr
@@ -86,6 +90,12 @@ contains
                 // status_message(self%common%status))
             call self%destroy()
             return
+        end if
+        if (self%unsymmetric_ordering) then
+            self%common%ordering = 1
+            self%symbolic_colamd = klu_l_analyze(n, self%col_ptr, self%row_index, &
+                self%common)
+            self%common%ordering = 0
         end if
         self%n = n
     end subroutine analyse
@@ -115,6 +125,7 @@ contains
             ok = klu_l_free_numeric(self%numeric, self%common)
         end if
 
+        if (c_associated(self%symbolic_colamd)) call choose_ordering()
         self%numeric = klu_l_factor(self%col_ptr, self%row_index, values, self%symbolic, &
             self%common)
         if (c_associated(self%numeric)) return
@@ -126,6 +137,33 @@ contains
             call fatal_error(error, 'klu: factorisation failed: ' &
                 // status_message(self%common%status))
         end if
+    contains
+        !> Factor with the COLAMD analysis; keep it if its factors are sparser than
+        !> AMD's (then the AMD factorisation below is the only one made twice).
+        subroutine choose_ordering()
+            type(c_ptr) :: trial, amd_numeric
+            type(klu_l_numeric_sizes), pointer :: colamd_sizes, amd_sizes
+
+            trial = klu_l_factor(self%col_ptr, self%row_index, values, self%symbolic_colamd, &
+                self%common)
+            amd_numeric = klu_l_factor(self%col_ptr, self%row_index, values, self%symbolic, &
+                self%common)
+            if (c_associated(trial) .and. c_associated(amd_numeric)) then
+                call c_f_pointer(trial, colamd_sizes)
+                call c_f_pointer(amd_numeric, amd_sizes)
+                if (colamd_sizes%lnz + colamd_sizes%unz < amd_sizes%lnz + amd_sizes%unz) then
+                    ok = klu_l_free_symbolic(self%symbolic, self%common)
+                    self%symbolic = self%symbolic_colamd
+                    self%symbolic_colamd = c_null_ptr
+                end if
+            end if
+            if (c_associated(trial)) ok = klu_l_free_numeric(trial, self%common)
+            if (c_associated(amd_numeric)) ok = klu_l_free_numeric(amd_numeric, self%common)
+            if (c_associated(self%symbolic_colamd)) then
+                ok = klu_l_free_symbolic(self%symbolic_colamd, self%common)
+            end if
+            self%symbolic_colamd = c_null_ptr
+        end subroutine choose_ordering
     end subroutine factor
 
     !> Overwrite rhs with the solution (in place, no allocation).
@@ -158,9 +196,13 @@ contains
             if (c_associated(self%symbolic)) then
                 ok = klu_l_free_symbolic(self%symbolic, self%common)
             end if
+            if (c_associated(self%symbolic_colamd)) then
+                ok = klu_l_free_symbolic(self%symbolic_colamd, self%common)
+            end if
         end if
         self%numeric = c_null_ptr
         self%symbolic = c_null_ptr
+        self%symbolic_colamd = c_null_ptr
         self%n = 0
         if (allocated(self%col_ptr)) deallocate(self%col_ptr)
         if (allocated(self%row_index)) deallocate(self%row_index)

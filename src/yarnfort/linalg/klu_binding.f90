@@ -8,7 +8,7 @@ module yarnfort_linalg_klu_binding
     implicit none
     private
 
-    public :: klu_l_common
+    public :: klu_l_common, klu_l_numeric_sizes
     public :: klu_ok, klu_singular, klu_out_of_memory, klu_invalid, klu_too_large
     public :: klu_l_defaults, klu_l_analyze, klu_l_factor, klu_l_refactor, klu_l_solve
     public :: klu_l_rcond, klu_l_free_symbolic, klu_l_free_numeric
@@ -29,6 +29,12 @@ module yarnfort_linalg_klu_binding
         real(c_double) :: flops, rcond, condest, rgrowth, work
         integer(c_size_t) :: memusage, mempeak
     end type klu_l_common
+
+    !> The leading members of `klu_l_numeric` (klu.h): order, blocks, and the actual
+    !> numbers of entries in L and U (diagonals included).
+    type, bind(C) :: klu_l_numeric_sizes
+        integer(c_long) :: n, nblocks, lnz, unz
+    end type klu_l_numeric_sizes
 
     interface
         !> Set default parameters; returns TRUE (1) on success.
