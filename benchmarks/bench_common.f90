@@ -1,5 +1,6 @@
 ! SPDX-License-Identifier: MIT
-!> What the benchmark programs share: peak memory and failing with a message.
+!> What the benchmark programs share: peak memory, failing with a message, and the
+!> node numbering of their square nets.
 module bench_common
     use, intrinsic :: iso_fortran_env, only: error_unit
     use yarnfort_kinds, only: wp
@@ -7,7 +8,7 @@ module bench_common
     implicit none
     private
 
-    public :: peak_memory_mib, fail
+    public :: peak_memory_mib, fail, number_grid_nodes
 
 contains
 
@@ -29,6 +30,25 @@ contains
         end do
         close(unit)
     end function peak_memory_mib
+
+    !> Node ids 1..n of a (side + 2) x (side + 2) grid without its four corners, row by
+    !> row (0 at the corners): interior nodes plus one anchor on each edge.
+    pure subroutine number_grid_nodes(side, id, n)
+        integer, intent(in) :: side
+        integer, allocatable, intent(out) :: id(:, :)
+        integer, intent(out) :: n
+        integer :: i, j
+
+        allocate(id(0:side + 1, 0:side + 1), source=0)
+        n = 0
+        do j = 0, side + 1
+            do i = 0, side + 1
+                if ((i == 0 .or. i == side + 1) .and. (j == 0 .or. j == side + 1)) cycle
+                n = n + 1
+                id(i, j) = n
+            end do
+        end do
+    end subroutine number_grid_nodes
 
     !> Print the error after the program's name and stop with exit code 1.
     subroutine fail(program_name, error)

@@ -58,7 +58,7 @@ program bench_friction
     use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
     use yarnfort_solver_timer, only: wall_time
     use bench_friction_counter, only: counter_type
-    use bench_common, only: peak_memory_mib, fail
+    use bench_common, only: peak_memory_mib, fail, number_grid_nodes
     implicit none
 
     type(config_type) :: config
@@ -67,7 +67,7 @@ program bench_friction
     type(counter_type) :: counter
     type(error_type), allocatable :: error
     real(wp) :: total, start, times(3, 5)
-    integer :: side, per_segment, factorisations(3), k
+    integer :: side, per_segment, factorisations(3)
     character(len=32) :: argument, scheme
 
     call get_command_argument(1, argument)
@@ -129,15 +129,7 @@ contains
         integer, allocatable :: id(:, :)
         real(wp), parameter :: crimp = 0.15_wp
 
-        allocate(id(0:side + 1, 0:side + 1), source=0)
-        n = 0
-        do j = 0, side + 1
-            do i = 0, side + 1
-                if ((i == 0 .or. i == side + 1) .and. (j == 0 .or. j == side + 1)) cycle
-                n = n + 1
-                id(i, j) = n
-            end do
-        end do
+        call number_grid_nodes(side, id, n)
         allocate(config%node_positions(3, n))
         do j = 0, side + 1
             do i = 0, side + 1

@@ -23,7 +23,7 @@ program bench_newton
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_timer, only: wall_time
-    use bench_common, only: peak_memory_mib, fail
+    use bench_common, only: peak_memory_mib, fail, number_grid_nodes
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
@@ -116,15 +116,7 @@ contains
         integer :: i, j, n, y
         integer, allocatable :: id(:, :)
 
-        allocate(id(0:side + 1, 0:side + 1), source=0)
-        n = 0
-        do j = 0, side + 1
-            do i = 0, side + 1
-                if ((i == 0 .or. i == side + 1) .and. (j == 0 .or. j == side + 1)) cycle
-                n = n + 1
-                id(i, j) = n
-            end do
-        end do
+        call number_grid_nodes(side, id, n)
         allocate(config%node_positions(3, n))
         do j = 0, side + 1
             do i = 0, side + 1

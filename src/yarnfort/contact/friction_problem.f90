@@ -83,7 +83,7 @@ module yarnfort_contact_friction_problem
         real(wp), allocatable :: x(:, :), length0(:), internal(:), tension(:), stretch(:)
     contains
         procedure :: get_size
-        procedure :: get_pattern
+        procedure :: get_nonzeros
         procedure :: copy_pattern
         procedure :: evaluate_residual
         procedure :: evaluate_jacobian
@@ -179,12 +179,10 @@ contains
         if (.not. self%positions_frozen) get_size = self%n_x + self%n_p
     end function get_size
 
-    subroutine get_pattern(self, col_ptr, row_index)
+    pure integer(ik) function get_nonzeros(self)
         class(friction_problem_type), intent(in) :: self
-        integer(ik), allocatable, intent(out) :: col_ptr(:), row_index(:)
-        col_ptr = self%col_ptr
-        row_index = self%row_index
-    end subroutine get_pattern
+        get_nonzeros = size(self%row_index, kind=ik)
+    end function get_nonzeros
 
     subroutine copy_pattern(self, col_ptr, row_index)
         class(friction_problem_type), intent(in) :: self

@@ -87,7 +87,8 @@ contains
     subroutine remove_previous(self)
         class(vtk_writer_type), intent(in) :: self
         character(len=1024) :: line
-        integer :: unit, status, first, last, old
+        character(len=:), allocatable :: name
+        integer :: unit, status, old
 
         open(newunit=unit, file=self%folder // '/states.pvd', status='old', action='read', &
             iostat=status)
@@ -95,15 +96,10 @@ contains
         do
             read(unit, '(a)', iostat=status) line
             if (status /= 0) exit
-            first = index(line, 'file="')
-            if (first == 0) cycle
-            first = first + len('file="')
-            last = index(line(first:), '"') + first - 2
-            if (last < first) cycle
+            name = get_attribute(line, 'file')
             ! Only plain file names written by this writer (no paths).
-            if (index(line(first:last), '/') > 0) cycle
-            open(newunit=old, file=self%folder // '/' // line(first:last), status='old', &
-                iostat=status)
+            if (len(name) == 0 .or. index(name, '/') > 0) cycle
+            open(newunit=old, file=self%folder // '/' // name, status='old', iostat=status)
             if (status == 0) close(old, status='delete')
         end do
         close(unit, status='delete')
@@ -117,8 +113,8 @@ contains
         integer, intent(in) :: step
         type(error_type), allocatable, intent(out) :: error
         character(len=1024) :: line
-        character(len=:), allocatable :: name
-        integer :: unit, status, first, last, old, state_step
+        character(len=:), allocatable :: name, value
+        integer :: unit, status, old, state_step
         real(wp) :: time
 
         allocate(self%files(0), self%times(0))
@@ -128,23 +124,15 @@ contains
         do
             read(unit, '(a)', iostat=status) line
             if (status /= 0) exit
-            first = index(line, 'file="')
-            if (first == 0) cycle
-            first = first + len('file="')
-            last = index(line(first:), '"') + first - 2
-            if (last < first) cycle
-            name = line(first:last)
+            name = get_attribute(line, 'file')
             ! Only the plain state_NNNNN.vtu names written by this writer.
             if (len(name) /= len('state_00000.vtu') .or. name(1:6) /= 'state_' .or. &
                     name(12:) /= '.vtu') cycle
             read(name(7:11), '(i5)', iostat=status) state_step
             if (status /= 0) cycle
             if (state_step <= step) then
-                first = index(line, 'timestep="')
-                if (first == 0) cycle
-                first = first + len('timestep="')
-                last = index(line(first:), '"') + first - 2
-                read(line(first:last), *, iostat=status) time
+                value = get_attribute(line, 'timestep')
+                read(value, *, iostat=status) time
                 if (status /= 0) cycle
                 self%files = [self%files, [character(len=32) :: name]]
                 self%times = [self%times, time]
@@ -156,6 +144,20 @@ contains
         close(unit)
         call write_collection(self, error)
     end subroutine resume_states
+
+    !> The value of attribute `key="..."` in a line of states.pvd ('' if absent or empty).
+    pure function get_attribute(line, key) result(value)
+        character(len=*), intent(in) :: line, key
+        character(len=:), allocatable :: value
+        integer :: first, last
+
+        value = ''
+        first = index(line, key // '="')
+        if (first == 0) return
+        first = first + len(key) + 2
+        last = index(line(first:), '"') + first - 2
+        if (last >= first) value = line(first:last)
+    end function get_attribute
 
     subroutine write_collection(self, error)
         type(vtk_writer_type), intent(in) :: self

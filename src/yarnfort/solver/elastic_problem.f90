@@ -22,7 +22,7 @@ module yarnfort_solver_elastic_problem
         real(wp), allocatable :: x(:, :)
     contains
         procedure :: get_size
-        procedure :: get_pattern
+        procedure :: get_nonzeros
         procedure :: copy_pattern
         procedure :: evaluate_residual
         procedure :: evaluate_jacobian
@@ -48,12 +48,10 @@ contains
         get_size = self%scene%dofs%n_unknowns
     end function get_size
 
-    subroutine get_pattern(self, col_ptr, row_index)
+    pure integer(ik) function get_nonzeros(self)
         class(elastic_problem_type), intent(in) :: self
-        integer(ik), allocatable, intent(out) :: col_ptr(:), row_index(:)
-        col_ptr = self%pattern%col_ptr
-        row_index = self%pattern%row_index
-    end subroutine get_pattern
+        get_nonzeros = self%pattern%nnz
+    end function get_nonzeros
 
     subroutine copy_pattern(self, col_ptr, row_index)
         class(elastic_problem_type), intent(in) :: self

@@ -93,15 +93,12 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_int64_t) :: n, nnz
         integer(c_int) :: ierr
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
 
         self%options = options
         allocate(self%problem)
         self%problem%problem => problem
-        call problem%get_pattern(col_ptr, row_index)
-        self%problem%n = size(col_ptr, kind=ik) - 1
-        self%problem%nnz = size(row_index, kind=ik)
-        deallocate(col_ptr, row_index)
+        self%problem%n = int(problem%get_size(), ik)
+        self%problem%nnz = problem%get_nonzeros()
         allocate(self%problem%history(options%max_iterations + 2))
         n = int(problem%get_size(), c_int64_t)
         nnz = max(int(self%problem%nnz, c_int64_t), 1_c_int64_t)

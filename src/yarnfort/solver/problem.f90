@@ -17,12 +17,12 @@ module yarnfort_solver_problem
     contains
         !> Number of unknowns.
         procedure(get_size_interface), deferred :: get_size
-        !> The Jacobian's CSC pattern (0-based), fixed for the problem's lifetime.
-        procedure(get_pattern_interface), deferred :: get_pattern
-        !> Write the pattern into arrays of its size (the Newton solver restores it in
-        !> KINSOL's matrix before each Jacobian, without a copy of its own). The default
-        !> goes through get_pattern; a problem that keeps its pattern copies it directly.
-        procedure :: copy_pattern
+        !> Number of stored entries of the Jacobian's CSC pattern.
+        procedure(get_nonzeros_interface), deferred :: get_nonzeros
+        !> Write the Jacobian's CSC pattern (0-based, fixed for the problem's lifetime)
+        !> into arrays of its size: the Newton solver restores it in KINSOL's matrix
+        !> before each Jacobian, without a copy of its own.
+        procedure(copy_pattern_interface), deferred :: copy_pattern
         procedure(evaluate_residual_interface), deferred :: evaluate_residual
         !> Jacobian values in the order of the pattern.
         procedure(evaluate_jacobian_interface), deferred :: evaluate_jacobian
@@ -40,11 +40,16 @@ module yarnfort_solver_problem
             class(nonlinear_problem_type), intent(in) :: self
         end function get_size_interface
 
-        subroutine get_pattern_interface(self, col_ptr, row_index)
+        pure integer(ik) function get_nonzeros_interface(self)
             import :: nonlinear_problem_type, ik
             class(nonlinear_problem_type), intent(in) :: self
-            integer(ik), allocatable, intent(out) :: col_ptr(:), row_index(:)
-        end subroutine get_pattern_interface
+        end function get_nonzeros_interface
+
+        subroutine copy_pattern_interface(self, col_ptr, row_index)
+            import :: nonlinear_problem_type, ik
+            class(nonlinear_problem_type), intent(in) :: self
+            integer(ik), intent(out) :: col_ptr(:), row_index(:)
+        end subroutine copy_pattern_interface
 
         subroutine evaluate_residual_interface(self, u, residual, error)
             import :: nonlinear_problem_type, wp, error_type
@@ -64,16 +69,6 @@ module yarnfort_solver_problem
     end interface
 
 contains
-
-    subroutine copy_pattern(self, col_ptr, row_index)
-        class(nonlinear_problem_type), intent(in) :: self
-        integer(ik), intent(out) :: col_ptr(:), row_index(:)
-        integer(ik), allocatable :: pattern_col_ptr(:), pattern_row_index(:)
-
-        call self%get_pattern(pattern_col_ptr, pattern_row_index)
-        col_ptr = pattern_col_ptr
-        row_index = pattern_row_index
-    end subroutine copy_pattern
 
     !> Nothing to prepare.
     subroutine prepare_solve(self, u, error)
