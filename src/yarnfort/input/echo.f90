@@ -158,62 +158,62 @@ contains
 
         !> &geometry or &nodes and &yarn, then &support and &load.
         subroutine put_network()
-        from_file = len_trim(config%geometry%file) > 0
-        call put('&geometry')
-        call put(indent // 'file = ' // quote_string(config%geometry%file))
-        call put('/')
-        if (from_file) then
-            call put('! The nodes and yarns are those of the geometry file.')
-        else
-            if (allocated(config%node_positions)) then
-                call put('&nodes')
-                n = size(config%node_positions, 2)
-                do k = 1, n
-                    if (k == 1) then
-                        call put(indent // 'xyz = ' // reals(config%node_positions(:, k)))
-                    else
-                        call put(indent // '      ' // reals(config%node_positions(:, k)))
-                    end if
-                end do
-                call put('/')
+            from_file = len_trim(config%geometry%file) > 0
+            call put('&geometry')
+            call put(indent // 'file = ' // quote_string(config%geometry%file))
+            call put('/')
+            if (from_file) then
+                call put('! The nodes and yarns are those of the geometry file.')
+            else
+                if (allocated(config%node_positions)) then
+                    call put('&nodes')
+                    n = size(config%node_positions, 2)
+                    do k = 1, n
+                        if (k == 1) then
+                            call put(indent // 'xyz = ' // reals(config%node_positions(:, k)))
+                        else
+                            call put(indent // '      ' // reals(config%node_positions(:, k)))
+                        end if
+                    end do
+                    call put('/')
+                end if
+                if (allocated(config%yarns)) then
+                    do k = 1, size(config%yarns)
+                        associate(yarn => config%yarns(k))
+                            call put('&yarn')
+                            call put(indent // 'material = ' // quote_string(yarn%material))
+                            call put(indent // 'elements_per_segment = ' &
+                                // format_integer(yarn%elements_per_segment))
+                            if (allocated(yarn%nodes)) call put_integers('nodes', yarn%nodes)
+                            call put('/')
+                        end associate
+                    end do
+                end if
             end if
-            if (allocated(config%yarns)) then
-                do k = 1, size(config%yarns)
-                    associate(yarn => config%yarns(k))
-                        call put('&yarn')
-                        call put(indent // 'material = ' // quote_string(yarn%material))
-                        call put(indent // 'elements_per_segment = ' &
-                            // format_integer(yarn%elements_per_segment))
-                        if (allocated(yarn%nodes)) call put_integers('nodes', yarn%nodes)
+
+            if (allocated(config%supports)) then
+                do k = 1, size(config%supports)
+                    associate(support => config%supports(k))
+                        call put('&support')
+                        call put(indent // 'name = ' // quote_string(support%name))
+                        call put(indent // 'fix = ' // quote_string(support%fix))
+                        call put(indent // 'displacement = ' // reals(support%displacement))
+                        if (allocated(support%nodes)) call put_integers('nodes', support%nodes)
                         call put('/')
                     end associate
                 end do
             end if
-        end if
 
-        if (allocated(config%supports)) then
-            do k = 1, size(config%supports)
-                associate(support => config%supports(k))
-                    call put('&support')
-                    call put(indent // 'name = ' // quote_string(support%name))
-                    call put(indent // 'fix = ' // quote_string(support%fix))
-                    call put(indent // 'displacement = ' // reals(support%displacement))
-                    if (allocated(support%nodes)) call put_integers('nodes', support%nodes)
-                    call put('/')
-                end associate
-            end do
-        end if
-
-        if (allocated(config%loads)) then
-            do k = 1, size(config%loads)
-                associate(load => config%loads(k))
-                    call put('&load')
-                    call put(indent // 'force = ' // reals(load%force))
-                    if (allocated(load%nodes)) call put_integers('nodes', load%nodes)
-                    call put('/')
-                end associate
-            end do
-        end if
+            if (allocated(config%loads)) then
+                do k = 1, size(config%loads)
+                    associate(load => config%loads(k))
+                        call put('&load')
+                        call put(indent // 'force = ' // reals(load%force))
+                        if (allocated(load%nodes)) call put_integers('nodes', load%nodes)
+                        call put('/')
+                    end associate
+                end do
+            end if
         end subroutine put_network
 
 
