@@ -6,7 +6,7 @@
 module yarnfort_input_echo
     use yarnfort_kinds, only: wp
     use yarnfort_input_config, only: config_type
-    use yarnfort_input_text, only: format_integer, format_real, quote_string
+    use yarnfort_text, only: format_integer, format_real, quote_string
     implicit none
     private
 

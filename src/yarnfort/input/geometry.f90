@@ -13,8 +13,8 @@ module yarnfort_input_geometry
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: yarn_config_type, name_length
-    use yarnfort_input_text, only: string_type, to_lower, format_integer, split_words, &
-        parse_integer, parse_real
+    use yarnfort_text, only: string_type, to_lower, format_integer, split_words, &
+        parse_integer, parse_real, is_folder, byte_order_mark
     implicit none
     private
 
@@ -40,6 +40,8 @@ contains
         content = ''
         call read_whole_file(path, content, error)
         if (allocated(error)) return
+        ! Some editors start a UTF-8 file with a byte order mark: not text of the file.
+        if (index(content, byte_order_mark) == 1) content = content(len(byte_order_mark) + 1:)
         allocate(node_ids(1024), node_lines(1024), node_xyz(3, 1024))
         allocate(yarns(16), yarn_lines(16))
         n_nodes = 0
@@ -205,6 +207,10 @@ contains
         integer :: unit, stat
         integer(int64) :: file_size
 
+        if (is_folder(path)) then
+            call fatal_error(error, "&geometry: file '" // path // "' is a folder, not a file")
+            return
+        end if
         open(newunit=unit, file=path, status='old', action='read', access='stream', &
             form='unformatted', iostat=stat, iomsg=message)
         if (stat /= 0) then
@@ -228,25 +234,25 @@ contains
         end if
     end subroutine read_whole_file
 
-    !> The line of `content` starting at `position` (without its end: LF or CR LF);
-    !> `position` moves to the start of the next line.
+    !> The line of `content` starting at `position` (without its end: LF, CR LF or a lone
+    !> CR, as old Mac editors write); `position` moves to the start of the next line.
     pure subroutine next_line(content, position, line)
         character(len=*), intent(in) :: content
         integer, intent(inout) :: position
         character(len=:), allocatable, intent(out) :: line
         integer :: last
 
-        last = index(content(position:), achar(10))
+        last = scan(content(position:), achar(10) // achar(13))
         if (last == 0) then
-            last = len(content)
-            line = content(position:last)
-        else
-            last = position + last - 1
-            line = content(position:last - 1)
+            line = content(position:)
+            position = len(content) + 1
+            return
         end if
+        last = position + last - 1
+        line = content(position:last - 1)
         position = last + 1
-        if (len(line) > 0) then
-            if (line(len(line):len(line)) == achar(13)) line = line(:len(line) - 1)
+        if (content(last:last) == achar(13) .and. position <= len(content)) then
+            if (content(position:position) == achar(10)) position = position + 1
         end if
     end subroutine next_line
 

@@ -22,7 +22,7 @@ module yarnfort_input_namelist
         fabric_config_type, get_solver_preset
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist, explain_read_error
     use yarnfort_input_geometry, only: read_geometry_file
-    use yarnfort_input_text, only: read_line, to_lower, format_integer, folder_of, &
+    use yarnfort_text, only: read_line, to_lower, format_integer, folder_of, &
         resolve_path
     use yarnfort_input_validate, only: check_config
     use yarnfort_generate_fabric, only: generate_fabric
@@ -223,6 +223,13 @@ contains
                 return
             end if
         end do
+        if (line_number == 0) then
+            ! A folder or a closed standard input reads as an empty one in gfortran.
+            call fatal_error(error, 'standard input is empty: no input was given (is it ' &
+                // 'closed or a folder?); run as: yarnfort < scene.nml')
+            close(scratch)
+            return
+        end if
         call read_config(scratch, config, error)
         close(scratch)
     end subroutine read_config_from_stdin

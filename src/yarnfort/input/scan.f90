@@ -7,8 +7,8 @@
 !> (which variable, which line, what was probably meant).
 module yarnfort_input_scan
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_text, only: string_type, read_line, to_lower, format_integer, &
-        closest_name, join_names
+    use yarnfort_text, only: string_type, read_line, to_lower, format_integer, &
+        closest_name, join_names, byte_order_mark
     implicit none
     private
 
@@ -50,7 +50,6 @@ module yarnfort_input_scan
     end type namelist_scan_type
 
     character(len=1), parameter :: tab = achar(9), carriage_return = achar(13)
-    character(len=*), parameter :: byte_order_mark = achar(239) // achar(187) // achar(191)
     character(len=*), parameter :: name_characters = &
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_'
     !> Characters that end a bare (unquoted) word inside a group.

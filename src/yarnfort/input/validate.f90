@@ -12,7 +12,7 @@ module yarnfort_input_validate
     use yarnfort_input_config, only: config_type, solver_config_type, output_config_type, &
         material_config_type, path_config_type, contact_config_type, name_length, &
         solver_presets
-    use yarnfort_input_text, only: format_integer, format_real, join_names, closest_name
+    use yarnfort_text, only: format_integer, format_real, join_names, closest_name
     implicit none
     private
 

@@ -10,6 +10,7 @@ module yarnfort_linalg_factory
     use yarnfort_linalg_cholmod, only: cholmod_solver_type
     use yarnfort_linalg_dense, only: dense_solver_type
     use yarnfort_linalg_fallback, only: fallback_solver_type
+    use yarnfort_text, only: to_lower
     implicit none
     private
 
@@ -85,21 +86,5 @@ contains
             name = 'umfpack'
         end if
     end function default_linear_solver_name
-
-    !> Lowercase copy of an ASCII string.
-    pure function to_lower(text) result(lower)
-        character(len=*), intent(in) :: text
-        character(len=len(text)) :: lower
-        integer :: i, code
-
-        do i = 1, len(text)
-            code = iachar(text(i:i))
-            if (code >= iachar('A') .and. code <= iachar('Z')) then
-                lower(i:i) = achar(code - iachar('A') + iachar('a'))
-            else
-                lower(i:i) = text(i:i)
-            end if
-        end do
-    end function to_lower
 
 end module yarnfort_linalg_factory

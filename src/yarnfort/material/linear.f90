@@ -5,7 +5,7 @@ module yarnfort_material_linear
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_material_law, only: force_law_type
-    use yarnfort_material_text, only: format_real
+    use yarnfort_text, only: format_real
     implicit none
     private
 

@@ -22,11 +22,12 @@
 !> increasing, energy quadratic). For lambda <= 1 the string is slack (f = 0).
 module yarnfort_material_table
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use, intrinsic :: iso_fortran_env, only: iostat_end, iostat_eor
+    use, intrinsic :: iso_fortran_env, only: iostat_end
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_material_law, only: force_law_type
-    use yarnfort_material_text, only: format_real
+    use yarnfort_text, only: format_real, format_integer, read_line, is_folder, &
+        byte_order_mark
     implicit none
     private
 
@@ -97,8 +98,8 @@ contains
         integer :: i, bad
 
         if (size(strain) /= size(force)) then
-            call fatal_error(error, context // ': ' // to_text(size(strain)) &
-                // ' strains but ' // to_text(size(force)) // ' forces')
+            call fatal_error(error, context // ': ' // format_integer(size(strain)) &
+                // ' strains but ' // format_integer(size(force)) // ' forces')
             return
         end if
         do i = 1, size(strain)
@@ -106,7 +107,7 @@ contains
             row%force = force(i)
             row%strain_text = format_real(strain(i))
             row%force_text = format_real(force(i))
-            row%place = 'row ' // to_text(i)
+            row%place = 'row ' // format_integer(i)
             if (i == 1) then
                 call check_row(row, error=error)
             else
@@ -126,7 +127,7 @@ contains
         if (allocated(error)) return
         call setup_table(self, strain, force, bad)
         if (bad > 0) then
-            call fatal_error(error, context // ', row ' // to_text(bad + 1) // ': ' &
+            call fatal_error(error, context // ', row ' // format_integer(bad + 1) // ': ' &
                 // slope_range_message(strain, force, bad))
         end if
     end subroutine new_table_law
@@ -149,6 +150,10 @@ contains
         integer :: unit, stat, line_number, nrow, outcome, bad
 
         context = "table '" // path // "'"
+        if (is_folder(path)) then
+            call fatal_error(error, context // ': is a folder, not a file')
+            return
+        end if
         open(newunit=unit, file=path, status='old', action='read', form='formatted', &
             access='sequential', iostat=stat, iomsg=iomsg)
         if (stat /= 0) then
@@ -164,19 +169,22 @@ contains
             if (stat == iostat_end) exit
             line_number = line_number + 1
             if (stat /= 0) then
-                call fatal_error(error, context // ', line ' // to_text(line_number) &
+                call fatal_error(error, context // ', line ' // format_integer(line_number) &
                     // ': cannot read the line (' // trim(iomsg) // ')')
                 exit
             end if
+            ! Some editors start a UTF-8 file with a byte order mark: not text of the table.
+            if (line_number == 1 .and. index(line, byte_order_mark) == 1) &
+                line = line(len(byte_order_mark) + 1:)
             call parse_line(line, row, outcome, message)
             if (outcome == line_skip) cycle
             if (outcome == line_bad) then
                 if (nrow == 0 .and. is_header(line)) cycle
-                call fatal_error(error, context // ', line ' // to_text(line_number) &
+                call fatal_error(error, context // ', line ' // format_integer(line_number) &
                     // ': ' // message)
                 exit
             end if
-            row%place = 'line ' // to_text(line_number)
+            row%place = 'line ' // format_integer(line_number)
             if (nrow == 0) then
                 call check_row(row, error=error)
             else
@@ -200,7 +208,7 @@ contains
         if (allocated(error)) return
         call setup_table(self, strain(:nrow), force(:nrow), bad)
         if (bad > 0) then
-            call fatal_error(error, context // ', line ' // to_text(lines(bad + 1)) // ': ' &
+            call fatal_error(error, context // ', line ' // format_integer(lines(bad + 1)) // ': ' &
                 // slope_range_message(strain(:nrow), force(:nrow), bad))
         end if
     end subroutine read_table_law
@@ -428,7 +436,7 @@ contains
         integer, intent(in) :: nrow
         character(len=:), allocatable :: message
 
-        message = 'found ' // to_text(nrow) // ' data rows, at least ' // to_text(min_rows) &
+        message = 'found ' // format_integer(nrow) // ' data rows, at least ' // format_integer(min_rows) &
             // ' rows are needed (the first row 0,0 and more)'
     end function too_few_rows
 
@@ -525,37 +533,6 @@ contains
             quoted = "'" // text // "'"
         end if
     end function quote
-
-    !> Decimal text of an integer.
-    pure function to_text(value) result(text)
-        integer, intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=20) :: buffer
-
-        write(buffer, '(i0)') value
-        text = trim(buffer)
-    end function to_text
-
-    !> Read one whole line of any length. `stat` is 0, iostat_end at the end of the file,
-    !> or another non-zero value with `iomsg` set.
-    subroutine read_line(unit, line, stat, iomsg)
-        integer, intent(in) :: unit
-        character(len=:), allocatable, intent(out) :: line
-        integer, intent(out) :: stat
-        character(len=*), intent(inout) :: iomsg
-        character(len=256) :: buffer
-        integer :: count
-
-        line = ''
-        do
-            read(unit, '(a)', advance='no', iostat=stat, iomsg=iomsg, size=count) buffer
-            line = line // buffer(:count)
-            if (stat /= 0) exit
-        end do
-        if (stat == iostat_eor) stat = 0
-        ! A last line without a newline still counts as a line.
-        if (stat == iostat_end .and. len(line) > 0) stat = 0
-    end subroutine read_line
 
     !> Append one row, growing the arrays geometrically.
     pure subroutine append_row(strain, force, lines, nrow, new_strain, new_force, new_line)

@@ -12,7 +12,7 @@ module test_input
     use yarnfort_input_namelist, only: read_config, read_config_from_file, check_config, &
         max_list
     use yarnfort_input_echo, only: write_config
-    use yarnfort_input_text, only: format_real, format_integer
+    use yarnfort_text, only: format_real, format_integer
     use test_input_paths, only: data_folder
     implicit none
     private

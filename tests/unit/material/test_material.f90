@@ -653,7 +653,7 @@ contains
             error)
         if (allocated(error)) return
         call new_neo_hookean_law(neo_hookean, -1.0e9_wp, neo_area, law_error)
-        call check_error(law_error, [character(len=40) :: 'modulus -1000000000', &
+        call check_error(law_error, [character(len=40) :: 'modulus -1.0e9', &
             'must be greater than 0'], error)
         if (allocated(error)) return
         call new_neo_hookean_law(neo_hookean, neo_modulus, 0.0_wp, law_error)

@@ -1,8 +1,8 @@
 ! SPDX-License-Identifier: MIT
-!> Text helpers for the input readers: records of any length, case folding, numbers
-!> written so that they read back exactly, words, strict number parsing, and the
-!> "did you mean" suggestions of error messages.
-module yarnfort_input_text
+!> The one text-utility module: records of any length (read in linear time, bounded),
+!> case folding, numbers written so that they read back exactly, words, strict number
+!> parsing, file names, and the "did you mean" suggestions of error messages.
+module yarnfort_text
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
     use, intrinsic :: iso_fortran_env, only: int64
     use yarnfort_kinds, only: wp
@@ -11,48 +11,70 @@ module yarnfort_input_text
 
     public :: string_type, read_line, to_lower, format_integer, format_real, quote_string
     public :: split_words, parse_integer, parse_real, edit_distance, closest_name
-    public :: join_names, folder_of, resolve_path
+    public :: join_names, folder_of, resolve_path, is_folder, max_line_length
+    public :: byte_order_mark
 
     !> One string of an array of strings of different lengths.
     type :: string_type
         character(len=:), allocatable :: text
     end type string_type
 
-    !> Characters read per chunk of a record (each read pads its whole chunk, so this is
-    !> about a usual line, not the longest).
-    integer, parameter :: chunk_length = 256
+    !> Characters read per non-advancing read of a record.
+    integer, parameter :: chunk_length = 4096
+    !> Longest record read_line accepts: far above the longest documented line (100 000
+    !> node ids of a &yarn on one line, about 7 MB); a longer one is an error, so that a
+    !> device like /dev/zero or a binary file ends with a message instead of never.
+    integer, parameter :: max_line_length = 2**26
     !> Largest edit distance at which a known name is suggested for a mistyped one.
     integer, parameter :: max_suggestion_distance = 2
     character(len=1), parameter :: tab = achar(9)
+    !> The UTF-8 byte order mark some editors put at the start of a file.
+    character(len=*), parameter :: byte_order_mark = achar(239) // achar(187) // achar(191)
 
 contains
 
-    !> Read one whole record, of any length, from a formatted sequential unit.
-    !> `stat` is 0, or iostat_end at the end of the file, or another iostat value.
+    !> Read one whole record from a formatted sequential unit, in time linear in its
+    !> length. `stat` is 0, or iostat_end at the end of the file, or another nonzero
+    !> value with `message` set (also for a record longer than max_line_length).
     subroutine read_line(unit, line, stat, message)
         integer, intent(in) :: unit
         character(len=:), allocatable, intent(out) :: line
         integer, intent(out) :: stat
         character(len=*), intent(out) :: message
-        character(len=chunk_length) :: chunk
-        integer :: size_read
+        character(len=:), allocatable :: buffer, grown
+        integer :: size_read, n
 
         line = ''
+        allocate(character(len=chunk_length) :: buffer)
+        n = 0
         message = ''
         do
-            read(unit, '(a)', advance='no', iostat=stat, iomsg=message, size=size_read) chunk
+            if (n + chunk_length > len(buffer)) then
+                if (len(buffer) >= max_line_length) then
+                    stat = -huge(1)
+                    message = 'a line is longer than ' // format_integer(max_line_length) &
+                        // ' characters (is this a binary file or a device?)'
+                    return
+                end if
+                allocate(character(len=2 * len(buffer)) :: grown)
+                grown(:n) = buffer(:n)
+                call move_alloc(grown, buffer)
+            end if
+            read(unit, '(a)', advance='no', iostat=stat, iomsg=message, size=size_read) &
+                buffer(n + 1:n + chunk_length)
             if (stat > 0) return
-            line = line // chunk(:size_read)
+            n = n + size_read
             if (is_iostat_eor(stat)) then
                 stat = 0
-                return
+                exit
             end if
             if (is_iostat_end(stat)) then
                 ! A last record without a newline is still a record.
-                if (len(line) > 0) stat = 0
-                return
+                if (n > 0) stat = 0
+                exit
             end if
         end do
+        line = buffer(:n)
     end subroutine read_line
 
     !> The string in lower case (ASCII letters only).
@@ -82,7 +104,7 @@ contains
 
     !> A real as the shortest decimal text that reads back to exactly the same value
     !> ('0.25', '150.0', '1.0e-6', '-3.0e12'); 'NaN', 'Infinity' and '-Infinity' as such.
-    function format_real(value) result(text)
+    pure function format_real(value) result(text)
         real(wp), intent(in) :: value
         character(len=:), allocatable :: text
         integer, parameter :: max_digits = 17
@@ -417,4 +439,17 @@ contains
         end if
     end function resolve_path
 
-end module yarnfort_input_text
+    !> Whether `path` names an existing folder (then opening it as a file must not be
+    !> mistaken for an empty file).
+    function is_folder(path) result(folder)
+        character(len=*), intent(in) :: path
+        logical :: folder
+        integer :: stat
+
+        folder = .false.
+        if (len_trim(path) == 0) return
+        inquire(file=trim(path) // '/.', exist=folder, iostat=stat)
+        if (stat /= 0) folder = .false.
+    end function is_folder
+
+end module yarnfort_text
