@@ -9,6 +9,7 @@ program yarnfort_main
     use yarnfort_input_config, only: config_type
     use yarnfort_input_namelist, only: read_config_from_stdin, check_config
     use yarnfort_input_echo, only: write_config
+    use yarnfort_input_groups, only: input_help_lines => help_lines
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_driver, only: run_scene, get_linear_solver_name
@@ -108,6 +109,8 @@ contains
     end subroutine handle_arguments
 
     subroutine print_help()
+        integer :: i
+
         write(output_unit, '(a)') &
             'usage: yarnfort [--help | --version] < scene.nml', &
             '', &
@@ -115,10 +118,11 @@ contains
             'by a Fortran namelist read from standard input, following its load path with', &
             "Newton's method (SUNDIALS KINSOL) and sparse direct linear solvers.", &
             '', &
-            'Namelist groups: &control &solver &material &contact &nodes &geometry &yarn', &
-            '&support &load &path &output, or &fabric (a generated knitted or woven', &
-            'fabric) instead of &nodes ... &load; every variable, default and unit:', &
-            'inputs/REFERENCE.md. Examples: inputs/*.nml.', &
+            'A generated knitted or woven fabric (&fabric) replaces &nodes ... &load.', &
+            'Examples: inputs/*.nml.', &
+            ''
+        write(output_unit, '(a)') (trim(input_help_lines(i)), i = 1, size(input_help_lines))
+        write(output_unit, '(a)') &
             '', &
             'Writes to the &output folder: curve.csv (one row per converged step),', &
             'state_NNNNN.vtu + states.pvd (ParaView) and input.nml (the effective input).', &

@@ -1,9 +1,15 @@
 ! SPDX-License-Identifier: MIT
 !> What the user asked for, as read from the namelist input, before any scene is built.
-!> Plain data with defaults; units are SI (N, m) unless a unit is given.
-!> Reading is in yarnfort_input_namelist; building the scene from it is in yarnfort_scene.
+!> Plain data with defaults; units are SI (N, m) unless a unit is given. The types of the
+!> namelist groups come from their description (variables.py, generated into
+!> yarnfort_input_groups); reading is in yarnfort_input_namelist; building the scene from
+!> it is in yarnfort_scene.
 module yarnfort_input_config
     use yarnfort_kinds, only: wp
+    use yarnfort_input_groups, only: control_config_type, solver_config_type, &
+        material_config_type, contact_config_type, fabric_config_type, geometry_config_type, &
+        yarn_config_type, support_config_type, load_config_type, path_config_type, &
+        output_config_type, name_length, path_length, solver_presets => solver_preset_choices
     implicit none
     private
 
@@ -12,189 +18,6 @@ module yarnfort_input_config
     public :: output_config_type, geometry_config_type, name_length, path_length
     public :: contact_config_type, fabric_config_type, link_config_type
     public :: solver_presets, get_solver_preset
-
-    integer, parameter :: name_length = 64
-    integer, parameter :: path_length = 512
-
-    !> Values of &solver preset: 'custom' keeps the defaults of solver_config_type, the
-    !> others set those of initial_step, max_step, residual_tolerance and scheme to values
-    !> chosen from the speed-accuracy study (verification/speed_accuracy; get_solver_preset).
-    character(len=*), parameter :: solver_presets(*) = [character(len=8) :: 'custom', &
-        'fast', 'balanced', 'accurate']
-
-    !> &control: what the run is.
-    type :: control_config_type
-        character(len=256) :: title = ''
-        !> Stop after reading and checking the input (no solve, no output).
-        logical :: check_only = .false.
-        !> Continue from the restart file of the &output folder (its last converged step)
-        !> instead of starting at the first knot.
-        logical :: restart = .false.
-        !> Stop after this many converged load steps of this run (0: no limit); a later
-        !> run with restart = .true. goes on from there.
-        integer :: max_steps = 0
-    end type control_config_type
-
-    !> &solver: nonlinear and linear solver settings, continuation step control.
-    type :: solver_config_type
-        !> 'auto', 'umfpack', 'klu', 'cholmod' or 'dense'.
-        character(len=16) :: linear_solver = 'auto'
-        !> Newton stops when max |residual| <= residual_tolerance * force_scale.
-        real(wp) :: residual_tolerance = 1.0e-10_wp
-        !> Newton also stops when the scaled step is below this (then checked against
-        !> the residual tolerance, never accepted alone).
-        real(wp) :: step_tolerance = 1.0e-14_wp
-        integer :: max_iterations = 50
-        !> Newton iterations between Jacobian updates (1 = full Newton).
-        integer :: max_setup_calls = 1
-        logical :: line_search = .true.
-        !> Regularisation of the tension-only law: every string also carries
-        !> slack_stiffness * k_ref * (stretch - 1/2) (a weak spring of rest length L0/2;
-        !> k_ref the law's reference stiffness), so slack strings keep a regular tangent.
-        !> 0 switches it off (exact tension-only law).
-        real(wp) :: slack_stiffness = 1.0e-6_wp
-        !> Continuation: first, smallest and largest pseudo-time step.
-        real(wp) :: initial_step = 0.1_wp
-        real(wp) :: min_step = 1.0e-6_wp
-        real(wp) :: max_step = 0.25_wp
-        !> Step growth factor after easy convergence and cut factor after a failure.
-        real(wp) :: step_growth = 1.5_wp
-        real(wp) :: step_cut = 0.5_wp
-        !> A step converged in at most this many Newton iterations is "easy".
-        integer :: easy_iterations = 4
-        !> Give up after this many consecutive step cuts.
-        integer :: max_step_cuts = 30
-        !> Friction: 'monolithic' (positions and sliding solved together with a
-        !> stick/slip active set) or 'staggered' (the paper's two-step scheme).
-        character(len=16) :: scheme = 'monolithic'
-        !> Friction: most stick/slip active-set updates (monolithic) or elastic/sliding
-        !> alternations (staggered) per load step.
-        integer :: max_friction_iterations = 200
-        !> Friction: sliding never makes an element's reference length shorter than this
-        !> fraction of its initial length (the passage then locks in that direction).
-        !> Much shorter elements make the wrap angle ill-conditioned: on the woven
-        !> benchmark net, elements at 1 % of their length stalled Newton.
-        real(wp) :: min_length_ratio = 0.05_wp
-        !> Friction: relative slack in the stick test T_max <= T_crit (1 + tol) and
-        !> the staggered scheme's convergence test on the friction conditions.
-        real(wp) :: friction_tolerance = 1.0e-9_wp
-        !> Named defaults of initial_step, max_step, residual_tolerance and scheme (one of
-        !> solver_presets); a variable set in &solver overrides its preset value.
-        character(len=16) :: preset = 'custom'
-    end type solver_config_type
-
-    !> &material: one yarn type and its force law (one group per yarn type).
-    type :: material_config_type
-        character(len=name_length) :: name = ''
-        !> 'linear', 'neo_hookean' or 'table'.
-        character(len=16) :: law = ''
-        !> linear: EA in N.
-        real(wp) :: stiffness = -1.0_wp
-        !> neo_hookean: modulus C in Pa and undeformed cross-section S(1) in m^2.
-        real(wp) :: modulus = -1.0_wp
-        real(wp) :: area = -1.0_wp
-        !> table: CSV file of (strain, force in N), relative to the input file's folder
-        !> or the working directory.
-        character(len=path_length) :: table_file = ''
-        !> Pre-stress (N): the tension every element of this yarn type carries in the
-        !> initial geometry; its reference length L0 is chosen so (0: stress-free).
-        real(wp) :: prestress = 0.0_wp
-    end type material_config_type
-
-    !> &yarn: one yarn, a polyline through node ids, split into elements.
-    type :: yarn_config_type
-        character(len=name_length) :: material = ''
-        integer, allocatable :: nodes(:)
-        !> Each segment between listed nodes is split into this many elements.
-        integer :: elements_per_segment = 1
-    end type yarn_config_type
-
-    !> &support: a named set of nodes whose listed components are prescribed.
-    type :: support_config_type
-        character(len=name_length) :: name = ''
-        integer, allocatable :: nodes(:)
-        !> Which components are prescribed: any of 'x', 'y', 'z'.
-        character(len=3) :: fix = 'xyz'
-        !> Displacement D at load factor p_disp = 1 (m), per component.
-        real(wp) :: displacement(3) = 0.0_wp
-    end type support_config_type
-
-    !> &load: a force P (N) at load factor p_force = 1 on each listed node.
-    type :: load_config_type
-        integer, allocatable :: nodes(:)
-        real(wp) :: force(3) = 0.0_wp
-    end type load_config_type
-
-    !> &path: the load path as knots over pseudo-time, linear in between.
-    type :: path_config_type
-        real(wp), allocatable :: time(:)
-        real(wp), allocatable :: p_force(:)
-        real(wp), allocatable :: p_disp(:)
-    end type path_config_type
-
-    !> &geometry: node positions and yarns from a plain text file instead of &nodes and
-    !> &yarn groups (format in inputs/REFERENCE.md).
-    type :: geometry_config_type
-        !> Geometry file; a relative name is resolved against `config_type%input_folder`.
-        !> Empty: no geometry file.
-        character(len=path_length) :: file = ''
-    end type geometry_config_type
-
-    !> &output: where and what to write.
-    type :: output_config_type
-        character(len=path_length) :: folder = 'out'
-        !> Write a VTK state every this many converged steps (0: none; the last step is
-        !> always written when vtk_every > 0).
-        integer :: vtk_every = 1
-        !> Progress lines on stderr.
-        logical :: progress = .true.
-        !> Also print each step's Newton residual history (scaled max-norm per iterate).
-        logical :: residual_history = .false.
-    end type output_config_type
-
-    !> &fabric: a generated fabric (knitted with inlay, or woven) instead of &nodes,
-    !> &yarn and &support groups. Geometry and parameters: inputs/REFERENCE.md.
-    type :: fabric_config_type
-        !> 'knit' (weft-knitted jersey, optional inlay), 'plain' or 'twill' (woven).
-        character(len=16) :: kind = ''
-        !> Repeats along x and y: wales x courses (knit); weft x warp yarns (woven).
-        integer :: cells(2) = [4, 4]
-        !> Repeat spacing along x and y (m): wale and course spacing; weft and warp
-        !> yarn spacing.
-        real(wp) :: spacing(2) = -1.0_wp
-        !> 'periodic' (a unit cell, eq. 53, with a macroscopic stretch) or 'clamped' (a
-        !> finite sample: left edge fixed, right edge pulled).
-        character(len=16) :: boundary = 'periodic'
-        !> Engineering strain along x at p_disp = 1 (1.0 stretches to twice the length).
-        real(wp) :: strain = 1.0_wp
-        !> Periodic: engineering strain of the y period at p_disp = 1 (prescribed).
-        real(wp) :: lateral_strain = 0.0_wp
-        !> Clamped: 'free' side edges, or 'rollers' (side-edge yarn ends held in y).
-        character(len=16) :: sides = 'free'
-        !> Elements per yarn segment between generated nodes.
-        integer :: elements_per_segment = 1
-        !> Knit: yarn type of the loops and of the inlay ('' = no inlay).
-        character(len=name_length) :: knit_material = ''
-        character(len=name_length) :: inlay_material = ''
-        !> Knit: width of a loop's head between its two contacts, as a fraction of the
-        !> wale spacing (the sinker between loops takes the rest). In this polygon model
-        !> a loop is 2*spacing(2) + spacing(1) long.
-        real(wp) :: head_width = 0.5_wp
-        !> Knit: an inlay yarn in every inlay_every-th course, crossing the loop legs at
-        !> inlay_offset * spacing(2) above the course line and the sinkers on it.
-        integer :: inlay_every = 1
-        real(wp) :: inlay_offset = 0.5_wp
-        !> Woven: yarn types along x (warp, the loaded direction) and y (weft).
-        character(len=name_length) :: warp_material = ''
-        character(len=name_length) :: weft_material = ''
-        !> Woven: distance between warp and weft axes at a crossing (m), kept by a
-        !> gap-holder (paper Fig. 12).
-        real(wp) :: gap = -1.0_wp
-        !> Woven: gap factor (multiplies gap) as a piecewise-linear function of the
-        !> displacement factor p_disp (paper Fig. 13b). Empty: factor 1.
-        real(wp), allocatable :: gap_factor_p_disp(:)
-        real(wp), allocatable :: gap_factor(:)
-    end type fabric_config_type
 
     !> A node that follows another one: a periodic image (eq. 53) or the other side of
     !> a gap-holder. Made by the fabric generators.
@@ -209,24 +32,6 @@ module yarnfort_input_config
     end type link_config_type
 
     !> The whole input.
-    !> &contact: the friction law where yarns of two types cross (one group per pair;
-    !> the pair is unordered and a type may pair with itself). Without any &contact
-    !> group every contact node is a plain shared node (no sliding).
-    type :: contact_config_type
-        !> The two yarn types (material names).
-        character(len=name_length) :: materials(2) = ''
-        !> 'bonded' (never slides), 'coulomb', 'adhesion' or 'decaying_adhesion'.
-        character(len=32) :: law = ''
-        !> Friction coefficient mu (1), for every law but 'bonded'.
-        real(wp) :: friction_coefficient = -1.0_wp
-        !> Adhesion beta (N), for 'adhesion' and 'decaying_adhesion'.
-        real(wp) :: adhesion = -1.0_wp
-        !> Decaying adhesion: tension w_d (N) where the adhesion starts to decay and s_d
-        !> (N) where it has vanished, 0 <= w_d < s_d.
-        real(wp) :: decay_start = -1.0_wp
-        real(wp) :: decay_end = -1.0_wp
-    end type contact_config_type
-
     type :: config_type
         type(control_config_type) :: control
         type(solver_config_type) :: solver

@@ -7,8 +7,9 @@
 !> (which variable, which line, what was probably meant).
 module yarnfort_input_scan
     use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_kinds, only: wp
     use yarnfort_text, only: string_type, read_line, to_lower, format_integer, &
-        closest_name, join_names, byte_order_mark
+        closest_name, join_names, byte_order_mark, parse_integer, parse_real
     implicit none
     private
 
@@ -47,6 +48,10 @@ module yarnfort_input_scan
         procedure :: find_group
         !> Text of a token.
         procedure :: token_text
+        !> Whether a group sets a variable (any of its entries).
+        procedure :: is_set
+        !> Whether a value of a group equals one of the reader's "not set" markers.
+        procedure :: holds_marker
     end type namelist_scan_type
 
     character(len=1), parameter :: tab = achar(9), carriage_return = achar(13)
@@ -296,11 +301,12 @@ contains
             end associate
         end subroutine add_token
 
-        !> The token before '=' is a variable name; it must not be set twice in a group.
+        !> The token before '=' is a variable name; no entry of it may be set twice in a
+        !> group (a whole-array assignment sets them all).
         subroutine mark_name(line)
             integer, intent(in) :: line
             integer :: k
-            character(len=:), allocatable :: this
+            character(len=:), allocatable :: this, other
 
             associate(group => scan%groups(scan%n_groups))
                 if (group%n_tokens == 0) then
@@ -318,11 +324,19 @@ contains
                 end associate
                 do k = 1, group%n_tokens - 1
                     if (.not. group%tokens(k)%is_name) cycle
-                    if (normalized_name(scan%token_text(group%tokens(k))) /= this) cycle
-                    call fatal_error(error, '&' // group%name // ': ' &
-                        // scan%token_text(group%tokens(k)) // ' is set twice (lines ' &
-                        // format_integer(group%tokens(k)%line) // ' and ' &
-                        // format_integer(line) // ')')
+                    other = normalized_name(scan%token_text(group%tokens(k)))
+                    if (other == this) then
+                        call fatal_error(error, '&' // group%name // ': ' &
+                            // scan%token_text(group%tokens(k)) // ' is set twice (lines ' &
+                            // format_integer(group%tokens(k)%line) // ' and ' &
+                            // format_integer(line) // ')')
+                        return
+                    end if
+                    if (.not. entries_overlap(this, other)) cycle
+                    call fatal_error(error, '&' // group%name // ': ' // this // ' (line ' &
+                        // format_integer(line) // ') sets again an entry that ' // other &
+                        // ' (line ' // format_integer(group%tokens(k)%line) // ') sets; ' &
+                        // 'each entry may be set only once')
                     return
                 end do
             end associate
@@ -408,6 +422,49 @@ contains
         name = to_lower(name)
     end function normalized_name
 
+    !> Whether two different normalized names (lower case, no blanks) of one group
+    !> set a common entry: the same variable, one of them whole, or subscripts i or
+    !> i:j whose ranges meet (a subscript of another form counts as meeting).
+    pure logical function entries_overlap(a, b)
+        character(len=*), intent(in) :: a, b
+        integer :: first_a, last_a, first_b, last_b
+        logical :: ok_a, ok_b
+
+        entries_overlap = .false.
+        if (base_name(a) /= base_name(b)) return
+        call entry_range(a, first_a, last_a, ok_a)
+        call entry_range(b, first_b, last_b, ok_b)
+        ! A subscript below 1 is left to the namelist reader ("Index 0 out of range").
+        if (min(first_a, first_b) < 1) return
+        entries_overlap = .true.
+        if (ok_a .and. ok_b) entries_overlap = first_a <= last_b .and. first_b <= last_a
+    end function entries_overlap
+
+    !> Entries first..last of a subscripted name 'x(i)', 'x(i:j)', 'x(i:)', 'x(:j)'.
+    pure subroutine entry_range(name, first, last, ok)
+        character(len=*), intent(in) :: name
+        integer, intent(out) :: first, last
+        logical, intent(out) :: ok
+        character(len=:), allocatable :: inner
+        integer :: colon
+
+        first = 1
+        last = huge(1)
+        ok = index(name, '(') == 0
+        if (ok .or. name(len(name):) /= ')') return
+        inner = name(index(name, '(') + 1:len(name) - 1)
+        colon = index(inner, ':')
+        if (colon == 0) then
+            call parse_integer(inner, first, ok)
+            last = first
+            return
+        end if
+        if (index(inner(colon + 1:), ':') > 0) return
+        ok = .true.
+        if (colon > 1) call parse_integer(inner(:colon - 1), first, ok)
+        if (ok .and. colon < len(inner)) call parse_integer(inner(colon + 1:), last, ok)
+    end subroutine entry_range
+
     !> At most 40 characters of a text for a message.
     pure function shorten(text) result(short)
         character(len=*), intent(in) :: text
@@ -477,6 +534,56 @@ contains
             end if
         end do
     end function find_group
+
+    !> Whether the `occurrence`-th group `name` has an assignment to `variable` (whole
+    !> or subscripted).
+    pure logical function is_set(self, name, occurrence, variable)
+        class(namelist_scan_type), intent(in) :: self
+        character(len=*), intent(in) :: name, variable
+        integer, intent(in) :: occurrence
+        integer :: g, k
+
+        is_set = .false.
+        g = self%find_group(name, occurrence)
+        if (g == 0) return
+        associate(group => self%groups(g))
+            do k = 1, group%n_tokens
+                if (.not. group%tokens(k)%is_name) cycle
+                if (base_name(self%token_text(group%tokens(k))) == variable) is_set = .true.
+            end do
+        end associate
+    end function is_set
+
+    !> Whether a value of the `occurrence`-th group `name` (with a repeat count r*v, its
+    !> v) reads as `real_marker` or `integer_marker`.
+    logical function holds_marker(self, name, occurrence, real_marker, integer_marker)
+        class(namelist_scan_type), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: occurrence
+        real(wp), intent(in) :: real_marker
+        integer, intent(in) :: integer_marker
+        character(len=:), allocatable :: text
+        real(wp) :: real_value
+        integer :: g, k, integer_value
+        logical :: ok
+
+        holds_marker = .false.
+        g = self%find_group(name, occurrence)
+        if (g == 0) return
+        associate(group => self%groups(g))
+            do k = 1, group%n_tokens
+                if (group%tokens(k)%is_name) cycle
+                text = self%token_text(group%tokens(k))
+                text = text(index(text, '*') + 1:)
+                call parse_integer(text, integer_value, ok)
+                if (ok) holds_marker = integer_value == integer_marker
+                if (holds_marker) return
+                call parse_real(text, real_value, ok)
+                if (ok) holds_marker = real_value == real_marker
+                if (holds_marker) return
+            end do
+        end associate
+    end function holds_marker
 
     pure function token_text(self, token) result(text)
         class(namelist_scan_type), intent(in) :: self

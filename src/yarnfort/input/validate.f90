@@ -10,14 +10,17 @@ module yarnfort_input_validate
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, solver_config_type, output_config_type, &
-        material_config_type, path_config_type, contact_config_type, name_length, &
-        solver_presets
-    use yarnfort_text, only: format_integer, format_real, join_names, closest_name
+        material_config_type, path_config_type, contact_config_type, name_length
+    use yarnfort_input_groups, only: check_control_variables, check_solver_variables, &
+        check_material_variables, check_contact_variables, check_yarn_variables, &
+        check_support_variables, check_load_variables, check_path_variables, &
+        check_output_variables
+    use yarnfort_input_fields, only: not_finite, suggestion, quoted_list
+    use yarnfort_text, only: format_integer, format_real, closest_name
     implicit none
     private
 
-    public :: check_config, coincidence_tolerance, known_laws, known_linear_solvers
-    public :: known_contact_laws, known_schemes
+    public :: check_config, coincidence_tolerance
 
     !> A segment between consecutive yarn nodes is of zero length when it is not longer
     !> than this times the diagonal of the box around all nodes.
@@ -29,18 +32,6 @@ module yarnfort_input_validate
     !> a 6 x 6 Jacobian block per element (elements_per_segment multiplies both).
     integer, parameter :: max_network_nodes = huge(1) / 3
     integer, parameter :: max_network_elements = huge(1) / 36
-    !> Values of &material law.
-    character(len=*), parameter :: known_laws(*) = [character(len=11) :: 'linear', &
-        'neo_hookean', 'table']
-    !> Values of &solver linear_solver.
-    character(len=*), parameter :: known_linear_solvers(*) = [character(len=11) :: 'auto', &
-        'umfpack', 'klu', 'cholmod', 'cholmod+klu', 'dense']
-    !> Values of &contact law.
-    character(len=*), parameter :: known_contact_laws(*) = [character(len=17) :: 'bonded', &
-        'coulomb', 'adhesion', 'decaying_adhesion']
-    !> Values of &solver scheme.
-    character(len=*), parameter :: known_schemes(*) = [character(len=10) :: 'monolithic', &
-        'staggered']
     character(len=1), parameter :: axis(3) = ['x', 'y', 'z']
     !> Characters of material and support names.
     character(len=*), parameter :: name_characters = &
@@ -54,7 +45,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer, allocatable :: owner(:, :)
 
-        call require_at_least(error, '&control', 'max_steps', config%control%max_steps, 0)
+        call check_control_variables(config%control, '&control', error)
         if (allocated(error)) return
         call check_solver(config%solver, error)
         if (allocated(error)) return
@@ -79,97 +70,22 @@ contains
         call check_step_resolution(config%solver, config%path, error)
     end subroutine check_config
 
+    !> &solver: its variables, and min_step <= initial_step (larger ones are capped at
+    !> max_step by the continuation), min_step <= max_step.
     subroutine check_solver(solver, error)
         type(solver_config_type), intent(in) :: solver
         type(error_type), allocatable, intent(out) :: error
 
-        if (.not. any(solver_presets == solver%preset)) then
-            call fatal_error(error, "&solver: preset = '" // trim(solver%preset) &
-                // "' is unknown (use " // join_names(solver_presets, '') // ')' &
-                // suggestion(solver%preset, solver_presets))
-            return
-        end if
-        if (.not. any(known_linear_solvers == solver%linear_solver)) then
-            call fatal_error(error, "&solver: linear_solver = '" // trim(solver%linear_solver) &
-                // "' is unknown (use " // join_names(known_linear_solvers, '') // ')')
-            return
-        end if
-        call require_positive(error, '&solver', 'residual_tolerance', solver%residual_tolerance)
-        if (allocated(error)) return
-        call require_positive(error, '&solver', 'step_tolerance', solver%step_tolerance)
-        if (allocated(error)) return
-        call require_at_least(error, '&solver', 'max_iterations', solver%max_iterations, 1)
-        if (allocated(error)) return
-        call require_at_least(error, '&solver', 'max_setup_calls', solver%max_setup_calls, 1)
-        if (allocated(error)) return
-        call require_at_least(error, '&solver', 'easy_iterations', solver%easy_iterations, 0)
-        if (allocated(error)) return
-        call require_at_least(error, '&solver', 'max_step_cuts', solver%max_step_cuts, 0)
-        if (allocated(error)) return
-        if (.not. ieee_is_finite(solver%slack_stiffness)) then
-            call not_finite(error, '&solver', 'slack_stiffness', solver%slack_stiffness)
-            return
-        end if
-        if (solver%slack_stiffness < 0.0_wp) then
-            call fatal_error(error, '&solver: slack_stiffness = ' &
-                // format_real(solver%slack_stiffness) // ' must be >= 0')
-            return
-        end if
-        call require_positive(error, '&solver', 'min_step', solver%min_step)
-        if (allocated(error)) return
-        call require_positive(error, '&solver', 'initial_step', solver%initial_step)
-        if (allocated(error)) return
-        call require_positive(error, '&solver', 'max_step', solver%max_step)
+        call check_solver_variables(solver, '&solver', error)
         if (allocated(error)) return
         if (solver%min_step > solver%max_step) then
             call fatal_error(error, '&solver: min_step = ' // format_real(solver%min_step) &
                 // ' is larger than max_step = ' // format_real(solver%max_step))
-            return
-        end if
-        ! An initial_step above max_step is simply capped at max_step by the continuation.
-        if (solver%initial_step < solver%min_step) then
+        else if (solver%initial_step < solver%min_step) then
             call fatal_error(error, '&solver: initial_step = ' &
                 // format_real(solver%initial_step) // ' is smaller than min_step = ' &
                 // format_real(solver%min_step))
-            return
         end if
-        if (.not. ieee_is_finite(solver%step_cut)) then
-            call not_finite(error, '&solver', 'step_cut', solver%step_cut)
-            return
-        end if
-        if (solver%step_cut <= 0.0_wp .or. solver%step_cut >= 1.0_wp) then
-            call fatal_error(error, '&solver: step_cut = ' // format_real(solver%step_cut) &
-                // ' must lie strictly between 0 and 1')
-            return
-        end if
-        if (.not. ieee_is_finite(solver%step_growth)) then
-            call not_finite(error, '&solver', 'step_growth', solver%step_growth)
-            return
-        end if
-        if (solver%step_growth < 1.0_wp) then
-            call fatal_error(error, '&solver: step_growth = ' // format_real(solver%step_growth) &
-                // ' must be >= 1')
-            return
-        end if
-        if (.not. any(known_schemes == solver%scheme)) then
-            call fatal_error(error, "&solver: scheme = '" // trim(solver%scheme) &
-                // "' is unknown (use " // join_names(known_schemes, '') // ')' &
-                // suggestion(solver%scheme, known_schemes))
-            return
-        end if
-        call require_at_least(error, '&solver', 'max_friction_iterations', &
-            solver%max_friction_iterations, 1)
-        if (allocated(error)) return
-        if (.not. ieee_is_finite(solver%min_length_ratio)) then
-            call not_finite(error, '&solver', 'min_length_ratio', solver%min_length_ratio)
-            return
-        end if
-        if (solver%min_length_ratio <= 0.0_wp .or. solver%min_length_ratio >= 1.0_wp) then
-            call fatal_error(error, '&solver: min_length_ratio = ' &
-                // format_real(solver%min_length_ratio) // ' must lie strictly between 0 and 1')
-            return
-        end if
-        call require_positive(error, '&solver', 'friction_tolerance', solver%friction_tolerance)
     end subroutine check_solver
 
     subroutine check_output(output, error)
@@ -180,13 +96,12 @@ contains
             call fatal_error(error, "&output: folder = '' is empty (give a folder name)")
             return
         end if
-        call require_at_least(error, '&output', 'vtk_every', output%vtk_every, 0)
+        call check_output_variables(output, '&output', error)
     end subroutine check_output
 
     subroutine check_materials(materials, error)
         type(material_config_type), intent(in), allocatable :: materials(:)
         type(error_type), allocatable, intent(out) :: error
-        type(material_config_type) :: unset
         integer :: m, other
         character(len=:), allocatable :: label
 
@@ -216,58 +131,8 @@ contains
                         return
                     end if
                 end do
-                select case (trim(material%law))
-                case ('')
-                    call fatal_error(error, label // ": law is not set (use " &
-                        // join_names(known_laws, '') // ')')
-                case ('linear')
-                    call require_parameter(error, label, 'stiffness', material%stiffness, &
-                        unset%stiffness, 'linear')
-                    if (allocated(error)) return
-                    call forbid_parameter(error, label, 'modulus', material%modulus, &
-                        unset%modulus, 'linear')
-                    if (allocated(error)) return
-                    call forbid_parameter(error, label, 'area', material%area, unset%area, &
-                        'linear')
-                    if (allocated(error)) return
-                    call forbid_table(error, label, material%table_file, 'linear')
-                case ('neo_hookean')
-                    call require_parameter(error, label, 'modulus', material%modulus, &
-                        unset%modulus, 'neo_hookean')
-                    if (allocated(error)) return
-                    call require_parameter(error, label, 'area', material%area, unset%area, &
-                        'neo_hookean')
-                    if (allocated(error)) return
-                    call forbid_parameter(error, label, 'stiffness', material%stiffness, &
-                        unset%stiffness, 'neo_hookean')
-                    if (allocated(error)) return
-                    call forbid_table(error, label, material%table_file, 'neo_hookean')
-                case ('table')
-                    if (len_trim(material%table_file) == 0) then
-                        call fatal_error(error, label // ": table_file is not set (law " &
-                            // "'table' needs a CSV file of strain, force)")
-                        return
-                    end if
-                    call forbid_parameter(error, label, 'stiffness', material%stiffness, &
-                        unset%stiffness, 'table')
-                    if (allocated(error)) return
-                    call forbid_parameter(error, label, 'modulus', material%modulus, &
-                        unset%modulus, 'table')
-                    if (allocated(error)) return
-                    call forbid_parameter(error, label, 'area', material%area, unset%area, &
-                        'table')
-                case default
-                    call fatal_error(error, label // ": law = '" // trim(material%law) &
-                        // "' is unknown (use " // join_names(known_laws, '') // ')')
-                end select
+                call check_material_variables(material, label, error)
                 if (allocated(error)) return
-                if (.not. (material%prestress >= 0.0_wp .and. &
-                        material%prestress < huge(1.0_wp))) then
-                    call fatal_error(error, label // ': prestress = ' &
-                        // format_real(material%prestress) &
-                        // ' must be a tension >= 0 (N)')
-                    return
-                end if
             end associate
         end do
     end subroutine check_materials
@@ -309,8 +174,16 @@ contains
                 end if
                 pair(a, b) = c
                 pair(b, a) = c
-                call check_contact_law(error, label, contact)
+                call check_contact_variables(contact, label, error)
                 if (allocated(error)) return
+                if (contact%law == 'decaying_adhesion' &
+                    .and. .not. (contact%decay_start < contact%decay_end)) then
+                    call fatal_error(error, label // ': decay_start = ' &
+                        // format_real(contact%decay_start) // ' must be less than ' &
+                        // 'decay_end = ' // format_real(contact%decay_end) // ' (the ' &
+                        // 'adhesion decays from tension decay_start to decay_end)')
+                    return
+                end if
             end associate
         end do
         call check_contacts_complete(config, pair, error)
@@ -346,62 +219,6 @@ contains
         end if
     end subroutine check_contact_material
 
-    !> A known friction law with its own parameters only: all of them finite and >= 0,
-    !> and decay_start < decay_end.
-    subroutine check_contact_law(error, label, contact)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label
-        type(contact_config_type), intent(in) :: contact
-        type(contact_config_type) :: unset
-        character(len=*), parameter :: variables(4) = [character(len=20) :: &
-            'friction_coefficient', 'adhesion', 'decay_start', 'decay_end']
-        logical :: needed(4)
-        real(wp) :: values(4), unset_values(4)
-        integer :: i
-
-        select case (trim(contact%law))
-        case ('')
-            call fatal_error(error, label // ': law is not set (use ' &
-                // join_names(known_contact_laws, '') // ')')
-            return
-        case ('bonded')
-            needed = [.false., .false., .false., .false.]
-        case ('coulomb')
-            needed = [.true., .false., .false., .false.]
-        case ('adhesion')
-            needed = [.true., .true., .false., .false.]
-        case ('decaying_adhesion')
-            needed = [.true., .true., .true., .true.]
-        case default
-            call fatal_error(error, label // ": law = '" // trim(contact%law) &
-                // "' is unknown (use " // join_names(known_contact_laws, '') // ')' &
-                // suggestion(contact%law, known_contact_laws))
-            return
-        end select
-        values = [contact%friction_coefficient, contact%adhesion, contact%decay_start, &
-            contact%decay_end]
-        unset_values = [unset%friction_coefficient, unset%adhesion, unset%decay_start, &
-            unset%decay_end]
-        do i = 1, size(variables)
-            if (needed(i)) then
-                call require_nonnegative_parameter(error, label, trim(variables(i)), &
-                    values(i), unset_values(i), trim(contact%law))
-            else
-                call forbid_parameter(error, label, trim(variables(i)), values(i), &
-                    unset_values(i), trim(contact%law))
-            end if
-            if (allocated(error)) return
-        end do
-        if (needed(3) .and. needed(4)) then
-            if (.not. (contact%decay_start < contact%decay_end)) then
-                call fatal_error(error, label // ': decay_start = ' &
-                    // format_real(contact%decay_start) // ' must be less than decay_end = ' &
-                    // format_real(contact%decay_end) // ' (the adhesion decays from ' &
-                    // 'tension decay_start to decay_end)')
-                return
-            end if
-        end if
-    end subroutine check_contact_law
 
     !> With any &contact, every pair of yarn types meeting at a node needs one. A node
     !> meets when two different yarns list it (yarns of two types, or two of one type).
@@ -475,41 +292,8 @@ contains
         end if
     end subroutine check_name
 
-    !> A law parameter must be set, positive and finite.
-    subroutine require_parameter(error, label, variable, value, unset, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, law
-        real(wp), intent(in) :: value, unset
 
-        if (value == unset) then
-            call fatal_error(error, label // ': ' // variable // " is not set (law '" // law &
-                // "' needs it)")
-            return
-        end if
-        call require_positive(error, label, variable, value)
-    end subroutine require_parameter
 
-    !> A parameter another law uses must stay unset (a silently ignored value is a mistake).
-    subroutine forbid_parameter(error, label, variable, value, unset, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, law
-        real(wp), intent(in) :: value, unset
-
-        if (.not. (value == unset)) then
-            call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
-                // " is not used by law '" // law // "' (remove it)")
-        end if
-    end subroutine forbid_parameter
-
-    subroutine forbid_table(error, label, table_file, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, table_file, law
-
-        if (len_trim(table_file) > 0) then
-            call fatal_error(error, label // ": table_file = '" // trim(table_file) &
-                // "' is not used by law '" // law // "' (remove it)")
-        end if
-    end subroutine forbid_table
 
     subroutine check_nodes(config, error)
         type(config_type), intent(in) :: config
@@ -601,11 +385,8 @@ contains
                         // quoted_list(material_names) // ')' // guess)
                     return
                 end if
-                if (yarn%elements_per_segment < 1) then
-                    call fatal_error(error, label // ': elements_per_segment = ' &
-                        // format_integer(yarn%elements_per_segment) // ' must be >= 1')
-                    return
-                end if
+                call check_yarn_variables(yarn, label, error)
+                if (allocated(error)) return
                 if (size(yarn%nodes) < 2) then
                     call fatal_error(error, label // ': nodes has ' &
                         // format_integer(size(yarn%nodes)) &
@@ -785,12 +566,9 @@ contains
                 end do
                 call check_fix(error, label, support%fix)
                 if (allocated(error)) return
+                call check_support_variables(support, label, error)
+                if (allocated(error)) return
                 do k = 1, 3
-                    if (.not. ieee_is_finite(support%displacement(k))) then
-                        call not_finite(error, label, 'displacement(' // format_integer(k) &
-                            // ')', support%displacement(k))
-                        return
-                    end if
                     if (support%displacement(k) /= 0.0_wp &
                         .and. index(support%fix, axis(k)) == 0) then
                         call fatal_error(error, label // ': displacement(' &
@@ -856,13 +634,8 @@ contains
         do l = 1, size(config%loads)
             associate(load => config%loads(l))
                 label = '&load #' // format_integer(l)
-                do k = 1, 3
-                    if (.not. ieee_is_finite(load%force(k))) then
-                        call not_finite(error, label, 'force(' // format_integer(k) // ')', &
-                            load%force(k))
-                        return
-                    end if
-                end do
+                call check_load_variables(load, label, error)
+                if (allocated(error)) return
                 call check_node_list(error, label, load%nodes, size(config%node_positions, 2))
                 if (allocated(error)) return
                 do i = 1, size(load%nodes)
@@ -947,18 +720,8 @@ contains
                 // ' values but time has ' // format_integer(n))
             return
         end if
-        do i = 1, n
-            if (.not. ieee_is_finite(path%time(i))) then
-                call not_finite(error, '&path', 'time(' // format_integer(i) // ')', path%time(i))
-            else if (.not. ieee_is_finite(path%p_force(i))) then
-                call not_finite(error, '&path', 'p_force(' // format_integer(i) // ')', &
-                    path%p_force(i))
-            else if (.not. ieee_is_finite(path%p_disp(i))) then
-                call not_finite(error, '&path', 'p_disp(' // format_integer(i) // ')', &
-                    path%p_disp(i))
-            end if
-            if (allocated(error)) return
-        end do
+        call check_path_variables(path, '&path', error)
+        if (allocated(error)) return
         do i = 2, n
             if (.not. (path%time(i) > path%time(i - 1))) then
                 call fatal_error(error, '&path: time(' // format_integer(i) // ') = ' &
@@ -990,78 +753,11 @@ contains
         end if
     end subroutine check_step_resolution
 
-    !> A law parameter that must be set, finite and >= 0.
-    subroutine require_nonnegative_parameter(error, label, variable, value, unset, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, law
-        real(wp), intent(in) :: value, unset
 
-        if (value == unset) then
-            call fatal_error(error, label // ': ' // variable // " is not set (law '" // law &
-                // "' needs it)")
-        else if (.not. ieee_is_finite(value)) then
-            call not_finite(error, label, variable, value)
-        else if (value < 0.0_wp) then
-            call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
-                // ' must be >= 0')
-        end if
-    end subroutine require_nonnegative_parameter
 
-    !> "; did you mean 'x'?" for the known name closest to `name`, or ''.
-    function suggestion(name, names) result(text)
-        character(len=*), intent(in) :: name
-        character(len=*), intent(in) :: names(:)
-        character(len=:), allocatable :: text
 
-        text = closest_name(trim(name), names)
-        if (len(text) > 0) text = "; did you mean '" // text // "'?"
-    end function suggestion
 
-    subroutine require_positive(error, label, variable, value)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable
-        real(wp), intent(in) :: value
 
-        if (.not. ieee_is_finite(value)) then
-            call not_finite(error, label, variable, value)
-        else if (value <= 0.0_wp) then
-            call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
-                // ' must be positive')
-        end if
-    end subroutine require_positive
-
-    subroutine not_finite(error, label, variable, value)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable
-        real(wp), intent(in) :: value
-
-        call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
-            // ' is not finite')
-    end subroutine not_finite
-
-    subroutine require_at_least(error, label, variable, value, minimum)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable
-        integer, intent(in) :: value, minimum
-
-        if (value < minimum) then
-            call fatal_error(error, label // ': ' // variable // ' = ' // format_integer(value) &
-                // ' must be >= ' // format_integer(minimum))
-        end if
-    end subroutine require_at_least
-
-    !> "'a', 'b', 'c'"
-    pure function quoted_list(names) result(list)
-        character(len=*), intent(in) :: names(:)
-        character(len=:), allocatable :: list
-        integer :: i
-
-        list = ''
-        do i = 1, size(names)
-            if (i > 1) list = list // ', '
-            list = list // "'" // trim(names(i)) // "'"
-        end do
-    end function quoted_list
 
     function format_position(x) result(text)
         real(wp), intent(in) :: x(3)

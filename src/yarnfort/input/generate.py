@@ -1,0 +1,589 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Make the namelist input layer from its one description (variables.py).
+
+    generate.py fortran OUT.f90     the module yarnfort_input_groups (meson runs this)
+    generate.py reference           the variable tables of inputs/REFERENCE.md, on stdout
+    generate.py check REFERENCE.md  exit 1 (with a diff) if the tables there differ
+    generate.py update REFERENCE.md rewrite the tables there
+
+The module holds, per group: its config type (defaults, one doc line per variable), a
+reader of one occurrence (local namelist, lists read against "not set" markers, text
+lengths checked, case folded), the generic checks (range, choices, the parameters of
+the selected law), the echo, and for all groups the names and the --help summary.
+"""
+from __future__ import annotations
+
+import difflib
+import re
+import sys
+import textwrap
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from descriptors import LENGTHS, Group, Var  # noqa: E402
+from variables import GROUPS  # noqa: E402
+
+INDENT = "    "
+WIDTH = 96
+
+
+# ---------------------------------------------------------------- Fortran text helpers
+def fortran_real(value: float) -> str:
+    text = repr(float(value))
+    if "e" in text:
+        mantissa, exponent = text.split("e")
+        if "." not in mantissa:
+            mantissa += ".0"
+        text = f"{mantissa}e{int(exponent)}"
+    elif "." not in text:
+        text += ".0"
+    return text + "_wp"
+
+
+def fortran_value(var: Var, value: object) -> str:
+    if var.type == "character":
+        return "'" + str(value).replace("'", "''") + "'"
+    if var.type == "logical":
+        return ".true." if value else ".false."
+    if var.type == "real":
+        return fortran_real(value)  # type: ignore[arg-type]
+    return str(value)
+
+
+def fortran_default(var: Var) -> str:
+    if isinstance(var.default, list):
+        if len(set(map(str, var.default))) == 1:
+            return fortran_value(var, var.default[0])
+        return "[" + ", ".join(fortran_value(var, v) for v in var.default) + "]"
+    return fortran_value(var, var.default)
+
+
+def declaration(var: Var, buffer: bool = False) -> str:
+    if var.type == "character":
+        kind = "character(len=buffer_length)" if buffer else f"character(len={var.length})"
+    else:
+        kind = {"real": "real(wp)", "integer": "integer", "logical": "logical"}[var.type]
+    if var.is_list:
+        return f"{kind}, allocatable :: {var.name}(:)"
+    shape = f"({var.size})" if var.size else ""
+    return f"{kind} :: {var.name}{shape}"
+
+
+def wrap_statement(text: str, indent: str) -> list[str]:
+    """A Fortran statement split at blanks outside character constants, with '&'
+    continuation lines."""
+    if len(indent + text) <= WIDTH:
+        return [indent + text]
+    breaks, quote = [], ""
+    for i, c in enumerate(text):
+        if quote:
+            quote = "" if c == quote else quote
+        elif c in "'\"":
+            quote = c
+        elif c == " ":
+            breaks.append(i)
+    lines, start, first = [], 0, True
+    while len(text) - start > WIDTH - len(indent) - (0 if first else 4):
+        room = WIDTH - len(indent) - (0 if first else 4) - 2
+        fits = [i for i in breaks if start < i <= start + room]
+        if not fits:
+            break
+        lines.append(text[start:fits[-1]])
+        start, first = fits[-1] + 1, False
+    lines.append(text[start:])
+    return [indent + (INDENT if i else "") + line + (" &" if i < len(lines) - 1 else "")
+            for i, line in enumerate(lines)]
+
+
+def wrap_strings(text: str, indent: str, width: int = WIDTH) -> list[str]:
+    """A Fortran string expression of `text`, over several lines if needed."""
+    chunks = textwrap.wrap(text, width - len(indent) - 10, drop_whitespace=False,
+                           break_long_words=True, break_on_hyphens=False) or [""]
+    quoted = ["'" + c.replace("'", "''") + "'" for c in chunks]
+    return [indent + q + (" &" if i < len(quoted) - 1 else "") if i == 0 else
+            indent + "// " + q + (" &" if i < len(quoted) - 1 else "")
+            for i, q in enumerate(quoted)]
+
+
+def doc_comment(text: str, indent: str) -> list[str]:
+    first = re.split(r"(?<=[.:;])\s", text.replace("`", ""), maxsplit=1)[0]
+    return [indent + "!> " + line for line in textwrap.wrap(first, WIDTH - len(indent) - 4)]
+
+
+def string_array(name: str, values: list[str], indent: str) -> list[str]:
+    length = max(len(v) for v in values)
+    items = ", ".join(f"'{v}'" for v in values)
+    return wrap_statement(f"character(len=*), parameter :: {name}(*) = "
+                          f"[character(len={length}) :: {items}]", indent)
+
+
+# ---------------------------------------------------------------- the Fortran module
+def range_call(var: Var, label: str, value: str, variable: str) -> list[str]:
+    """The call checking `value` against var.range (reals and integers)."""
+    if var.range is None:
+        return []
+    text = var.range.strip()
+    if var.type == "integer":
+        minimum = re.fullmatch(r">=\s*(-?\d+)", text)
+        if not minimum:
+            raise ValueError(f"{var.name}: integer range {text!r} is not '>= n'")
+        return [f"call check_at_least(error, {label}, {variable}, {value}, {minimum[1]})"]
+    if text == "finite":
+        return [f"call check_real(error, {label}, {variable}, {value})"]
+    one = re.fullmatch(r"(>=|>)\s*(\S+)", text)
+    if one:
+        bound = one[2]
+        return [f"call check_real(error, {label}, {variable}, {value}, "
+                f"lower={fortran_real(float(bound))}, lower_text='{bound}', "
+                f"lower_open={'.true.' if one[1] == '>' else '.false.'})"]
+    interval = re.fullmatch(r"([(\[])\s*(\S+),\s*(\S+)\s*([)\]])", text)
+    if interval:
+        lo, hi = interval[2], interval[3]
+        return [f"call check_real(error, {label}, {variable}, {value}, "
+                f"lower={fortran_real(float(lo))}, lower_text='{lo}', "
+                f"lower_open={'.true.' if interval[1] == '(' else '.false.'}, "
+                f"upper={fortran_real(float(hi))}, upper_text='{hi}', "
+                f"upper_open={'.true.' if interval[4] == ')' else '.false.'})"]
+    raise ValueError(f"{var.name}: range {text!r} is not understood")
+
+
+def element_checks(var: Var, calls_for) -> list[tuple[int, str]]:
+    """Checks of every entry of `var` (scalar, fixed array or list), as (depth, line)."""
+    field = f"value%{var.name}"
+    if var.size or var.is_list:
+        calls = calls_for(f"{field}(i)", f"'{var.name}(' // format_integer(i) // ')'")
+        if not calls:
+            return []
+        upper = str(var.size) if var.size else f"size({field})"
+        lines = [(0, f"do i = 1, {upper}")]
+        for call in calls:
+            lines += [(1, call), (1, "if (allocated(error)) return")]
+        return lines + [(0, "end do")]
+    lines = []
+    for call in calls_for(field, f"'{var.name}'"):
+        lines += [(0, call), (0, "if (allocated(error)) return")]
+    return lines
+
+
+def choices_name(group: Group, var: Var) -> str:
+    return f"{group.name}_{var.name}_choices"
+
+
+def law_block(var: Var, law_bound: list[Var]) -> list[tuple[int, str]]:
+    """select case over the selected law: its parameters required, the others not set."""
+    body = [(0, f"select case (trim(value%{var.name}))")]
+    for law in var.choices or []:
+        body.append((0, f"case ('{law}')"))
+        for v in [v for v in law_bound if law in (v.laws or [])]:
+            if v.type == "character":
+                body.append((1, f"call require_text(error, label, '{v.name}', value%{v.name}, "
+                                f"'{law}')"))
+            else:
+                body.append((1, f"call require_set(error, label, '{v.name}', value%{v.name}, "
+                                f"{fortran_default(v)}, '{law}')"))
+                for call in range_call(v, "label", f"value%{v.name}", f"'{v.name}'"):
+                    body += [(1, "if (allocated(error)) return"), (1, call)]
+            body.append((1, "if (allocated(error)) return"))
+        for v in [v for v in law_bound if law not in (v.laws or [])]:
+            unset = "''" if v.type == "character" else fortran_default(v)
+            body += [(1, f"call forbid_set(error, label, '{v.name}', value%{v.name}, {unset}, "
+                         f"'{law}')"), (1, "if (allocated(error)) return")]
+    return body + [(0, "end select")]
+
+
+def check_routine(group: Group) -> list[str]:
+    checked = [v for v in group.variables if not v.checked_by]
+    law_bound = [v for v in checked if v.laws]
+    body: list[tuple[int, str]] = []
+    for var in checked:
+        if var.laws:
+            continue
+        if var.choices:
+            body += [(0, f"call check_choice(error, label, '{var.name}', value%{var.name}, "
+                         f"{choices_name(group, var)}, {'.true.' if var.selects else '.false.'})"),
+                     (0, "if (allocated(error)) return")]
+        if var.selects and law_bound:
+            body += law_block(var, law_bound)
+        elif var.type in ("real", "integer"):
+            body += element_checks(var, lambda value, name, v=var: range_call(
+                v, "label", value, name))
+    if not body:
+        return []
+    if body[-1][1] == "if (allocated(error)) return":
+        body = body[:-1]
+    out = [f"{INDENT}!> The checks of &{group.name} that its description gives: ranges, "
+           "choices and",
+           f"{INDENT}!> the parameters of the selected law. `label` names the group in "
+           "messages.",
+           f"{INDENT}subroutine check_{group.name}_variables(value, label, error)",
+           f"{INDENT * 2}type({group.type_name}), intent(in) :: value",
+           f"{INDENT * 2}character(len=*), intent(in) :: label",
+           f"{INDENT * 2}type(error_type), allocatable, intent(out) :: error"]
+    if any(line.startswith("do i") for _, line in body):
+        out.append(f"{INDENT * 2}integer :: i")
+    out.append("")
+    for depth, line in body:
+        out += wrap_statement(line, INDENT * (2 + depth))
+    out.append(f"{INDENT}end subroutine check_{group.name}_variables")
+    return out + [""]
+
+
+def read_routine(group: Group) -> list[str]:
+    lists = [v for v in group.variables if v.is_list]
+    i2 = INDENT * 2
+    out = [f"{INDENT}!> Read the next &{group.name} group of the comment-free text `unit` "
+           "(at its",
+           f"{INDENT}!> `occurrence`, 0 for a singleton) into `value`; `found` is false at "
+           "the end.",
+           f"{INDENT}subroutine read_{group.name}(unit, scan, occurrence, value, found, error)",
+           f"{i2}integer, intent(in) :: unit, occurrence",
+           f"{i2}type(namelist_scan_type), intent(in) :: scan",
+           f"{i2}type({group.type_name}), intent(out) :: value",
+           f"{i2}logical, intent(out) :: found",
+           f"{i2}type(error_type), allocatable, intent(out) :: error"]
+    for var in group.variables:
+        out.append(i2 + declaration(var, buffer=True))
+    for var in lists:
+        out.append(i2 + declaration(var).replace(f":: {var.name}(:)", f":: {var.name}_again(:)"))
+    out += wrap_statement(f"namelist /{group.name}/ "
+                          + ", ".join(v.name for v in group.variables), i2)
+    needs_k = bool(lists) or any(v.type == "character" and v.size for v in group.variables)
+    out += [f"{i2}character(len=message_length) :: message",
+            f"{i2}integer :: stat" + (", k" if needs_k else ""), ""]
+    for var in lists:
+        out.append(f"{i2}allocate({var.name}({var.max} + 1))")
+    out += [f"{i2}call reset(.false.)",
+            f"{i2}message = ''",
+            f"{i2}read(unit, nml={group.name}, iostat=stat, iomsg=message)",
+            f"{i2}found = .not. is_iostat_end(stat)",
+            f"{i2}if (.not. found) return",
+            f"{i2}if (stat /= 0) then",
+            f"{i2}{INDENT}call read_failed(error, scan, '{group.name}', occurrence, stat, "
+            f"message, &",
+            f"{i2}{INDENT * 2}{group.name}_variables)",
+            f"{i2}{INDENT}return",
+            f"{i2}end if"]
+    if lists:
+        out += [f"{i2}! A value equal to a 'not set' marker: read again with the other markers",
+                f"{i2}! (an entry is unset only where both reads left their marker).",
+                f"{i2}if (scan%holds_marker('{group.name}', max(occurrence, 1), unset_real, &",
+                f"{i2}{INDENT * 2}unset_integer)) then"]
+        for var in lists:
+            out.append(f"{i2}{INDENT}{var.name}_again = {var.name}")
+        out += [f"{i2}{INDENT}rewind(unit)",
+                f"{i2}{INDENT}do k = 1, max(occurrence, 1)",
+                f"{i2}{INDENT * 2}call reset(.true.)",
+                f"{i2}{INDENT * 2}read(unit, nml={group.name}, iostat=stat)",
+                f"{i2}{INDENT}end do",
+                f"{i2}end if"]
+    for var in group.variables:
+        if var.type == "character":
+            args = (f"{'.true.' if var.lower else '.false.'}, "
+                    f"{'.true.' if var.adjust else '.false.'}")
+            if var.size:
+                out.append(f"{i2}do k = 1, {var.size}")
+                out += wrap_statement(f"call take_text(error, scan, '{group.name}', occurrence, "
+                                      f"'{var.name}(' // format_integer(k) // ')', "
+                                      f"{var.name}(k), value%{var.name}(k), {args})", i2 + INDENT)
+                out += [f"{i2}{INDENT}if (allocated(error)) return", f"{i2}end do"]
+            else:
+                out += wrap_statement(f"call take_text(error, scan, '{group.name}', occurrence,"
+                                      f" '{var.name}', {var.name}, value%{var.name}, {args})", i2)
+                out.append(f"{i2}if (allocated(error)) return")
+        elif var.is_list:
+            kind = "real" if var.type == "real" else "integer"
+            out += wrap_statement(f"call take_{kind}_list(error, scan, '{group.name}', "
+                                  f"occurrence, '{var.name}', {var.name}, {var.name}_again, "
+                                  f"value%{var.name})", i2)
+            out.append(f"{i2}if (allocated(error)) return")
+        else:
+            out.append(f"{i2}value%{var.name} = {var.name}")
+    out += ["", f"{INDENT}contains", "",
+            f"{i2}!> Defaults from the type; lists filled with the first or the `second` "
+            "markers.",
+            f"{i2}subroutine reset(second)",
+            f"{i2}{INDENT}logical, intent(in) :: second"]
+    if len(lists) < len(group.variables):
+        out.append(f"{i2}{INDENT}type({group.type_name}) :: defaults")
+    out.append("")
+    for var in group.variables:
+        if var.is_list:
+            kind = "real" if var.type == "real" else "integer"
+            out.append(f"{i2}{INDENT}{var.name} = merge(other_{kind}, unset_{kind}, second)")
+        else:
+            out.append(f"{i2}{INDENT}{var.name} = defaults%{var.name}")
+    if not lists:
+        out.append(f"{i2}{INDENT}if (second) return")
+    out += [f"{i2}end subroutine reset"]
+    out += [f"{INDENT}end subroutine read_{group.name}", ""]
+    return out
+
+
+def read_all_routine(group: Group) -> list[str]:
+    """read_<group>_groups: every occurrence, checked against the structural scan."""
+    i2, i3 = INDENT * 2, INDENT * 3
+    name = group.name
+    if group.kind == "singleton":
+        return [f"{INDENT}!> The &{name} group into `value` if there is one (`value` is "
+                "unchanged otherwise).",
+                f"{INDENT}subroutine read_{name}_groups(unit, scan, value, error)",
+                f"{i2}integer, intent(in) :: unit",
+                f"{i2}type(namelist_scan_type), intent(in) :: scan",
+                f"{i2}type({group.type_name}), intent(inout) :: value",
+                f"{i2}type(error_type), allocatable, intent(out) :: error",
+                f"{i2}logical :: found", "",
+                f"{i2}if (scan%count_group('{name}') == 0) return",
+                f"{i2}rewind(unit)",
+                f"{i2}call read_{name}(unit, scan, 0, value, found, error)",
+                f"{i2}if (.not. allocated(error) .and. .not. found) &",
+                f"{i3}call read_failed(error, scan, '{name}', 0, iostat_end, '', {name}_variables)",
+                f"{INDENT}end subroutine read_{name}_groups", ""]
+    return [f"{INDENT}!> Every &{name} group, in the order of the text.",
+            f"{INDENT}subroutine read_{name}_groups(unit, scan, values, error)",
+            f"{i2}integer, intent(in) :: unit",
+            f"{i2}type(namelist_scan_type), intent(in) :: scan",
+            f"{i2}type({group.type_name}), allocatable, intent(out) :: values(:)",
+            f"{i2}type(error_type), allocatable, intent(out) :: error",
+            f"{i2}type({group.type_name}) :: extra",
+            f"{i2}type(error_type), allocatable :: ignored",
+            f"{i2}logical :: found",
+            f"{i2}integer :: k", "",
+            f"{i2}allocate(values(scan%count_group('{name}')))",
+            f"{i2}rewind(unit)",
+            f"{i2}do k = 1, size(values)",
+            f"{i3}call read_{name}(unit, scan, k, values(k), found, error)",
+            f"{i3}if (allocated(error)) return",
+            f"{i3}if (.not. found) then",
+            f"{i3}{INDENT}call read_failed(error, scan, '{name}', k, iostat_end, '', "
+            f"{name}_variables)",
+            f"{i3}{INDENT}return",
+            f"{i3}end if",
+            f"{i2}end do",
+            f"{i2}call read_{name}(unit, scan, size(values) + 1, extra, found, ignored)",
+            f"{i2}if (found) call too_many_found(error, '{name}', size(values))",
+            f"{INDENT}end subroutine read_{name}_groups", ""]
+
+
+def preset_routine(group: Group) -> list[str]:
+    preset = [v for v in group.variables if v.preset]
+    if not preset:
+        return []
+    i2 = INDENT * 2
+    out = [f"{INDENT}!> The values of `preset` for the variables of &{group.name} that a "
+           "preset sets and",
+           f"{INDENT}!> the input does not.",
+           f"{INDENT}subroutine apply_{group.name}_preset(scan, preset, value)",
+           f"{i2}type(namelist_scan_type), intent(in) :: scan",
+           f"{i2}type({group.type_name}), intent(in) :: preset",
+           f"{i2}type({group.type_name}), intent(inout) :: value", ""]
+    for var in preset:
+        out += wrap_statement(f"if (.not. scan%is_set('{group.name}', 1, '{var.name}')) "
+                              f"value%{var.name} = preset%{var.name}", i2)
+    return out + [f"{INDENT}end subroutine apply_{group.name}_preset", ""]
+
+
+def write_routine(group: Group) -> list[str]:
+    i2 = INDENT * 2
+    out = [f"{INDENT}!> Write `value` as a &{group.name} group, every variable with its value.",
+           f"{INDENT}subroutine write_{group.name}(unit, value)",
+           f"{i2}integer, intent(in) :: unit",
+           f"{i2}type({group.type_name}), intent(in) :: value", "",
+           f"{i2}call put(unit, '&{group.name}')"]
+    for var in group.variables:
+        field = f"value%{var.name}"
+        if var.is_list:
+            kind = "reals" if var.type == "real" else "integers"
+            out += wrap_statement(f"if (allocated({field})) call put_{kind}(unit, "
+                                  f"'{var.name}', {field})", i2)
+            continue
+        text = {"character": "quote_string", "real": "format_real",
+                "integer": "format_integer", "logical": "format_logical"}[var.type]
+        if var.size:
+            joined = f" // ', ' // ".join(f"{text}({field}({k}))" for k in range(1, var.size + 1))
+        else:
+            joined = f"{text}({field})"
+        out += wrap_statement(f"call put(unit, indent // '{var.name} = ' // {joined})", i2)
+    out += [f"{i2}call put(unit, '/')", f"{INDENT}end subroutine write_{group.name}", ""]
+    return out
+
+
+def type_definition(group: Group) -> list[str]:
+    out = doc_comment(f"&{group.name}: {group.doc}", INDENT)
+    out.append(f"{INDENT}type, public :: {group.type_name}")
+    for var in group.variables:
+        out += doc_comment(var.doc, INDENT * 2)
+        text = declaration(var)
+        if not var.is_list:
+            text += f" = {fortran_default(var)}"
+        out.append(INDENT * 2 + text)
+    out += [f"{INDENT}end type {group.type_name}", ""]
+    return out
+
+
+def help_lines() -> list[str]:
+    lines = ["Namelist groups and their variables (every default, unit and range:",
+             "inputs/REFERENCE.md):"]
+    for group in GROUPS:
+        head = f"  &{group.name} ({group.kind}): "
+        lines += textwrap.wrap(head + " ".join(v.name for v in group.variables), 79,
+                               subsequent_indent="      ")
+    return lines
+
+
+def fortran_module() -> str:
+    out = ["! SPDX-License-Identifier: MIT",
+           "! Generated by src/yarnfort/input/generate.py from variables.py: do not edit.",
+           "!> The namelist groups as described in variables.py: config types, one reader, "
+           "the",
+           "!> generic checks and the echo per group, the group and variable names and the "
+           "--help",
+           "!> summary. The helpers they call are in yarnfort_input_fields.",
+           "module yarnfort_input_groups",
+           f"{INDENT}use, intrinsic :: iso_fortran_env, only: iostat_end",
+           f"{INDENT}use yarnfort_kinds, only: wp",
+           f"{INDENT}use yarnfort_error, only: error_type",
+           f"{INDENT}use yarnfort_text, only: format_integer, format_real, quote_string",
+           f"{INDENT}use yarnfort_input_scan, only: namelist_scan_type",
+           f"{INDENT}use yarnfort_input_fields, only: buffer_length, message_length, max_list, &",
+           f"{INDENT * 3}max_coordinates, unset_real, unset_integer, other_real, other_integer, &",
+           f"{INDENT * 3}read_failed, too_many_found, take_text, take_real_list, take_integer_list, &",
+           f"{INDENT * 3}check_real, check_at_least, check_choice, require_set, &",
+           f"{INDENT * 3}require_text, forbid_set, put, put_reals, put_integers, format_logical, &",
+           f"{INDENT * 3}indent",
+           f"{INDENT}implicit none",
+           f"{INDENT}private", ""]
+    publics = []
+    for group in GROUPS:
+        publics += [f"read_{group.name}_groups", f"write_{group.name}"]
+        if check_routine(group):
+            publics.append(f"check_{group.name}_variables")
+        if preset_routine(group):
+            publics.append(f"apply_{group.name}_preset")
+    out += wrap_statement("public :: " + ", ".join(publics), INDENT)
+    out += wrap_statement("public :: group_names, singleton_names, help_lines, "
+                          "name_length, path_length", INDENT)
+    choice_names = [choices_name(g, v) for g in GROUPS for v in g.variables if v.choices]
+    out += wrap_statement("public :: " + ", ".join(choice_names), INDENT)
+    out.append("")
+    for name, value in LENGTHS.items():
+        out.append(f"{INDENT}integer, parameter :: {name} = {value}")
+    out.append(f"{INDENT}!> All group names, in the order they are read and echoed.")
+    out += string_array("group_names", [g.name for g in GROUPS], INDENT)
+    out.append(f"{INDENT}!> Groups that may appear at most once.")
+    out += string_array("singleton_names", [g.name for g in GROUPS if g.kind == "singleton"],
+                        INDENT)
+    for group in GROUPS:
+        out += string_array(f"{group.name}_variables", [v.name for v in group.variables],
+                            INDENT)
+        for var in group.variables:
+            if var.choices:
+                out.append(f"{INDENT}!> Values of &{group.name} {var.name}.")
+                out += string_array(choices_name(group, var), var.choices, INDENT)
+    out.append(f"{INDENT}!> The group and variable summary of --help.")
+    out += string_array("help_lines", help_lines(), INDENT)
+    out.append("")
+    for group in GROUPS:
+        out += type_definition(group)
+    out += ["contains", ""]
+    for group in GROUPS:
+        out += read_all_routine(group)
+        out += read_routine(group)
+        out += preset_routine(group)
+        out += write_routine(group)
+        out += check_routine(group)
+    out.append("end module yarnfort_input_groups")
+    return "\n".join(out) + "\n"
+
+
+# ---------------------------------------------------------------- REFERENCE.md tables
+def markdown_real(value: float) -> str:
+    return fortran_real(value)[:-3]
+
+
+def default_text(var: Var) -> str:
+    if var.default_doc is not None:
+        return var.default_doc
+    if var.is_list:
+        return "none"
+    values = var.default if isinstance(var.default, list) else [var.default]
+    text = ", ".join(markdown_real(v) if var.type == "real" else
+                     fortran_value(var, v) for v in values)  # type: ignore[arg-type]
+    return f"`{text}`"
+
+
+def type_text(var: Var) -> str:
+    if var.type_doc is not None:
+        return var.type_doc
+    text = var.type if var.type != "character" else f"character({var.char_length})"
+    if var.is_list:
+        text += " list"
+    elif var.size:
+        text += f" x {var.size}"
+    if var.choices:
+        text += ": " + ", ".join(f"`'{c}'`" for c in var.choices)
+    elif var.range and var.range != "finite":
+        text += (" in " if var.range[0] in "([" else " ") + var.range
+    return text
+
+
+def reference_table(group: Group) -> str:
+    rows = ["| variable | type | default | unit | meaning |", "|---|---|---|---|---|"]
+    for var in group.variables:
+        unit = f" {var.unit} " if var.unit else " "
+        rows.append(f"| `{var.name}` | {type_text(var)} | {default_text(var)} |{unit}"
+                    f"| {var.doc} |")
+    return "\n".join(rows)
+
+
+TABLE = re.compile(r"^\| variable \| type \| default \| unit \| meaning \|\n(?:\|.*\n)+",
+                   re.MULTILINE)
+HEADING = re.compile(r"^## `&(\w+)`", re.MULTILINE)
+
+
+def with_tables(text: str) -> str:
+    """REFERENCE.md with each group's variable table (the first after its heading)
+    replaced by the generated one."""
+    groups = {g.name: g for g in GROUPS}
+    out, position = [], 0
+    headings = list(HEADING.finditer(text))
+    missing = set(groups) - {h[1] for h in headings}
+    if missing:
+        raise SystemExit(f"REFERENCE.md has no section for {sorted(missing)}")
+    for heading in headings:
+        table = TABLE.search(text, heading.end())
+        if table is None:
+            raise SystemExit(f"REFERENCE.md: no variable table after &{heading[1]}")
+        out.append(text[position:table.start()])
+        out.append(reference_table(groups[heading[1]]) + "\n")
+        position = table.end()
+    out.append(text[position:])
+    return "".join(out)
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) == 2 and argv[0] == "fortran":
+        Path(argv[1]).write_text(fortran_module())
+        return 0
+    if argv == ["reference"]:
+        print("\n\n".join(f"## `&{g.name}`\n\n{reference_table(g)}" for g in GROUPS))
+        return 0
+    if len(argv) == 2 and argv[0] in ("check", "update"):
+        path = Path(argv[1])
+        text = path.read_text()
+        wanted = with_tables(text)
+        if argv[0] == "update":
+            path.write_text(wanted)
+            return 0
+        if wanted != text:
+            sys.stdout.writelines(difflib.unified_diff(
+                text.splitlines(True), wanted.splitlines(True), str(path),
+                "from variables.py"))
+            return 1
+        return 0
+    print(__doc__, file=sys.stderr)
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

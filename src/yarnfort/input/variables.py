@@ -1,0 +1,321 @@
+# SPDX-License-Identifier: MIT
+"""The one description of the namelist input: every group and variable, in the order
+they are read, echoed and documented. generate.py makes from it the config types, the
+reader, the generic checks, the echo and the --help summary (Fortran, at build time)
+and the variable tables of inputs/REFERENCE.md (checked by a test).
+
+A group: name, kind (singleton or repeatable), one line of documentation, variables.
+A variable: name, type (character, real, integer, logical), default; optional: length
+(character), shape (a size or "list"), max (most entries of a list, a Fortran name),
+unit, range (">= 0", "> 0", "(0, 1)", "[a, b]", "finite"), choices (allowed values,
+case-folded), lower (fold the value to lower case), adjust (drop leading blanks),
+selects (the variable choosing the law whose parameters the others are), laws (the
+values of the selecting variable that use this one: required for those, an error for
+the others), preset (&solver: set by a preset unless given), checked_by (checked by
+another module, named here: range and choices are documentation only), default_doc
+and type_doc (table text where the value alone does not say it), doc (the meaning).
+"""
+from __future__ import annotations
+
+from descriptors import Group, Var
+
+GROUPS = [
+    Group('control', 'singleton',
+          'What the run is.', [
+        Var('title', 'character', '', length=256, adjust=False,
+            doc='Title of the run (kept in the scene and the echoed input).'),
+        Var('check_only', 'logical', False,
+            doc='Stop after reading and checking the input (no solve, no output).'),
+        Var('restart', 'logical', False,
+            doc='Continue from the restart file `restart.dat` of the `&output` folder, i.e. from '
+                'the last converged step of an earlier run of this scene that was stopped, '
+                'killed or failed, instead of starting at the first knot. See *Restart* below.'),
+        Var('max_steps', 'integer', 0, range='>= 0',
+            doc='Stop after this many converged load steps of this run (0: no limit), with every '
+                'output and the restart file written (exit code 0). A run with `restart = '
+                '.true.` goes on from there: long runs can be made in pieces.'),
+    ]),
+    Group('solver', 'singleton',
+          'Nonlinear and linear solver settings, continuation step control and the friction '
+          'scheme.', [
+        Var('preset', 'character', 'custom', length=16, lower=True,
+            choices=['custom', 'fast', 'balanced', 'accurate'],
+            doc='Named defaults for `initial_step`, `max_step`, `residual_tolerance` and '
+                "`scheme`: `'fast'`, `'balanced'` or `'accurate'` (case-insensitive), chosen "
+                "from a speed-accuracy study; `'custom'` keeps the defaults of this table. A "
+                'variable given in `&solver` overrides its preset value. See *Presets* below.'),
+        Var('linear_solver', 'character', 'auto', length=16, lower=True,
+            choices=['auto', 'umfpack', 'klu', 'cholmod', 'cholmod+klu', 'dense'],
+            doc="Case-insensitive. `'cholmod+klu'` is CHOLMOD, switching to KLU for good if "
+                "a matrix is not positive definite. `'auto'` picks from measurements "
+                "(`benchmarks/run`): "
+                "`'cholmod+klu'` for the elastic solves when `slack_stiffness > 0` (the tangent "
+                'is then symmetric positive definite), otherwise KLU up to 2e5 unknowns and '
+                'UMFPACK above; the unsymmetric friction systems never use CHOLMOD.'),
+        Var('residual_tolerance', 'real', 1e-10, unit='1', range='> 0', preset=True,
+            doc='Newton stops when max \\|residual\\| <= residual_tolerance * force_scale. The '
+                'friction slip rows (T_hi - T_crit(T_lo) = 0) are divided by max(1, '
+                'dT_crit/dT_lo), frozen for each Newton solve. Where exp(mu alpha) is large, '
+                'that asks for the flow to about residual_tolerance * length_scale, not for a '
+                'tension below round-off times exp(mu alpha).'),
+        Var('step_tolerance', 'real', 1e-14, unit='1', range='> 0',
+            doc='Newton also stops when the scaled step is below this. The residual tolerance is '
+                'then still checked: a small step alone never counts as convergence.'),
+        Var('max_iterations', 'integer', 50, range='>= 1',
+            doc='Newton iterations per step.'),
+        Var('max_setup_calls', 'integer', 1, range='>= 1',
+            doc='Newton iterations between Jacobian updates (1 = full Newton).'),
+        Var('line_search', 'logical', True,
+            doc="Line search in Newton's method."),
+        Var('slack_stiffness', 'real', 1e-06, unit='1', range='>= 0',
+            doc='Regularisation of the tension-only law: every string also carries '
+                '`slack_stiffness * k_ref * (stretch - 1/2)` (a weak spring of rest length L0/2; '
+                "`k_ref` is the law's stiffness at stretch 1), so slack and straight strings "
+                "keep a small transverse stiffness and Newton's tangent stays regular and exact; "
+                'an unloaded dangling yarn end rests at half its reference length. It changes '
+                'tensions by about `slack_stiffness / strain` relative in taut strings; 0 gives '
+                'the exact tension-only law (then a net at zero tension has no stiffness).'),
+        Var('initial_step', 'real', 0.1, unit='pseudo-time', range='> 0', preset=True,
+            doc='First continuation step; at least min_step, capped at max_step.'),
+        Var('min_step', 'real', 1e-06, unit='pseudo-time', range='> 0',
+            doc='Smallest step; min_step <= max_step, and at least `100 * epsilon` times the '
+                'largest absolute `&path time` (a shorter step would not advance the '
+                'pseudo-time).'),
+        Var('max_step', 'real', 0.25, unit='pseudo-time', range='> 0', preset=True,
+            doc='Largest step.'),
+        Var('step_growth', 'real', 1.5, unit='1', range='>= 1',
+            doc='Step growth factor after an easy step.'),
+        Var('step_cut', 'real', 0.5, unit='1', range='(0, 1)',
+            doc='Step cut factor after a failed step.'),
+        Var('easy_iterations', 'integer', 4, range='>= 0',
+            doc='A step that converges in at most this many Newton iterations is "easy".'),
+        Var('max_step_cuts', 'integer', 30, range='>= 0',
+            doc='Give up after this many consecutive step cuts.'),
+        Var('scheme', 'character', 'monolithic', length=16, lower=True,
+            choices=['monolithic', 'staggered'], preset=True,
+            doc="Friction: `'monolithic'` solves positions and sliding together with a "
+                "stick/slip active set; `'staggered'` is the paper's two-step scheme (elastic "
+                'solve, then sliding). Case-insensitive.'),
+        Var('max_friction_iterations', 'integer', 200, range='>= 1',
+            doc='Friction: most stick/slip active-set updates (monolithic) or elastic/sliding '
+                'alternations (staggered) per load step. A slip front advances by about one '
+                'passage per monolithic round, so a yarn over many contact nodes may need as '
+                'many rounds in its first slipping step.'),
+        Var('min_length_ratio', 'real', 0.05, unit='1', range='(0, 1)',
+            doc="Friction: sliding never makes an element's reference length (and so its "
+                "segment's) shorter than this fraction of its initial length. The passage then "
+                'locks in that direction. Much shorter elements make the wrap angle at their '
+                'nodes ill-conditioned (measured: elements at 1 % of their length stalled Newton '
+                'on the woven benchmark net).'),
+        Var('friction_tolerance', 'real', 1e-09, unit='1', range='> 0',
+            doc='Friction: relative slack in the stick test T_max <= T_crit (1 + '
+                "friction_tolerance), and the staggered scheme's convergence test on the "
+                'friction conditions.'),
+    ]),
+    Group('material', 'repeatable',
+          'One yarn type and its force law (one group per yarn type).', [
+        Var('name', 'character', '', length='name_length',
+            doc='Required and unique. One word of letters, digits, `_`, `-`, `.`. `&yarn` and '
+                'the geometry file refer to it (case-sensitive).'),
+        Var('law', 'character', '', length=16, lower=True,
+            choices=['linear', 'neo_hookean', 'table'], selects=True,
+            doc='Required (case-insensitive).'),
+        Var('stiffness', 'real', -1.0, unit='N', range='> 0', laws=['linear'],
+            default_doc='`-1` (not set)',
+            doc='`linear`: EA.'),
+        Var('modulus', 'real', -1.0, unit='Pa', range='> 0', laws=['neo_hookean'],
+            default_doc='`-1` (not set)',
+            doc='`neo_hookean`: modulus C.'),
+        Var('area', 'real', -1.0, unit='m^2', range='> 0', laws=['neo_hookean'],
+            default_doc='`-1` (not set)',
+            doc='`neo_hookean`: undeformed cross-section S(1).'),
+        Var('table_file', 'character', '', length='path_length', adjust=False, laws=['table'],
+            doc='`table`: CSV file of (strain, force in N). The material code reads it. A '
+                "relative name is taken relative to the input file's folder (the working "
+                'directory when the input comes from standard input).'),
+        Var('prestress', 'real', 0.0, unit='N', range='>= 0',
+            doc='Pre-stress: every element of this yarn type starts with reference length L0 = l '
+                '/ lambda_p, where f(lambda_p) = prestress and l is its length in the initial '
+                "geometry, so it carries that tension there (the paper's knitting yarns carry 2 "
+                'cN: `prestress = 0.02`). The initial geometry is then not in equilibrium in '
+                'general; step 0 of the run finds the equilibrium. An error if the law never '
+                'reaches that force.'),
+    ]),
+    Group('contact', 'repeatable',
+          'The friction law where yarns of two types cross (one group per unordered pair).', [
+        Var('materials', 'character', '', length='name_length', shape=2,
+            doc='Required: the two yarn types, names of `&material` groups (`materials = '
+                "'cotton', 'wool'`)."),
+        Var('law', 'character', '', length=32, lower=True,
+            choices=['bonded', 'coulomb', 'adhesion', 'decaying_adhesion'], selects=True,
+            doc='Required (case-insensitive).'),
+        Var('friction_coefficient', 'real', -1.0, unit='1', range='>= 0',
+            laws=['coulomb', 'adhesion', 'decaying_adhesion'], default_doc='`-1` (not set)',
+            doc='Friction coefficient mu. Every law but `bonded`.'),
+        Var('adhesion', 'real', -1.0, unit='N', range='>= 0',
+            laws=['adhesion', 'decaying_adhesion'], default_doc='`-1` (not set)',
+            doc='Adhesion beta (per radian of wrap angle). `adhesion` and `decaying_adhesion`.'),
+        Var('decay_start', 'real', -1.0, unit='N', range='>= 0', laws=['decaying_adhesion'],
+            default_doc='`-1` (not set)',
+            doc='Tension w_d where the adhesion starts to decay. `decaying_adhesion`.'),
+        Var('decay_end', 'real', -1.0, unit='N', range='>= 0', laws=['decaying_adhesion'],
+            default_doc='`-1` (not set)', type_doc='real > `decay_start`',
+            doc='Tension s_d where the adhesion has vanished. `decaying_adhesion`.'),
+    ]),
+    Group('fabric', 'singleton',
+          'A generated fabric (knitted with inlay, or woven) instead of &nodes, &yarn and '
+          '&support groups.', [
+        Var('kind', 'character', '', length=16, lower=True, choices=['knit', 'plain', 'twill'],
+            checked_by='fabric', default_doc='required',
+            doc="`'knit'` (weft-knitted single jersey, optional inlay), `'plain'` (plain weave) "
+                "or `'twill'` (2/2 twill)."),
+        Var('cells', 'integer', [4, 4], shape=2, range='>= 1', checked_by='fabric',
+            doc='Repeats along x and y: wales x courses (knit); weft yarns (crossings along x) x '
+                'warp yarns (woven). A periodic plain weave needs even counts, a periodic twill '
+                'multiples of 4.'),
+        Var('spacing', 'real', [-1.0, -1.0], shape=2, unit='m', range='> 0', checked_by='fabric',
+            default_doc='required',
+            doc='Repeat spacing along x and y: wale and course spacing (knit); weft and warp '
+                'yarn spacing (woven).'),
+        Var('boundary', 'character', 'periodic', length=16, lower=True,
+            choices=['periodic', 'clamped'], checked_by='fabric',
+            doc="`'periodic'`: a unit cell whose edge nodes are tied to the opposite edge (paper "
+                'eq. 53), stretched by the macroscopic strain below; one node (`anchor`) is held '
+                "against rigid translation. `'clamped'`: a finite sample, yarn ends at x = 0 "
+                'held (`left`), those at the right edge pulled (`right`).'),
+        Var('strain', 'real', 1.0, unit='1', range='[-0.9, 100]', checked_by='fabric',
+            doc='Engineering strain along x at p_disp = 1 (`1.0` stretches to twice the length). '
+                "Periodic: of the cell's x period; clamped: of the sample's length."),
+        Var('lateral_strain', 'real', 0.0, unit='1', range='[-0.9, 100]', checked_by='fabric',
+            doc='Periodic: engineering strain of the y period at p_disp = 1, prescribed. Give '
+                'the measured lateral contraction if you know it; 0 holds the height. The height '
+                'cannot be left free: a string network has no resistance to lateral compaction, '
+                'because nothing models yarns jamming against each other. We tried making the y '
+                'period one more unknown, with zero net y force across the cell. The '
+                'pre-stressed plain-weave cell then collapsed to a lateral strain of -0.99999 at '
+                "step 0, and the knit cell's initial state did not converge. For free lateral "
+                "contraction, use a clamped sample with `sides = 'free'`."),
+        Var('sides', 'character', 'free', length=16, lower=True, choices=['free', 'rollers'],
+            checked_by='fabric',
+            doc="Clamped: `'free'` side edges or `'rollers'`. Woven: rollers hold the weft ends "
+                'in y and z (a selvedge); free weft ends of pre-stressed weft yarns cannot carry '
+                'their tension, so woven strips need rollers. Knit: rollers hold the contacts of '
+                'the first and last course in y.'),
+        Var('elements_per_segment', 'integer', 1, range='>= 1', checked_by='fabric',
+            doc='Elements per yarn segment between generated nodes. A string under tension is '
+                'straight between contacts, so 1 is exact: `verification/fabrics` finds 2, 4 and '
+                '8 give the same curve to 2e-14. More only cost time, most with sliding, where a '
+                "passage's flow reaches every element of its two segments, which fills the "
+                'sparse factors. Measured on `benchmarks/bench_friction` (woven net, 578 '
+                'passages): 132 ms per load step with 4 elements per segment against 29 ms with '
+                '1.'),
+        Var('knit_material', 'character', '', length='name_length', checked_by='fabric',
+            default_doc='required (knit)',
+            doc='Yarn type of the loops.'),
+        Var('head_width', 'real', 0.5, unit='1', range='[0.05, 0.95]', checked_by='fabric',
+            doc="Knit: width of a loop's head, as a fraction of the wale spacing. The loops are "
+                'polygons through their contacts (a string under tension is straight between '
+                'contacts): a loop is 2*spacing(2) + spacing(1) long.'),
+        Var('inlay_material', 'character', '', length='name_length', checked_by='fabric',
+            default_doc="`''` (no inlay)",
+            doc='Knit: yarn type of the inlay.'),
+        Var('inlay_every', 'integer', 1, range='>= 1', checked_by='fabric',
+            doc='Knit: an inlay in every inlay_every-th course (0, k, 2k, ...).'),
+        Var('inlay_offset', 'real', 0.5, unit='1', range='[0.05, 0.95]', checked_by='fabric',
+            doc='Knit: height of the inlay above its course line, as a fraction of the course '
+                'spacing.'),
+        Var('warp_material', 'character', '', length='name_length', checked_by='fabric',
+            default_doc='required (woven)',
+            doc='Woven: yarn types along x (warp, the loaded direction) and along y (weft).'),
+        Var('weft_material', 'character', '', length='name_length', checked_by='fabric',
+            default_doc='required (woven)',
+            doc='Woven: yarn types along x (warp, the loaded direction) and along y (weft).'),
+        Var('gap', 'real', -1.0, unit='m', checked_by='fabric',
+            default_doc='required (woven, knit with inlay)',
+            type_doc='real, 0 < gap < min(spacing)',
+            doc='Gap-holder length: distance between the axes of the two yarns at a crossing.'),
+        Var('gap_factor_p_disp', 'real', None, shape='list', unit='1', checked_by='fabric',
+            default_doc='empty (factor 1)',
+            doc='The gap factor as a piecewise-linear function of the displacement factor p_disp '
+                "(constant beyond the end knots): the holders' length is gap * factor (paper "
+                'Fig. 13b). `gap_factor_p_disp` increasing; factors positive.'),
+        Var('gap_factor', 'real', None, shape='list', unit='1', checked_by='fabric',
+            default_doc='empty (factor 1)',
+            doc='The gap factor as a piecewise-linear function of the displacement factor p_disp '
+                "(constant beyond the end knots): the holders' length is gap * factor (paper "
+                'Fig. 13b). `gap_factor_p_disp` increasing; factors positive.'),
+    ]),
+    Group('nodes', 'singleton',
+          'Node coordinates (node ids 1..n in list order).', [
+        Var('xyz', 'real', None, shape='list', max='max_coordinates', unit='m',
+            doc='Node coordinates as a flat list `x1, y1, z1, x2, y2, z2, ...`. The count must '
+                'be a multiple of 3. Node ids are 1..n in list order.'),
+    ]),
+    Group('geometry', 'singleton',
+          'Node positions and yarns from a plain text file instead of &nodes and &yarn groups.', [
+        Var('file', 'character', '', length='path_length', adjust=False, default_doc="`''` (none)",
+            doc='Geometry file with the nodes and yarns (format below).'),
+    ]),
+    Group('yarn', 'repeatable',
+          'One yarn, a polyline through node ids, split into elements.', [
+        Var('material', 'character', '', length='name_length',
+            doc='Required: the name of a `&material`.'),
+        Var('nodes', 'integer', None, shape='list',
+            doc='Node ids along the yarn: at least 2, each in 1..n_nodes. Two consecutive ids '
+                'may not be equal or at the same position. An id may come back later (loops), '
+                'but no two segments of the net (of this yarn or another) may join the same two '
+                'nodes.'),
+        Var('elements_per_segment', 'integer', 1, range='>= 1',
+            doc='Each segment between listed nodes is split into this many elements through new, '
+                'evenly spaced nodes. Sliding at a contact node moves reference length into or '
+                'out of the whole segment: each of its elements takes its share of the change, '
+                'in proportion to its initial length. The new nodes are material points that a '
+                'yarn does not slide through.'),
+    ]),
+    Group('support', 'repeatable',
+          'A named set of nodes whose listed components are prescribed.', [
+        Var('name', 'character', '', length='name_length',
+            doc='Required and unique. One word of letters, digits, `_`, `-`, `.`. Names the '
+                "support's reaction-force columns in the curve CSV."),
+        Var('nodes', 'integer', None, shape='list',
+            doc='At least one node id, each in 1..n_nodes, no repeats.'),
+        Var('fix', 'character', 'xyz', length=3, lower=True,
+            doc='The prescribed components: one or more of `x`, `y`, `z`, each once '
+                '(case-insensitive).'),
+        Var('displacement', 'real', [0.0, 0.0, 0.0], shape=3, unit='m', range='finite',
+            doc='Displacement D at load factor p_disp = 1, per component. Prescribed position = '
+                'initial position + p_disp(t) * D. A nonzero component outside `fix` is an '
+                'error.'),
+    ]),
+    Group('load', 'repeatable',
+          'A force P (N) at load factor p_force = 1 on each listed node.', [
+        Var('nodes', 'integer', None, shape='list',
+            doc='At least one node id, each in 1..n_nodes, no repeats.'),
+        Var('force', 'real', [0.0, 0.0, 0.0], shape=3, unit='N', range='finite',
+            doc='Force P on each listed node at load factor p_force = 1. Applied force = '
+                'p_force(t) * P. A nonzero component on a coordinate that a support prescribes '
+                'is an error.'),
+    ]),
+    Group('path', 'singleton',
+          'The load path as knots over pseudo-time, linear in between.', [
+        Var('time', 'real', None, shape='list', unit='pseudo-time', range='finite',
+            doc='At least 2 knots, strictly increasing.'),
+        Var('p_force', 'real', None, shape='list', unit='1', range='finite', default_doc='zeros',
+            doc='Force factor at each knot (scales every `&load` force).'),
+        Var('p_disp', 'real', None, shape='list', unit='1', range='finite', default_doc='zeros',
+            doc='Displacement factor at each knot (scales every `&support` displacement).'),
+    ]),
+    Group('output', 'singleton',
+          'Where and what to write.', [
+        Var('folder', 'character', 'out', length='path_length', adjust=False,
+            doc='Folder for the results (not empty).'),
+        Var('vtk_every', 'integer', 1, range='>= 0',
+            doc='Write a VTK state every this many converged steps. 0 writes none. When it is '
+                'above 0, the last step is always written.'),
+        Var('progress', 'logical', True,
+            doc='Progress lines on stderr.'),
+        Var('residual_history', 'logical', False,
+            doc='Also print, per step, the scaled residual max\\|F\\|/force_scale of every Newton '
+                'iterate (to see the convergence rate).'),
+    ]),
+]
