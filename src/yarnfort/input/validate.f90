@@ -16,6 +16,7 @@ module yarnfort_input_validate
         check_support_variables, check_load_variables, check_path_variables, &
         check_output_variables
     use yarnfort_input_fields, only: not_finite, suggestion, quoted_list
+    use yarnfort_input_magnitudes, only: check_scene_size, check_prescribed_reach
     use yarnfort_text, only: format_integer, format_real, closest_name
     implicit none
     private
@@ -55,6 +56,8 @@ contains
         if (allocated(error)) return
         call check_nodes(config, error)
         if (allocated(error)) return
+        call check_scene_size(config, error)
+        if (allocated(error)) return
         call check_yarns(config, error)
         if (allocated(error)) return
         call check_duplicate_segments(config, error)
@@ -65,7 +68,16 @@ contains
         if (allocated(error)) return
         call check_loads(config, owner, error)
         if (allocated(error)) return
+        ! New nodes inside segments, sliding at contacts and generated fabrics are unknowns.
+        if (all(owner > 0) .and. all(config%yarns%elements_per_segment == 1) &
+            .and. size(config%contacts) == 0 .and. len_trim(config%fabric%kind) == 0) then
+            call fatal_error(error, 'every coordinate of every node is prescribed by a ' &
+                // '&support: the scene has no unknowns (nothing to solve)')
+            return
+        end if
         call check_path(config%path, error)
+        if (allocated(error)) return
+        call check_prescribed_reach(config, error)
         if (allocated(error)) return
         call check_step_resolution(config%solver, config%path, error)
     end subroutine check_config
@@ -731,6 +743,12 @@ contains
                 return
             end if
         end do
+        if (.not. ieee_is_finite(path%time(n) - path%time(1))) then
+            call fatal_error(error, '&path: time(' // format_integer(n) // ') - time(1) = ' &
+                // format_real(path%time(n)) // ' - ' // format_real(path%time(1)) &
+                // ' overflows: the path is too long to step through')
+            return
+        end if
     end subroutine check_path
 
     !> Every continuation step (at least min_step) must advance the pseudo-time: min_step

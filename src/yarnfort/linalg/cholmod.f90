@@ -8,8 +8,8 @@ module yarnfort_linalg_cholmod
     use, intrinsic :: iso_c_binding, only: c_int, c_long, c_ptr, c_null_ptr, c_associated
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size, format_integer
+    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_csc_pattern, only: format_integer
     use yarnfort_linalg_cholmod_binding, only: cholmod_ok, cholmod_not_posdef, &
         cholmod_dsmall, cholmod_not_installed, cholmod_out_of_memory, cholmod_too_large, &
         cholmod_invalid, cholmod_gpu_problem, cholmod_no_handle, yarnfort_cholmod_create, &
@@ -21,12 +21,8 @@ module yarnfort_linalg_cholmod
     public :: cholmod_solver_type
 
     !> CHOLMOD solver. Owns a C handle: never copy an analysed object by assignment.
-    type, extends(linear_solver_type) :: cholmod_solver_type
+    type, extends(direct_solver_type) :: cholmod_solver_type
         private
-        !> Matrix order, 0 before `analyse`.
-        integer(ik) :: n = 0
-        !> Copies of the pattern (CHOLMOD reads it again at factor time).
-        integer(c_long), allocatable :: col_ptr(:), row_index(:)
         !> Opaque cholmod_shim.c handle (common, factor, solve workspaces).
         type(c_ptr) :: handle = c_null_ptr
         logical :: factored = .false.
@@ -49,17 +45,13 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_int) :: status
 
-        call self%destroy()
-        call check_csc_pattern('cholmod', n, col_ptr, row_index, error)
+        call self%keep_pattern(n, col_ptr, row_index, error)
         if (allocated(error)) return
-
         self%handle = yarnfort_cholmod_create()
         if (.not. c_associated(self%handle)) then
             call fatal_error(error, 'cholmod: could not start CHOLMOD (cholmod_l_start)')
             return
         end if
-        self%col_ptr = col_ptr
-        self%row_index = row_index(1:col_ptr(n + 1))
         status = yarnfort_cholmod_analyze(self%handle, n, self%col_ptr, self%row_index)
         if (status < cholmod_ok) then
             call fatal_error(error, 'cholmod: symbolic analysis failed: ' &
@@ -79,12 +71,7 @@ contains
         integer(c_long) :: minor
 
         self%factored = .false.
-        if (self%n == 0) then
-            call fatal_error(error, 'cholmod: factor called before analyse')
-            return
-        end if
-        call check_array_size('cholmod', 'values', size(values, kind=ik), &
-            int(size(self%row_index), ik), error, at_least=.true.)
+        call self%check_factor_call(self%n > 0, values, error)
         if (allocated(error)) return
 
         status = yarnfort_cholmod_factorize(self%handle, self%n, self%col_ptr, &
@@ -107,11 +94,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_int) :: status
 
-        if (.not. self%factored) then
-            call fatal_error(error, 'cholmod: solve called without a valid factorisation')
-            return
-        end if
-        call check_array_size('cholmod', 'rhs', size(rhs, kind=ik), self%n, error)
+        call self%check_solve_call(self%factored, rhs, error)
         if (allocated(error)) return
 
         status = yarnfort_cholmod_solve(self%handle, self%n, rhs)
@@ -127,9 +110,7 @@ contains
         if (c_associated(self%handle)) call yarnfort_cholmod_free(self%handle)
         self%handle = c_null_ptr
         self%factored = .false.
-        self%n = 0
-        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
-        if (allocated(self%row_index)) deallocate(self%row_index)
+        call self%forget_pattern()
     end subroutine destroy
 
     pure function get_name(self) result(name)

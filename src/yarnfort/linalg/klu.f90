@@ -10,8 +10,8 @@ module yarnfort_linalg_klu
         c_associated, c_f_pointer
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size, format_integer
+    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_csc_pattern, only: format_integer
     use yarnfort_linalg_klu_binding, only: klu_l_common, klu_ok, klu_singular, &
         klu_out_of_memory, klu_invalid, klu_too_large, klu_l_defaults, klu_l_analyze, &
         klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_rcond, klu_l_free_symbolic, &
@@ -30,7 +30,7 @@ module yarnfort_linalg_klu
     integer(c_long), parameter :: c_true = 1
 
     !> KLU solver. Owns C handles: never copy an analysed object by assignment.
-    type, extends(linear_solver_type) :: klu_solver_type
+    type, extends(direct_solver_type) :: klu_solver_type
         private
         !> Refactorisations below this reciprocal condition estimate are redone with pivoting.
         real(wp), public :: refactor_rcond_min = default_refactor_rcond_min
@@ -41,10 +41,6 @@ module yarnfort_linalg_klu
         !> 4.6 / 10.4 / 2.5 s; bench_friction woven nets 68 / 22 / 29 and 1480 / 374 /
         !> 623 ms per load step. The choice is never the worst and at most 1.8x the best.
         logical, public :: unsymmetric_ordering = .false.
-        !> Matrix order, 0 before `analyse`.
-        integer(ik) :: n = 0
-        !> Copies of the pattern (KLU needs them again at factor time).
-        integer(c_long), allocatable :: col_ptr(:), row_index(:)
         type(klu_l_common) :: common
         logical :: common_ready = .false.
         type(c_ptr) :: symbolic = c_null_ptr
@@ -69,10 +65,8 @@ contains
         integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
 
-        call self%destroy()
-        call check_csc_pattern('klu', n, col_ptr, row_index, error)
+        call self%keep_pattern(n, col_ptr, row_index, error)
         if (allocated(error)) return
-
         if (klu_l_defaults(self%common) /= c_true) then
             call fatal_error(error, 'klu: klu_l_defaults failed')
             return
@@ -81,9 +75,6 @@ contains
         self%common%user_data = c_null_ptr
         self%common%halt_if_singular = c_true
         self%common_ready = .true.
-
-        self%col_ptr = col_ptr
-        self%row_index = row_index(1:col_ptr(n + 1))
         self%symbolic = klu_l_analyze(n, self%col_ptr, self%row_index, self%common)
         if (.not. c_associated(self%symbolic)) then
             call fatal_error(error, 'klu: symbolic analysis failed: ' &
@@ -107,12 +98,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: ok
 
-        if (.not. c_associated(self%symbolic)) then
-            call fatal_error(error, 'klu: factor called before analyse')
-            return
-        end if
-        call check_array_size('klu', 'values', size(values, kind=ik), &
-            int(size(self%row_index), ik), error, at_least=.true.)
+        call self%check_factor_call(c_associated(self%symbolic), values, error)
         if (allocated(error)) return
 
         if (c_associated(self%numeric)) then
@@ -173,11 +159,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: ok
 
-        if (.not. c_associated(self%numeric)) then
-            call fatal_error(error, 'klu: solve called without a valid factorisation')
-            return
-        end if
-        call check_array_size('klu', 'rhs', size(rhs, kind=ik), self%n, error)
+        call self%check_solve_call(c_associated(self%numeric), rhs, error)
         if (allocated(error)) return
 
         ok = klu_l_solve(self%symbolic, self%numeric, self%n, 1_c_long, rhs, self%common)
@@ -203,9 +185,7 @@ contains
         self%numeric = c_null_ptr
         self%symbolic = c_null_ptr
         self%symbolic_colamd = c_null_ptr
-        self%n = 0
-        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
-        if (allocated(self%row_index)) deallocate(self%row_index)
+        call self%forget_pattern()
     end subroutine destroy
 
     pure function get_name(self) result(name)

@@ -7,8 +7,8 @@ module yarnfort_linalg_umfpack
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr, c_null_ptr, c_associated
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size, format_integer
+    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_csc_pattern, only: format_integer
     use yarnfort_linalg_umfpack_binding, only: umfpack_control, umfpack_info, umfpack_prl, &
         umfpack_irstep, umfpack_rcond, umfpack_a, umfpack_ok, &
         umfpack_warning_singular_matrix, umfpack_error_out_of_memory, &
@@ -40,12 +40,8 @@ module yarnfort_linalg_umfpack
     end type umfpack_memory_type
 
     !> UMFPACK solver. Owns C handles: never copy an analysed object by assignment.
-    type, extends(linear_solver_type) :: umfpack_solver_type
+    type, extends(direct_solver_type) :: umfpack_solver_type
         private
-        !> Matrix order, 0 before `analyse`.
-        integer(ik) :: n = 0
-        !> Copies of the pattern (UMFPACK needs them again at numeric time).
-        integer(c_long), allocatable :: col_ptr(:), row_index(:)
         real(c_double) :: control(0:umfpack_control - 1) = 0.0_c_double
         real(c_double) :: info(0:umfpack_info - 1) = 0.0_c_double
         type(c_ptr) :: symbolic = c_null_ptr
@@ -75,12 +71,8 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: status
 
-        call self%destroy()
-        call check_csc_pattern('umfpack', n, col_ptr, row_index, error)
+        call self%keep_pattern(n, col_ptr, row_index, error)
         if (allocated(error)) return
-
-        self%col_ptr = col_ptr
-        self%row_index = row_index(1:col_ptr(n + 1))
         call umfpack_dl_defaults(self%control)
         self%control(umfpack_irstep) = real(umfpack_refinement_steps, c_double)
         self%control(umfpack_prl) = real(umfpack_print_level, c_double)
@@ -104,12 +96,7 @@ contains
         integer(c_long) :: status
         character(len=24) :: rcond
 
-        if (.not. c_associated(self%symbolic)) then
-            call fatal_error(error, 'umfpack: factor called before analyse')
-            return
-        end if
-        call check_array_size('umfpack', 'values', size(values, kind=ik), &
-            int(size(self%row_index), ik), error, at_least=.true.)
+        call self%check_factor_call(c_associated(self%symbolic), values, error)
         if (allocated(error)) return
 
         call umfpack_dl_free_numeric(self%numeric)
@@ -144,11 +131,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: status
 
-        if (.not. c_associated(self%numeric)) then
-            call fatal_error(error, 'umfpack: solve called without a valid factorisation')
-            return
-        end if
-        call check_array_size('umfpack', 'rhs', size(rhs, kind=ik), self%n, error)
+        call self%check_solve_call(c_associated(self%numeric), rhs, error)
         if (allocated(error)) return
 
         self%rhs_copy(:) = rhs
@@ -167,9 +150,7 @@ contains
         if (c_associated(self%symbolic)) call umfpack_dl_free_symbolic(self%symbolic)
         self%numeric = c_null_ptr
         self%symbolic = c_null_ptr
-        self%n = 0
-        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
-        if (allocated(self%row_index)) deallocate(self%row_index)
+        call self%forget_pattern()
         if (allocated(self%int_work)) deallocate(self%int_work)
         if (allocated(self%real_work)) deallocate(self%real_work)
         if (allocated(self%rhs_copy)) deallocate(self%rhs_copy)

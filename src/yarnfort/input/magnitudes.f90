@@ -1,0 +1,97 @@
+! SPDX-License-Identifier: MIT
+!> Checks that the numbers of a scene stay in the range the solver can compute with:
+!> lengths, squared lengths and force scales must be finite normal numbers. Values
+!> outside it are input errors here, not NaN residuals in the solve.
+module yarnfort_input_magnitudes
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_input_config, only: config_type
+    use yarnfort_text, only: format_real, format_integer
+    implicit none
+    private
+
+    public :: check_scene_size, check_prescribed_reach, max_coordinate, min_scene_size
+
+    !> Largest coordinate of a node, initial or prescribed (m): lengths and stretches are
+    !> squared by the force laws, which overflows above this.
+    real(wp), parameter :: max_coordinate = sqrt(huge(1.0_wp))
+    !> Smallest extent of the nodes (m): below it squared lengths are no normal numbers.
+    real(wp), parameter :: min_scene_size = sqrt(tiny(1.0_wp))
+
+contains
+
+    !> The extent and coordinates of the nodes and the force scales of the laws.
+    subroutine check_scene_size(config, error)
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: source
+        real(wp) :: extent, reach
+        integer :: m
+
+        source = '&nodes'
+        if (len_trim(config%geometry%file) > 0) source = "&geometry file '" &
+            // trim(config%geometry%file) // "'"
+        if (len_trim(config%fabric%kind) > 0) source = '&fabric'
+        extent = maxval(maxval(config%node_positions, dim=2) &
+            - minval(config%node_positions, dim=2))
+        if (extent < min_scene_size) then
+            call fatal_error(error, source // ': the nodes span at most ' // format_real(extent) &
+                // ' m along x, y and z, below ' // format_real(min_scene_size) // ' m (lengths ' &
+                // 'are squared, and their squares would not be normal numbers); give ' &
+                // 'the coordinates in a unit that makes the scene larger')
+            return
+        end if
+        reach = maxval(abs(config%node_positions))
+        if (reach > max_coordinate) then
+            call fatal_error(error, source // ': a coordinate of ' // format_real(reach) &
+                // ' m is above ' // format_real(max_coordinate) // ' m, where squared ' &
+                // 'lengths overflow')
+            return
+        end if
+        do m = 1, size(config%materials)
+            associate(material => config%materials(m))
+                if (material%law /= 'neo_hookean') cycle
+                ! The law's force scale is modulus * area, its stiffness 3 times that.
+                if (.not. (3 * material%modulus * material%area <= huge(1.0_wp) &
+                        .and. material%modulus * material%area >= tiny(1.0_wp))) then
+                    call fatal_error(error, "&material '" // trim(material%name) &
+                        // "': modulus * area = " // format_real(material%modulus) // ' * ' &
+                        // format_real(material%area) // ' is not a normal number (its ' &
+                        // 'force scale, in N, must lie between ' // format_real(tiny(1.0_wp)) &
+                        // ' and ' // format_real(huge(1.0_wp) / 3) // ')')
+                    return
+                end if
+            end associate
+        end do
+    end subroutine check_scene_size
+
+    !> The prescribed positions: initial ones plus p_disp times the displacements.
+    subroutine check_prescribed_reach(config, error)
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: reach, factor
+        integer :: s, k
+
+        reach = maxval(abs(config%node_positions))
+        factor = maxval(abs(config%path%p_disp))
+        if (allocated(config%supports)) then
+            do s = 1, size(config%supports)
+                do k = 1, 3
+                    associate(d => config%supports(s)%displacement(k))
+                        if (.not. (abs(d) * factor + reach <= max_coordinate)) then
+                            call fatal_error(error, "&support '" &
+                                // trim(config%supports(s)%name) // "': displacement(" &
+                                // format_integer(k) // ') = ' // format_real(d) &
+                                // ' times p_disp up to ' // format_real(factor) &
+                                // ' moves nodes beyond ' // format_real(max_coordinate) &
+                                // ' m, where squared lengths overflow')
+                            return
+                        end if
+                    end associate
+                end do
+            end do
+        end if
+    end subroutine check_prescribed_reach
+
+end module yarnfort_input_magnitudes

@@ -1,0 +1,85 @@
+! SPDX-License-Identifier: MIT
+!> The bookkeeping the sparse direct solvers (UMFPACK, KLU, CHOLMOD) share: the copy of
+!> the CSC pattern they read again at factor time, the checks of the call sequence and
+!> of array sizes, and forgetting it all on destroy. Each solver keeps its own C objects
+!> and status codes.
+module yarnfort_linalg_direct
+    use, intrinsic :: iso_c_binding, only: c_long
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size
+    implicit none
+    private
+
+    public :: direct_solver_type
+
+    !> A linear solver over a library that needs the pattern as 64-bit C arrays.
+    type, abstract, extends(linear_solver_type) :: direct_solver_type
+        !> Matrix order, 0 before `analyse`.
+        integer(ik) :: n = 0
+        !> Copies of the pattern (the libraries read them again at factor time).
+        integer(c_long), allocatable :: col_ptr(:), row_index(:)
+    contains
+        !> Check a pattern and keep a copy of it (after destroying what was there).
+        procedure :: keep_pattern
+        !> Check that `factor` may run (analysed) with these values.
+        procedure :: check_factor_call
+        !> Check that `solve` may run (`factored`) on this right-hand side.
+        procedure :: check_solve_call
+        !> Drop the pattern copy (for `destroy`).
+        procedure :: forget_pattern
+    end type direct_solver_type
+
+contains
+
+    subroutine keep_pattern(self, n, col_ptr, row_index, error)
+        class(direct_solver_type), intent(inout) :: self
+        integer(ik), intent(in) :: n
+        integer(ik), intent(in) :: col_ptr(:), row_index(:)
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%destroy()
+        call check_csc_pattern(self%get_name(), n, col_ptr, row_index, error)
+        if (allocated(error)) return
+        self%col_ptr = col_ptr
+        self%row_index = row_index(1:col_ptr(n + 1))
+    end subroutine keep_pattern
+
+    subroutine check_factor_call(self, analysed, values, error)
+        class(direct_solver_type), intent(in) :: self
+        logical, intent(in) :: analysed
+        real(wp), intent(in) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+
+        if (.not. analysed) then
+            call fatal_error(error, self%get_name() // ': factor called before analyse')
+            return
+        end if
+        call check_array_size(self%get_name(), 'values', size(values, kind=ik), &
+            int(size(self%row_index), ik), error, at_least=.true.)
+    end subroutine check_factor_call
+
+    subroutine check_solve_call(self, factored, rhs, error)
+        class(direct_solver_type), intent(in) :: self
+        logical, intent(in) :: factored
+        real(wp), intent(in) :: rhs(:)
+        type(error_type), allocatable, intent(out) :: error
+
+        if (.not. factored) then
+            call fatal_error(error, self%get_name() &
+                // ': solve called without a valid factorisation')
+            return
+        end if
+        call check_array_size(self%get_name(), 'rhs', size(rhs, kind=ik), self%n, error)
+    end subroutine check_solve_call
+
+    subroutine forget_pattern(self)
+        class(direct_solver_type), intent(inout) :: self
+
+        self%n = 0
+        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
+        if (allocated(self%row_index)) deallocate(self%row_index)
+    end subroutine forget_pattern
+
+end module yarnfort_linalg_direct
