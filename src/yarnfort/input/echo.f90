@@ -7,8 +7,9 @@
 module yarnfort_input_echo
     use yarnfort_input_config, only: config_type
     use yarnfort_input_groups, only: nodes_config_type, write_control, write_solver, &
-        write_material, write_contact, write_fabric, write_nodes, write_geometry, write_yarn, &
-        write_support, write_load, write_path, write_output
+        write_material_groups, write_contact_groups, write_fabric, write_nodes, &
+        write_geometry, write_yarn_groups, write_support_groups, write_load_groups, &
+        write_path, write_output
     use yarnfort_input_fields, only: put
     use yarnfort_text, only: quote_string
     implicit none
@@ -22,7 +23,6 @@ contains
     subroutine write_config(unit, config)
         integer, intent(in) :: unit
         type(config_type), intent(in) :: config
-        integer :: k
 
         call put(unit, '! yarnfort effective input: every namelist variable with its ' &
             // 'value, defaults included')
@@ -33,54 +33,26 @@ contains
         end if
         call write_control(unit, config%control)
         call write_solver(unit, config%solver)
-        if (allocated(config%materials)) then
-            do k = 1, size(config%materials)
-                call write_material(unit, config%materials(k))
-            end do
-        end if
-        if (allocated(config%contacts)) then
-            do k = 1, size(config%contacts)
-                call write_contact(unit, config%contacts(k))
-            end do
-        end if
+        call write_material_groups(unit, config%materials)
+        call write_contact_groups(unit, config%contacts)
         if (len_trim(config%fabric%kind) > 0) then
             ! The fabric generator makes the nodes, yarns and supports.
             call write_fabric(unit, config%fabric)
         else
-            call put_network()
-        end if
-        if (allocated(config%path%time)) call write_path(unit, config%path)
-        call write_output(unit, config%output)
-
-    contains
-
-        !> &geometry or &nodes and &yarn, then &support and &load.
-        subroutine put_network()
             call write_geometry(unit, config%geometry)
             if (len_trim(config%geometry%file) > 0) then
                 call put(unit, '! The nodes and yarns are those of the geometry file.')
             else
-                if (allocated(config%node_positions)) &
-                    call write_nodes(unit, nodes_config_type(reshape(config%node_positions, &
+                if (allocated(config%node_positions)) call write_nodes(unit, &
+                    nodes_config_type(reshape(config%node_positions, &
                     [size(config%node_positions)])))
-                if (allocated(config%yarns)) then
-                    do k = 1, size(config%yarns)
-                        call write_yarn(unit, config%yarns(k))
-                    end do
-                end if
+                call write_yarn_groups(unit, config%yarns)
             end if
-            if (allocated(config%supports)) then
-                do k = 1, size(config%supports)
-                    call write_support(unit, config%supports(k))
-                end do
-            end if
-            if (allocated(config%loads)) then
-                do k = 1, size(config%loads)
-                    call write_load(unit, config%loads(k))
-                end do
-            end if
-        end subroutine put_network
-
+            call write_support_groups(unit, config%supports)
+            call write_load_groups(unit, config%loads)
+        end if
+        if (allocated(config%path%time)) call write_path(unit, config%path)
+        call write_output(unit, config%output)
     end subroutine write_config
 
 end module yarnfort_input_echo

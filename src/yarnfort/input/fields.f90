@@ -15,7 +15,7 @@ module yarnfort_input_fields
     public :: buffer_length, message_length, max_list, max_coordinates, indent
     public :: unset_real, unset_integer, other_real, other_integer
     public :: read_failed, post_read_error, too_many_found, group_label
-    public :: take_text, take_real_list, take_integer_list
+    public :: take_text, unset_reals, unset_integers, count_set
     public :: check_real, check_at_least, check_choice, require_set, require_text, forbid_set
     public :: not_finite, suggestion, quoted_list
     public :: put, put_reals, put_integers, format_logical
@@ -130,54 +130,34 @@ contains
         field = buffer(:len(field))
     end subroutine take_text
 
-    !> The set entries of a list read into `values`, prefilled with unset_real. If
-    !> `again` is allocated, `values` holds a second read prefilled with other_real and
-    !> `again` the first: an entry is unset only where both kept their marker. The
-    !> buffer's last entry is a guard against overflow, and gaps are errors.
-    subroutine take_real_list(error, scan, name, occurrence, variable, values, again, list)
-        type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name, variable
-        integer, intent(in) :: occurrence
+    !> Which entries of a list read into `values` (prefilled with unset_real) the input
+    !> did not set. If `again` is allocated, `values` holds a second read prefilled with
+    !> other_real and `again` the first: an entry is unset only where both kept their
+    !> marker (so an input value equal to a marker is a value).
+    pure function unset_reals(values, again) result(unset)
         real(wp), intent(in) :: values(:)
         real(wp), allocatable, intent(in) :: again(:)
-        real(wp), allocatable, intent(out) :: list(:)
-        logical, allocatable :: unset(:)
-        integer :: n
+        logical :: unset(size(values))
 
         if (allocated(again)) then
             unset = values == other_real .and. again == unset_real
-            list = again
         else
             unset = values == unset_real
-            list = values
         end if
-        call count_set(error, scan, name, occurrence, variable, unset, n)
-        if (.not. allocated(error)) list = list(:n)
-    end subroutine take_real_list
+    end function unset_reals
 
-    !> As take_real_list for integers (markers unset_integer and other_integer).
-    subroutine take_integer_list(error, scan, name, occurrence, variable, values, again, list)
-        type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name, variable
-        integer, intent(in) :: occurrence
+    !> As unset_reals for integers (markers unset_integer and other_integer).
+    pure function unset_integers(values, again) result(unset)
         integer, intent(in) :: values(:)
         integer, allocatable, intent(in) :: again(:)
-        integer, allocatable, intent(out) :: list(:)
-        logical, allocatable :: unset(:)
-        integer :: n
+        logical :: unset(size(values))
 
         if (allocated(again)) then
             unset = values == other_integer .and. again == unset_integer
-            list = again
         else
             unset = values == unset_integer
-            list = values
         end if
-        call count_set(error, scan, name, occurrence, variable, unset, n)
-        if (.not. allocated(error)) list = list(:n)
-    end subroutine take_integer_list
+    end function unset_integers
 
     !> `n`, the last set entry of a list; an error for a set guard or an unset entry
     !> before the last set one.

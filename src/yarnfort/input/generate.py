@@ -250,7 +250,7 @@ def read_routine(group: Group) -> list[str]:
                           + ", ".join(v.name for v in group.variables), i2)
     needs_k = bool(lists) or any(v.type == "character" and v.size for v in group.variables)
     out += [f"{i2}character(len=message_length) :: message",
-            f"{i2}integer :: stat" + (", k" if needs_k else ""), ""]
+            f"{i2}integer :: stat" + (", k" if needs_k else "") + (", n" if lists else ""), ""]
     for var in lists:
         out.append(f"{i2}allocate({var.name}({var.max} + 1))")
     out += [f"{i2}call reset(.false.)",
@@ -292,11 +292,13 @@ def read_routine(group: Group) -> list[str]:
                                       f" '{var.name}', {var.name}, value%{var.name}, {args})", i2)
                 out.append(f"{i2}if (allocated(error)) return")
         elif var.is_list:
-            kind = "real" if var.type == "real" else "integer"
-            out += wrap_statement(f"call take_{kind}_list(error, scan, '{group.name}', "
-                                  f"occurrence, '{var.name}', {var.name}, {var.name}_again, "
-                                  f"value%{var.name})", i2)
+            kind = "reals" if var.type == "real" else "integers"
+            out += wrap_statement(f"call count_set(error, scan, '{group.name}', occurrence, "
+                                  f"'{var.name}', unset_{kind}({var.name}, {var.name}_again), "
+                                  "n)", i2)
             out.append(f"{i2}if (allocated(error)) return")
+            out.append(f"{i2}if (allocated({var.name}_again)) {var.name} = {var.name}_again")
+            out.append(f"{i2}value%{var.name} = {var.name}(:n)")
         else:
             out.append(f"{i2}value%{var.name} = {var.name}")
     out += ["", f"{INDENT}contains", "",
@@ -405,6 +407,17 @@ def write_routine(group: Group) -> list[str]:
             joined = f"{text}({field})"
         out += wrap_statement(f"call put(unit, indent // '{var.name} = ' // {joined})", i2)
     out += [f"{i2}call put(unit, '/')", f"{INDENT}end subroutine write_{group.name}", ""]
+    if group.kind == "repeatable":
+        out += [f"{INDENT}!> Write each of `values` as a &{group.name} group.",
+                f"{INDENT}subroutine write_{group.name}_groups(unit, values)",
+                f"{i2}integer, intent(in) :: unit",
+                f"{i2}type({group.type_name}), allocatable, intent(in) :: values(:)",
+                f"{i2}integer :: k", "",
+                f"{i2}if (.not. allocated(values)) return",
+                f"{i2}do k = 1, size(values)",
+                f"{i2}{INDENT}call write_{group.name}(unit, values(k))",
+                f"{i2}end do",
+                f"{INDENT}end subroutine write_{group.name}_groups", ""]
     return out
 
 
@@ -447,7 +460,7 @@ def fortran_module() -> str:
            f"{INDENT}use yarnfort_input_scan, only: namelist_scan_type",
            f"{INDENT}use yarnfort_input_fields, only: buffer_length, message_length, max_list, &",
            f"{INDENT * 3}max_coordinates, unset_real, unset_integer, other_real, other_integer, &",
-           f"{INDENT * 3}read_failed, too_many_found, take_text, take_real_list, take_integer_list, &",
+           f"{INDENT * 3}read_failed, too_many_found, take_text, unset_reals, unset_integers, count_set, &",
            f"{INDENT * 3}check_real, check_at_least, check_choice, require_set, &",
            f"{INDENT * 3}require_text, forbid_set, put, put_reals, put_integers, format_logical, &",
            f"{INDENT * 3}indent",
@@ -456,6 +469,8 @@ def fortran_module() -> str:
     publics = []
     for group in GROUPS:
         publics += [f"read_{group.name}_groups", f"write_{group.name}"]
+        if group.kind == "repeatable":
+            publics.append(f"write_{group.name}_groups")
         if check_routine(group):
             publics.append(f"check_{group.name}_variables")
         if preset_routine(group):

@@ -46,8 +46,7 @@ contains
         character(len=*), intent(in), optional :: folder
         type(namelist_scan_type) :: scan
         character(len=:), allocatable :: name
-        character(len=message_length) :: message
-        integer :: k, text, stat
+        integer :: k, text
 
         if (present(folder)) then
             if (len_trim(folder) > len(config%input_folder)) then
@@ -72,12 +71,8 @@ contains
             end if
         end do
 
-        open(newunit=text, status='scratch', action='readwrite', form='formatted', &
-            access='sequential', iostat=stat, iomsg=message)
-        if (stat /= 0) then
-            call fatal_error(error, 'cannot open a scratch file for the input: ' // trim(message))
-            return
-        end if
+        call open_scratch(text, error)
+        if (allocated(error)) return
         call scan%write_without_comments(text, error)
         if (.not. allocated(error)) call read_groups(text, scan, config, error)
         close(text)
@@ -206,12 +201,8 @@ contains
         character(len=message_length) :: message
         integer :: scratch, stat, line_number
 
-        open(newunit=scratch, status='scratch', action='readwrite', form='formatted', &
-            access='sequential', iostat=stat, iomsg=message)
-        if (stat /= 0) then
-            call fatal_error(error, 'cannot open a scratch file for the input: ' // trim(message))
-            return
-        end if
+        call open_scratch(scratch, error)
+        if (allocated(error)) return
         line_number = 0
         do
             call read_line(input_unit, line, stat, message)
@@ -241,5 +232,17 @@ contains
         call read_config(scratch, config, error)
         close(scratch)
     end subroutine read_config_from_stdin
+
+    subroutine open_scratch(unit, error)
+        integer, intent(out) :: unit
+        type(error_type), allocatable, intent(out) :: error
+        character(len=message_length) :: message
+        integer :: stat
+
+        open(newunit=unit, status='scratch', action='readwrite', form='formatted', &
+            access='sequential', iostat=stat, iomsg=message)
+        if (stat /= 0) call fatal_error(error, 'cannot open a scratch file for the input: ' &
+            // trim(message))
+    end subroutine open_scratch
 
 end module yarnfort_input_namelist

@@ -8,7 +8,7 @@ module yarnfort_linalg_cholmod
     use, intrinsic :: iso_c_binding, only: c_int, c_long, c_ptr, c_null_ptr, c_associated
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_direct, only: direct_solver_type, describe_status
     use yarnfort_linalg_csc_pattern, only: format_integer
     use yarnfort_linalg_cholmod_binding, only: cholmod_ok, cholmod_not_posdef, &
         cholmod_dsmall, cholmod_not_installed, cholmod_out_of_memory, cholmod_too_large, &
@@ -131,24 +131,17 @@ contains
         integer(c_int), intent(in) :: status
         character(len=:), allocatable :: message
 
-        select case (status)
-        case (cholmod_not_posdef)
-            message = 'matrix is not positive definite (CHOLMOD_NOT_POSDEF)'
-        case (cholmod_not_installed)
-            message = 'method not installed (CHOLMOD_NOT_INSTALLED)'
-        case (cholmod_out_of_memory)
-            message = 'out of memory (CHOLMOD_OUT_OF_MEMORY)'
-        case (cholmod_too_large)
-            message = 'integer overflow (CHOLMOD_TOO_LARGE)'
-        case (cholmod_invalid)
-            message = 'invalid input (CHOLMOD_INVALID)'
-        case (cholmod_gpu_problem)
-            message = 'GPU error (CHOLMOD_GPU_PROBLEM)'
-        case (cholmod_no_handle)
-            message = 'no CHOLMOD handle'
-        case default
-            message = 'CHOLMOD status ' // format_integer(int(status, ik))
-        end select
+        message = describe_status(int(status, c_long), [integer(c_long) :: &
+            cholmod_not_posdef, cholmod_not_installed, cholmod_out_of_memory, &
+            cholmod_too_large, cholmod_invalid, cholmod_gpu_problem, cholmod_no_handle], &
+            [character(len=52) :: &
+            'matrix is not positive definite (CHOLMOD_NOT_POSDEF)', &
+            'method not installed (CHOLMOD_NOT_INSTALLED)', &
+            'out of memory (CHOLMOD_OUT_OF_MEMORY)', &
+            'integer overflow (CHOLMOD_TOO_LARGE)', &
+            'invalid input (CHOLMOD_INVALID)', &
+            'GPU error (CHOLMOD_GPU_PROBLEM)', &
+            'no CHOLMOD handle'], 'CHOLMOD')
     end function status_message
 
 end module yarnfort_linalg_cholmod

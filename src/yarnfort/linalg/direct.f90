@@ -8,11 +8,11 @@ module yarnfort_linalg_direct
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size
+    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size, format_integer
     implicit none
     private
 
-    public :: direct_solver_type
+    public :: direct_solver_type, describe_status
 
     !> A linear solver over a library that needs the pattern as 64-bit C arrays.
     type, abstract, extends(linear_solver_type) :: direct_solver_type
@@ -81,5 +81,22 @@ contains
         if (allocated(self%col_ptr)) deallocate(self%col_ptr)
         if (allocated(self%row_index)) deallocate(self%row_index)
     end subroutine forget_pattern
+
+    !> The text of a library status code from the library's table of codes and texts
+    !> (its header's name and what it means), or '<library> status <code>'.
+    pure function describe_status(status, codes, texts, library) result(message)
+        integer(c_long), intent(in) :: status
+        integer(c_long), intent(in) :: codes(:)
+        character(len=*), intent(in) :: texts(:), library
+        character(len=:), allocatable :: message
+        integer :: k
+
+        k = findloc(codes, status, dim=1)
+        if (k > 0) then
+            message = trim(texts(k))
+        else
+            message = library // ' status ' // format_integer(int(status, ik))
+        end if
+    end function describe_status
 
 end module yarnfort_linalg_direct

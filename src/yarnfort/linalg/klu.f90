@@ -10,7 +10,7 @@ module yarnfort_linalg_klu
         c_associated, c_f_pointer
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_direct, only: direct_solver_type, describe_status
     use yarnfort_linalg_csc_pattern, only: format_integer
     use yarnfort_linalg_klu_binding, only: klu_l_common, klu_ok, klu_singular, &
         klu_out_of_memory, klu_invalid, klu_too_large, klu_l_defaults, klu_l_analyze, &
@@ -206,18 +206,13 @@ contains
         integer(c_long), intent(in) :: status
         character(len=:), allocatable :: message
 
-        select case (status)
-        case (klu_singular)
-            message = 'matrix is singular (KLU_SINGULAR)'
-        case (klu_out_of_memory)
-            message = 'out of memory (KLU_OUT_OF_MEMORY)'
-        case (klu_invalid)
-            message = 'invalid matrix or argument (KLU_INVALID)'
-        case (klu_too_large)
-            message = 'integer overflow (KLU_TOO_LARGE)'
-        case default
-            message = 'KLU status ' // format_integer(int(status, ik))
-        end select
+        message = describe_status(int(status, c_long), [integer(c_long) :: &
+            klu_singular, klu_out_of_memory, klu_invalid, klu_too_large], &
+            [character(len=40) :: &
+            'matrix is singular (KLU_SINGULAR)', &
+            'out of memory (KLU_OUT_OF_MEMORY)', &
+            'invalid matrix or argument (KLU_INVALID)', &
+            'integer overflow (KLU_TOO_LARGE)'], 'KLU')
     end function status_message
 
 end module yarnfort_linalg_klu

@@ -7,7 +7,7 @@ module yarnfort_linalg_umfpack
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr, c_null_ptr, c_associated
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_direct, only: direct_solver_type, describe_status
     use yarnfort_linalg_csc_pattern, only: format_integer
     use yarnfort_linalg_umfpack_binding, only: umfpack_control, umfpack_info, umfpack_prl, &
         umfpack_irstep, umfpack_rcond, umfpack_a, umfpack_ok, &
@@ -181,34 +181,26 @@ contains
         integer(c_long), intent(in) :: status
         character(len=:), allocatable :: message
 
-        select case (status)
-        case (umfpack_warning_singular_matrix)
-            message = 'matrix is singular (UMFPACK_WARNING_singular_matrix)'
-        case (umfpack_error_out_of_memory)
-            message = 'out of memory (UMFPACK_ERROR_out_of_memory)'
-        case (umfpack_error_invalid_numeric_object)
-            message = 'invalid Numeric object (UMFPACK_ERROR_invalid_Numeric_object)'
-        case (umfpack_error_invalid_symbolic_object)
-            message = 'invalid Symbolic object (UMFPACK_ERROR_invalid_Symbolic_object)'
-        case (umfpack_error_argument_missing)
-            message = 'argument missing (UMFPACK_ERROR_argument_missing)'
-        case (umfpack_error_n_nonpositive)
-            message = 'matrix order not positive (UMFPACK_ERROR_n_nonpositive)'
-        case (umfpack_error_invalid_matrix)
-            message = 'invalid CSC matrix (UMFPACK_ERROR_invalid_matrix)'
-        case (umfpack_error_different_pattern)
-            message = 'pattern changed since analyse (UMFPACK_ERROR_different_pattern)'
-        case (umfpack_error_invalid_system)
-            message = 'invalid system (UMFPACK_ERROR_invalid_system)'
-        case (umfpack_error_invalid_permutation)
-            message = 'invalid permutation (UMFPACK_ERROR_invalid_permutation)'
-        case (umfpack_error_internal_error)
-            message = 'internal error (UMFPACK_ERROR_internal_error)'
-        case (umfpack_error_ordering_failed)
-            message = 'ordering failed (UMFPACK_ERROR_ordering_failed)'
-        case default
-            message = 'UMFPACK status ' // format_integer(int(status, ik))
-        end select
+        message = describe_status(int(status, c_long), [integer(c_long) :: &
+            umfpack_warning_singular_matrix, umfpack_error_out_of_memory, &
+            umfpack_error_invalid_numeric_object, umfpack_error_invalid_symbolic_object, &
+            umfpack_error_argument_missing, umfpack_error_n_nonpositive, &
+            umfpack_error_invalid_matrix, umfpack_error_different_pattern, &
+            umfpack_error_invalid_system, umfpack_error_invalid_permutation, &
+            umfpack_error_internal_error, umfpack_error_ordering_failed], &
+            [character(len=63) :: &
+            'matrix is singular (UMFPACK_WARNING_singular_matrix)', &
+            'out of memory (UMFPACK_ERROR_out_of_memory)', &
+            'invalid Numeric object (UMFPACK_ERROR_invalid_Numeric_object)', &
+            'invalid Symbolic object (UMFPACK_ERROR_invalid_Symbolic_object)', &
+            'argument missing (UMFPACK_ERROR_argument_missing)', &
+            'matrix order not positive (UMFPACK_ERROR_n_nonpositive)', &
+            'invalid CSC matrix (UMFPACK_ERROR_invalid_matrix)', &
+            'pattern changed since analyse (UMFPACK_ERROR_different_pattern)', &
+            'invalid system (UMFPACK_ERROR_invalid_system)', &
+            'invalid permutation (UMFPACK_ERROR_invalid_permutation)', &
+            'internal error (UMFPACK_ERROR_internal_error)', &
+            'ordering failed (UMFPACK_ERROR_ordering_failed)'], 'UMFPACK')
     end function status_message
 
 end module yarnfort_linalg_umfpack
