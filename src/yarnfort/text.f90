@@ -12,7 +12,7 @@ module yarnfort_text
     public :: string_type, read_line, to_lower, format_integer, format_real, quote_string
     public :: split_words, parse_integer, parse_real, edit_distance, closest_name
     public :: join_names, folder_of, resolve_path, is_folder, max_line_length
-    public :: byte_order_mark
+    public :: byte_order_mark, remove_characters
 
     !> One string of an array of strings of different lengths.
     type :: string_type
@@ -173,6 +173,7 @@ contains
         end if
     end function format_real
 
+    !> `text` without the characters of `set`.
     pure function remove_characters(text, set) result(cleaned)
         character(len=*), intent(in) :: text, set
         character(len=:), allocatable :: cleaned

@@ -17,7 +17,7 @@ module yarnfort_input_fields
     public :: read_failed, post_read_error, too_many_found, group_label
     public :: take_text, unset_reals, unset_integers, count_set
     public :: check_real, check_at_least, check_choice, require_set, require_text, forbid_set
-    public :: not_finite, suggestion, quoted_list
+    public :: not_finite, suggestion, quoted_list, check_name
     public :: put, put_reals, put_integers, format_logical
 
     !> Most node ids in one &yarn, &support or &load group, and most knots in &path.
@@ -36,6 +36,9 @@ module yarnfort_input_fields
     !> Indent of the variables in the echo, and values per line of its lists.
     character(len=*), parameter :: indent = '    '
     integer, parameter :: integers_per_line = 10, reals_per_line = 3
+    !> Characters of material and support names.
+    character(len=*), parameter :: name_characters = &
+        'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
 
     !> A law parameter that another law uses must stay unset.
     interface forbid_set
@@ -332,6 +335,17 @@ contains
             list = list // "'" // trim(names(i)) // "'"
         end do
     end function quoted_list
+
+    !> Names are single words (the geometry file and the curve CSV header use them).
+    subroutine check_name(error, label, name)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, name
+
+        if (verify(trim(name), name_characters) > 0) then
+            call fatal_error(error, label // ": name = '" // trim(name) // "' may contain " &
+                // "only letters, digits, '_', '-' and '.'")
+        end if
+    end subroutine check_name
 
     subroutine put(unit, line)
         integer, intent(in) :: unit

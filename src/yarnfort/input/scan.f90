@@ -9,7 +9,8 @@ module yarnfort_input_scan
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_kinds, only: wp
     use yarnfort_text, only: string_type, read_line, to_lower, format_integer, &
-        closest_name, join_names, byte_order_mark, parse_integer, parse_real
+        closest_name, join_names, byte_order_mark, parse_integer, parse_real, &
+        remove_characters
     implicit none
     private
 
@@ -413,13 +414,8 @@ contains
     pure function normalized_name(text) result(name)
         character(len=*), intent(in) :: text
         character(len=:), allocatable :: name
-        integer :: i
 
-        name = ''
-        do i = 1, len(text)
-            if (text(i:i) /= ' ' .and. text(i:i) /= tab) name = name // text(i:i)
-        end do
-        name = to_lower(name)
+        name = to_lower(remove_characters(text, ' ' // tab))
     end function normalized_name
 
     !> Whether two different normalized names (lower case, no blanks) of one group
