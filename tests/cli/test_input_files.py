@@ -109,3 +109,10 @@ def test_geometry_file_that_is_a_folder(run_yarnfort, tmp_path):
     run = run_yarnfort(text)
     assert run.returncode == 2, run.stderr
     assert "&geometry: file 'net.geo' is a folder, not a file" in run.stderr
+
+
+def test_table_without_line_ends_is_bounded(run_yarnfort):
+    run = run_yarnfort(table_scene("/dev/zero"), timeout=HANG_GUARD)
+    assert run.returncode == 2, run.stderr
+    assert "table '/dev/zero', line 1: cannot read the line (a line is longer than" \
+        in run.stderr
