@@ -14,6 +14,10 @@ module yarnfort_text
     public :: join_names, folder_of, resolve_path, is_folder, max_line_length
     public :: byte_order_mark, remove_characters
 
+    interface format_integer
+        module procedure format_default_integer, format_long_integer
+    end interface format_integer
+
     !> One string of an array of strings of different lengths.
     type :: string_type
         character(len=:), allocatable :: text
@@ -92,15 +96,22 @@ contains
         end do
     end function to_lower
 
-    !> An integer as text without blanks.
-    pure function format_integer(value) result(text)
+    !> An integer (default or 64-bit) as text without blanks.
+    pure function format_default_integer(value) result(text)
         integer, intent(in) :: value
+        character(len=:), allocatable :: text
+
+        text = format_long_integer(int(value, int64))
+    end function format_default_integer
+
+    pure function format_long_integer(value) result(text)
+        integer(int64), intent(in) :: value
         character(len=:), allocatable :: text
         character(len=24) :: buffer
 
         write(buffer, '(i0)') value
         text = trim(buffer)
-    end function format_integer
+    end function format_long_integer
 
     !> A real as the shortest decimal text that reads back to exactly the same value
     !> ('0.25', '150.0', '1.0e-6', '-3.0e12'); 'NaN', 'Infinity' and '-Infinity' as such.

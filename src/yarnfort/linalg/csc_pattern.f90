@@ -5,6 +5,7 @@
 module yarnfort_linalg_csc_pattern
     use yarnfort_kinds, only: ik
     use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_text, only: format_integer
     implicit none
     private
 
@@ -93,15 +94,5 @@ contains
                 // format_integer(actual) // ' entries, expected ' // format_integer(expected))
         end if
     end subroutine check_array_size
-
-    !> Decimal text of an integer, without blanks.
-    pure function format_integer(value) result(text)
-        integer(ik), intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=24) :: buffer
-
-        write(buffer, '(i0)') value
-        text = trim(buffer)
-    end function format_integer
 
 end module yarnfort_linalg_csc_pattern
