@@ -359,18 +359,15 @@ contains
         integer, intent(in) :: unit
         character(len=*), intent(in) :: name
         integer, intent(in) :: values(:)
-        character(len=:), allocatable :: line
-        integer :: i
 
-        if (size(values) == 0) return
-        line = indent // name // ' ='
-        do i = 1, size(values)
-            line = line // ' ' // format_integer(values(i))
-            if (mod(i, integers_per_line) == 0 .or. i == size(values)) then
-                call put(unit, line)
-                line = indent // repeat(' ', len(name) + 2)
-            end if
-        end do
+        call put_values(unit, name, size(values), integers_per_line, integer_text)
+    contains
+        function integer_text(i) result(text)
+            integer, intent(in) :: i
+            character(len=:), allocatable :: text
+
+            text = format_integer(values(i))
+        end function integer_text
     end subroutine put_integers
 
     !> `name = v1 v2 ...`, reals_per_line values per line; nothing for no values.
@@ -378,19 +375,40 @@ contains
         integer, intent(in) :: unit
         character(len=*), intent(in) :: name
         real(wp), intent(in) :: values(:)
+
+        call put_values(unit, name, size(values), reals_per_line, real_text)
+    contains
+        function real_text(i) result(text)
+            integer, intent(in) :: i
+            character(len=:), allocatable :: text
+
+            text = format_real(values(i))
+        end function real_text
+    end subroutine put_reals
+
+    !> `name = ` and the texts of values 1..n, `per_line` of them per line.
+    subroutine put_values(unit, name, n, per_line, text_of)
+        integer, intent(in) :: unit, n, per_line
+        character(len=*), intent(in) :: name
+        interface
+            function text_of(i) result(text)
+                integer, intent(in) :: i
+                character(len=:), allocatable :: text
+            end function text_of
+        end interface
         character(len=:), allocatable :: line
         integer :: i
 
-        if (size(values) == 0) return
+        if (n == 0) return
         line = indent // name // ' ='
-        do i = 1, size(values)
-            line = line // ' ' // format_real(values(i))
-            if (mod(i, reals_per_line) == 0 .or. i == size(values)) then
+        do i = 1, n
+            line = line // ' ' // text_of(i)
+            if (mod(i, per_line) == 0 .or. i == n) then
                 call put(unit, line)
                 line = indent // repeat(' ', len(name) + 2)
             end if
         end do
-    end subroutine put_reals
+    end subroutine put_values
 
     pure function format_logical(value) result(text)
         logical, intent(in) :: value

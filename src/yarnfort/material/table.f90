@@ -108,15 +108,8 @@ contains
             row%strain_text = format_real(strain(i))
             row%force_text = format_real(force(i))
             row%place = 'row ' // format_integer(i)
-            if (i == 1) then
-                call check_row(row, error=error)
-            else
-                call check_row(row, previous, error)
-            end if
-            if (allocated(error)) then
-                error%message = context // ', ' // row%place // ': ' // error%message
-                return
-            end if
+            call check_in_order(row, previous, i == 1, context, error)
+            if (allocated(error)) return
             previous = row
         end do
         if (size(strain) < min_rows) then
@@ -185,15 +178,8 @@ contains
                 exit
             end if
             row%place = 'line ' // format_integer(line_number)
-            if (nrow == 0) then
-                call check_row(row, error=error)
-            else
-                call check_row(row, previous, error)
-            end if
-            if (allocated(error)) then
-                error%message = context // ', ' // row%place // ': ' // error%message
-                exit
-            end if
+            call check_in_order(row, previous, nrow == 0, context, error)
+            if (allocated(error)) exit
             call append_row(strain, force, lines, nrow, row%strain, row%force, line_number)
             previous = row
         end do
@@ -533,6 +519,23 @@ contains
             quoted = "'" // text // "'"
         end if
     end function quote
+
+    !> Check a row, after `previous` unless it is the `first`; the message names the
+    !> table (`context`) and the row's place.
+    subroutine check_in_order(row, previous, first, context, error)
+        type(row_type), intent(in) :: row, previous
+        logical, intent(in) :: first
+        character(len=*), intent(in) :: context
+        type(error_type), allocatable, intent(out) :: error
+
+        if (first) then
+            call check_row(row, error=error)
+        else
+            call check_row(row, previous, error)
+        end if
+        if (allocated(error)) error%message = context // ', ' // row%place // ': ' &
+            // error%message
+    end subroutine check_in_order
 
     !> Append one row, growing the arrays geometrically.
     pure subroutine append_row(strain, force, lines, nrow, new_strain, new_force, new_line)
