@@ -205,11 +205,13 @@ contains
                         i = i + 1
                     case ('/')
                         call end_group(iline)
+                        if (allocated(error)) return
                         i = i + 1
                     case ('&', '$')
                         call read_name(text, i + 1, j, name)
                         if (name == 'end') then
                             call end_group(iline)
+                            if (allocated(error)) return
                             i = j
                         else if (len(name) == 0) then
                             call fatal_error(error, 'line ' // format_integer(iline) &
@@ -283,9 +285,72 @@ contains
             associate(group => scan%groups(scan%n_groups))
                 group%last_line = last_line
                 group%tokens = group%tokens(:group%n_tokens)
+                call check_entries(group)
             end associate
             in_group = .false.
         end subroutine end_group
+
+        !> No entry of a variable may be set by two assignments of a group (p_force =
+        !> 0, 1, 0 then p_force(2) = 3): each sets the entries from its subscript (1
+        !> without one) on, as many as it has values, or the entries of its section.
+        subroutine check_entries(group)
+            type(group_occurrence_type), intent(in) :: group
+            integer :: j, k
+            integer, allocatable :: first(:), last(:)
+            logical, allocatable :: known(:)
+
+            allocate(first(group%n_tokens), last(group%n_tokens), known(group%n_tokens))
+            known = .false.
+            do k = 1, group%n_tokens
+                if (group%tokens(k)%is_name) call assigned_entries(group, k, first(k), &
+                    last(k), known(k))
+            end do
+            do k = 1, group%n_tokens
+                if (.not. known(k)) cycle
+                do j = 1, k - 1
+                    if (.not. known(j)) cycle
+                    if (base_name(scan%token_text(group%tokens(j))) &
+                        /= base_name(scan%token_text(group%tokens(k)))) cycle
+                    if (first(j) > last(k) .or. first(k) > last(j)) cycle
+                    call fatal_error(error, '&' // group%name // ': ' &
+                        // normalized_name(scan%token_text(group%tokens(k))) // ' (line ' &
+                        // format_integer(group%tokens(k)%line) // ') sets again an entry ' &
+                        // 'that ' // normalized_name(scan%token_text(group%tokens(j))) &
+                        // ' (line ' // format_integer(group%tokens(j)%line) // ') sets; ' &
+                        // 'each entry may be set only once')
+                    return
+                end do
+            end do
+        end subroutine check_entries
+
+        !> Entries first..last that the assignment of name token k sets; `known` is false
+        !> for a subscript of another form (left to the namelist reader).
+        subroutine assigned_entries(group, k, first, last, known)
+            type(group_occurrence_type), intent(in) :: group
+            integer, intent(in) :: k
+            integer, intent(out) :: first, last
+            logical, intent(out) :: known
+            character(len=:), allocatable :: name, text
+            integer :: j, n, repeat_count
+            logical :: ok
+
+            name = normalized_name(scan%token_text(group%tokens(k)))
+            call entry_range(name, first, last, known)
+            known = known .and. first >= 1
+            if (.not. known .or. index(name, ':') > 0) return
+            n = 0
+            do j = k + 1, group%n_tokens
+                if (group%tokens(j)%is_name) exit
+                text = scan%token_text(group%tokens(j))
+                repeat_count = 1
+                if (index(text, '*') > 1) then
+                    call parse_integer(text(:index(text, '*') - 1), repeat_count, ok)
+                    if (.not. ok) repeat_count = 1
+                end if
+                n = n + repeat_count
+            end do
+            last = first + n - 1
+        end subroutine assigned_entries
 
         subroutine add_token(line, first, last)
             integer, intent(in) :: line, first, last
@@ -302,8 +367,7 @@ contains
             end associate
         end subroutine add_token
 
-        !> The token before '=' is a variable name; no entry of it may be set twice in a
-        !> group (a whole-array assignment sets them all).
+        !> The token before '=' is a variable name; it must not be set twice in a group.
         subroutine mark_name(line)
             integer, intent(in) :: line
             integer :: k
@@ -333,12 +397,6 @@ contains
                             // format_integer(line) // ')')
                         return
                     end if
-                    if (.not. entries_overlap(this, other)) cycle
-                    call fatal_error(error, '&' // group%name // ': ' // this // ' (line ' &
-                        // format_integer(line) // ') sets again an entry that ' // other &
-                        // ' (line ' // format_integer(group%tokens(k)%line) // ') sets; ' &
-                        // 'each entry may be set only once')
-                    return
                 end do
             end associate
         end subroutine mark_name
@@ -418,25 +476,8 @@ contains
         name = to_lower(remove_characters(text, ' ' // tab))
     end function normalized_name
 
-    !> Whether two different normalized names (lower case, no blanks) of one group
-    !> set a common entry: the same variable, one of them whole, or subscripts i or
-    !> i:j whose ranges meet (a subscript of another form counts as meeting).
-    pure logical function entries_overlap(a, b)
-        character(len=*), intent(in) :: a, b
-        integer :: first_a, last_a, first_b, last_b
-        logical :: ok_a, ok_b
-
-        entries_overlap = .false.
-        if (base_name(a) /= base_name(b)) return
-        call entry_range(a, first_a, last_a, ok_a)
-        call entry_range(b, first_b, last_b, ok_b)
-        ! A subscript below 1 is left to the namelist reader ("Index 0 out of range").
-        if (min(first_a, first_b) < 1) return
-        entries_overlap = .true.
-        if (ok_a .and. ok_b) entries_overlap = first_a <= last_b .and. first_b <= last_a
-    end function entries_overlap
-
-    !> Entries first..last of a subscripted name 'x(i)', 'x(i:j)', 'x(i:)', 'x(:j)'.
+    !> Entries first..last of a name: 'x' (1..), 'x(i)' (i..), 'x(i:j)', 'x(i:)', 'x(:j)';
+    !> `ok` is false for a subscript of another form.
     pure subroutine entry_range(name, first, last, ok)
         character(len=*), intent(in) :: name
         integer, intent(out) :: first, last
