@@ -116,3 +116,13 @@ def test_table_without_line_ends_is_bounded(run_yarnfort):
     assert run.returncode == 2, run.stderr
     assert "table '/dev/zero', line 1: cannot read the line (a line is longer than" \
         in run.stderr
+
+
+def test_subscript_after_a_shorter_list_is_accepted(run_yarnfort):
+    """'nodes = 1 2, nodes(3) = 3' sets each entry once (issue 14 item 9 must not turn
+    this into an error); the yarn then has 3 nodes, 2 elements."""
+    network = ("&nodes xyz = 0 0 0  1 0 0  2 0 0 /\n"
+               "&yarn material = 'a', nodes = 1 2, nodes(3) = 3 /")
+    run = run_yarnfort(SCENE.format(law=LINEAR, network=network, last=3))
+    assert run.returncode == 0, run.stderr
+    assert "3 nodes, 2 elements" in run.stderr
