@@ -22,7 +22,7 @@ module yarnfort_input_namelist
         post_read_error
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
     use yarnfort_input_geometry, only: read_geometry_file
-    use yarnfort_text, only: read_line, format_integer, folder_of, resolve_path
+    use yarnfort_text, only: read_line, format_integer, folder_of, resolve_path, is_folder
     use yarnfort_input_validate, only: check_config
     use yarnfort_generate_fabric, only: generate_fabric
     implicit none
@@ -181,6 +181,10 @@ contains
         character(len=message_length) :: message
         integer :: unit, stat
 
+        if (is_folder(path)) then
+            call fatal_error(error, "input file '" // path // "' is a folder, not a file")
+            return
+        end if
         open(newunit=unit, file=path, status='old', action='read', form='formatted', &
             access='sequential', iostat=stat, iomsg=message)
         if (stat /= 0) then

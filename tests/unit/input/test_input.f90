@@ -12,7 +12,7 @@ module test_input
     use yarnfort_input_namelist, only: read_config, read_config_from_file, check_config, &
         max_list
     use yarnfort_input_echo, only: write_config
-    use yarnfort_text, only: format_real, format_integer
+    use yarnfort_text, only: format_real, format_integer, read_line
     use test_input_paths, only: data_folder
     implicit none
     private
@@ -42,6 +42,8 @@ contains
             new_unittest('list_overflow', test_list_overflow), &
             new_unittest('list_beyond_buffer', test_list_beyond_buffer), &
             new_unittest('missing_input_file', test_missing_input_file), &
+            new_unittest('input_file_is_a_folder', test_input_file_is_a_folder), &
+            new_unittest('long_record', test_long_record), &
             new_unittest('bad_unknown_group', test_bad_unknown_group), &
             new_unittest('bad_unknown_variable', test_bad_unknown_variable), &
             new_unittest('bad_wrong_type', test_bad_wrong_type), &
@@ -493,6 +495,42 @@ contains
         call check(error, index(input_error%message, 'cannot open input file') == 1, &
             input_error%message)
     end subroutine test_missing_input_file
+
+    subroutine test_input_file_is_a_folder(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(config_type) :: config
+        type(error_type), allocatable :: input_error
+
+        call read_config_from_file('.', config, input_error)
+        call check(error, allocated(input_error), 'no error for a folder')
+        if (allocated(error)) return
+        call check(error, input_error%message == "input file '.' is a folder, not a file", &
+            input_error%message)
+    end subroutine test_input_file_is_a_folder
+
+    !> read_line returns a record of several buffer growths whole, and the next one.
+    subroutine test_long_record(error)
+        type(error_type), allocatable, intent(out) :: error
+        integer, parameter :: n = 100003
+        character(len=:), allocatable :: line, record
+        character(len=512) :: message
+        integer :: unit, stat, i
+
+        allocate(character(len=n) :: record)
+        do i = 1, n
+            record(i:i) = achar(iachar('a') + mod(i, 26))
+        end do
+        open(newunit=unit, status='scratch', action='readwrite', form='formatted')
+        write(unit, '(a)') record
+        write(unit, '(a)') 'next'
+        rewind(unit)
+        call read_line(unit, line, stat, message)
+        call check(error, stat == 0 .and. line == record, 'long record not read whole')
+        if (allocated(error)) return
+        call read_line(unit, line, stat, message)
+        call check(error, stat == 0 .and. line == 'next', 'record after it: ' // line)
+        close(unit)
+    end subroutine test_long_record
 
     !> Every variable of two configs is equal (reals exactly, NaN equal to NaN).
     subroutine check_configs_equal(error, actual, expected)
