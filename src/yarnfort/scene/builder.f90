@@ -63,10 +63,6 @@ contains
         scene%path%time = config%path%time
         scene%path%p_force = config%path%p_force
         scene%path%p_disp = config%path%p_disp
-        scene%force_scale = 0.0_wp
-        do m = 1, size(scene%laws)
-            scene%force_scale = max(scene%force_scale, scene%laws(m)%law%get_reference_stiffness())
-        end do
         scene%length_scale = sum(scene%network%length0) / size(scene%network%length0)
     end subroutine new_scene
 
