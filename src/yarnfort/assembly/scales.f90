@@ -8,10 +8,11 @@ module yarnfort_assembly_scales
     use yarnfort_kinds, only: wp
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_assembly_truss, only: get_truss_tension
+    use yarnfort_material_law, only: force_law_type
     implicit none
     private
 
-    public :: get_node_force_levels, get_unknown_levels, get_tension_noise, node_level_floor
+    public :: get_node_force_levels, get_unknown_levels, get_tension_with_noise, node_level_floor
 
     !> A node where no force meets (a slack region) is judged against this fraction of
     !> the largest force of the scene.
@@ -35,17 +36,14 @@ contains
         real(wp), intent(in) :: x(:, :), length0(:), p_force, spring
         real(wp), intent(out) :: level(:), noise(:), max_force
         integer :: e, n, k
-        real(wp) :: stretch, tension, dtension, rounding
+        real(wp) :: tension, rounding
 
         level = 0.0_wp
         noise = 0.0_wp
         do e = 1, scene%network%n_elements()
             associate(nodes => scene%network%element_nodes(:, e))
-                stretch = norm2(x(:, nodes(2)) - x(:, nodes(1))) / length0(e)
-                call get_truss_tension(scene%laws(scene%network%element_material(e))%law, &
-                    spring, stretch, tension, dtension)
-                rounding = get_tension_noise(tension, dtension, (norm2(x(:, nodes(1))) &
-                    + norm2(x(:, nodes(2)))) / length0(e) + stretch)
+                call get_tension_with_noise(scene%laws(scene%network%element_material(e))%law, &
+                    spring, x(:, nodes(1)), x(:, nodes(2)), length0(e), tension, rounding)
                 do k = 1, 2
                     level(nodes(k)) = max(level(nodes(k)), abs(tension))
                     noise(nodes(k)) = noise(nodes(k)) + rounding
@@ -59,14 +57,25 @@ contains
         level = max(level, node_level_floor * max_force)
     end subroutine get_node_force_levels
 
-    !> Rounding error of an element tension T(lambda) computed from lambda = l/L0, with
-    !> rounding_stretch = (|x1| + |x2| + l) / L0 (see rounding_factor).
-    elemental real(wp) function get_tension_noise(tension, dtension, rounding_stretch) &
-            result(noise)
-        real(wp), intent(in) :: tension, dtension, rounding_stretch
-        noise = rounding_factor * epsilon(1.0_wp) &
-            * (abs(tension) + rounding_stretch * abs(dtension))
-    end function get_tension_noise
+    !> Tension of an element with nodes at x1, x2 and its rounding error: the tension is
+    !> computed from lambda = l/L0, and l from coordinate differences, which carry the
+    !> rounding of the coordinates: noise = rounding_factor * eps * (|T| + r |dT/dlambda|)
+    !> with r = (|x1| + |x2| + l) / L0. A string within that rounding of stretch 1 (the
+    !> kink of the tension-only law) counts with the slope of its taut side.
+    pure subroutine get_tension_with_noise(law, spring, x1, x2, length0, tension, noise)
+        class(force_law_type), intent(in) :: law
+        real(wp), intent(in) :: spring, x1(3), x2(3), length0
+        real(wp), intent(out) :: tension, noise
+        real(wp) :: length, stretch, dtension, r
+
+        length = norm2(x2 - x1)
+        stretch = length / length0
+        call get_truss_tension(law, spring, stretch, tension, dtension)
+        r = (norm2(x1) + norm2(x2) + length) / length0
+        if (dtension == 0.0_wp .and. stretch > 1.0_wp - rounding_factor * epsilon(1.0_wp) * r) &
+            dtension = law%get_reference_stiffness()
+        noise = rounding_factor * epsilon(1.0_wp) * (abs(tension) + r * abs(dtension))
+    end subroutine get_tension_with_noise
 
     !> The levels of the equilibrium rows (one per unknown coordinate) from the node
     !> levels: a row that gathers several nodes (linked nodes share unknowns) takes the

@@ -38,7 +38,7 @@ module yarnfort_contact_friction_problem
     use yarnfort_assembly_pattern, only: build_clique_pattern
     use yarnfort_assembly_assemble, only: assemble_internal_force, add_element_tangents
     use yarnfort_assembly_scales, only: get_node_force_levels, get_unknown_levels, &
-        get_tension_noise, node_level_floor
+        get_tension_with_noise, node_level_floor
     use yarnfort_contact_geometry, only: get_wrap_angle
     use yarnfort_solver_problem, only: nonlinear_problem_type
     implicit none
@@ -378,12 +378,11 @@ contains
     real(wp) function get_element_noise(self, e) result(noise)
         class(friction_problem_type), intent(in) :: self
         integer, intent(in) :: e
-        real(wp) :: t, dt
-        call get_truss_tension(self%scene%laws(self%scene%network%element_material(e))%law, &
-            self%spring, self%stretch(e), t, dt)
+        real(wp) :: tension
         associate(nodes => self%scene%network%element_nodes(:, e))
-            noise = get_tension_noise(t, dt, self%stretch(e) + (norm2(self%x(:, nodes(1))) &
-                + norm2(self%x(:, nodes(2)))) / self%length0(e))
+            call get_tension_with_noise(self%scene%laws(self%scene%network%element_material(e))%law, &
+                self%spring, self%x(:, nodes(1)), self%x(:, nodes(2)), self%length0(e), &
+                tension, noise)
         end associate
     end function get_element_noise
 
