@@ -9,8 +9,9 @@
 !> guess and checked again at the solution (KINSOL goes on if they changed).
 !> Regularisation: every solve is first tried with the exact tension-only law (the
 !> regularising spring, weight slack_stiffness, only in the tangent of slack strings).
-!> If that fails, it is predicted with the spring in the model and corrected from there
-!> with the exact law, so the answer is always that of the exact law.
+!> If that fails, it is predicted with the spring in the model (weight falling from 0.1
+!> to slack_stiffness by factors of 10, each solve from the last) and corrected from
+!> there with the exact law, so the answer is always that of the exact law.
 module yarnfort_solver_newton
     use, intrinsic :: iso_c_binding
     use fsundials_context_mod
@@ -35,6 +36,10 @@ module yarnfort_solver_newton
     !> Times KINSOL goes on from its solution when the row levels taken there ask for
     !> a smaller residual than those of the initial guess.
     integer, parameter :: max_level_rounds = 4
+    !> First weight of the regularising spring when a solve needs the predictor: a net
+    !> of strings that all carry a tenth of their reference stiffness is regular and
+    !> well conditioned from any start; the weight then falls by factors of 10.
+    real(wp), parameter :: predictor_weight = 0.1_wp
 
     interface
         !> C's strlen, for KINSOL's messages.
@@ -199,6 +204,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         type(error_type), allocatable :: exact_error
         real(wp), allocatable :: guess(:)
+        real(wp) :: weight
         associate(problem => self%problem%problem, spring => self%options%slack_stiffness)
             problem%spring = 0.0_wp
             problem%tangent_spring = spring
@@ -208,17 +214,26 @@ contains
                 call move_alloc(exact_error, error)
                 return
             end if
-            ! Predict with the spring in the model, then correct with the exact law.
+            ! Predict with the spring in the model, weight driven down from
+            ! predictor_weight to slack_stiffness by factors of 10 (each solve from the
+            ! last), then correct with the exact law.
             guess = u
-            problem%spring = spring
-            problem%tangent_spring = 0.0_wp
-            call solve_once(self, guess, stats, error)
+            weight = max(predictor_weight, spring)
+            do
+                problem%spring = weight
+                problem%tangent_spring = 0.0_wp
+                call solve_once(self, guess, stats, error)
+                if (allocated(error)) then
+                    problem%spring = 0.0_wp
+                    problem%tangent_spring = spring
+                    call combine(error, '; with the regularised law as predictor: ')
+                    return
+                end if
+                if (weight <= spring) exit
+                weight = max(spring, weight / 10)
+            end do
             problem%spring = 0.0_wp
             problem%tangent_spring = spring
-            if (allocated(error)) then
-                call combine(error, '; with the regularised law as predictor: ')
-                return
-            end if
             call solve_once(self, guess, stats, error)
             if (allocated(error)) then
                 call combine(error, '; corrected from the regularised prediction: ')
@@ -245,50 +260,66 @@ contains
         integer(c_int) :: ierr, strategy
         integer(c_long) :: count(1)
         real(c_double) :: residual(size(u))
-        integer :: round
+        integer :: round, attempt, n_attempts
+        logical :: converged
         character(len=200) :: buffer
 
-        self%problem%n_history = 0
-        if (allocated(self%problem%error)) deallocate(self%problem%error)
-        if (allocated(self%problem%kinsol_message)) deallocate(self%problem%kinsol_message)
-        call self%problem%problem%prepare_solve(u, error)
-        if (allocated(error)) return
-        self%u = u
-        strategy = merge(KIN_LINESEARCH, KIN_NONE, self%options%line_search)
-        call set_row_weights(self, .true., error)
-        if (allocated(error)) return
-        do round = 1, max_level_rounds
-            ierr = FKINSol(self%kinsol, self%u_vector, strategy, self%u_scale, self%f_scale)
-            stats%flag = ierr
-            if (FKINGetNumNonlinSolvIters(self%kinsol, count) == 0) &
-                stats%iterations = stats%iterations + int(count(1))
-            if (FKINGetNumFuncEvals(self%kinsol, count) == 0) &
-                stats%residual_evaluations = stats%residual_evaluations + int(count(1))
-            if (FKINGetNumJacEvals(self%kinsol, count) == 0) &
-                stats%jacobian_evaluations = stats%jacobian_evaluations + int(count(1))
-            if (allocated(self%problem%error)) then
-                call move_alloc(self%problem%error, error)
-                return
-            end if
-            if (allocated(self%adapter%error) .and. ierr < 0) then
-                call fatal_error(error, 'linear solver (' // self%linear%get_name() // '): ' &
-                    // self%adapter%error%message)
-                return
-            end if
-            ! Judge convergence by our own test on the final iterate, with its levels.
-            call set_row_weights(self, .false., error)
+        ! Full Newton steps first; with line_search, a failed attempt is repeated from
+        ! the initial guess with KINSOL's line search (back-tracking where needed only).
+        n_attempts = merge(2, 1, self%options%line_search)
+        do attempt = 1, n_attempts
+            strategy = merge(KIN_NONE, KIN_LINESEARCH, attempt == 1)
+            self%problem%n_history = 0
+            if (allocated(self%problem%error)) deallocate(self%problem%error)
+            if (allocated(self%problem%kinsol_message)) deallocate(self%problem%kinsol_message)
+            if (allocated(self%adapter%error)) deallocate(self%adapter%error)
+            call self%problem%problem%prepare_solve(u, error)
             if (allocated(error)) return
-            call self%problem%problem%evaluate_residual(self%u, residual, error)
+            self%u = u
+            call set_row_weights(self, .true., error)
             if (allocated(error)) return
-            stats%residual_norm = maxval([0.0_wp, abs(residual) * self%f_scale_data])
-            ! Our test decides: a line search that stalls at a converged iterate is fine.
-            if (ierr < 0 .or. stats%residual_norm <= self%options%residual_tolerance) exit
+            converged = .false.
+            do round = 1, max_level_rounds
+                ierr = FKINSol(self%kinsol, self%u_vector, strategy, self%u_scale, self%f_scale)
+                stats%flag = ierr
+                if (FKINGetNumNonlinSolvIters(self%kinsol, count) == 0) &
+                    stats%iterations = stats%iterations + int(count(1))
+                if (FKINGetNumFuncEvals(self%kinsol, count) == 0) &
+                    stats%residual_evaluations = stats%residual_evaluations + int(count(1))
+                if (FKINGetNumJacEvals(self%kinsol, count) == 0) &
+                    stats%jacobian_evaluations = stats%jacobian_evaluations + int(count(1))
+                if (allocated(self%problem%error)) then
+                    if (attempt < n_attempts) exit
+                    call move_alloc(self%problem%error, error)
+                    return
+                end if
+                if (allocated(self%adapter%error) .and. ierr < 0) then
+                    if (attempt < n_attempts) exit
+                    call fatal_error(error, 'linear solver (' // self%linear%get_name() // &
+                        '): ' // self%adapter%error%message)
+                    return
+                end if
+                ! Judge convergence by our own test on the final iterate, with its levels.
+                call set_row_weights(self, .false., error)
+                if (allocated(error)) return
+                call self%problem%problem%evaluate_residual(self%u, residual, error)
+                if (allocated(error)) then
+                    if (attempt == n_attempts) return
+                    deallocate(error)
+                    exit
+                end if
+                stats%residual_norm = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+                ! Our test decides: a line search that stalls at a converged iterate is fine.
+                converged = stats%residual_norm <= self%options%residual_tolerance
+                if (ierr < 0 .or. converged) exit
+            end do
+            if (converged) exit
         end do
         self%problem%n_history = min(self%problem%n_history + 1, size(self%problem%history))
         self%problem%history(self%problem%n_history) = stats%residual_norm
         stats%residual_history = self%problem%history(1:self%problem%n_history)
 
-        if (.not. (stats%residual_norm <= self%options%residual_tolerance)) then
+        if (.not. converged) then
             write(buffer, '("Newton did not converge: KINSOL flag ", i0, ", ", i0, &
                 & " iterations, scaled residual ", es10.3, " > tolerance ", es10.3)') &
                 ierr, stats%iterations, stats%residual_norm, self%options%residual_tolerance
