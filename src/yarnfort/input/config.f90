@@ -39,7 +39,9 @@ module yarnfort_input_config
     type :: solver_config_type
         !> 'auto', 'umfpack', 'klu', 'cholmod' or 'dense'.
         character(len=16) :: linear_solver = 'auto'
-        !> Newton stops when max |residual| <= residual_tolerance * force_scale.
+        !> Relative: Newton stops when every row has |F_i| <= residual_tolerance *
+        !> level_i + noise_i (the forces meeting at the row's node, the rounding of its
+        !> evaluation; yarnfort_solver_newton). No material stiffness enters.
         real(wp) :: residual_tolerance = 1.0e-10_wp
         !> Newton also stops when the scaled step is below this (then checked against
         !> the residual tolerance, never accepted alone).
@@ -47,13 +49,15 @@ module yarnfort_input_config
         integer :: max_iterations = 50
         !> Newton iterations between Jacobian updates (1 = full Newton).
         integer :: max_setup_calls = 1
+        !> Full Newton steps first; a failed solve is repeated with a line search.
         logical :: line_search = .true.
-        !> Regularisation of the tension-only law: every string also carries
-        !> slack_stiffness * k_ref * (stretch - 1/2) (a weak spring of rest length L0/2;
-        !> k_ref the law's reference stiffness), so slack strings keep a regular tangent.
-        !> 0 switches it off (exact tension-only law).
+        !> Regularisation of the Newton solve, never of the answer: a weak spring of rest
+        !> length L0/2, slack_stiffness * k_ref (k_ref the law's reference stiffness), in
+        !> the tangent of slack strings, and in the model of a predictor solve when the
+        !> exact one fails (then corrected with the exact law). 0 switches it off.
         real(wp) :: slack_stiffness = 1.0e-6_wp
-        !> Continuation: first, smallest and largest pseudo-time step.
+        !> Continuation: first, smallest and largest step, as fractions of the knot
+        !> interval being followed.
         real(wp) :: initial_step = 0.1_wp
         real(wp) :: min_step = 1.0e-6_wp
         real(wp) :: max_step = 0.25_wp
@@ -75,8 +79,8 @@ module yarnfort_input_config
         !> Much shorter elements make the wrap angle ill-conditioned: on the woven
         !> benchmark net, elements at 1 % of their length stalled Newton.
         real(wp) :: min_length_ratio = 0.05_wp
-        !> Friction: relative slack in the stick test T_max <= T_crit (1 + tol) and
-        !> the staggered scheme's convergence test on the friction conditions.
+        !> Friction: relative slack in the stick test T_max <= T_crit (1 + tol) + band,
+        !> band = 10 times the uncertainty of the passage's own tensions at convergence.
         real(wp) :: friction_tolerance = 1.0e-9_wp
         !> Named defaults of initial_step, max_step, residual_tolerance and scheme (one of
         !> solver_presets); a variable set in &solver overrides its preset value.
