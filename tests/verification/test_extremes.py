@@ -857,15 +857,16 @@ def neo_hookean_chain(solver: dict, path: dict) -> str:
 def test_hundreds_of_step_cuts_then_finish(run_yarnfort, tmp_path):
     """The neo-Hookean yarn over the pin (coulomb mu = 0.3) pulled to d = 4 (3x its
     length) in one go (initial_step = max_step = 1) with max_iterations = 2, step_cut =
-    0.99 and no step growth: the first step is cut hundreds of times (1 % each) until
-    two Newton iterations suffice; within max_step_cuts = 1000 the run finishes, every
+    0.99, no step growth and plain Newton steps (line_search = .false.: no fallback
+    attempts): the first step is cut hundreds of times (1 % each) until two Newton
+    iterations suffice; within max_step_cuts = 1000 the run finishes, every
     step at the closed form. (The elastic chain below cannot be used here: from its
     stress-free start, where both strings sit at the kink of the tension-only law, the
     first step needs 5 or more iterations at any step length.)"""
     pin = Pin(coulomb_law(0.3), knots=(0.0, 4.0), step=1.0,
               material=dict(law="neo_hookean", modulus=1e6, area=1e-5))
     pin = replace(pin, solver=dict(max_iterations=2, step_cut=0.99, max_step_cuts=1000,
-                                   step_growth=1.0))
+                                   step_growth=1.0, line_search=False))
     result = run_pin(run_yarnfort, tmp_path, pin)
     curve = result.outcome.curve
     cuts = int(curve["step_cuts"].sum())
@@ -876,7 +877,8 @@ def test_hundreds_of_step_cuts_then_finish(run_yarnfort, tmp_path):
 
 
 def test_hundreds_of_step_cuts_then_a_clean_stop(run_yarnfort, tmp_path):
-    """The chain with max_iterations = 1, step_cut = 0.99, max_step_cuts = 300: the path
+    """The chain with max_iterations = 1 (plain Newton steps, line_search = .false.: no
+    fallback attempts), step_cut = 0.99, max_step_cuts = 300: the path
     holds still up to time 1 (steps that converge at once), then stretches the chain
     to 3x, which no step of length >= 0.5 * 0.99^300 = 0.025 does in one Newton
     iteration. The run must stop after exactly 301 consecutive cuts, within
@@ -884,7 +886,7 @@ def test_hundreds_of_step_cuts_then_a_clean_stop(run_yarnfort, tmp_path):
     converged steps up to time 1 kept in curve.csv and as VTK states."""
     text = neo_hookean_chain(dict(max_iterations=1, step_cut=0.99, max_step_cuts=300,
                                   initial_step=0.5, max_step=1.0, step_growth=1.0,
-                                  min_step=1e-12),
+                                  min_step=1e-12, line_search=False),
                              dict(time=[0.0, 1.0, 2.0], p_force=[0.0, 0.0, 0.0],
                                   p_disp=[0.0, 0.0, 1.0]))
     outcome = run_case(run_yarnfort, tmp_path, "give_up", text)

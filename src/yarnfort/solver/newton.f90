@@ -11,7 +11,9 @@
 !> regularising spring, weight slack_stiffness, only in the tangent of slack strings).
 !> If that fails, it is predicted with the spring in the model (weight falling from 0.1
 !> to slack_stiffness by factors of 10, each solve from the last) and corrected from
-!> there with the exact law, so the answer is always that of the exact law.
+!> there with the exact law, so the answer is always that of the exact law. A solve
+!> whose full Newton steps fail is repeated with a line search, and then by
+!> pseudo-transient continuation (solve_transient).
 module yarnfort_solver_newton
     use, intrinsic :: iso_c_binding
     use fsundials_context_mod
@@ -36,6 +38,11 @@ module yarnfort_solver_newton
     !> Times KINSOL goes on from its solution when the row levels taken there ask for
     !> a smaller residual than those of the initial guess.
     integer, parameter :: max_level_rounds = 4
+    !> Iterations of the pseudo-transient fallback, in units of max_iterations.
+    integer, parameter :: transient_iterations = 4
+    !> The fallback gives up when its shift exceeds this multiple of the row levels per
+    !> length (steps too short to matter).
+    real(wp), parameter :: max_transient_shift = 1.0e12_wp
     !> First weight of the regularising spring when a solve needs the predictor: a net
     !> of strings that all carry a tenth of their reference stiffness is regular and
     !> well conditioned from any start; the weight then falls by factors of 10.
@@ -315,6 +322,11 @@ contains
             end do
             if (converged) exit
         end do
+        if (.not. converged .and. self%options%line_search) then
+            ! Neither full nor line-searched Newton steps: pseudo-transient continuation.
+            call solve_transient(self, u, stats, converged, error)
+            if (allocated(error)) return
+        end if
         self%problem%n_history = min(self%problem%n_history + 1, size(self%problem%history))
         self%problem%history(self%problem%n_history) = stats%residual_norm
         stats%residual_history = self%problem%history(1:self%problem%n_history)
@@ -334,6 +346,102 @@ contains
         if (allocated(error)) return
         u = self%u
     end subroutine solve_once
+
+    !> Pseudo-transient continuation (switched evolution relaxation): Newton steps on
+    !> F(u) + mu D du = 0, D_i = level_i / length_scale, with mu falling as the scaled
+    !> residual f does (mu <- mu f_new / f_old) and a step that raises f rejected (mu
+    !> times 10). Far from the solution it follows a damped, implicit-Euler path that
+    !> handles stiff directions (an inextensible yarn) and slow ones (a ring sliding
+    !> along it) together, where a line search on |F| crawls; as mu -> 0 it is Newton.
+    !> Works on self%u from u; on success self%u is the solution, `converged` is set.
+    subroutine solve_transient(self, u, stats, converged, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        type(newton_stats_type), intent(inout) :: stats
+        logical, intent(out) :: converged
+        type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: trial_error
+        real(wp), allocatable :: residual(:), trial(:), values(:), step(:), shift(:)
+        real(wp), allocatable :: level(:), noise(:)
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        integer, allocatable :: diagonal(:)
+        integer :: i, k, iteration
+        real(wp) :: mu, f, merit, merit_trial
+
+        converged = .false.
+        associate(problem => self%problem%problem, n => size(u))
+            allocate(col_ptr(n + 1), row_index(self%problem%nnz), values(self%problem%nnz))
+            call problem%copy_pattern(col_ptr, row_index)
+            allocate(diagonal(n), source=0)
+            do i = 1, n
+                do k = int(col_ptr(i)) + 1, int(col_ptr(i + 1))
+                    if (row_index(k) == i - 1) diagonal(i) = k
+                end do
+            end do
+            if (any(diagonal == 0)) return
+            if (.not. self%adapter%analysed) then
+                call self%linear%analyse(int(n, ik), col_ptr, row_index, error)
+                if (allocated(error)) return
+                self%adapter%analysed = .true.
+            end if
+            call problem%prepare_solve(u, error)
+            if (allocated(error)) return
+            self%u = u
+            allocate(residual(n), step(n), level(n), noise(n), shift(n))
+            call problem%get_row_levels(self%u, level, noise, error)
+            if (allocated(error)) return
+            shift = max(level, tiny(1.0_wp)) / problem%length_scale
+            call set_row_weights(self, .false., error)
+            if (allocated(error)) return
+            call problem%evaluate_residual(self%u, residual, error)
+            if (allocated(error)) return
+            f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+            merit = norm2(residual * self%f_scale_data)
+            mu = 1.0_wp
+            do iteration = 1, transient_iterations * self%options%max_iterations
+                if (f <= self%options%residual_tolerance) exit
+                call problem%evaluate_jacobian(self%u, values, error)
+                if (allocated(error)) return
+                values(diagonal) = values(diagonal) + mu * shift
+                call self%linear%factor(values, trial_error)
+                stats%jacobian_evaluations = stats%jacobian_evaluations + 1
+                if (.not. allocated(trial_error)) then
+                    step = -residual
+                    call self%linear%solve(step, trial_error)
+                end if
+                if (.not. allocated(trial_error)) then
+                    trial = self%u + step
+                    call problem%evaluate_residual(trial, residual, trial_error)
+                    stats%residual_evaluations = stats%residual_evaluations + 1
+                end if
+                ! Accept a step that lowers the weighted 2-norm of the residual (a smooth
+                ! merit: the max-norm test stalls on steps that trade one row for another).
+                if (allocated(trial_error)) then
+                    deallocate(trial_error)
+                    merit_trial = huge(1.0_wp)
+                else
+                    merit_trial = norm2(residual * self%f_scale_data)
+                end if
+                if (merit_trial < merit) then
+                    stats%iterations = stats%iterations + 1
+                    self%u = trial
+                    mu = mu * merit_trial / merit
+                    ! The levels follow the state (as in solve_once).
+                    call set_row_weights(self, .false., error)
+                    if (allocated(error)) return
+                    f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+                    merit = norm2(residual * self%f_scale_data)
+                else
+                    mu = 10 * mu
+                    if (mu > max_transient_shift) exit
+                    call problem%evaluate_residual(self%u, residual, error)
+                    if (allocated(error)) return
+                end if
+            end do
+            stats%residual_norm = f
+            converged = f <= self%options%residual_tolerance
+        end associate
+    end subroutine solve_transient
 
     !> KINSOL's residual scaling from the problem's row levels at the current iterate:
     !> 1 / (level + noise / tol), so that |F_i| * weight_i <= tol is the row's test. A
