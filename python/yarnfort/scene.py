@@ -1,0 +1,2 @@
+# SPDX-License-Identifier: MIT
+"""Scene building (in progress)."""
