@@ -62,6 +62,15 @@ class Address:
 def parse_address(address: str) -> Address:
     """Parse ``'group.variable'``, ``'group[i].variable'`` or ``'group[name].variable'``.
 
+    Parameters
+    ----------
+    address : str
+        The address.
+
+    Returns
+    -------
+    Address
+
     Raises
     ------
     AddressError

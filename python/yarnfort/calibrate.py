@@ -147,6 +147,11 @@ def read_measured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.n
     +1/-1). Without one, the branch follows the sign of the strain increments. Lines
     starting with ``#`` are comments.
 
+    Parameters
+    ----------
+    path : path
+        The CSV file.
+
     Returns
     -------
     strain, force, branch : numpy.ndarray
@@ -354,6 +359,15 @@ def plot_fit(result: CalibrationResult, path: str | os.PathLike,
              title: str = "measured vs fitted") -> Path:
     """Plot the measured points (by branch) and the fitted simulated curve to a file.
 
+    Parameters
+    ----------
+    result : CalibrationResult
+        The fit.
+    path : path
+        The image to write.
+    title : str
+        Title above the fitted values.
+
     Returns
     -------
     pathlib.Path
@@ -395,6 +409,21 @@ def write_synthetic_curve(scene_path: str | os.PathLike, values: Mapping[str, An
     initial state, and adds seeded Gaussian noise of standard deviation ``noise`` times
     each point's force. The file starts with ``#`` lines saying it is synthetic: it is
     not a measurement.
+
+    Parameters
+    ----------
+    scene_path : path
+        The scene.
+    values : mapping
+        Parameter address -> value of the "true" parameters.
+    path : path
+        The CSV to write.
+    support, component, x_column, x_scale, force_scale
+        As in :func:`calibrate`.
+    noise : float
+        Relative standard deviation of the noise.
+    seed : int
+        Seed of the noise.
 
     Returns
     -------

@@ -422,7 +422,28 @@ class Scene:
         self._nodes = array.reshape(-1, 3)
 
     def add_material(self, name: str, law: str, **parameters: Any) -> Material:
-        """Add a :class:`Material` (keywords: its parameters); returns it."""
+        """Add a :class:`Material`.
+
+        Parameters
+        ----------
+        name : str
+            Unique material name.
+        law : str
+            ``'linear'``, ``'neo_hookean'`` or ``'table'``.
+        **parameters
+            The law's parameters (``stiffness``; ``modulus``, ``area``; ``table_file``),
+            ``prestress`` and any further ``&material`` variable.
+
+        Returns
+        -------
+        Material
+            The material added.
+
+        Raises
+        ------
+        SceneError
+            For a repeated name or a bad value.
+        """
         if any(m.name == name for m in self.materials):
             raise SceneError(f"&material name: {name!r} is given twice")
         known = {f.name for f in fields(Material)} - {"name", "law", "extra"}
@@ -433,7 +454,23 @@ class Scene:
 
     def add_contact(self, materials: tuple[str, str], law: str, **parameters: Any
                     ) -> Contact:
-        """Add a :class:`Contact` between two materials; returns it."""
+        """Add a :class:`Contact` between two materials.
+
+        Parameters
+        ----------
+        materials : tuple of str
+            The two material names (added before).
+        law : str
+            ``'bonded'``, ``'coulomb'``, ``'adhesion'`` or ``'decaying_adhesion'``.
+        **parameters
+            ``friction_coefficient``, ``adhesion``, ``decay_start``, ``decay_end`` and
+            any further ``&contact`` variable.
+
+        Returns
+        -------
+        Contact
+            The contact added.
+        """
         known = {f.name for f in fields(Contact)} - {"materials", "law", "extra"}
         contact = Contact(tuple(materials), law,
                           **{k: v for k, v in parameters.items() if k in known},
@@ -443,7 +480,22 @@ class Scene:
         return contact
 
     def add_yarn(self, material: str, nodes: ArrayLike, **variables: Any) -> Yarn:
-        """Add a :class:`Yarn` through the given node ids (from 1); returns it."""
+        """Add a :class:`Yarn`.
+
+        Parameters
+        ----------
+        material : str
+            Material name (added before).
+        nodes : array_like of int
+            Node ids along the yarn (from 1).
+        **variables
+            ``elements_per_segment`` and any further ``&yarn`` variable.
+
+        Returns
+        -------
+        Yarn
+            The yarn added.
+        """
         yarn = Yarn(material, nodes, variables.pop("elements_per_segment", None), variables)
         self._check_materials([material], "&yarn material")
         self._check_nodes(yarn.nodes, f"&yarn ({material}) nodes")
@@ -452,7 +504,26 @@ class Scene:
 
     def add_support(self, name: str, nodes: ArrayLike, fix: str | None = None,
                     displacement: ArrayLike | None = None, **variables: Any) -> Support:
-        """Add a named :class:`Support`; returns it."""
+        """Add a named :class:`Support`.
+
+        Parameters
+        ----------
+        name : str
+            Unique support name.
+        nodes : array_like of int
+            Node ids.
+        fix : str, optional
+            Prescribed components (default ``'xyz'``).
+        displacement : array_like of 3 floats, optional
+            Displacement at p_disp = 1 (m).
+        **variables
+            Any further ``&support`` variable.
+
+        Returns
+        -------
+        Support
+            The support added.
+        """
         if any(s.name == name for s in self.supports):
             raise SceneError(f"&support name: {name!r} is given twice")
         support = Support(name, nodes, fix, displacement, variables)
@@ -461,7 +532,22 @@ class Scene:
         return support
 
     def add_load(self, nodes: ArrayLike, force: ArrayLike, **variables: Any) -> Load:
-        """Add a :class:`Load` (force per node at p_force = 1); returns it."""
+        """Add a :class:`Load`.
+
+        Parameters
+        ----------
+        nodes : array_like of int
+            Node ids.
+        force : array_like of 3 floats
+            Force on each node at p_force = 1 (N).
+        **variables
+            Any further ``&load`` variable.
+
+        Returns
+        -------
+        Load
+            The load added.
+        """
         load = Load(nodes, force, variables)
         self._check_nodes(load.nodes, "&load nodes")
         self.loads.append(load)
@@ -536,7 +622,18 @@ class Scene:
         return make_namelist(groups)
 
     def write(self, path: str | os.PathLike) -> Path:
-        """Write the scene as a namelist file; returns the path written."""
+        """Write the scene as a namelist file.
+
+        Parameters
+        ----------
+        path : str or path
+            The file to write (parent folders are created).
+
+        Returns
+        -------
+        pathlib.Path
+            The path written.
+        """
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         self.to_namelist().write(str(path), force=True)
@@ -545,6 +642,15 @@ class Scene:
     @classmethod
     def from_namelist(cls, nml: f90nml.Namelist) -> Scene:
         """Build a scene from a namelist (:func:`yarnfort.read_scene`).
+
+        Parameters
+        ----------
+        nml : f90nml.Namelist
+            The namelist.
+
+        Returns
+        -------
+        Scene
 
         Raises
         ------
@@ -582,7 +688,17 @@ class Scene:
 
     @classmethod
     def read(cls, path: str | os.PathLike) -> Scene:
-        """Read a scene from a namelist file."""
+        """Read a scene from a namelist file.
+
+        Parameters
+        ----------
+        path : str or path
+            The namelist file.
+
+        Returns
+        -------
+        Scene
+        """
         return cls.from_namelist(read_scene(path))
 
     # -- running ------------------------------------------------------------------------

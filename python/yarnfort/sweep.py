@@ -182,8 +182,19 @@ def run_patched(scene_path: str | os.PathLike, values: Mapping[str, Any],
 
 def parameter_grid(parameters: Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]]
                    ) -> list[dict[str, Any]]:
-    """The runs of a sweep: the Cartesian product of a dict of lists (first key varies
-    slowest), or an explicit list of dicts, as a list of dicts."""
+    """The runs of a sweep.
+
+    Parameters
+    ----------
+    parameters : dict of lists, or list of dicts
+        Address -> values (every combination; the first key varies slowest), or an
+        explicit list of runs.
+
+    Returns
+    -------
+    list of dict
+        One dict address -> value per run.
+    """
     if isinstance(parameters, Mapping):
         names = list(parameters)
         return [dict(zip(names, combo))
