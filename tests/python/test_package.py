@@ -56,6 +56,16 @@ def test_version_comes_from_meson_build():
     assert out.strip() == f"yarnfort {project}"
 
 
+def test_citation_names_this_version_and_the_paper():
+    yaml = pytest.importorskip("yaml")
+    citation = yaml.safe_load((TOP / "CITATION.cff").read_text())
+    assert citation["version"] == yarnfort.__version__
+    assert citation["license"] == "MIT"
+    dois = [reference.get("doi") for reference in citation["references"]]
+    assert "10.3390/lubricants6020033" in dois
+    assert "The yarnfort developers" in (TOP / "LICENSE").read_text()
+
+
 def test_console_command_is_the_program(workdir):
     command = Path(sys.executable).parent / "yarnfort"
     assert command.is_file(), "the yarnfort console command is not installed"
