@@ -13,7 +13,6 @@ yarn or material ids, contact state, ...) are kept in :attr:`State.point_data` a
 from __future__ import annotations
 
 import csv
-import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -302,7 +301,3 @@ def read_run(folder: str | Path) -> tuple[Curve, list[State]]:
     states : list of State
     """
     return read_curve(folder), read_states(folder)
-
-
-def _finite(value: float) -> bool:
-    return math.isfinite(value)

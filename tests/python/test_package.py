@@ -302,3 +302,59 @@ def test_pip_install_in_a_fresh_venv(tmp_path):
     version = subprocess.run([str(venv / "bin" / "yarnfort"), "--version"],
                              capture_output=True, text=True, check=True).stdout
     assert version.startswith("yarnfort ")
+
+
+INTERRUPTED_RUN = r"""
+import sys, yarnfort
+def report(step):
+    print("STEP", step.step, flush=True)
+try:
+    yarnfort.run_scene(sys.argv[1], progress=report)
+except yarnfort.RunInterrupted as stop:
+    print("INTERRUPTED", stop.result.n_steps, stop.result.outcome, flush=True)
+    sys.exit(130)
+print("FINISHED", flush=True)
+"""
+
+
+def test_ctrl_c_from_outside_keeps_the_converged_steps(workdir):
+    """SIGINT sent by another process while the library solves: the run stops at the
+    next step boundary, and the kept rows match the steps reported."""
+    scene = patched(Path("inputs/knit.nml"), workdir / "slow.nml",
+                    solver__max_step=0.002, solver__initial_step=0.002,
+                    output__folder="out/slow")
+    proc = subprocess.Popen([sys.executable, "-c", INTERRUPTED_RUN, str(scene)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        for line in proc.stdout:
+            if line.startswith("STEP 3"):
+                proc.send_signal(signal.SIGINT)
+                break
+        out, err = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130, err
+    last = [line for line in out.splitlines() if line.startswith("INTERRUPTED")]
+    assert last, out + err
+    _, n_steps, outcome = last[0].split()
+    assert outcome == "interrupted" and int(n_steps) >= 4
+    curve = yarnfort.read_curve(workdir / "out" / "slow")
+    assert len(curve) == int(n_steps)
+    assert curve["time"][-1] < 4.0  # stopped before the end of the path
+    assert (workdir / "out" / "slow" / "restart.dat").is_file()
+
+
+def test_states_read_alike_with_and_without_meshio(workdir):
+    pytest.importorskip("meshio")
+    from yarnfort import results
+
+    run = yarnfort.run_scene("inputs/capstan.nml")
+    for path in sorted(run.folder.glob("state_*.vtu"))[-2:]:
+        state = results.read_state(path)
+        try:
+            points, elements, _, cells = results._read_ascii(path)
+        except results.ResultError:
+            pytest.skip("the states are binary: only meshio reads them")
+        np.testing.assert_array_equal(state.position, points)
+        np.testing.assert_array_equal(state.elements, elements)
+        np.testing.assert_array_equal(state.tension, cells["tension"])
