@@ -119,11 +119,51 @@ def _variables(obj: Any, skip: tuple[str, ...] = ()) -> dict[str, Any]:
     return out
 
 
+def _expanded(group: f90nml.Namelist) -> dict[str, Any]:
+    """The variables of a read group, each array from its first entry: f90nml keeps
+    ``x(2) = 5`` as ``[5]`` with a start index; entries before it become None (a null
+    value when written, so the default stays)."""
+    starts = getattr(group, "start_index", {}) or {}
+    out: dict[str, Any] = {}
+    for key, value in group.items():
+        start = starts.get(key)
+        if start and len(start) == 1 and start[0] is not None and start[0] > 1:
+            value = [None] * (start[0] - 1) + (list(value) if isinstance(value, list)
+                                                else [value])
+        out[key] = value
+    return out
+
+
 def _split(group: f90nml.Namelist, names: tuple[str, ...]) -> tuple[dict, dict]:
     """Variables of a read group: those a class names, and the rest."""
-    known = {key: value for key, value in group.items() if key in names}
-    extra = {key: value for key, value in group.items() if key not in names}
+    variables = _expanded(group)
+    known = {key: value for key, value in variables.items() if key in names}
+    extra = {key: value for key, value in variables.items() if key not in names}
     return known, extra
+
+
+#: Array variables whose unset entries take the default 0 (``displacement(2) = -0.3``
+#: leaves the first and third at 0), with the length they have.
+_ZERO_FILLED: dict[tuple[str, str], int | None] = {
+    ("support", "displacement"): 3, ("load", "force"): 3,
+    ("path", "p_force"): None, ("path", "p_disp"): None,
+}
+
+
+def _defaults_filled(group: str, variables: dict[str, Any]) -> dict[str, Any]:
+    """Variables as read from a namelist, with the entries a namelist may leave unset
+    (f90nml gives None, or a shorter list) set to their default 0."""
+    out = dict(variables)
+    for (name, variable), length in _ZERO_FILLED.items():
+        if name != group or variable not in out:
+            continue
+        values = out[variable]
+        values = list(values) if isinstance(values, list) else [values]
+        values = [0.0 if value is None else value for value in values]
+        if length is not None and len(values) < length:
+            values += [0.0] * (length - len(values))
+        out[variable] = values
+    return out
 
 
 @dataclass
@@ -662,7 +702,7 @@ class Scene:
             groups = list(content) if isinstance(content, list) else [content]
             if key in _SETTINGS:
                 for group in groups:
-                    getattr(scene, key).update(group)
+                    getattr(scene, key).update(_expanded(group))
             elif key == "nodes":
                 known, scene.nodes_extra = _split(groups[0], ("xyz",))
                 scene.nodes = known.get("xyz")
@@ -675,7 +715,7 @@ class Scene:
                 objects = []
                 for group in groups:
                     known, extra = _split(group, names)
-                    objects.append(kind(**known, extra=extra))
+                    objects.append(kind(**_defaults_filled(key, known), extra=extra))
                 if repeated:
                     getattr(scene, {"material": "materials", "contact": "contacts",
                                     "yarn": "yarns", "support": "supports",

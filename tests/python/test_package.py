@@ -259,6 +259,33 @@ def test_fabric_and_geometry_scenes(workdir):
     scene.check()
 
 
+def test_round_trip_of_partly_set_arrays(workdir, run_yarnfort):
+    """A namelist may set single entries (``displacement(2) = ...``) or fewer values; the
+    others keep their default 0, and so they do after the round trip."""
+    text = Path("inputs/capstan.nml").read_text()
+    text, count = re.subn(r"displacement = 0.0, -0.3, 0.0", "displacement(2) = -0.3", text)
+    assert count == 1
+    text = text.replace("out/capstan", "out/partial")
+    (workdir / "partial.nml").write_text(text)
+    cli = run_yarnfort(text, cwd=workdir)
+    assert cli.returncode == 0, cli.stderr
+    echoed = (workdir / "out" / "partial" / "input.nml").read_text()
+    scene = Scene.read(workdir / "partial.nml")
+    assert list(scene.supports[1].displacement) == [0.0, -0.3, 0.0]
+    yarnfort.run_scene(scene.write(workdir / "again.nml"))
+    assert (workdir / "out" / "partial" / "input.nml").read_text() == echoed
+    # A variable Scene keeps as it is (&fabric cells): the first entry stays default.
+    text = Path("inputs/knit.nml").read_text().replace("out/knit", "out/cells")
+    text, count = re.subn(r"cells = 2, 2", "cells(2) = 1", text)
+    assert count == 1
+    (workdir / "cells.nml").write_text(text)
+    run = yarnfort.run_scene(workdir / "cells.nml")
+    echoed = (run.folder / "input.nml").read_text()
+    assert re.search(r"cells\s*=\s*4,\s*1", echoed), echoed
+    yarnfort.run_scene(Scene.read(workdir / "cells.nml").write(workdir / "cells2.nml"))
+    assert (run.folder / "input.nml").read_text() == echoed
+
+
 def test_make_namelist_writes_repeated_groups(tmp_path):
     nml = yarnfort.make_namelist({"material": [{"name": "a", "law": "linear"},
                                                {"name": "b", "law": "linear"}],
