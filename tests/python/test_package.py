@@ -171,6 +171,13 @@ def test_max_steps_and_restart_as_the_cli(workdir, run_yarnfort):
     cli_again = re.sub(r"(?i)&control", "&control\n    restart = .true.", cli_text, count=1)
     assert run_yarnfort(cli_again, cwd=workdir).returncode == 0
     same_curve(second.curve, yarnfort.read_curve(workdir / "out" / "cli"))
+    # A run stopped by the program goes on in Python: the same restart file and input.
+    mixed = patched(scene, workdir / "mixed.nml", output__folder="out/mixed")
+    assert run_yarnfort(mixed.read_text(), cwd=workdir).returncode == 0
+    going_on = yarnfort.run_scene(patched(mixed, workdir / "mixed2.nml",
+                                          control__restart=True))
+    assert going_on.outcome == "max_steps" and len(going_on.curve) == 7
+    same_curve(going_on.curve, second.curve)
 
 
 def test_errors_raise_with_message_and_category(workdir):
