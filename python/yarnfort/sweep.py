@@ -60,6 +60,8 @@ DEFAULT_TIMEOUT = 600.0
 STATUS = {0: "ok", 1: "solve_failed", 2: "bad_input"}
 
 _COMPONENTS = {"x": 0, "y": 1, "z": 2}
+#: Row key set when the summarised support is not in a run's curve.
+_UNKNOWN_SUPPORT = "_unknown_support"
 
 
 def _patched_text(scene: f90nml.Namelist, values: Mapping[str, Any], folder: Path,
@@ -82,7 +84,7 @@ def _patched_text(scene: f90nml.Namelist, values: Mapping[str, Any], folder: Pat
 class _Task:
     """One run, self-contained and picklable (sent to worker processes)."""
 
-    program: str
+    program: str | None  # None: the worker's own installation
     cwd: str
     text: str
     folder: str | None
@@ -110,7 +112,8 @@ def _execute(task: _Task) -> dict[str, Any]:
         (folder / "input.nml").write_text(text)
         env = dict(os.environ)
         env.setdefault("OMP_NUM_THREADS", "1")  # one core per run: runs are the parallelism
-        proc = subprocess.run([task.program], input=text, capture_output=True, text=True,
+        program = task.program or str(program_path())
+        proc = subprocess.run([program], input=text, capture_output=True, text=True,
                               cwd=task.cwd, timeout=task.timeout, env=env)
         row["status"] = STATUS.get(proc.returncode, "error")
         if proc.returncode != 0:
@@ -120,7 +123,14 @@ def _execute(task: _Task) -> dict[str, Any]:
         if curve_file.is_file():
             curve = read_curve(curve_file)
             row["n_steps"] = len(curve["step"])
-            if proc.returncode == 0:
+            known = [name[:-3] for name in curve.names if name.endswith("_rx")]
+            if proc.returncode == 0 and task.support not in known:
+                # Only a generated &fabric names supports the scene file does not list.
+                row["status"] = "error"
+                row["error"] = (f"support {task.support!r} is not in the curve; supports: "
+                                + ", ".join(known))
+                row[_UNKNOWN_SUPPORT] = known
+            elif proc.returncode == 0:
                 row["final_reaction"], row["max_reaction"] = _summary(
                     curve, task.support, task.component)
     except subprocess.TimeoutExpired:
@@ -324,8 +334,10 @@ def run_sweep(scene_path: str | os.PathLike,
     Raises
     ------
     ValueError
-        For a malformed parameter address or an unknown component; the program's
-        failures do not raise (they are rows).
+        For a malformed parameter address, an unknown component, or a support the scene
+        does not have (checked before any run against its ``&support`` groups; for a
+        generated ``&fabric``, on the runs' curves); the program's failures do not raise
+        (they are rows).
     FileNotFoundError
         If the installation has no program.
     """
@@ -344,7 +356,7 @@ def run_sweep(scene_path: str | os.PathLike,
         component = _COMPONENTS[component.lower()]
     elif component is not None and component not in (0, 1, 2):
         raise ValueError(f"component {component!r}: expected 0, 1 or 2")
-    program = str(program_path())
+    program = None if scheduler is not None else str(program_path())
     cwd = os.getcwd()
     tasks = []
     for i, run in enumerate(runs):
@@ -362,6 +374,10 @@ def run_sweep(scene_path: str | os.PathLike,
                 rows = _run_tasks(tasks, executor, bar)
     finally:
         bar.close()
+    unknown = next((row[_UNKNOWN_SUPPORT] for row in rows if _UNKNOWN_SUPPORT in row), None)
+    if unknown is not None:
+        raise ValueError(f"support {support!r}: the scene's runs have supports "
+                         + ", ".join(unknown))
     table = {name: _column([run.get(name) for run in runs]) for name in names}
     for key in ("status", "error", "n_steps", "final_reaction", "max_reaction",
                 "wall_time"):

@@ -64,6 +64,13 @@ def test_sweep_with_an_unknown_support_fails_before_any_run(tmp_path):
         yarnfort.run_sweep(CAPSTAN, {"contact friction": [0.1]}, progress=False)
 
 
+def test_sweep_of_a_fabric_with_an_unknown_support_raises(tmp_path, monkeypatch):
+    monkeypatch.chdir(TOP)  # the knit's tables are relative to the repository root
+    with pytest.raises(ValueError, match="support 'nope': the scene's runs have supports"):
+        yarnfort.run_sweep("inputs/knit.nml", {"solver.max_step": [0.25]}, support="nope",
+                           progress=False, workers=1)
+
+
 def test_calibrate_errors_name_what_is_wrong(tmp_path):
     measured = tmp_path / "measured.csv"
     measured.write_text("strain,force\n0.1,1.0\n0.2,2.0\n0.3,3.0\n")
