@@ -4,15 +4,13 @@ import yarnfort
 from yarnfort.plots import plot_fabric_hysteresis, plot_hysteresis, save_figure
 
 rig = yarnfort.Scene("yarn over three pegs", output={"folder": "out/rig"})  # VTK states there
-for name in ("yarn", "peg"):
-    rig.add_material(name, "linear", stiffness=10.0)
-rig.add_contact(("yarn", "peg"), "adhesion", friction_coefficient=0.3, adhesion=0.05)
+rig.add_material("yarn", "linear", stiffness=10.0)
+rig.add_contact(("yarn", "yarn"), "adhesion", friction_coefficient=0.3, adhesion=0.05)
 pegs = np.c_[np.cos(np.radians([150, 90, 30])), np.sin(np.radians([150, 90, 30])), [0, 0, 0]]
 rig.nodes = np.vstack([[-1, -1, 0], pegs, [1, -1, 0], 0.8 * pegs])  # ids 1..8
-rig.add_yarn("yarn", [1, 2, 3, 4, 5])
-for peg in (2, 3, 4):
-    rig.add_yarn("peg", [peg, peg + 4])
-rig.add_support("fixed", [1]), rig.add_support("pegs", [2, 3, 4, 6, 7, 8])
+for nodes in ([1, 2, 3, 4, 5], [2, 6], [3, 7], [4, 8]):  # the yarn, then three pegs
+    rig.add_yarn("yarn", nodes)
+rig.add_support("held", [1, 2, 3, 4, 6, 7, 8])
 rig.add_support("pull", [5], displacement=[0, -0.3, 0])
 rig.path = yarnfort.LoadPath(time=[0, 1, 2], p_disp=[0, 1, 0])  # pull, release
 
@@ -20,9 +18,8 @@ knit = yarnfort.Scene("knitted jersey", output={"folder": "out/jersey"})
 knit.add_material("knit", "linear", stiffness=5.0, prestress=0.02)
 knit.add_contact(("knit", "knit"), "adhesion", friction_coefficient=0.4, adhesion=0.015)
 knit.fabric = yarnfort.Fabric("knit", cells=[2, 2], spacing=[1e-3, 0.8e-3], knit_material="knit")
-knit.path = yarnfort.LoadPath(time=[0, 1, 2], p_disp=[0, 1, 0])  # stretch to 2x, release
+knit.path = rig.path  # stretch to twice the length, release
 
 rig_run, knit_run = rig.run(progress=True), knit.run(progress=True)
 save_figure(plot_hysteresis(rig_run.curve, "pull"), "out/rig.png")
 save_figure(plot_fabric_hysteresis(knit_run.curve), "out/jersey.png")
-print(f"rig: {len(rig_run.curve)} steps, {len(rig_run.states)} VTK states in {rig_run.folder}")
