@@ -23,6 +23,10 @@ module yarnfort_facade
     ! For run_scene_file (outside the module); not wrapped by f2py.
     public :: set_status, cut_text
 
+    !> Status of a law or parameter the library refuses (the program's exit code for
+    !> bad input).
+    integer(c_int), parameter :: status_bad_law = 2_c_int
+
     !> Marker that ends a message cut to fit its string.
     character(len=*), parameter :: cut_marker = ' [...]'
 
@@ -53,6 +57,8 @@ contains
         dforce = real(dforce_wp, c_double)
         energy = real(energy_wp, c_double)
         call set_status(error, status, message)
+        ! A law the library refuses is bad input, like a bad &material in a scene.
+        if (status /= 0_c_int) status = status_bad_law
     end subroutine force_law_eval
 
     !> Critical tension T_crit(T_min, alpha) of a friction law and its derivatives with
@@ -80,6 +86,7 @@ contains
         dcrit_dtension = real(dtension_wp, c_double)
         dcrit_dangle = real(dangle_wp, c_double)
         call set_status(error, status, message)
+        if (status /= 0_c_int) status = status_bad_law
     end subroutine friction_critical_tension
 
     !> Status 0 and a blank message without an error, else the error's status (at least 1)

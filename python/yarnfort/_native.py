@@ -41,8 +41,9 @@ class YarnfortError(RuntimeError):
     Attributes
     ----------
     status : int
-        The program's exit code for it: 1 for a failed solve (or a bad law parameter),
-        2 for bad input, a bad restart file or an unusable output folder.
+        The program's exit code for it: 1 for a failed solve, 2 for bad input (a law or
+        parameter the library refuses included), a bad restart file or an unusable
+        output folder.
     category : str
         ``'solve_failed'`` (status 1) or ``'bad_input'`` (status 2).
     result : object or None

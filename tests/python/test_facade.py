@@ -89,7 +89,7 @@ def test_empty_input_still_checks_the_law():
 def test_negative_stiffness_raises_naming_the_value():
     with pytest.raises(YarnfortError, match=r"stiffness -2\b") as info:
         yarnfort.force_law("linear", [1.0, 1.1], stiffness=-2.0)
-    assert info.value.status != 0
+    assert (info.value.status, info.value.category) == (2, "bad_input")
 
 
 def test_bad_neo_hookean_area_and_unknown_law_raise():
