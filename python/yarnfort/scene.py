@@ -24,14 +24,17 @@ files, the output folder) are taken from the working directory of the run, as fo
 
 Example
 -------
->>> import numpy as np, yarnfort
->>> scene = yarnfort.Scene(title="V-net")
->>> scene.add_material("yarn", "linear", stiffness=100.0)
->>> scene.nodes = np.array([[-1.0, 0, 0], [0, 0, 0], [1, 0, 0]])
->>> scene.add_yarn("yarn", [1, 2, 3])
->>> scene.add_support("ends", [1, 3])
->>> scene.add_load([2], force=[0, -1.0, 0])
->>> scene.path = yarnfort.LoadPath(time=[0, 1], p_force=[0, 1])
+A V-shaped string under a point load (``inputs/vnet.nml`` built in Python)::
+
+    import numpy as np, yarnfort
+    scene = yarnfort.Scene("V-net", output={"folder": "out/vnet_py"})
+    scene.add_material("yarn", "linear", stiffness=100.0)
+    scene.nodes = np.array([[-1.0, 0, 0], [0, 0, 0], [1, 0, 0]])
+    scene.add_yarn("yarn", [1, 2, 3])
+    scene.add_support("ends", [1, 3])
+    scene.add_load([2], force=[0, -1.0, 0])
+    scene.path = yarnfort.LoadPath(time=[0, 1], p_force=[0, 1])
+    result = scene.run(progress=True)
 """
 from __future__ import annotations
 
@@ -444,6 +447,15 @@ class Scene:
         self.control: dict[str, Any] = dict(control or {})
         if title is not None:
             self.control["title"] = title
+
+    def __repr__(self) -> str:
+        source = ("fabric" if self.fabric is not None else "geometry"
+                  if self.geometry is not None else
+                  f"{len(self._nodes)} nodes" if self._nodes is not None else "no nodes")
+        title = self.control.get("title")
+        return (f"Scene({title!r}: {len(self.materials)} materials, {len(self.contacts)}"
+                f" contacts, {source}, {len(self.yarns)} yarns, {len(self.supports)}"
+                f" supports, {len(self.loads)} loads)")
 
     # -- building -------------------------------------------------------------------
     @property
