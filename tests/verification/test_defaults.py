@@ -264,3 +264,301 @@ def test_capstan_full_curve_with_defaults(run_yarnfort, tmp_path, k, law_name):
     T = EA (l/L0 - 1) with L0 unchanged."""
     net, curve, states = run_capstan(run_yarnfort, tmp_path, "capstan", k, law_name)
     check_capstan(net, k, law_name, curve, states)
+
+
+# ======================================================================================
+# 2. One pin loaded and unloaded twice (test_hysteresis's play operator), defaults.
+
+def without_solver(text: str) -> str:
+    """The namelist text with its &solver group taken out (defaults)."""
+    out = re.sub(r"&solver\n(?:[^/\n][^\n]*\n)*/\n", "", text)
+    assert "&solver" not in out and out.count("&") == text.count("&") - 1
+    return out
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_hysteresis_loops_with_defaults(run_yarnfort, tmp_path, name):
+    """test_hysteresis's scene (one yarn over one pin, pulled and released twice) without
+    any &solver group, against its piecewise closed form (the play operator
+    s(d) = clip(s_old, s_f(d), s_r(d)) with exact quadratic / bisection roots of the
+    slip relations, evaluated at the run's own d): the force at every step, both element
+    tensions, the stick/slip flag at every step, the loop area of each cycle and the
+    permanent sliding left after each release."""
+    case = Case(**CASES[name].__dict__)
+    run = run_yarnfort(without_solver(hysteresis_scene(case)), cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    cmp = compare(case, tmp_path / "out")
+    area, area_exact = cmp.areas()
+    scale = np.max(cmp.tension_exact)
+    errors = dict(
+        force=cmp.force_error(),
+        tension=float(np.max(np.abs(cmp.tension - cmp.tension_exact)) / scale),
+        area=float(np.max(np.abs(area - area_exact) / area_exact)),
+        sliding=float(max(abs(cmp.s[i] - cmp.s_exact[i]) / cmp.s_exact[i]
+                          for i in cmp.unload_steps)),
+        length0=float(np.max(np.abs(cmp.s - cmp.s_exact)) / case.length_a))
+    print(f"hysteresis {name}: {len(cmp.d)} steps, flag mismatches {cmp.flag_mismatches()}, "
+          f"errors {', '.join(f'{n} {v:.1e}' for n, v in errors.items())}")
+    for phase in ("stick", "forward", "reverse"):
+        assert phase in cmp.phases[1:]
+    assert np.all(area_exact > 0) and all(cmp.s_exact[i] > 0 for i in cmp.unload_steps)
+    assert cmp.flag_mismatches() == []
+    for key, value in errors.items():
+        assert value <= (POSITION_RTOL if key == "length0" else FORCE_RTOL), (key, value)
+
+
+# ======================================================================================
+# 3-4. A ring on a yarn between two supports at different heights.
+
+RING_A = np.array([-1.0, 0.4, 0.0])
+RING_B = np.array([1.0, 0.0, 0.0])
+#: Load P (N) hanging from the ring by a stub yarn of stiffness STUB_EA (N).
+RING_LOAD = 1.0
+STUB_EA = 10.0
+STUB_LENGTH = 0.3
+#: Yarn stiffness EA (N): soft (strains of a few per cent) and nearly inextensible.
+RING_STIFFNESS = {"soft": 10.0 * RING_LOAD, "stiff": 1e6 * RING_LOAD}
+#: The load ramps from 5 % of P (at the first state, solved from the stress-free
+#: input) to P; the frictionless ring is also run from zero load.
+FIRST_LOAD = 0.05
+#: Scene size (m) for position tolerances: the span A-B.
+RING_SIZE = float(np.linalg.norm(RING_B - RING_A))
+
+
+def ring_namelist(start, stiffness: float, mu: float, units=(1.0, 1.0),
+                  first_load: float = FIRST_LOAD) -> str:
+    """Nodes A = 1 and B = 3 held, the ring R = 2 (starting at `start`, stress free),
+    S = 4 the far end of the stub R-S hanging below R, loaded by (0, -P, 0). The yarn
+    1-2-3 passes through R, the stub ends there: R is a contact node, Coulomb with mu."""
+    a, f = units
+    start = np.asarray(start, float)
+    nodes = a * np.array([RING_A, start, RING_B, start - [0.0, STUB_LENGTH, 0.0]])
+    return defaults_namelist(
+        nodes, [dict(material="yarn", nodes=[1, 2, 3]), dict(material="stub", nodes=[2, 4])],
+        [dict(name="a", nodes=[1], fix="xyz"), dict(name="b", nodes=[3], fix="xyz")],
+        [dict(nodes=[4], force=[0.0, -f * RING_LOAD, 0.0])],
+        [dict(name="yarn", law="linear", stiffness=f * stiffness),
+         dict(name="stub", law="linear", stiffness=f * STUB_EA)],
+        dict(time=[0.0, 1.0], p_force=[first_load, 1.0], p_disp=[0.0, 0.0]),
+        [dict(materials=["yarn", "stub"], law="coulomb", friction_coefficient=mu)])
+
+
+def frictionless_ring(length0: float, stiffness: float, load: float):
+    """mu = 0: equal tensions T on both sides, so the load's line bisects the angle at
+    the ring and both segments make the same angle theta with the vertical. Horizontal
+    span b = L sin(theta), L = l1 + l2 the stretched length; heights: (l2 - l1) cos(theta)
+    = h (B above A by h); vertical equilibrium 2 T cos(theta) = P; linear law
+    L = L0 (1 + T/EA). So theta is the root of L0 (1 + P/(2 EA cos theta)) sin theta = b
+    (increasing in theta), l1 = (L - h/cos theta)/2 and R = A + l1 (sin theta, -cos theta).
+    For EA -> infinity R is the lowest point of the ellipse with foci A, B and major
+    axis L0. Returns R, T, L."""
+    b, h = RING_B[0] - RING_A[0], RING_B[1] - RING_A[1]
+    total = lambda theta: length0 * (1.0 + load / (2.0 * stiffness * np.cos(theta)))  # noqa
+    theta = optimize.brentq(lambda x: total(x) * np.sin(x) - b, 0.0, 0.5 * np.pi * (1 - 1e-12),
+                            xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
+    length = total(theta)
+    l1 = 0.5 * (length - h / np.cos(theta))
+    ring = RING_A + l1 * np.array([np.sin(theta), -np.cos(theta), 0.0])
+    return ring, load / (2.0 * np.cos(theta)), length
+
+
+def lower_intersection(l1: float, l2: float) -> np.ndarray:
+    """The lower intersection of the circles of radius l1 about A and l2 about B."""
+    e = RING_B - RING_A
+    d = np.linalg.norm(e)
+    e = e / d
+    a = (l1 * l1 - l2 * l2 + d * d) / (2.0 * d)
+    assert l1 * l1 >= a * a, "the circles do not meet"
+    h = np.sqrt(l1 * l1 - a * a)
+    normal = np.array([e[1], -e[0], 0.0])            # points downwards for A left of B
+    return RING_A + a * e + h * normal
+
+
+def stuck_ring(split: float, length0: float, stiffness: float, load: float):
+    """The ring held at a fixed split of the reference length (L0 = split on the A side,
+    length0 - split on the B side): an elastic V. Unknowns T1, T2: the segment lengths
+    l_i = L0_i (1 + T_i/EA) place R at the circles' lower intersection, and R's
+    equilibrium T1 u1 + T2 u2 = (0, P) closes the two equations (scipy root, started
+    from the statics of the unstretched V). Returns R, (T1, T2), alpha."""
+    def place(t):
+        ring = lower_intersection(split * (1 + t[0] / stiffness),
+                                  (length0 - split) * (1 + t[1] / stiffness))
+        u = np.array([RING_A - ring, RING_B - ring])[:, :2]
+        return ring, u / np.linalg.norm(u, axis=1)[:, None]
+
+    def residual(t):
+        u = place(t)[1]
+        return (t[0] * u[0] + t[1] * u[1] - [0.0, load]) / load
+
+    guess = np.linalg.solve(place([0.0, 0.0])[1].T, [0.0, load])
+    sol = optimize.root(residual, guess, method="hybr", options=dict(xtol=1e-15))
+    assert np.max(np.abs(residual(sol.x))) < 1e-13, sol
+    ring, u = place(sol.x)
+    alpha = np.pi - np.arctan2(abs(u[0, 0] * u[1, 1] - u[0, 1] * u[1, 0]), u[0] @ u[1])
+    return ring, sol.x, alpha
+
+
+def statics_at(ring: np.ndarray, load: float):
+    """Tensions T1, T2 that hold a ring at `ring` under the load (2x2 statics) and alpha."""
+    u = np.array([RING_A - ring, RING_B - ring])[:, :2]
+    u = u / np.linalg.norm(u, axis=1)[:, None]
+    t = np.linalg.solve(u.T, [0.0, load])
+    return t, np.pi - np.arctan2(abs(u[0, 0] * u[1, 1] - u[0, 1] * u[1, 0]), u[0] @ u[1])
+
+
+def admissible_splits(length0: float, stiffness: float, load: float, mu: float):
+    """The splits s of the stuck ring where T_max <= T_min exp(mu alpha): an interval
+    [s_lo, s_hi] (g1 = T1 - T2 e^(mu alpha) falls and g2 = T2 - T1 e^(mu alpha) rises
+    with s), its ends found by brentq on g1 and g2 (s_lo = s_hi for mu = 0)."""
+    def g(s, side):
+        _, t, alpha = stuck_ring(s, length0, stiffness, load)
+        assert np.all(t > 0.0)
+        return (t[0] - t[1] * np.exp(mu * alpha)) if side == 1 else \
+            (t[1] - t[0] * np.exp(mu * alpha))
+
+    # Bracket: a grid over the splits where the circles meet, keeping the points where
+    # the stuck V holds the load in tension on both sides.
+    d = np.linalg.norm(RING_B - RING_A)
+    grid = []
+    for s in np.linspace(0.5 * (length0 - d), 0.5 * (length0 + d), 42)[1:-1]:
+        try:
+            grid.append((s, g(s, 1), g(s, 2)))
+        except AssertionError:
+            continue
+    tol = dict(xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=500)
+    ends = []
+    for side in (1, 2):
+        change = [(a[0], b[0]) for a, b in zip(grid, grid[1:])
+                  if a[side] * b[side] <= 0.0]
+        assert len(change) == 1, (side, change)
+        ends.append(optimize.brentq(lambda s: g(s, side), *change[0], **tol))
+    return tuple(ends)
+
+
+def run_ring(run_yarnfort, tmp_path, name, start, stiffness, mu, units=(1.0, 1.0),
+             first_load=FIRST_LOAD):
+    folder = tmp_path / name
+    folder.mkdir()
+    run = run_yarnfort(ring_namelist(start, stiffness, mu, units, first_load), cwd=folder)
+    assert run.returncode == 0, run.stderr
+    curve, states = read_curve(folder / "out"), read_states(folder / "out")
+    assert len(states) == len(curve["step"])
+    return curve, states
+
+
+def ring_errors(curve, states, rings, tensions, stiffness) -> dict:
+    """Worst errors over the loaded steps: ring and stub-end positions (fraction of the
+    scene size), both tensions and both reactions (relative to the step's load)."""
+    errors = dict(ring=0.0, stub_end=0.0, tension=0.0, reaction=0.0)
+    for i in range(len(states)):
+        load = curve["p_force"][i] * RING_LOAD
+        if load == 0.0:
+            continue                    # stress free: test_zero_load covers it
+        x = states[i].position
+        ring, t = rings[i], tensions[i]
+        end = ring - [0.0, STUB_LENGTH * (1 + load / STUB_EA), 0.0]
+        u = np.array([RING_A - ring, RING_B - ring])     # reaction on the net at A, B
+        u /= np.linalg.norm(u, axis=1)[:, None]
+        reactions = np.vstack([curve.reaction("a")[i], curve.reaction("b")[i]])
+        errors["ring"] = max(errors["ring"], np.max(np.abs(x[1] - ring)) / RING_SIZE)
+        errors["stub_end"] = max(errors["stub_end"], np.max(np.abs(x[3] - end)) / RING_SIZE)
+        errors["tension"] = max(errors["tension"],
+                                np.max(np.abs(states[i].tension[:2] - t)) / load)
+        errors["reaction"] = max(errors["reaction"],
+                                 np.max(np.abs(reactions - t[:, None] * u)) / load)
+    return errors
+
+
+def test_frictionless_ring_reference_is_the_ellipse():
+    """The references of the ring against each other and against the ellipse: for mu = 0
+    the admissible interval of the stuck-ring solve is one split, whose ring is the
+    closed form's; and for EA -> infinity the closed form's ring lies on the ellipse
+    |R - A| + |R - B| = L0 with equal angles to the vertical."""
+    length0 = np.linalg.norm(RING_A - [0, -0.6, 0]) + np.linalg.norm(RING_B - [0, -0.6, 0])
+    for stiffness in RING_STIFFNESS.values():
+        ring, t, _ = frictionless_ring(length0, stiffness, RING_LOAD)
+        s_lo, s_hi = admissible_splits(length0, stiffness, RING_LOAD, 0.0)
+        assert s_hi == pytest.approx(s_lo, rel=1e-13)
+        ring2, t2, _ = stuck_ring(s_lo, length0, stiffness, RING_LOAD)
+        np.testing.assert_allclose(ring2, ring, rtol=0, atol=1e-13)
+        np.testing.assert_allclose(t2, t, rtol=1e-12)
+    ring, t, _ = frictionless_ring(length0, 1e300, RING_LOAD)
+    u1, u2 = (RING_A - ring) / np.linalg.norm(RING_A - ring), \
+        (RING_B - ring) / np.linalg.norm(RING_B - ring)
+    assert np.linalg.norm(RING_A - ring) + np.linalg.norm(RING_B - ring) == \
+        pytest.approx(length0, rel=1e-15)
+    assert u1[1] == pytest.approx(u2[1], rel=1e-14) and u1[0] == pytest.approx(-u2[0],
+                                                                             rel=1e-14)
+
+
+@pytest.mark.parametrize("yarn, first_load", [("soft", FIRST_LOAD), ("stiff", FIRST_LOAD),
+                                              ("soft", 0.0)])
+def test_frictionless_ring_with_defaults(run_yarnfort, tmp_path, yarn, first_load):
+    """mu = 0 ring, stress free at (0, -0.6), the load ramped from first_load P to P:
+    at every loaded step the ring, the stub's end, both tensions and both support
+    reactions against frictionless_ring (the ellipse closed form solved for the
+    extensible yarn)."""
+    stiffness = RING_STIFFNESS[yarn]
+    start = np.array([0.0, -0.6, 0.0])
+    length0 = np.linalg.norm(RING_A - start) + np.linalg.norm(RING_B - start)
+    curve, states = run_ring(run_yarnfort, tmp_path, "ring", start, stiffness, 0.0,
+                             first_load=first_load)
+    rings, tensions = [], []
+    for p in curve["p_force"]:
+        ring, t, _ = frictionless_ring(length0, stiffness, p * RING_LOAD)
+        rings.append(ring)
+        tensions.append(np.array([t, t]))
+    errors = ring_errors(curve, states, rings, tensions, stiffness)
+    print(f"frictionless ring ({yarn}, from {first_load} P): {len(states)} steps, errors "
+          f"{', '.join(f'{n} {v:.1e}' for n, v in errors.items())}; "
+          f"final ring at {states[-1].position[1]}")
+    for key, value in errors.items():
+        assert value <= (FORCE_RTOL if key in ("tension", "reaction") else POSITION_RTOL), \
+            (key, value)
+
+
+#: Start of the friction ring: far to the A side (split 0.61 m, where the admissible
+#: splits start at 1.17 m), so it slides from the first state on; there the lower end
+#: s_lo(P) of the admissible interval rises with P for both yarns, so the ring keeps
+#: sliding and the exact path is the clip at the run's own loads, whatever its steps.
+FRICTION_START = np.array([-0.9, -0.2, 0.0])
+RING_MU = 0.3
+
+
+@pytest.mark.parametrize("yarn", list(RING_STIFFNESS))
+def test_friction_ring_with_defaults(run_yarnfort, tmp_path, yarn):
+    """Coulomb ring (mu = 0.3) from a stress-free start far on the A side, the load
+    ramped from 5 % of P to P. One passage, so the exact quasi-static path is the play operator
+    s(P) = clip(s_old, s_lo(P), s_hi(P)) over the admissible splits of the stuck ring
+    (admissible_splits, each end a brentq over the elastic-V solve stuck_ring). Checked
+    at every loaded step: ring, stub end, tensions and reactions against that reference;
+    at the end, from the run's own ring position and load by statics alone, the ring lies
+    in the admissible set T_max <= T_min exp(mu alpha) and, the load being monotone from
+    a stress-free start, on its boundary (T_max = T_min exp(mu alpha))."""
+    stiffness = RING_STIFFNESS[yarn]
+    length0 = np.linalg.norm(RING_A - FRICTION_START) + np.linalg.norm(RING_B - FRICTION_START)
+    curve, states = run_ring(run_yarnfort, tmp_path, "ring", FRICTION_START, stiffness,
+                             RING_MU)
+    split = np.linalg.norm(RING_A - FRICTION_START)
+    rings, tensions, lower = [], [], []
+    for p in curve["p_force"]:
+        s_lo, s_hi = admissible_splits(length0, stiffness, p * RING_LOAD, RING_MU)
+        lower.append(s_lo)
+        at_boundary = not s_lo < split < s_hi
+        split = min(max(split, s_lo), s_hi)
+        ring, t, _ = stuck_ring(split, length0, stiffness, p * RING_LOAD)
+        rings.append(ring)
+        tensions.append(t)
+    # The scene is what the test says (reference): sliding along a rising s_lo.
+    assert at_boundary and np.all(np.diff(lower) > 0.0)
+    errors = ring_errors(curve, states, rings, tensions, stiffness)
+    t, alpha = statics_at(states[-1].position[1], RING_LOAD)
+    ratio = t.max() / (t.min() * np.exp(RING_MU * alpha))
+    errors["boundary"] = abs(ratio - 1.0)
+    print(f"friction ring ({yarn}): {len(states)} steps, errors "
+          f"{', '.join(f'{n} {v:.1e}' for n, v in errors.items())}; T_max/(T_min e^(mu "
+          f"alpha)) = {ratio:.12f} at the end (run's position)")
+    assert ratio <= 1.0 + FORCE_RTOL
+    for key, value in errors.items():
+        assert value <= (POSITION_RTOL if key in ("ring", "stub_end") else FORCE_RTOL), \
+            (key, value)
