@@ -562,3 +562,189 @@ def test_friction_ring_with_defaults(run_yarnfort, tmp_path, yarn):
     for key, value in errors.items():
         assert value <= (POSITION_RTOL if key in ("ring", "stub_end") else FORCE_RTOL), \
             (key, value)
+
+
+# ======================================================================================
+# 5. A pretensioned 8 x 8 cable net under a centre load, stuck and frictionless.
+
+NET_N = 8                    #: crossings per side
+NET_EA = 100.0               #: cable stiffness EA (N), linear law
+NET_PULL = 0.05              #: pretension: each boundary end moved outwards (m)
+NET_LOAD = 2.0               #: total load (N) on the four centre crossings, along -z
+NET_SIZE = float(NET_N + 1)  #: span (m), unit spacing
+
+
+def cable_net_scene(frictionless: bool):
+    """Warp cables along x (y = 1..8) and weft cables along y (x = 1..8) through the
+    64 crossings, ends on the boundary (0 and 9) moved outwards by NET_PULL at
+    p_disp = 1; then the load on the crossings (4,4), (5,4), (4,5), (5,5). Stuck: one
+    material, no &contact (the crossings are plain shared nodes). Frictionless: warp
+    and weft materials with a mu = 0 &contact, so both cables slide through every
+    crossing. Returns (namelist text, nodes, elements [(a, b, yarn)], free node ids,
+    boundary displacement per node)."""
+    n = NET_N
+    keys = [(i, j) for j in range(1, n + 1) for i in range(1, n + 1)]
+    keys += [(0, j) for j in range(1, n + 1)] + [(n + 1, j) for j in range(1, n + 1)]
+    keys += [(i, 0) for i in range(1, n + 1)] + [(i, n + 1) for i in range(1, n + 1)]
+    index = {key: k for k, key in enumerate(keys)}
+    nodes = np.array([[i, j, 0.0] for i, j in keys], float)
+    warp = [[index[(i, j)] for i in range(n + 2)] for j in range(1, n + 1)]
+    weft = [[index[(i, j)] for j in range(n + 2)] for i in range(1, n + 1)]
+    names = ("warp", "weft") if frictionless else ("cable", "cable")
+    yarns = [dict(material=names[0], nodes=[v + 1 for v in w]) for w in warp]
+    yarns += [dict(material=names[1], nodes=[v + 1 for v in w]) for w in weft]
+    elements = [(a, b, y) for y, w in enumerate(warp + weft) for a, b in zip(w, w[1:])]
+    sides = {"west": ([(0, j) for j in range(1, n + 1)], [-NET_PULL, 0.0, 0.0]),
+             "east": ([(n + 1, j) for j in range(1, n + 1)], [NET_PULL, 0.0, 0.0]),
+             "south": ([(i, 0) for i in range(1, n + 1)], [0.0, -NET_PULL, 0.0]),
+             "north": ([(i, n + 1) for i in range(1, n + 1)], [0.0, NET_PULL, 0.0])}
+    displacement = np.zeros_like(nodes)
+    supports = []
+    for name, (side, d) in sides.items():
+        ids = [index[key] for key in side]
+        displacement[ids] = d
+        supports.append(dict(name=name, nodes=[v + 1 for v in ids], fix="xyz", displacement=d))
+    centre = [index[key] for key in ((4, 4), (5, 4), (4, 5), (5, 5))]
+    load = np.zeros_like(nodes)
+    load[centre, 2] = -NET_LOAD / 4
+    materials = [dict(name=m, law="linear", stiffness=NET_EA) for m in sorted(set(names))]
+    contacts = [dict(materials=["warp", "weft"], law="coulomb",
+                     friction_coefficient=0.0)] if frictionless else []
+    text = defaults_namelist(
+        nodes, yarns, supports, [dict(nodes=[v + 1 for v in centre],
+                                      force=[0.0, 0.0, -NET_LOAD / 4])],
+        materials, dict(time=[0.0, 1.0, 2.0], p_disp=[0.0, 1.0, 1.0], p_force=[0.0, 0.0, 1.0]),
+        contacts)
+    return text, nodes, elements, np.arange(n * n), displacement, load
+
+
+class NetReference:
+    """Independent equilibrium of the cable net (numpy residual and analytic Jacobian,
+    scipy.optimize.root 'hybr', continued from step to step). Unknowns: the 64 free
+    crossings; frictionless also one tension per cable.
+    - stuck: element tension T = EA max(0, l/L0 - 1), L0 = 1 (the exact tension-only
+      law), tangent (T/l)(I - u u^T) + (EA/L0) u u^T for taut elements;
+    - frictionless (mu = 0): one tension T_y along each cable y (the capstan condition
+      with mu = 0 at every crossing), and each cable keeps its reference length:
+      sum_e l_e / (1 + T_y/EA) = 9 m; then L0_e = l_e / (1 + T_y/EA).
+    The stress-free start (p = 0) is its own solution. The first pretensioned solve
+    starts from the uniformly stretched flat net."""
+
+    def __init__(self, nodes, elements, free, displacement, load, frictionless):
+        self.nodes0, self.free, self.disp, self.load = nodes, free, displacement, load
+        self.a = np.array([e[0] for e in elements])
+        self.b = np.array([e[1] for e in elements])
+        self.yarn = np.array([e[2] for e in elements])
+        self.n_yarns = int(self.yarn.max()) + 1
+        self.frictionless = frictionless
+        self.unknowns = None
+
+    def _unpack(self, z, p_disp):
+        x = self.nodes0 + p_disp * self.disp
+        nf = 3 * len(self.free)
+        x[self.free] = z[:nf].reshape(-1, 3)
+        return x, z[nf:]
+
+    def residual(self, z, p_disp, p_force):
+        x, t_yarn = self._unpack(z, p_disp)
+        vec = x[self.b] - x[self.a]
+        length = np.linalg.norm(vec, axis=1)
+        u = vec / length[:, None]
+        nf, ne = len(self.free), len(self.a)
+        if self.frictionless:
+            t = t_yarn[self.yarn]
+            axial = np.zeros(ne)
+        else:
+            t = NET_EA * np.maximum(0.0, length - 1.0)
+            axial = np.where(length > 1.0, NET_EA, 0.0)
+        force = p_force * self.load.copy()
+        np.add.at(force, self.a, t[:, None] * u)
+        np.add.at(force, self.b, -t[:, None] * u)
+        position = -np.ones(len(x), int)
+        position[self.free] = np.arange(nf)
+        n_unknowns = 3 * nf + (self.n_yarns if self.frictionless else 0)
+        jac = np.zeros((n_unknowns, n_unknowns))
+        for e in range(ne):
+            k = t[e] / length[e] * (np.eye(3) - np.outer(u[e], u[e])) \
+                + axial[e] * np.outer(u[e], u[e])
+            for row, sign_row in ((self.a[e], 1.0), (self.b[e], -1.0)):
+                if position[row] < 0:
+                    continue
+                r = slice(3 * position[row], 3 * position[row] + 3)
+                for col, sign_col in ((self.a[e], -1.0), (self.b[e], 1.0)):
+                    if position[col] >= 0:
+                        c = slice(3 * position[col], 3 * position[col] + 3)
+                        jac[r, c] += sign_row * sign_col * k
+                if self.frictionless:
+                    jac[r, 3 * nf + self.yarn[e]] += sign_row * u[e]
+        rows = [force[self.free].ravel()]
+        if self.frictionless:
+            stretch = 1.0 + t_yarn / NET_EA
+            lengths = np.zeros(self.n_yarns)
+            np.add.at(lengths, self.yarn, length)
+            rows.append(lengths / stretch - NET_SIZE)
+            for e in range(ne):
+                y = self.yarn[e]
+                for node, sign in ((self.a[e], -1.0), (self.b[e], 1.0)):
+                    if position[node] >= 0:
+                        c = slice(3 * position[node], 3 * position[node] + 3)
+                        jac[3 * nf + y, c] += sign * u[e] / stretch[y]
+            jac[3 * nf:, 3 * nf:] = np.diag(-lengths / NET_EA / stretch ** 2)
+        return np.concatenate(rows), jac
+
+    def solve(self, p_disp: float, p_force: float):
+        """(positions, element tensions, element L0) at the load factors."""
+        if p_disp == 0.0 and p_force == 0.0:
+            return self.nodes0.copy(), np.zeros(len(self.a)), np.ones(len(self.a))
+        if self.unknowns is None:                  # uniformly stretched flat net
+            x = self.nodes0 + p_disp * NET_PULL * (2 * self.nodes0 / NET_SIZE - 1) \
+                * [1.0, 1.0, 0.0]
+            z = [x[self.free].ravel()]
+            if self.frictionless:
+                x = self.nodes0[self.free].ravel()
+                z = [x, np.full(self.n_yarns, NET_EA * 2 * p_disp * NET_PULL / NET_SIZE)]
+            self.unknowns = np.concatenate(z)
+        sol = optimize.root(self.residual, self.unknowns, args=(p_disp, p_force), jac=True,
+                            method="hybr", options=dict(xtol=1e-15))
+        scale = max(NET_LOAD, NET_EA * NET_PULL / NET_SIZE)
+        assert np.max(np.abs(self.residual(sol.x, p_disp, p_force)[0])) < 1e-12 * scale, sol
+        self.unknowns = sol.x
+        x, t_yarn = self._unpack(sol.x, p_disp)
+        length = np.linalg.norm(x[self.b] - x[self.a], axis=1)
+        if self.frictionless:
+            t = t_yarn[self.yarn]
+            return x, t, length / (1.0 + t / NET_EA)
+        return x, NET_EA * np.maximum(0.0, length - 1.0), np.ones(len(self.a))
+
+
+@pytest.mark.parametrize("crossings", ["stuck", "frictionless"])
+def test_cable_net_with_defaults(run_yarnfort, tmp_path, crossings):
+    """Pretension (p_disp 0 -> 1), then the centre load (p_force 0 -> 1). At every step:
+    all node positions, element tensions and reference lengths against NetReference
+    (an independent numpy/scipy equilibrium solve of the same truss: tension-only
+    linear law for the stuck net; one tension per cable and conserved cable length for
+    the frictionless one)."""
+    frictionless = crossings == "frictionless"
+    text, nodes, elements, free, displacement, load = cable_net_scene(frictionless)
+    run, curve, states = run_scene(run_yarnfort, tmp_path, "net", text, ok=False)
+    assert run.returncode == 0, run.stderr
+    assert len(states) == len(curve["step"])
+    reference = NetReference(nodes, elements, free, displacement, load, frictionless)
+    n_elements = len(elements)
+    errors = dict(position=0.0, tension=0.0, length0=0.0)
+    for i, state in enumerate(states):
+        x, t, length0 = reference.solve(float(curve["p_disp"][i]), float(curve["p_force"][i]))
+        errors["position"] = max(errors["position"],
+                                 np.max(np.abs(state.position - x)) / NET_SIZE)
+        if t.max() > 0.0:
+            errors["tension"] = max(errors["tension"], relative_error(
+                state.tension[:n_elements], t, t.max()))
+        errors["length0"] = max(errors["length0"],
+                                np.max(np.abs(state.length0[:n_elements] - length0)) / NET_SIZE)
+    sag = -x[free, 2].min()
+    print(f"cable net ({crossings}): {len(states)} steps, sag {sag:.4f} m, errors "
+          f"{', '.join(f'{n} {v:.1e}' for n, v in errors.items())}, Newton iterations "
+          f"{int(curve['newton_iterations'].sum())}")
+    assert sag > 0.1
+    for key, value in errors.items():
+        assert value <= (FORCE_RTOL if key == "tension" else POSITION_RTOL), (key, value)
