@@ -146,15 +146,21 @@ class CapstanReference:
         return (hi - crit) / max(crit, floor)
 
     def advance(self, d: float, direction: int):
-        """(L0, tensions, zone size) at d, reached over a monotone step in `direction`."""
+        """(L0, tensions, zone size, wrap angles, margin) at d, reached over a monotone
+        step in `direction`; margin is the smallest |violation| of the stick tests that
+        decided the zone (a passage that joined it in this step, the first one left out)."""
         if direction != self.direction:
             self.zone, self.direction = 0, direction
         lengths, alphas = self.geometry(d)
         old, k = self.length0, self.k
-        n = self.zone
+        n, margin = self.zone, np.inf
         while True:
             length0, tension = self._zone_state(n, lengths, alphas, old, direction)
-            if n == k or self.violation(k - n, tension, alphas, direction) <= STICK_SLACK:
+            if n == k:
+                break
+            violation = self.violation(k - n, tension, alphas, direction)
+            margin = min(margin, abs(violation))
+            if violation <= STICK_SLACK:
                 break
             n += 1
         for p in range(1, k + 1):                        # every passage admissible
@@ -164,7 +170,7 @@ class CapstanReference:
             flow = length0[p:].sum() - old[p:].sum()
             assert direction * flow >= -1e-13 * old.sum(), (d, p, flow)
         self.length0, self.zone = length0, n
-        return length0, tension, n, alphas
+        return length0, tension, n, alphas, margin
 
 
 def capstan_net(k: int, peg_stiffness: float = YARN_EA, units=(1.0, 1.0)):
@@ -188,10 +194,10 @@ def scaled_law(law: dict, force: float) -> dict:
 
 
 def run_capstan(run_yarnfort, tmp_path, name, k, law_name, peg_stiffness=YARN_EA,
-                units=(1.0, 1.0)):
+                units=(1.0, 1.0), path=None):
     net, materials = capstan_net(k, peg_stiffness, units)
     text = defaults_namelist(net["nodes"], net["yarns"], net["supports"], net["loads"],
-                             materials, CAPSTAN_PATH,
+                             materials, path or CAPSTAN_PATH,
                              [dict(materials=["yarn", "peg"],
                                    **scaled_law(LAWS[law_name], units[1]))])
     run, curve, states = run_scene(run_yarnfort, tmp_path, name, text, ok=False)
@@ -200,19 +206,20 @@ def run_capstan(run_yarnfort, tmp_path, name, k, law_name, peg_stiffness=YARN_EA
     return net, curve, states
 
 
-def check_capstan(net, k, law_name, curve, states) -> dict:
-    """Compare a capstan run with CapstanReference at every converged step; returns the
-    worst errors (and asserts them)."""
+def check_capstan(net, k, law_name, curve, states, peak_time: float = 1.0):
+    """Compare a capstan run with CapstanReference at every converged step (loading up
+    to peak_time); asserts and returns the worst errors and the steps whose stick/slip
+    flags were judged."""
     law = LAWS[law_name]
     reference = CapstanReference(net, k, law)
     yarn = element_ranges(net)[0]
-    directions = np.where(curve["time"] <= 1.0, 1, -1)
+    directions = np.where(curve["time"] <= peak_time, 1, -1)
     exact = [reference.advance(float(d), int(w)) for d, w in zip(curve["p_disp"], directions)]
     peak = max(e[1].max() for e in exact)
     errors = dict(tension=0.0, length0=0.0, reaction=0.0, gross_slip=0.0)
     flags, gross, onsets = [], 0, 0
     previous = (0, 1)
-    for i, (state, (length0, tension, zone, alphas)) in enumerate(zip(states, exact)):
+    for i, (state, (length0, tension, zone, alphas, margin)) in enumerate(zip(states, exact)):
         direction = directions[i]
         # Relative to the step's largest tension; to the run's where all are slack.
         scale = tension.max() if tension.max() > 0.0 else peak
@@ -233,9 +240,7 @@ def check_capstan(net, k, law_name, curve, states) -> dict:
                                        abs(t_hi - critical(law, t_lo, angle)) / t_hi)
             gross += 1
         # Stick/slip flags where no passage is within CLOSE_CALL of its threshold.
-        margins = [abs(reference.violation(p, tension, alphas, direction)) for p in
-                   range(1, k + 1) if p <= k - zone]
-        if i > 0 and (not margins or min(margins) > CLOSE_CALL):
+        if i > 0 and margin > CLOSE_CALL:
             flags.append((i, int(curve["slipping"][i]), zone))
         onsets += direction == previous[1] and zone > previous[0]
         previous = (zone, direction)
@@ -248,7 +253,7 @@ def check_capstan(net, k, law_name, curve, states) -> dict:
     assert mismatched == []
     for name, value in errors.items():
         assert value <= (POSITION_RTOL if name == "length0" else FORCE_RTOL), (name, value)
-    return errors
+    return errors, [f[0] for f in flags]
 
 
 @pytest.mark.parametrize("law_name", list(LAWS))
@@ -264,6 +269,71 @@ def test_capstan_full_curve_with_defaults(run_yarnfort, tmp_path, k, law_name):
     T = EA (l/L0 - 1) with L0 unchanged."""
     net, curve, states = run_capstan(run_yarnfort, tmp_path, "capstan", k, law_name)
     check_capstan(net, k, law_name, curve, states)
+
+
+#: Exact violation of the stick test T_max / T_crit(T_min) - 1 at the knots placed just
+#: before (stick) and just after (slip) each slip onset: far above the solver's
+#: friction_tolerance (1e-9) and CLOSE_CALL, far below a step of the path.
+ONSET_MARGIN = 1e-5
+
+
+def slip_onset_knots(net, k: int, law: dict) -> tuple[list, list]:
+    """Loads d just before and just after every slip onset of the pull (0 -> 1) and of
+    the release (1 -> 0), from CapstanReference: with n passages slipping, the state is
+    a function of d alone (the zone's conserved length is that of the start of the
+    half), so the onset of passage K-n is the root in d of its stick-test violation,
+    and the knots are the roots of violation = -+ONSET_MARGIN (brentq). Onsets at d = 0+
+    (Coulomb from a slack start: everything slips at once) get no knots."""
+    reference = CapstanReference(net, k, law)
+    tol = dict(xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=500)
+
+    def violation(d, n, direction, start):
+        lengths, alphas = reference.geometry(d)
+        tension = reference._zone_state(n, lengths, alphas, start, direction)[1]
+        return reference.violation(k - n, tension, alphas, direction)
+
+    halves = []
+    for direction, start_d, end_d in ((1, 0.0, 1.0), (-1, 1.0, 0.0)):
+        start = reference.length0.copy()
+        knots, d_from = [], start_d
+        for n in range(k):
+            f = lambda d, m: violation(d, n, direction, start) - m     # noqa: E731
+            step = 1e-9 * (end_d - start_d)
+            if f(d_from + step, 0.0) > 0.0:
+                continue                          # slips at once: no onset to bracket
+            if f(end_d, ONSET_MARGIN) < 0.0:
+                break                             # never slips on this half
+            before = optimize.brentq(f, d_from + step, end_d, args=(-ONSET_MARGIN,), **tol)
+            after = optimize.brentq(f, d_from + step, end_d, args=(ONSET_MARGIN,), **tol)
+            knots += [before, after]
+            d_from = after
+        halves.append(knots)
+        reference.advance(end_d, direction)       # the state the release starts from
+    return halves[0], halves[1]
+
+
+@pytest.mark.parametrize("law_name", list(LAWS))
+@pytest.mark.parametrize("k", [1, 4])
+def test_capstan_slip_onsets_with_defaults(run_yarnfort, tmp_path, k, law_name):
+    """The capstan of test_capstan_full_curve_with_defaults with path knots just before
+    and just after every exact slip onset (slip_onset_knots: stick-test violation
+    -1e-5 and +1e-5 of T_crit), so that an onset that comes early or late shows as a
+    wrong number of slipping passages at a knot. Everything of the full-curve test is
+    checked at every step, and every knot step must be judged."""
+    net, _ = capstan_net(k)
+    load, release = slip_onset_knots(net, k, LAWS[law_name])
+    p_disp = [0.0, *load, 1.0, *release, 0.0]
+    path = dict(time=list(map(float, range(len(p_disp)))), p_force=[0.0] * len(p_disp),
+                p_disp=p_disp)
+    _, curve, states = run_capstan(run_yarnfort, tmp_path, "onsets", k, law_name, path=path)
+    knot_steps = [i for i, t in enumerate(curve["time"])
+                  if abs(t - round(t)) < 1e-9 and 0 < round(t) < len(p_disp) - 1
+                  and round(t) != len(load) + 1]
+    print(f"K={k} {law_name}: {len(load) // 2} onsets on the pull, {len(release) // 2} on "
+          f"the release")
+    _, judged = check_capstan(net, k, law_name, curve, states, peak_time=len(load) + 1)
+    assert len(knot_steps) == len(load) + len(release) > 0
+    assert set(knot_steps) <= set(judged)
 
 
 # ======================================================================================
@@ -963,7 +1033,7 @@ def test_yarn_revisiting_a_node_keeps_its_passages(run_yarnfort, tmp_path):
         reference = CapstanReference(dict(nodes=[nodes[3], nodes[1], nodes[4]]), 1, law)
         error, slid = 0.0, 0.0
         for i, d in enumerate(curve["p_disp"]):
-            _, exact, _, _ = reference.advance(float(d), 1)
+            exact = reference.advance(float(d), 1)[1]
             scale = exact.max() if exact.max() > 0 else 1.0
             error = max(error, np.max(np.abs(tension[i, 3:5] - exact)) / scale,
                         np.max(np.abs(tension[i, :3])) / scale)
