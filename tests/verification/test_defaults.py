@@ -476,33 +476,45 @@ def statics_at(ring: np.ndarray, load: float):
     return t, np.pi - np.arctan2(abs(u[0, 0] * u[1, 1] - u[0, 1] * u[1, 0]), u[0] @ u[1])
 
 
-def admissible_splits(length0: float, stiffness: float, load: float, mu: float):
+def admissible_splits(length0: float, stiffness: float, load: float, mu: float,
+                      hint=None):
     """The splits s of the stuck ring where T_max <= T_min exp(mu alpha): an interval
     [s_lo, s_hi] (g1 = T1 - T2 e^(mu alpha) falls and g2 = T2 - T1 e^(mu alpha) rises
-    with s), its ends found by brentq on g1 and g2 (s_lo = s_hi for mu = 0)."""
+    with s), its ends found by brentq on g1 and g2 (s_lo = s_hi for mu = 0). Brackets
+    come from a grid over the splits where the circles meet and the stuck V holds the
+    load in tension on both sides, or from a window about `hint` (the ends at a nearby
+    load) widened until g changes sign."""
     def g(s, side):
         _, t, alpha = stuck_ring(s, length0, stiffness, load)
         assert np.all(t > 0.0)
         return (t[0] - t[1] * np.exp(mu * alpha)) if side == 1 else \
             (t[1] - t[0] * np.exp(mu * alpha))
 
-    # Bracket: a grid over the splits where the circles meet, keeping the points where
-    # the stuck V holds the load in tension on both sides.
-    d = np.linalg.norm(RING_B - RING_A)
-    grid = []
-    for s in np.linspace(0.5 * (length0 - d), 0.5 * (length0 + d), 42)[1:-1]:
-        try:
-            grid.append((s, g(s, 1), g(s, 2)))
-        except AssertionError:
-            continue
-    tol = dict(xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=500)
-    ends = []
-    for side in (1, 2):
-        change = [(a[0], b[0]) for a, b in zip(grid, grid[1:])
-                  if a[side] * b[side] <= 0.0]
+    def bracket(side):
+        if hint is not None:
+            width = 1e-6 * length0
+            for _ in range(12):
+                a, b = hint[side - 1] - width, hint[side - 1] + width
+                try:
+                    if g(a, side) * g(b, side) <= 0.0:
+                        return a, b
+                except AssertionError:
+                    break
+                width *= 8.0
+        d = np.linalg.norm(RING_B - RING_A)
+        grid = []
+        for s in np.linspace(0.5 * (length0 - d), 0.5 * (length0 + d), 42)[1:-1]:
+            try:
+                grid.append((s, g(s, side)))
+            except AssertionError:
+                continue
+        change = [(a[0], b[0]) for a, b in zip(grid, grid[1:]) if a[1] * b[1] <= 0.0]
         assert len(change) == 1, (side, change)
-        ends.append(optimize.brentq(lambda s: g(s, side), *change[0], **tol))
-    return tuple(ends)
+        return change[0]
+
+    tol = dict(xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=500)
+    return tuple(optimize.brentq(lambda s: g(s, side), *bracket(side), **tol)
+                 for side in (1, 2))
 
 
 def run_ring(run_yarnfort, tmp_path, name, start, stiffness, mu, units=(1.0, 1.0),
@@ -610,9 +622,10 @@ def test_friction_ring_with_defaults(run_yarnfort, tmp_path, yarn):
     curve, states = run_ring(run_yarnfort, tmp_path, "ring", FRICTION_START, stiffness,
                              RING_MU)
     split = np.linalg.norm(RING_A - FRICTION_START)
-    rings, tensions, lower = [], [], []
+    rings, tensions, lower, ends = [], [], [], None
     for p in curve["p_force"]:
-        s_lo, s_hi = admissible_splits(length0, stiffness, p * RING_LOAD, RING_MU)
+        ends = s_lo, s_hi = admissible_splits(length0, stiffness, p * RING_LOAD, RING_MU,
+                                              hint=ends)
         lower.append(s_lo)
         at_boundary = not s_lo < split < s_hi
         split = min(max(split, s_lo), s_hi)
