@@ -135,7 +135,7 @@ class CapstanReference:
             total = old[zone].sum()
             excess = lambda t: float(np.sum(lengths[zone] / (       # noqa: E731
                 1.0 + self._chain(t, n, alphas, direction) / self.ea)) - total)
-            if excess(0.0) <= 0.0:
+            if excess(0.0) <= 4 * np.finfo(float).eps * total:      # slack to round-off
                 ts = self._chain(0.0, n, alphas, direction)
                 zone_l0 = lengths[zone] / (1.0 + ts / self.ea)
                 seed = 0 if direction > 0 else n
