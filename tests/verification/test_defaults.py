@@ -793,31 +793,29 @@ class NetReference:
         position[self.free] = np.arange(nf)
         n_unknowns = 3 * nf + (self.n_yarns if self.frictionless else 0)
         jac = np.zeros((n_unknowns, n_unknowns))
-        for e in range(ne):
-            k = t[e] / length[e] * (np.eye(3) - np.outer(u[e], u[e])) \
-                + axial[e] * np.outer(u[e], u[e])
-            for row, sign_row in ((self.a[e], 1.0), (self.b[e], -1.0)):
-                if position[row] < 0:
-                    continue
-                r = slice(3 * position[row], 3 * position[row] + 3)
-                for col, sign_col in ((self.a[e], -1.0), (self.b[e], 1.0)):
-                    if position[col] >= 0:
-                        c = slice(3 * position[col], 3 * position[col] + 3)
-                        jac[r, c] += sign_row * sign_col * k
-                if self.frictionless:
-                    jac[r, 3 * nf + self.yarn[e]] += sign_row * u[e]
+        uu = u[:, :, None] * u[:, None, :]
+        k = (t / length)[:, None, None] * (np.eye(3) - uu) + axial[:, None, None] * uu
+        three = np.arange(3)
+        for row_node, sign_row in ((self.a, 1.0), (self.b, -1.0)):
+            for col_node, sign_col in ((self.a, -1.0), (self.b, 1.0)):
+                keep = (position[row_node] >= 0) & (position[col_node] >= 0)
+                rows = 3 * position[row_node][keep][:, None, None] + three[None, :, None]
+                cols = 3 * position[col_node][keep][:, None, None] + three[None, None, :]
+                np.add.at(jac, (np.broadcast_to(rows, k[keep].shape),
+                                np.broadcast_to(cols, k[keep].shape)),
+                          sign_row * sign_col * k[keep])
         rows = [force[self.free].ravel()]
         if self.frictionless:
             stretch = 1.0 + t_yarn / NET_EA
             lengths = np.zeros(self.n_yarns)
             np.add.at(lengths, self.yarn, length)
             rows.append(lengths / stretch - NET_SIZE)
-            for e in range(ne):
-                y = self.yarn[e]
-                for node, sign in ((self.a[e], -1.0), (self.b[e], 1.0)):
-                    if position[node] >= 0:
-                        c = slice(3 * position[node], 3 * position[node] + 3)
-                        jac[3 * nf + y, c] += sign * u[e] / stretch[y]
+            for node, sign in ((self.a, 1.0), (self.b, -1.0)):
+                keep = position[node] >= 0
+                r = 3 * position[node][keep][:, None] + three[None, :]
+                y = np.broadcast_to(3 * nf + self.yarn[keep][:, None], r.shape)
+                np.add.at(jac, (r, y), sign * u[keep])          # force rows, d/dT_y
+                np.add.at(jac, (y, r), -sign * u[keep] / stretch[self.yarn[keep]][:, None])
             jac[3 * nf:, 3 * nf:] = np.diag(-lengths / NET_EA / stretch ** 2)
         return np.concatenate(rows), jac
 
