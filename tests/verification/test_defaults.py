@@ -710,7 +710,7 @@ def cable_net_scene(frictionless: bool):
     material, no &contact (the crossings are plain shared nodes). Frictionless: warp
     and weft materials with a mu = 0 &contact, so both cables slide through every
     crossing. Returns (namelist text, nodes, elements [(a, b, yarn)], free node ids,
-    boundary displacement per node)."""
+    boundary displacement per node, load per node, node ids of each support)."""
     n = NET_N
     keys = [(i, j) for j in range(1, n + 1) for i in range(1, n + 1)]
     keys += [(0, j) for j in range(1, n + 1)] + [(n + 1, j) for j in range(1, n + 1)]
@@ -728,9 +728,9 @@ def cable_net_scene(frictionless: bool):
              "south": ([(i, 0) for i in range(1, n + 1)], [0.0, -NET_PULL, 0.0]),
              "north": ([(i, n + 1) for i in range(1, n + 1)], [0.0, NET_PULL, 0.0])}
     displacement = np.zeros_like(nodes)
-    supports = []
+    supports, side_nodes = [], {}
     for name, (side, d) in sides.items():
-        ids = [index[key] for key in side]
+        ids = side_nodes[name] = [index[key] for key in side]
         displacement[ids] = d
         supports.append(dict(name=name, nodes=[v + 1 for v in ids], fix="xyz", displacement=d))
     centre = [index[key] for key in ((4, 4), (5, 4), (4, 5), (5, 5))]
@@ -744,7 +744,7 @@ def cable_net_scene(frictionless: bool):
                                       force=[0.0, 0.0, -NET_LOAD / 4])],
         materials, dict(time=[0.0, 1.0, 2.0], p_disp=[0.0, 1.0, 1.0], p_force=[0.0, 0.0, 1.0]),
         contacts)
-    return text, nodes, elements, np.arange(n * n), displacement, load
+    return text, nodes, elements, np.arange(n * n), displacement, load, side_nodes
 
 
 class NetReference:
@@ -850,17 +850,27 @@ def test_cable_net_with_defaults(run_yarnfort, tmp_path, crossings):
     all node positions, element tensions and reference lengths against NetReference
     (an independent numpy/scipy equilibrium solve of the same truss: tension-only
     linear law for the stuck net; one tension per cable and conserved cable length for
-    the frictionless one)."""
+    the frictionless one); and the reaction of each side's supports, the sum of
+    -T u over the elements that start there (u pointing into the net)."""
     frictionless = crossings == "frictionless"
-    text, nodes, elements, free, displacement, load = cable_net_scene(frictionless)
+    text, nodes, elements, free, displacement, load, sides = cable_net_scene(frictionless)
     run, curve, states = run_scene(run_yarnfort, tmp_path, "net", text, ok=False)
     assert run.returncode == 0, run.stderr
     assert len(states) == len(curve["step"])
     reference = NetReference(nodes, elements, free, displacement, load, frictionless)
     n_elements = len(elements)
-    errors = dict(position=0.0, tension=0.0, length0=0.0)
+    errors = dict(position=0.0, tension=0.0, length0=0.0, reaction=0.0)
+    ends = {name: [(e, 1.0 if a in ids else -1.0) for e, (a, b, _) in enumerate(elements)
+                   if a in ids or b in ids] for name, ids in sides.items()}
     for i, state in enumerate(states):
         x, t, length0 = reference.solve(float(curve["p_disp"][i]), float(curve["p_force"][i]))
+        u = x[[e[1] for e in elements]] - x[[e[0] for e in elements]]
+        u /= np.linalg.norm(u, axis=1)[:, None]
+        for name, list_ in ends.items():
+            exact = -sum(sign * t[e] * u[e] for e, sign in list_)
+            scale = t.max() if t.max() > 0.0 else 1.0
+            errors["reaction"] = max(errors["reaction"],
+                                     relative_error(curve.reaction(name)[i], exact, scale))
         errors["position"] = max(errors["position"],
                                  np.max(np.abs(state.position - x)) / NET_SIZE)
         if t.max() > 0.0:
@@ -874,7 +884,8 @@ def test_cable_net_with_defaults(run_yarnfort, tmp_path, crossings):
           f"{int(curve['newton_iterations'].sum())}")
     assert sag > 0.1
     for key, value in errors.items():
-        assert value <= (FORCE_RTOL if key == "tension" else POSITION_RTOL), (key, value)
+        assert value <= (FORCE_RTOL if key in ("tension", "reaction") else POSITION_RTOL), \
+            (key, value)
 
 
 # ======================================================================================
