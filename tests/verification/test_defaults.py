@@ -1019,8 +1019,13 @@ def order_runs(run_yarnfort, tmp_path, nodes, yarns, supports, materials, contac
         name = "order_" + "".join(map(str, order))
         text = defaults_namelist(nodes, permuted(yarns, order), supports, [], materials, path,
                                  contacts)
-        run, curve, states = run_scene(run_yarnfort, tmp_path, name, text, ok=False)
-        out.append((order, run, curve, states))
+        folder = tmp_path / name
+        folder.mkdir()
+        run = run_yarnfort(text, cwd=folder)
+        if run.returncode == 0:
+            out.append((order, run, read_curve(folder / "out"), read_states(folder / "out")))
+        else:
+            out.append((order, run, None, None))
     return out
 
 

@@ -276,15 +276,15 @@ contains
         found = .true.
         solver%preset = name
         select case (name)
-        case ('fast')           ! 4 steps per unit of pseudo-time
+        case ('fast')           ! 4 steps per knot interval
             step = 0.25_wp
             tolerance = 1.0e-6_wp
-        case ('balanced')       ! 20 steps per unit
+        case ('balanced')       ! 20 steps per knot interval
             step = 0.05_wp
-            tolerance = 1.0e-8_wp
-        case ('accurate')       ! 200 steps per unit
-            step = 0.005_wp
-            tolerance = 1.0e-10_wp
+            tolerance = 1.0e-9_wp
+        case ('accurate')       ! 100 steps per knot interval
+            step = 0.01_wp
+            tolerance = 1.0e-11_wp
         case default
             found = name == 'custom'
             return
