@@ -2,6 +2,7 @@
 """Read a run's output folder: ``curve.csv`` and the ``state_NNNNN.vtu`` files."""
 from __future__ import annotations
 
+import base64
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,25 +48,46 @@ def read_curve(path: str | Path) -> Curve:
     return Curve({name: np.atleast_1d(data[name]) for name in data.dtype.names})
 
 
-def _array(piece: ET.Element, name: str) -> np.ndarray:
+_VTK_TYPES = {"Float64": "<f8", "Int64": "<i8", "Int32": "<i4", "UInt8": "u1"}
+
+
+def _values(node: ET.Element, appended: str) -> np.ndarray:
+    """The values of a DataArray: inline ASCII, or appended base64 (a UInt64 byte
+    count, then the bytes, each encoded on its own), as yarnfort writes them."""
+    dtype = np.dtype(_VTK_TYPES[node.get("type")])
+    if node.get("format") != "appended":
+        return np.array((node.text or "").split(), dtype=float).astype(dtype)
+    data = appended[int(node.get("offset")):]
+    count = int(np.frombuffer(base64.b64decode(data[:12]), "<u8")[0])
+    return np.frombuffer(base64.b64decode(data[12:12 + 4 * -(-count // 3)]), dtype)
+
+
+def _array(piece: ET.Element, name: str, appended: str = "") -> np.ndarray:
     for node in piece.iter("DataArray"):
         if node.get("Name") == name:
-            return np.array(node.text.split(), dtype=float)
+            return _values(node, appended)
     raise KeyError(f"no DataArray named {name!r}")
 
 
 def read_state(path: str | Path) -> State:
-    """Read one ``state_NNNNN.vtu`` file written by yarnfort."""
+    """Read one ``state_NNNNN.vtu`` file written by yarnfort: the yarn elements (the
+    links, cells of another ``kind``, are left out)."""
     root = ET.parse(path).getroot()
+    block = root.find("AppendedData")
+    appended = "" if block is None else (block.text or "").strip()[1:]
     piece = root.find("UnstructuredGrid/Piece")
-    points = np.array(piece.find("Points/DataArray").text.split(), dtype=float)
-    connectivity = _array(piece, "connectivity").astype(int)
+    points = _values(piece.find("Points/DataArray"), appended).astype(float)
+    connectivity = _array(piece, "connectivity", appended).astype(int).reshape(-1, 2)
+    try:
+        element = _array(piece, "kind", appended) == 0
+    except KeyError:
+        element = np.ones(len(connectivity), dtype=bool)
     return State(
         position=points.reshape(-1, 3),
-        elements=connectivity.reshape(-1, 2),
-        tension=_array(piece, "tension"),
-        stretch=_array(piece, "stretch"),
-        length0=_array(piece, "L0"),
+        elements=connectivity[element],
+        tension=_array(piece, "tension", appended).astype(float)[element],
+        stretch=_array(piece, "stretch", appended).astype(float)[element],
+        length0=_array(piece, "L0", appended).astype(float)[element],
     )
 
 
