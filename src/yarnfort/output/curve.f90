@@ -5,7 +5,8 @@ module yarnfort_output_curve
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
-    use yarnfort_output_filesystem, only: rename_file, remove_file
+    use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, &
+        flush_checked
     implicit none
     private
 
@@ -63,11 +64,14 @@ contains
 
         message = ''
         write(self%unit, '(a)', iostat=status, iomsg=message) line
-        if (status == 0) flush(self%unit, iostat=status, iomsg=message)
         if (status /= 0) then
+            call fatal_error(error, "cannot write '" // self%path // "': " // trim(message))
+        else
+            call flush_checked(self%unit, self%path, error)
+        end if
+        if (allocated(error)) then
             close(self%unit, iostat=status)
             self%unit = -1
-            call fatal_error(error, "cannot write '" // self%path // "': " // trim(message))
         end if
     end subroutine put_line
 
@@ -137,13 +141,13 @@ contains
         end do
         close(old)
         if (write_status == 0) then
-            close(new, iostat=write_status, iomsg=message)
+            call close_checked(new, temporary, error)
         else
             close(new)
-        end if
-        if (write_status /= 0) then
-            call remove_file(temporary, ignored)
             call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
+        end if
+        if (allocated(error)) then
+            call remove_file(temporary, ignored)
             return
         end if
         if (last_kept /= step) then
@@ -268,15 +272,12 @@ contains
     subroutine close_curve(self, error)
         class(curve_writer_type), intent(inout) :: self
         type(error_type), allocatable, intent(out), optional :: error
-        character(len=256) :: message
-        integer :: status
+        type(error_type), allocatable :: close_error
 
         if (self%unit == -1) return
-        message = ''
-        close(self%unit, iostat=status, iomsg=message)
+        call close_checked(self%unit, self%path, close_error)
         self%unit = -1
-        if (status /= 0 .and. present(error)) call fatal_error(error, "cannot write '" &
-            // self%path // "': " // trim(message))
+        if (present(error) .and. allocated(close_error)) call move_alloc(close_error, error)
     end subroutine close_curve
 
     !> A real with 17 significant digits (the curve file's format).

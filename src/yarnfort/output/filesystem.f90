@@ -3,12 +3,13 @@
 !> small C shim (filesystem_shim.c): folder creation, atomic rename, removal, fsync, and
 !> the exclusive lock of an output folder.
 module yarnfort_output_filesystem
-    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_long_long
     use yarnfort_error, only: error_type, fatal_error
     implicit none
     private
 
     public :: make_folder, rename_file, remove_file, sync_file, folder_lock_type
+    public :: close_checked, flush_checked
     public :: lock_file_name
 
     !> The lock file of an output folder (kept; the lock is the kernel's, not the file).
@@ -66,6 +67,18 @@ module yarnfort_output_filesystem
             character(kind=c_char), intent(in) :: path(*)
             integer(c_int) :: status
         end function c_remove_file
+
+        function c_file_size(path) result(bytes) bind(C, name='yarnfort_file_size')
+            import :: c_char, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long) :: bytes
+        end function c_file_size
+
+        function c_free_space(path) result(bytes) bind(C, name='yarnfort_free_space')
+            import :: c_char, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long) :: bytes
+        end function c_free_space
 
         subroutine c_last_error(text, length) bind(C, name='yarnfort_last_error')
             import :: c_int, c_char
@@ -136,6 +149,70 @@ contains
         if (c_sync_file(path // c_null_char) /= 0) &
             call fatal_error(error, "cannot write '" // path // "' to disk: " // get_reason())
     end subroutine sync_file
+
+    !> Close `unit`, connected to the file `path`, and check that every byte written
+    !> reached the file. (gfortran's CLOSE and FLUSH report no error when the buffered
+    !> data cannot be written, e.g. on a full disk: the file's size tells.)
+    subroutine close_checked(unit, path, error)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        character(len=256) :: message
+        integer(8) :: expected
+        integer :: status
+
+        inquire(unit=unit, size=expected)
+        message = ''
+        close(unit, iostat=status, iomsg=message)
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+            return
+        end if
+        call check_size(path, expected, error)
+    end subroutine close_checked
+
+    !> Flush `unit`, connected to the file `path`, and check that every byte written so
+    !> far reached the file (see close_checked).
+    subroutine flush_checked(unit, path, error)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        character(len=256) :: message
+        integer(8) :: expected
+        integer :: status
+
+        message = ''
+        flush(unit, iostat=status, iomsg=message)
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+            return
+        end if
+        inquire(unit=unit, size=expected)
+        call check_size(path, expected, error)
+    end subroutine flush_checked
+
+    !> Fail unless the file `path` has `expected` bytes; the error says whether its
+    !> device is full.
+    subroutine check_size(path, expected, error)
+        character(len=*), intent(in) :: path
+        integer(8), intent(in) :: expected
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_long_long) :: actual, free
+        character(len=64) :: counts
+
+        if (expected < 0) return
+        actual = c_file_size(path // c_null_char)
+        if (actual == expected) return
+        write(counts, '(i0, " of its ", i0)') max(actual, 0_c_long_long), expected
+        free = c_free_space(path // c_null_char)
+        if (free == 0) then
+            call fatal_error(error, "cannot write '" // path // "': No space left on " &
+                // 'device (the file got ' // trim(counts) // ' bytes)')
+        else
+            call fatal_error(error, "cannot write '" // path // "': the file got " &
+                // trim(counts) // ' bytes (the device failed or is full)')
+        end if
+    end subroutine check_size
 
     !> Take the lock of `folder` (its file .yarnfort-lock). If another process holds it
     !> the error says who (pid, host, since when); the lock then stays theirs.

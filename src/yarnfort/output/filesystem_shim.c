@@ -10,6 +10,7 @@
 #include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -93,6 +94,22 @@ int yarnfort_remove_file(const char *path)
 {
     if (unlink(path) == 0 || errno == ENOENT) return 0;
     return -1;
+}
+
+/* The size in bytes of the file `path` on its device, -1 if it cannot be told. */
+long long yarnfort_file_size(const char *path)
+{
+    struct stat info;
+    if (stat(path, &info) != 0) return -1;
+    return (long long)info.st_size;
+}
+
+/* Bytes still free for this user on the device of `path`, -1 if it cannot be told. */
+long long yarnfort_free_space(const char *path)
+{
+    struct statvfs info;
+    if (statvfs(path, &info) != 0) return -1;
+    return (long long)info.f_bavail * (long long)info.f_frsize;
 }
 
 /* The text of errno (the reason of the last failed call), NUL-terminated. */

@@ -14,7 +14,8 @@
 module yarnfort_output_manifest
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file
+    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, &
+        close_checked, flush_checked
     implicit none
     private
 
@@ -126,7 +127,7 @@ contains
                     self%times(i), status, message)
             end do
             if (status == 0) then
-                close(unit, iostat=status, iomsg=message)
+                call close_checked(unit, temporary, error)
             else
                 close(unit, status='delete')
             end if
@@ -135,7 +136,7 @@ contains
             call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
             return
         end if
-        call sync_file(temporary, error)
+        if (.not. allocated(error)) call sync_file(temporary, error)
         if (.not. allocated(error)) call rename_file(temporary, path, error)
         if (allocated(error)) then
             call remove_file(temporary, ignored)
@@ -165,12 +166,13 @@ contains
         end if
         call put_state(self%unit, name, step, time, &
             status, message)
-        if (status == 0) flush(self%unit, iostat=status, iomsg=message)
         if (status /= 0) then
             call fatal_error(error, "cannot write '" // self%folder // '/' &
                 // manifest_file_name // "': " // trim(message))
             return
         end if
+        call flush_checked(self%unit, self%folder // '/' // manifest_file_name, error)
+        if (allocated(error)) return
         self%states = [self%states, [character(len=entry_length) :: name]]
         self%steps = [self%steps, step]
         self%times = [self%times, time]

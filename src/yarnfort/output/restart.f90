@@ -24,7 +24,7 @@ module yarnfort_output_restart
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_input_text, only: resolve_path
     use yarnfort_solver_restart, only: restart_type, stepper_elastic, stepper_friction
-    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file
+    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, close_checked
     implicit none
     private
 
@@ -103,11 +103,10 @@ contains
                 // " (the previous '" // path // "' is kept)")
             return
         end if
-        close(unit, iostat=status, iomsg=message)
-        if (status /= 0) then
+        call close_checked(unit, temporary, error)
+        if (allocated(error)) then
             call remove_file(temporary, ignored)
-            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message) &
-                // " (the previous '" // path // "' is kept)")
+            error%message = error%message // " (the previous '" // path // "' is kept)"
             return
         end if
         ! On disk before it replaces the previous file: a crash of the machine cannot

@@ -20,7 +20,7 @@ module yarnfort_output_vtk
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
-    use yarnfort_output_filesystem, only: rename_file, remove_file
+    use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked
     implicit none
     private
 
@@ -247,14 +247,15 @@ contains
         if (status == 0) then
             write(unit, iostat=status, iomsg=message) text
             if (status == 0) then
-                close(unit, iostat=status, iomsg=message)
+                call close_checked(unit, target, error)
             else
                 close(unit)
             end if
         end if
-        if (status /= 0) then
+        if (status /= 0) call fatal_error(error, "cannot write '" // target // "': " &
+            // trim(message))
+        if (allocated(error)) then
             call remove_file(target, ignored)
-            call fatal_error(error, "cannot write '" // target // "': " // trim(message))
             return
         end if
         if (through_temporary) then

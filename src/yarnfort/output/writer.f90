@@ -16,7 +16,7 @@ module yarnfort_output_writer
     use yarnfort_output_curve, only: curve_writer_type
     use yarnfort_output_vtk, only: vtk_writer_type
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
-        remove_file, lock_file_name
+        remove_file, lock_file_name, close_checked
     use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_output_restart, only: write_restart, remove_restart
@@ -213,14 +213,15 @@ contains
         if (status == 0) then
             call write_config(unit, config, status, message)
             if (status == 0) then
-                close(unit, iostat=status, iomsg=message)
+                call close_checked(unit, temporary, error)
             else
                 close(unit)
             end if
         end if
-        if (status /= 0) then
+        if (status /= 0) call fatal_error(error, "cannot write '" // temporary // "': " &
+            // trim(message))
+        if (allocated(error)) then
             call remove_file(temporary, ignored)
-            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
             return
         end if
         call rename_file(temporary, path, error)
