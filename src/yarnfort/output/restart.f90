@@ -365,8 +365,8 @@ contains
         real(wp), intent(in) :: value
         character(len=:), allocatable :: text
         character(len=32) :: buffer
-        write(buffer, '(g0.6)') value
-        text = trim(buffer)
+        write(buffer, '(es13.6e2)') value
+        text = trim(adjustl(buffer))
     end function format_real_text
 
     !> Delete folder/restart.dat if there is one and it is a yarnfort restart file (a
