@@ -14,6 +14,7 @@ program yarnfort_main
     use yarnfort_app_progress, only: progress_writer_type
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash
+    use yarnfort_output_filesystem, only: ignore_file_size_signal
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
@@ -24,6 +25,8 @@ program yarnfort_main
     logical :: stopped
 
     call handle_arguments()
+    ! A write past a file size limit then fails like any other write (exit 1, message).
+    call ignore_file_size_signal()
 
     call read_config_from_stdin(config, error)
     if (allocated(error)) call fail('input', error, 2)

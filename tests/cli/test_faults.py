@@ -33,14 +33,19 @@ CRASH_MARKERS = ("Fortran runtime", "Program received signal", "Backtrace", "ERR
 LONG_CAPSTAN = CAPSTAN.replace("max_step = 0.05", "max_step = 0.002\n    initial_step = 0.002")
 
 
-def run(text: str, cwd: Path, *, memory: int | None = None) -> subprocess.CompletedProcess:
+def run(text: str, cwd: Path, *, memory: int | None = None,
+        file_size: int | None = None) -> subprocess.CompletedProcess:
     """Run yarnfort on `text` in `cwd`, optionally with its address space limited to
-    `memory` bytes."""
+    `memory` bytes, or its files to `file_size` bytes (a write past it fails: EFBIG)."""
     def limit() -> None:
-        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+        if memory:
+            resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+        if file_size:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (file_size, file_size))
 
     proc = subprocess.run([str(EXECUTABLE)], input=text, capture_output=True, text=True,
-                          cwd=cwd, timeout=TIMEOUT, preexec_fn=limit if memory else None)
+                          cwd=cwd, timeout=TIMEOUT,
+                          preexec_fn=limit if memory or file_size else None)
     for marker in CRASH_MARKERS:
         assert marker not in proc.stderr, proc.stderr
     return proc
@@ -129,6 +134,24 @@ def test_full_disk_ends_the_run_and_keeps_the_restart_file(small_disk, tmp_path)
     assert again.returncode == 0, again.stderr
     compare_curves(read_rows(tmp_path / "full"), read_rows(out))
     assert collection(out) == collection(tmp_path / "full")
+
+
+def test_curve_row_that_fails_part_way_is_cut_off(tmp_path):
+    """Files may not grow past 6000 bytes: the curve row that crosses it is written only
+    in part. The run stops with exit 1 and the reason, and curve.csv keeps whole rows;
+    a restart (without the limit) gives the uninterrupted curve."""
+    full = run(with_output(CAPSTAN, "full", output="vtk_every = 0"), tmp_path)
+    assert full.returncode == 0, full.stderr
+    proc = run(with_output(CAPSTAN, "out", output="vtk_every = 0"), tmp_path, file_size=6000)
+    assert proc.returncode == 1, proc.stderr
+    assert "yarnfort: error (output): cannot write 'out/curve.csv': File too large" in proc.stderr
+    rows = complete_rows(tmp_path / "out")
+    assert 5 <= len(rows) < len(read_rows(tmp_path / "full"))
+    assert (tmp_path / "out" / "curve.csv").stat().st_size < 6000
+    again = run(with_output(CAPSTAN, "out", control="restart = .true.",
+                            output="vtk_every = 0"), tmp_path)
+    assert again.returncode == 0, again.stderr
+    compare_curves(read_rows(tmp_path / "full"), read_rows(tmp_path / "out"))
 
 
 @pytest.mark.parametrize("size", ["4k", "12k"])

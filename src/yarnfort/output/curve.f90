@@ -6,7 +6,7 @@ module yarnfort_output_curve
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, &
-        flush_checked
+        flush_checked, truncate_file
     implicit none
     private
 
@@ -54,14 +54,18 @@ contains
         call self%put_line(get_header(scene), error)
     end subroutine open_curve
 
-    !> Write a line and flush it to the file; a failure closes the file and says why.
+    !> Write a line and flush it to the file. A failure closes the file, cuts off what
+    !> reached it of the line (so the file keeps whole rows only) and says why.
     subroutine put_line(self, line, error)
         class(curve_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: line
         type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: ignored
         character(len=256) :: message
         integer :: status
+        integer(8) :: whole
 
+        inquire(unit=self%unit, size=whole)
         message = ''
         write(self%unit, '(a)', iostat=status, iomsg=message) line
         if (status /= 0) then
@@ -72,6 +76,7 @@ contains
         if (allocated(error)) then
             close(self%unit, iostat=status)
             self%unit = -1
+            if (whole >= 0) call truncate_file(self%path, whole, ignored)
         end if
     end subroutine put_line
 

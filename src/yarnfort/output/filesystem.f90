@@ -9,7 +9,7 @@ module yarnfort_output_filesystem
     private
 
     public :: make_folder, rename_file, remove_file, sync_file, folder_lock_type
-    public :: close_checked, flush_checked
+    public :: close_checked, flush_checked, truncate_file, ignore_file_size_signal
     public :: lock_file_name
 
     !> The lock file of an output folder (kept; the lock is the kernel's, not the file).
@@ -67,6 +67,22 @@ module yarnfort_output_filesystem
             character(kind=c_char), intent(in) :: path(*)
             integer(c_int) :: status
         end function c_remove_file
+
+        subroutine ignore_file_size_signal() bind(C, name='yarnfort_ignore_file_size_signal')
+        end subroutine ignore_file_size_signal
+
+        function c_truncate_file(path, bytes) result(status) &
+                bind(C, name='yarnfort_truncate_file')
+            import :: c_int, c_char, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long), value :: bytes
+            integer(c_int) :: status
+        end function c_truncate_file
+
+        function c_file_size_limit() result(bytes) bind(C, name='yarnfort_file_size_limit')
+            import :: c_long_long
+            integer(c_long_long) :: bytes
+        end function c_file_size_limit
 
         function c_file_size(path) result(bytes) bind(C, name='yarnfort_file_size')
             import :: c_char, c_long_long
@@ -150,6 +166,18 @@ contains
             call fatal_error(error, "cannot write '" // path // "' to disk: " // get_reason())
     end subroutine sync_file
 
+    !> Cut the (closed) file `path` back to `bytes` bytes, e.g. to drop a line that could
+    !> be written only in part.
+    subroutine truncate_file(path, bytes, error)
+        character(len=*), intent(in) :: path
+        integer(8), intent(in) :: bytes
+        type(error_type), allocatable, intent(out) :: error
+
+        if (c_truncate_file(path // c_null_char, int(bytes, c_long_long)) /= 0) &
+            call fatal_error(error, "cannot cut '" // path // "' back to its last whole " &
+                // 'line: ' // get_reason())
+    end subroutine truncate_file
+
     !> Close `unit`, connected to the file `path`, and check that every byte written
     !> reached the file. (gfortran's CLOSE and FLUSH report no error when the buffered
     !> data cannot be written, e.g. on a full disk: the file's size tells.)
@@ -197,15 +225,21 @@ contains
         character(len=*), intent(in) :: path
         integer(8), intent(in) :: expected
         type(error_type), allocatable, intent(out) :: error
-        integer(c_long_long) :: actual, free
-        character(len=64) :: counts
+        integer(c_long_long) :: actual, free, limit
+        character(len=64) :: counts, limit_text
 
         if (expected < 0) return
         actual = c_file_size(path // c_null_char)
         if (actual == expected) return
         write(counts, '(i0, " of its ", i0)') max(actual, 0_c_long_long), expected
         free = c_free_space(path // c_null_char)
-        if (free == 0) then
+        limit = c_file_size_limit()
+        if (limit >= 0 .and. expected > limit) then
+            write(limit_text, '(i0)') limit
+            call fatal_error(error, "cannot write '" // path // "': File too large (the " &
+                // 'file size limit, ulimit -f, is ' // trim(limit_text) // ' bytes; the ' &
+                // 'file got ' // trim(counts) // ' bytes)')
+        else if (free == 0) then
             call fatal_error(error, "cannot write '" // path // "': No space left on " &
                 // 'device (the file got ' // trim(counts) // ' bytes)')
         else

@@ -6,9 +6,11 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/file.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <time.h>
@@ -94,6 +96,27 @@ int yarnfort_remove_file(const char *path)
 {
     if (unlink(path) == 0 || errno == ENOENT) return 0;
     return -1;
+}
+
+/* Make a write past the file size limit (ulimit -f) fail with EFBIG, reported like any
+ * failed write, instead of killing the process with SIGXFSZ. */
+void yarnfort_ignore_file_size_signal(void)
+{
+    signal(SIGXFSZ, SIG_IGN);
+}
+
+/* The largest file this process may write (ulimit -f), in bytes; -1 for no limit. */
+long long yarnfort_file_size_limit(void)
+{
+    struct rlimit limit;
+    if (getrlimit(RLIMIT_FSIZE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return -1;
+    return (long long)limit.rlim_cur;
+}
+
+/* Cut the file `path` to `size` bytes. */
+int yarnfort_truncate_file(const char *path, long long size)
+{
+    return truncate(path, (off_t)size);
 }
 
 /* The size in bytes of the file `path` on its device, -1 if it cannot be told. */

@@ -100,13 +100,13 @@ contains
         if (status /= 0) then
             close(unit, status='delete')
             call fatal_error(error, "cannot write '" // temporary // "': " // trim(message) &
-                // " (the previous '" // path // "' is kept)")
+                // kept())
             return
         end if
         call close_checked(unit, temporary, error)
         if (allocated(error)) then
             call remove_file(temporary, ignored)
-            error%message = error%message // " (the previous '" // path // "' is kept)"
+            error%message = error%message // kept()
             return
         end if
         ! On disk before it replaces the previous file: a crash of the machine cannot
@@ -115,6 +115,15 @@ contains
         if (.not. allocated(error)) call rename_file(temporary, path, error)
         if (allocated(error)) call remove_file(temporary, ignored)
     contains
+        !> What the failure leaves: the previous restart file, if there is one.
+        function kept() result(text)
+            character(len=:), allocatable :: text
+            logical :: exists
+            inquire(file=path, exist=exists)
+            text = ''
+            if (exists) text = " (the previous '" // path // "' is kept)"
+        end function kept
+
         !> The array, or zeros when the snapshot has none (e.g. no previous state).
         subroutine put_reals(values, n)
             real(wp), allocatable, intent(in) :: values(:)

@@ -134,6 +134,7 @@ contains
         call self%manifest%list_fixed_files()
         call self%manifest%save(error)
         if (allocated(error)) return
+        if (allocated(self%vtk%files)) deallocate(self%vtk%files, self%vtk%times)
         allocate(self%vtk%files(0), self%vtk%times(0))
         call self%curve%open(self%folder, scene, error)
     end subroutine start_files
