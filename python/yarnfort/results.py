@@ -99,7 +99,8 @@ def read_states(folder: str | Path) -> list[State]:
     if collection.exists():
         root = ET.parse(collection).getroot()
         return [read_state(folder / d.get("file")) for d in root.iter("DataSet")]
-    return [read_state(p) for p in sorted(folder.glob("state_*.vtu"))]
+    return [read_state(p) for p in sorted(folder.glob("state_*.vtu"),
+                                          key=lambda p: int(p.stem[len("state_"):]))]
 
 
 def read_run(folder: str | Path) -> tuple[Curve, list[State]]:
