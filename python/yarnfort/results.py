@@ -222,7 +222,8 @@ def _read_meshio(meshio: Any, path: Path) -> tuple[np.ndarray, np.ndarray, dict,
 
 
 def read_state(path: str | Path) -> State:
-    """Read one VTK state file (``state_*.vtu``) written by yarnfort.
+    """Read one VTK state file (``state_*.vtu``) written by yarnfort: its yarn elements
+    (links, the cells of another ``kind``, are left out).
 
     Parameters
     ----------
@@ -254,6 +255,11 @@ def read_state(path: str | Path) -> State:
     missing = [name for name in ("tension", "stretch", "L0") if name not in cell_data]
     if missing:
         raise ResultError(f"{path}: no cell data {', '.join(missing)}")
+    # Links (gap-holders, periodic images) are cells of another `kind`: keep elements.
+    if "kind" in cell_data:
+        element = np.ravel(cell_data["kind"]) == 0
+        elements = elements[element]
+        cell_data = {name: np.asarray(values)[element] for name, values in cell_data.items()}
     return State(position=points, elements=elements,
                  tension=np.ravel(cell_data["tension"]),
                  stretch=np.ravel(cell_data["stretch"]),
@@ -284,7 +290,8 @@ def read_states(folder: str | Path) -> list[State]:
         except ET.ParseError as error:
             raise ResultError(f"{collection}: not a readable collection ({error})") from None
         return [read_state(folder / d.get("file")) for d in root.iter("DataSet")]
-    return [read_state(p) for p in sorted(folder.glob("state_*.vtu"))]
+    return [read_state(p) for p in sorted(folder.glob("state_*.vtu"),
+                                          key=lambda p: int(p.stem[len("state_"):]))]
 
 
 def read_run(folder: str | Path) -> tuple[Curve, list[State]]:

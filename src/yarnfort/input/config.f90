@@ -150,6 +150,8 @@ module yarnfort_input_config
         !> Write a VTK state every this many converged steps (0: none; the last step is
         !> always written when vtk_every > 0).
         integer :: vtk_every = 1
+        !> Encoding of the VTK data: 'binary' (appended, base64) or 'ascii' (inline).
+        character(len=8) :: vtk_format = 'binary'
         !> Progress lines on stderr.
         logical :: progress = .true.
         !> Also print each step's Newton residual history (scaled max-norm per iterate).

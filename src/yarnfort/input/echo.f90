@@ -19,12 +19,20 @@ module yarnfort_input_echo
 
 contains
 
-    !> Write `config` as namelist groups to the formatted sequential unit `unit`.
-    subroutine write_config(unit, config)
+    !> Write `config` as namelist groups to the formatted sequential unit `unit`. With
+    !> `status`, a failed write stops the writing and its iostat (and iomsg in
+    !> `message`) is returned instead of ending the program.
+    subroutine write_config(unit, config, status, message)
         integer, intent(in) :: unit
         type(config_type), intent(in) :: config
-        integer :: k, n
+        integer, intent(out), optional :: status
+        character(len=*), intent(inout), optional :: message
+        integer :: k, n, stat
+        character(len=256) :: iomsg
         logical :: from_file
+
+        stat = 0
+        iomsg = ''
 
         call put('! yarnfort effective input: every namelist variable with its value, ' &
             // 'defaults included')
@@ -118,10 +126,12 @@ contains
             call put('&output')
             call put(indent // 'folder = ' // quote_string(output%folder))
             call put(indent // 'vtk_every = ' // format_integer(output%vtk_every))
+            call put(indent // 'vtk_format = ' // quote_string(output%vtk_format))
             call put(indent // 'progress = ' // format_logical(output%progress))
             call put(indent // 'residual_history = ' // format_logical(output%residual_history))
             call put('/')
         end associate
+        if (present(status)) status = stat
 
     contains
 
@@ -220,7 +230,14 @@ contains
         subroutine put(line)
             character(len=*), intent(in) :: line
 
-            write(unit, '(a)') line
+            if (stat /= 0) return
+            if (present(status)) then
+                write(unit, '(a)', iostat=stat, iomsg=iomsg) line
+                status = stat
+                if (stat /= 0 .and. present(message)) message = iomsg
+            else
+                write(unit, '(a)') line
+            end if
         end subroutine put
 
         !> `name = v1 v2 ...`, integers_per_line values per line; nothing for no values.

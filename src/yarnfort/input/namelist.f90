@@ -841,7 +841,7 @@ contains
         end subroutine take_name
     end subroutine read_fabric
 
-    !> &output: folder, vtk_every, progress, residual_history.
+    !> &output: folder, vtk_every, vtk_format, progress, residual_history.
     subroutine read_output(unit, scan, cfg, error)
         integer, intent(in) :: unit
         type(namelist_scan_type), intent(in) :: scan
@@ -850,14 +850,16 @@ contains
         type(output_config_type) :: defaults
         character(len=buffer_length) :: folder
         integer :: vtk_every
+        character(len=buffer_length) :: vtk_format
         logical :: progress, residual_history
-        namelist /output/ folder, vtk_every, progress, residual_history
+        namelist /output/ folder, vtk_every, vtk_format, progress, residual_history
         character(len=message_length) :: message
         integer :: stat
 
         if (scan%count_group('output') == 0) return
         folder = defaults%folder
         vtk_every = defaults%vtk_every
+        vtk_format = defaults%vtk_format
         progress = defaults%progress
         residual_history = defaults%residual_history
         rewind(unit)
@@ -865,12 +867,17 @@ contains
         read(unit, nml=output, iostat=stat, iomsg=message)
         if (stat /= 0) then
             call read_failed(error, scan, 'output', 0, stat, message, &
-                [character(len=16) :: 'folder', 'vtk_every', 'progress', 'residual_history'])
+                [character(len=16) :: 'folder', 'vtk_every', 'vtk_format', 'progress', &
+                'residual_history'])
             return
         end if
         call check_length(error, scan, 'output', 0, 'folder', folder, len(cfg%output%folder))
         if (allocated(error)) return
         cfg%output%folder = folder(:len(cfg%output%folder))
+        call check_length(error, scan, 'output', 0, 'vtk_format', vtk_format, &
+            len(cfg%output%vtk_format))
+        if (allocated(error)) return
+        cfg%output%vtk_format = vtk_format(:len(cfg%output%vtk_format))
         cfg%output%vtk_every = vtk_every
         cfg%output%progress = progress
         cfg%output%residual_history = residual_history

@@ -181,6 +181,12 @@ contains
             return
         end if
         call require_at_least(error, '&output', 'vtk_every', output%vtk_every, 0)
+        if (allocated(error)) return
+        if (output%vtk_format /= 'binary' .and. output%vtk_format /= 'ascii') then
+            call fatal_error(error, "&output: vtk_format = '" // trim(output%vtk_format) &
+                // "' is unknown (use 'binary' or 'ascii')")
+            return
+        end if
     end subroutine check_output
 
     subroutine check_materials(materials, error)

@@ -294,8 +294,12 @@ contains
             scene%dofs%gap_p_disp = config%fabric%gap_factor_p_disp
             scene%dofs%gap_factor = config%fabric%gap_factor
         end if
+        allocate(scene%link_nodes(2, 0), scene%link_is_gap(0))
         if (.not. allocated(config%links)) return
         if (size(config%links) == 0) return
+        scene%link_nodes = reshape([(config%links(l)%leader, config%links(l)%follower, &
+            l = 1, size(config%links))], [2, size(config%links)])
+        scene%link_is_gap = config%links%gap
         allocate(leader(n_nodes), link_of(n_nodes), source=0)
         do l = 1, size(config%links)
             n = config%links(l)%follower

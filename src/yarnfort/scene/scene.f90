@@ -56,6 +56,10 @@ module yarnfort_scene_scene
         real(wp) :: fabric_width = 0.0_wp
         real(wp) :: fabric_strain = 0.0_wp
         integer :: fabric_set = 0
+        !> Links (gap-holders and periodic images), for the output: (leader, follower)
+        !> node pairs (2, n_links), and whether each is a gap-holder.
+        integer, allocatable :: link_nodes(:, :)
+        logical, allocatable :: link_is_gap(:)
     end type scene_type
 
 contains
