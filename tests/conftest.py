@@ -2,17 +2,19 @@
 """Shared pytest fixtures: run the built yarnfort program on namelist text."""
 from __future__ import annotations
 
+import os
 import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
+import yarnfort
+
 TOP = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(TOP / "python"))
-import os
-EXECUTABLE = Path(os.environ.get("YARNFORT_EXE", TOP / "build" / "yarnfort"))
+#: The program of the installed package (tools/bootstrap: the editable install, whose
+#: build folder is build/), or $YARNFORT_EXE.
+EXECUTABLE = Path(os.environ.get("YARNFORT_EXE") or yarnfort.program_path())
 
 
 @dataclass
@@ -25,7 +27,7 @@ class Run:
 
 @pytest.fixture
 def run_yarnfort(tmp_path):
-    """Run ``build/yarnfort`` with namelist text on stdin inside a fresh folder."""
+    """Run the yarnfort program with namelist text on stdin inside a fresh folder."""
 
     def run(text: str, *args: str, cwd: Path | None = None, timeout: float = 600) -> Run:
         where = cwd or tmp_path

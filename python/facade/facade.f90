@@ -9,17 +9,23 @@
 !> library's error message (cut to `text_length` characters). Nothing here prints or stops.
 !>
 !> f2py resolves only parameters declared in the wrapped routine itself, so each routine
-!> declares its own `text_length`.
+!> declares its own `text_length`. `run_scene_file` takes a Python call-back, which f2py
+!> supports only for routines outside a module: it follows the module.
 module yarnfort_facade
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     use yarnfort_facade_laws, only: get_force_law_values, get_critical_tensions
-    use yarnfort_facade_scene_runner, only: run_scene_from_file
     implicit none
     private
 
-    public :: force_law_eval, friction_critical_tension, run_scene_file
+    public :: force_law_eval, friction_critical_tension
+    ! For run_scene_file (outside the module); not wrapped by f2py.
+    public :: set_status, cut_text
+
+    !> Status of a law or parameter the library refuses (the program's exit code for
+    !> bad input).
+    integer(c_int), parameter :: status_bad_law = 2_c_int
 
     !> Marker that ends a message cut to fit its string.
     character(len=*), parameter :: cut_marker = ' [...]'
@@ -51,6 +57,8 @@ contains
         dforce = real(dforce_wp, c_double)
         energy = real(energy_wp, c_double)
         call set_status(error, status, message)
+        ! A law the library refuses is bad input, like a bad &material in a scene.
+        if (status /= 0_c_int) status = status_bad_law
     end subroutine force_law_eval
 
     !> Critical tension T_crit(T_min, alpha) of a friction law and its derivatives with
@@ -78,30 +86,8 @@ contains
         dcrit_dtension = real(dtension_wp, c_double)
         dcrit_dangle = real(dangle_wp, c_double)
         call set_status(error, status, message)
+        if (status /= 0_c_int) status = status_bad_law
     end subroutine friction_critical_tension
-
-    !> Run the scene in the namelist file `path` like `yarnfort < path`, silently, writing
-    !> curve.csv, the VTK states and input.nml to its &output `folder` (a relative folder
-    !> is taken from the working directory). `n_steps`: converged steps written (rows of
-    !> curve.csv, step 0 included; also set after a failed solve, whose steps are kept).
-    !> Status: 2 for bad input or an unusable output folder, 1 for a failed solve.
-    subroutine run_scene_file(path, status, message, n_steps, folder)
-        !> Length of `message` and `folder` (above the input's path length, 512).
-        integer, parameter :: text_length = 1024
-        character(len=*), intent(in) :: path
-        integer(c_int), intent(out) :: status
-        character(len=text_length), intent(out) :: message
-        integer(c_int), intent(out) :: n_steps
-        character(len=text_length), intent(out) :: folder
-        type(error_type), allocatable :: error
-        character(len=:), allocatable :: folder_text
-        integer :: steps
-
-        call run_scene_from_file(trim(path), steps, folder_text, error)
-        n_steps = int(steps, c_int)
-        call cut_text(folder_text, folder)
-        call set_status(error, status, message)
-    end subroutine run_scene_file
 
     !> Status 0 and a blank message without an error, else the error's status (at least 1)
     !> and message.
@@ -136,3 +122,56 @@ contains
     end subroutine cut_text
 
 end module yarnfort_facade
+
+!> Run the scene in the namelist file `path` as `yarnfort < path` does (relative names from
+!> the working directory, `&control restart` and `max_steps` honoured), writing curve.csv,
+!> the VTK states, input.nml and restart.dat to its &output `folder`, without progress
+!> lines. `notify(step, time, time_start, time_end, p_force, p_disp, iterations, residual,
+!> n_slipping, n_passages, wall_time)` is called after every converged step once its files are
+!> written; a non-zero answer stops the run there (as `max_steps` would). It is called a
+!> last time with step = -1 when the run ends, whatever the outcome.
+!> `n_steps`: converged steps written by this run (rows added to curve.csv; also set after
+!> a failed solve, whose steps are kept). `outcome`: 0 the path's end was reached, 1
+!> stopped by `max_steps`, 2 stopped by the call-back. Status: 2 for bad input, a bad
+!> restart file or an unusable output folder, 1 for a failed solve.
+subroutine run_scene_file(path, notify, status, message, n_steps, folder, outcome)
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use yarnfort_error, only: error_type
+    use yarnfort_facade, only: set_status, cut_text
+    use yarnfort_facade_scene_runner, only: run_scene_from_file
+    implicit none
+    !> Length of `message` and `folder` (above the input's path length, 512).
+    integer, parameter :: text_length = 1024
+    character(len=*), intent(in) :: path
+    integer(c_int), external :: notify
+    integer(c_int), intent(out) :: status
+    character(len=text_length), intent(out) :: message
+    integer(c_int), intent(out) :: n_steps
+    character(len=text_length), intent(out) :: folder
+    integer(c_int), intent(out) :: outcome
+    type(error_type), allocatable :: error
+    character(len=:), allocatable :: folder_text
+    integer(c_int) :: step, iterations, n_slipping, n_passages, answer
+    real(c_double) :: time, time_start, time_end, p_force, p_disp, residual, wall_time
+    integer :: steps, how
+
+    call run_scene_from_file(trim(path), notify, steps, folder_text, how, error)
+    n_steps = int(steps, c_int)
+    outcome = int(how, c_int)
+    call cut_text(folder_text, folder)
+    call set_status(error, status, message)
+    ! The closing call (step -1): the same signature, so that f2py sees it here.
+    step = -1_c_int
+    iterations = 0_c_int
+    n_slipping = 0_c_int
+    n_passages = 0_c_int
+    time = 0.0_c_double
+    time_start = 0.0_c_double
+    time_end = 0.0_c_double
+    p_force = 0.0_c_double
+    p_disp = 0.0_c_double
+    residual = 0.0_c_double
+    wall_time = 0.0_c_double
+    answer = notify(step, time, time_start, time_end, p_force, p_disp, iterations, &
+        residual, n_slipping, n_passages, wall_time)
+end subroutine run_scene_file

@@ -1,63 +1,103 @@
 ! SPDX-License-Identifier: MIT
-!> Run a scene from a namelist file for the Python facade, writing the same files as the
-!> program (curve.csv, VTK states, input.nml) but no progress lines, and counting the
-!> converged steps. Kept out of `yarnfort_facade`, which f2py reads, because f2py cannot
-!> parse derived types with type-bound procedures.
+!> Run a scene from a namelist file for the Python facade, as the program does with the
+!> same file on standard input: the same files (curve.csv, VTK states, input.nml,
+!> restart.dat), `&control restart` and `max_steps` honoured, relative file names taken
+!> from the working directory. Instead of progress lines, a call-back after every
+!> converged step, which can ask the run to stop there. Kept out of `yarnfort_facade`,
+!> which f2py reads, because f2py cannot parse derived types with type-bound procedures.
 module yarnfort_facade_scene_runner
+    use, intrinsic :: iso_c_binding, only: c_double, c_int
+    use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
+    use yarnfort_solver_restart, only: restart_type
     use yarnfort_input_config, only: config_type
-    use yarnfort_input_namelist, only: read_config_from_file, check_config
+    use yarnfort_input_namelist, only: read_config, check_config
     use yarnfort_input_echo, only: write_config
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_output_writer, only: output_writer_type
+    use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash
     use yarnfort_driver, only: run_scene
     implicit none
     private
 
-    public :: run_scene_from_file, status_input, status_solve
+    public :: run_scene_from_file, step_callback_interface
+    public :: status_input, status_solve, outcome_done, outcome_max_steps, outcome_stopped
 
     !> Error status for bad input or an unusable output folder (the program's exit code).
     integer, parameter :: status_input = 2
-
     !> Error status for a failed solve, or an output error after it (the program's exit
     !> code); the converged steps are kept.
     integer, parameter :: status_solve = 1
 
+    !> How a run without error ended: the path's end reached, `&control max_steps`
+    !> reached, or stopped on the call-back's request (at a step boundary).
+    integer, parameter :: outcome_done = 0, outcome_max_steps = 1, outcome_stopped = 2
+
+    !> Marker status of the error that unwinds the continuation after a stop request.
+    integer, parameter :: status_stop_request = -1
+
     !> Longest I/O error message kept.
     integer, parameter :: iomsg_length = 512
 
-    !> The library's file writer, silent, counting the converged steps it wrote.
-    type, extends(output_writer_type) :: counting_writer_type
-        !> Converged steps written so far (step 0, the initial equilibrium, included).
+    abstract interface
+        !> Called after every converged step (step 0 included) once its files are written;
+        !> returns 0 to go on, anything else to stop the run after this step.
+        function step_callback_interface(step, time, time_start, time_end, p_force, &
+                p_disp, iterations, residual, n_slipping, n_passages, wall_time) result(answer)
+            import :: c_double, c_int
+            integer(c_int), intent(in) :: step, iterations, n_slipping, n_passages
+            real(c_double), intent(in) :: time, time_start, time_end, p_force, p_disp, &
+                residual, wall_time
+            integer(c_int) :: answer
+        end function step_callback_interface
+    end interface
+
+    !> The library's file writer, silent, counting the converged steps it wrote and
+    !> reporting each to the call-back.
+    type, extends(output_writer_type) :: facade_writer_type
+        !> Converged steps written by this run (step 0, the initial equilibrium, included).
         integer :: n_steps = 0
+        !> Start and end of the load path's pseudo-time.
+        real(wp) :: time_start = 0.0_wp, time_end = 0.0_wp
+        !> The call-back asked to stop after the step just written.
+        logical :: stop_requested = .false.
+        procedure(step_callback_interface), pointer, nopass :: notify => null()
     contains
         procedure :: on_step
-    end type counting_writer_type
+        procedure :: on_checkpoint
+    end type facade_writer_type
 
 contains
 
     !> Read, check and build the scene in the namelist file `path`, then solve its load
-    !> path writing the outputs to its &output folder (returned in `folder`). `n_steps`:
-    !> converged steps written, the rows of curve.csv. Relative file names in the input are
-    !> resolved against the folder of `path`, a relative &output folder against the working
-    !> directory, as for `yarnfort < path`. With &control check_only nothing is solved or
-    !> written. On failure `error%stat` is `status_input` or `status_solve` and the message
-    !> starts with the stage (input, output, solve).
-    subroutine run_scene_from_file(path, n_steps, folder, error)
+    !> path writing the outputs to its &output folder (returned in `folder`), as
+    !> `yarnfort < path` does: relative file names in the input and a relative &output
+    !> folder are taken from the working directory, `&control restart` continues from the
+    !> folder's restart.dat and `max_steps` stops the run early. `notify` is called after
+    !> every converged step. `n_steps`: converged steps written by this run (rows added to
+    !> curve.csv). `outcome`: outcome_done, outcome_max_steps or outcome_stopped. With
+    !> &control check_only nothing is solved or written. On failure `error%stat` is
+    !> `status_input` or `status_solve` and the message starts with the stage (input,
+    !> restart, output, solve).
+    subroutine run_scene_from_file(path, notify, n_steps, folder, outcome, error)
         character(len=*), intent(in) :: path
-        integer, intent(out) :: n_steps
+        procedure(step_callback_interface) :: notify
+        integer, intent(out) :: n_steps, outcome
         character(len=:), allocatable, intent(out) :: folder
         type(error_type), allocatable, intent(out) :: error
         type(config_type) :: config
         type(scene_type), target :: scene
-        type(counting_writer_type) :: writer
+        type(facade_writer_type) :: writer
+        type(restart_type) :: restart
         type(error_type), allocatable :: finish_error
+        logical :: stopped
 
         n_steps = 0
+        outcome = outcome_done
         folder = ''
-        call read_config_from_file(path, config, error)
+        call read_scene_file(path, config, error)
         if (.not. allocated(error)) then
             folder = trim(config%output%folder)
             call check_config(config, error)
@@ -69,13 +109,43 @@ contains
         end if
         if (config%control%check_only) return
 
-        call writer%open(scene, error)
+        writer%notify => notify
+        writer%time_start = scene%path%time(1)
+        writer%time_end = scene%path%time(size(scene%path%time))
+        writer%input_hash = get_input_hash(config, scene)
+        if (config%control%restart) then
+            ! Check the restart file before touching anything in the folder.
+            call read_restart(trim(config%output%folder), restart, error)
+            if (.not. allocated(error)) call check_restart(restart, scene, &
+                writer%input_hash, trim(config%output%folder), error)
+            if (allocated(error)) then
+                call set_stage(error, 'restart', status_input)
+                return
+            end if
+            call writer%open(scene, error, resume_step=restart%step)
+        else
+            call writer%open(scene, error)
+        end if
         if (.not. allocated(error)) call write_effective_input(config, error)
         if (allocated(error)) then
             call set_stage(error, 'output', status_input)
             return
         end if
-        call run_scene(scene, writer, error)
+
+        if (config%control%restart) then
+            call run_scene(scene, writer, error, restart=restart, &
+                max_steps=config%control%max_steps, stopped=stopped)
+        else
+            call run_scene(scene, writer, error, max_steps=config%control%max_steps, &
+                stopped=stopped)
+        end if
+        if (stopped) outcome = outcome_max_steps
+        if (allocated(error)) then
+            if (error%stat == status_stop_request) then
+                deallocate(error)
+                outcome = outcome_stopped
+            end if
+        end if
         call writer%finish(scene, finish_error)
         n_steps = writer%n_steps
         if (allocated(error)) then
@@ -86,9 +156,28 @@ contains
         end if
     end subroutine run_scene_from_file
 
-    !> Write the step with the parent writer; count it if that succeeded.
+    !> Read the namelist file `path` with relative names taken from the working
+    !> directory (as for standard input).
+    subroutine read_scene_file(path, config, error)
+        character(len=*), intent(in) :: path
+        type(config_type), intent(out) :: config
+        type(error_type), allocatable, intent(out) :: error
+        character(len=iomsg_length) :: iomsg
+        integer :: unit, stat
+
+        open(newunit=unit, file=path, status='old', action='read', form='formatted', &
+            access='sequential', iostat=stat, iomsg=iomsg)
+        if (stat /= 0) then
+            call fatal_error(error, "cannot open input file '" // path // "': " // trim(iomsg))
+            return
+        end if
+        call read_config(unit, config, error)
+        close(unit)
+    end subroutine read_scene_file
+
+    !> Write the step with the parent writer, count it, and report it to the call-back.
     subroutine on_step(self, scene, state, error)
-        class(counting_writer_type), intent(inout) :: self
+        class(facade_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(step_state_type), intent(in) :: state
         type(error_type), allocatable, intent(out) :: error
@@ -96,7 +185,29 @@ contains
         call self%output_writer_type%on_step(scene, state, error)
         if (allocated(error)) return
         self%n_steps = self%n_steps + 1
+        if (.not. associated(self%notify)) return
+        self%stop_requested = self%notify(int(state%step, c_int), &
+            real(state%time, c_double), real(self%time_start, c_double), &
+            real(self%time_end, c_double), &
+            real(state%p_force, c_double), real(state%p_disp, c_double), &
+            int(state%newton_iterations, c_int), real(state%newton%residual_norm, c_double), &
+            int(state%n_slipping, c_int), int(state%n_passages, c_int), &
+            real(state%wall_time, c_double)) /= 0_c_int
     end subroutine on_step
+
+    !> Write the restart file of the step just written; then, if the call-back asked
+    !> for it, stop the continuation with a marker error (the step is complete on disk).
+    subroutine on_checkpoint(self, scene, snapshot, error)
+        class(facade_writer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        type(restart_type), intent(in) :: snapshot
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%output_writer_type%on_checkpoint(scene, snapshot, error)
+        if (allocated(error) .or. .not. self%stop_requested) return
+        call fatal_error(error, 'stopped on request')
+        error%stat = status_stop_request
+    end subroutine on_checkpoint
 
     !> Echo the effective input to <folder>/input.nml, as the program does.
     subroutine write_effective_input(config, error)
@@ -109,12 +220,11 @@ contains
         file = trim(config%output%folder) // '/input.nml'
         open(newunit=unit, file=file, status='replace', action='write', iostat=stat, &
             iomsg=iomsg)
-        if (stat /= 0) then
-            call fatal_error(error, "cannot write '" // file // "': " // trim(iomsg))
-            return
+        if (stat == 0) then
+            call write_config(unit, config)
+            close(unit, iostat=stat, iomsg=iomsg)
         end if
-        call write_config(unit, config)
-        close(unit)
+        if (stat /= 0) call fatal_error(error, "cannot write '" // file // "': " // trim(iomsg))
     end subroutine write_effective_input
 
     !> Name the stage in front of the message and set the status.

@@ -1,16 +1,49 @@
 # SPDX-License-Identifier: MIT
-"""yarnfort: textile stretching with capstan friction — Python side.
+"""yarnfort: textiles as networks of 1D hyperelastic strings with capstan friction.
 
-Readers for the outputs of ``./yarnfort < scene.nml`` (curve CSV, VTK states) and
-helpers to run the program. The physics lives in the Fortran library.
+The Python side of yarnfort: build scenes (:class:`Scene`), run them in process
+(:func:`run_scene`) or over parameter grids (:func:`run_sweep`), fit friction and
+adhesion to a measured curve (:func:`calibrate`), and read and plot the results
+(:func:`read_run`, :mod:`yarnfort.plots`). The physics lives in the Fortran library.
+
+Names are loaded on first use, so that ``import yarnfort`` stays quick.
 """
-from .results import Curve, State, read_curve, read_state, read_states, read_run
-from ._native import SceneRun, YarnfortError, critical_tension, force_law, run_scene
-from .namelist import get_parameter, read_scene, set_parameter, write_scene
+from __future__ import annotations
 
-__all__ = ["Curve", "State", "read_curve", "read_state", "read_states", "read_run",
-           "SceneRun", "YarnfortError", "critical_tension", "force_law", "run_scene",
-           "read_scene", "write_scene", "set_parameter", "get_parameter"]
-from .sweep import run_sweep  # noqa: E402
-from .calibrate import CalibrationResult, calibrate, plot_fit  # noqa: E402
-__all__ += ["run_sweep", "CalibrationResult", "calibrate", "plot_fit"]
+import importlib
+from typing import Any
+
+from ._version import __version__
+
+#: Public name -> module that defines it.
+_EXPORTS: dict[str, str] = {
+    "Curve": "results", "State": "results", "ResultError": "results",
+    "read_curve": "results", "read_state": "results", "read_states": "results",
+    "read_run": "results",
+    "YarnfortError": "_native", "critical_tension": "_native", "force_law": "_native",
+    "run_scene": "runner", "RunResult": "runner", "RunInterrupted": "runner",
+    "Step": "runner",
+    "read_scene": "namelist", "write_scene": "namelist", "make_namelist": "namelist",
+    "set_parameter": "address", "get_parameter": "address", "AddressError": "address",
+    "Scene": "scene", "Material": "scene", "Contact": "scene", "Yarn": "scene",
+    "Support": "scene", "Load": "scene", "LoadPath": "scene", "Fabric": "scene",
+    "Geometry": "scene", "SceneError": "scene",
+    "run_sweep": "sweep",
+    "CalibrationResult": "calibrate", "calibrate": "calibrate", "plot_fit": "calibrate",
+    "program_path": "_program",
+}
+
+__all__ = ["__version__", *_EXPORTS]
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'yarnfort' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

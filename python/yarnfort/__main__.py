@@ -46,8 +46,28 @@ def _moving_supports(folder: Path) -> list[str]:
 
 
 def choose_support(curve: Curve, folder: Path, name: str | None = None) -> str:
-    """``name`` if given (it must exist), else the first support set that moves, else
-    the first with a non-zero reaction, else the first."""
+    """The support set to plot.
+
+    Parameters
+    ----------
+    curve : Curve
+        The run's curve.
+    folder : Path
+        Its output folder (its input.nml tells which supports move).
+    name : str, optional
+        The support asked for; it must exist.
+
+    Returns
+    -------
+    str
+        ``name`` if given, else the first support set that moves, else the first with a
+        non-zero reaction, else the first.
+
+    Raises
+    ------
+    CommandError
+        If the curve has no supports or ``name`` is not one of them.
+    """
     from .plots import supports
 
     known = supports(curve)
@@ -79,7 +99,27 @@ def _dominant_projection(position: np.ndarray) -> str:
 
 
 def plot_folder(folder: Path, support: str | None = None, out: Path | None = None) -> Path:
-    """Write the summary plot of an output folder; returns the PNG path."""
+    """Write the summary plot of an output folder.
+
+    Parameters
+    ----------
+    folder : Path
+        A run's output folder (holds curve.csv).
+    support : str, optional
+        Support set to plot (default: the first that moves).
+    out : Path, optional
+        PNG to write (default ``<folder>/plot.png``).
+
+    Returns
+    -------
+    Path
+        The PNG written.
+
+    Raises
+    ------
+    CommandError
+        For a missing folder or curve, a curve without rows or an unknown support.
+    """
     if not folder.is_dir():
         raise CommandError(f"no output folder {str(folder)!r}")
     if not (folder / "curve.csv").is_file():
@@ -90,6 +130,9 @@ def plot_folder(folder: Path, support: str | None = None, out: Path | None = Non
     from .plots import plot_fabric_hysteresis, plot_hysteresis, plot_network, save_figure
 
     curve = read_curve(folder)
+    if len(curve) == 0:
+        raise CommandError(f"{folder / 'curve.csv'} has no rows (only its header): the run"
+                           " wrote no converged step, nothing to plot")
     states = read_states(folder)
     figure = Figure(figsize=(11, 4.5), layout="constrained")
     left, right = figure.subplots(1, 2)
@@ -131,7 +174,18 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; returns the exit code."""
+    """Run the command line.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit code: 0 success, 2 bad arguments or unusable inputs.
+    """
     args = _parser().parse_args(argv)
     try:
         if args.command == "plot":

@@ -1,46 +1,25 @@
 # SPDX-License-Identifier: MIT
-"""Thin wrappers over the f2py extension ``_yarnfort`` (the flat Fortran facade).
+"""Thin wrappers over the f2py extension ``yarnfort._yarnfort`` (the flat Fortran facade).
 
 Every facade routine returns an integer status and a message; a non-zero status becomes a
 :class:`YarnfortError`. No physics here: the laws are evaluated by the Fortran library.
-
-Where the extension is found
-----------------------------
-The extension is built by meson with ``-Dpython=true`` into ``<build>/python/`` and is
-not copied into the source tree. It is loaded on first use (so that ``import yarnfort``
-works without it, for the result readers) from the first of:
-
-1. ``$YARNFORT_NATIVE``: the extension file, or a folder holding it;
-2. the package folder ``yarnfort/`` (an installed or copied ``_yarnfort.<abi>.so``);
-3. ``<top>/build/python/`` (the build made by ``tools/bootstrap``), else the most
-   recently built ``<top>/build*/python/_yarnfort.<abi>.so`` of this checkout.
-
-Only files with an extension suffix of the running interpreter are considered.
+The extension is part of the installed package (``pip install .``) and is imported on
+first use, so that ``import yarnfort`` stays quick.
 """
 from __future__ import annotations
 
 import functools
-import importlib.machinery
-import importlib.util
+import importlib
 import os
-import sys
-from pathlib import Path
 from types import ModuleType
-from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["YarnfortError", "SceneRun", "force_law", "critical_tension", "run_scene",
-           "native_path"]
+__all__ = ["YarnfortError", "force_law", "critical_tension", "EXIT_CATEGORIES"]
 
-#: Environment variable naming the extension file (or its folder).
-NATIVE_ENV = "YARNFORT_NATIVE"
-#: Name of the f2py extension module.
-NATIVE_NAME = "_yarnfort"
-
-_PACKAGE = Path(__file__).resolve().parent
-_TOP = _PACKAGE.parents[1]
+#: Exit category of each status, as the program's exit codes.
+EXIT_CATEGORIES: dict[int, str] = {1: "solve_failed", 2: "bad_input"}
 
 #: Keyword parameters of each force law, in the order of the facade's p1, p2.
 FORCE_LAW_PARAMETERS: dict[str, tuple[str, ...]] = {
@@ -56,81 +35,54 @@ FRICTION_LAW_PARAMETERS: dict[str, tuple[str, ...]] = {
 }
 
 
-class SceneRun(NamedTuple):
-    """Outcome of :func:`run_scene`: the output folder and the converged steps written."""
-
-    folder: Path
-    n_steps: int
-
-
 class YarnfortError(RuntimeError):
     """An error reported by the Fortran library; the message names what was wrong.
 
     Attributes
     ----------
     status : int
-        The facade's status: 1 for a bad law parameter or a failed solve, 2 for a bad
-        scene input or an unusable output folder (the program's exit codes).
-    run : SceneRun or None
-        For a failed :func:`run_scene` solve: the output folder and the converged steps
-        written before the failure (they are kept).
+        The program's exit code for it: 1 for a failed solve, 2 for bad input (a law or
+        parameter the library refuses included), a bad restart file or an unusable
+        output folder.
+    category : str
+        ``'solve_failed'`` (status 1) or ``'bad_input'`` (status 2).
+    result : object or None
+        For a failed :func:`yarnfort.run_scene` solve, the :class:`yarnfort.RunResult`
+        of the converged steps written before the failure (they are kept).
     """
 
-    def __init__(self, message: str, status: int = 1, run: SceneRun | None = None) -> None:
+    def __init__(self, message: str, status: int = 1, result: object | None = None) -> None:
         super().__init__(message)
-        self.status = status
-        self.run = run
+        self.status = int(status)
+        self.category = EXIT_CATEGORIES.get(self.status, "error")
+        self.result = result
 
 
-def _candidates(folder: Path) -> list[Path]:
-    names = [NATIVE_NAME + suffix for suffix in importlib.machinery.EXTENSION_SUFFIXES]
-    return [folder / name for name in names if (folder / name).is_file()]
-
-
-def native_path() -> Path:
-    """Path of the extension module that :func:`force_law` and friends load.
+@functools.cache
+def extension() -> ModuleType:
+    """The f2py extension module ``yarnfort._yarnfort``, imported once.
 
     Raises
     ------
     ImportError
-        If no built extension is found (see the module notes for where it is looked for).
+        If the package was not built with its extension (install it with ``pip install``).
     """
-    override = os.environ.get(NATIVE_ENV)
-    if override:
-        path = Path(override)
-        found = _candidates(path) if path.is_dir() else [path] if path.is_file() else []
-        if not found:
-            raise ImportError(f"{NATIVE_ENV}={override!r}: no {NATIVE_NAME} extension there")
-        return found[0]
-    found = _candidates(_PACKAGE) or _candidates(_TOP / "build" / "python")
-    if found:
-        return found[0]
-    built = [path for folder in _TOP.glob("build*/python") for path in _candidates(folder)]
-    if not built:
-        raise ImportError(
-            f"the {NATIVE_NAME} extension is not built: in {_TOP} run 'meson configure build"
-            f" -Dpython=true && meson compile -C build' (or set {NATIVE_ENV})")
-    return max(built, key=lambda path: path.stat().st_mtime)
+    return importlib.import_module(f"{__package__}._yarnfort")
 
 
-@functools.cache
 def _facade() -> ModuleType:
-    """The facade module inside the extension, loaded once."""
-    path = native_path()
-    name = f"{__package__}.{NATIVE_NAME}" if __package__ else NATIVE_NAME
-    spec = importlib.util.spec_from_file_location(name, path)
-    if spec is None or spec.loader is None:
-        raise ImportError(f"cannot load the {NATIVE_NAME} extension from {path}")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    sys.modules[name] = module
-    return module.yarnfort_facade
+    """The facade module inside the extension."""
+    return extension().yarnfort_facade
 
 
-def _check(status: int, message: bytes, run: SceneRun | None = None) -> None:
+def check_status(status: int, message: bytes | str, result: object | None = None) -> None:
+    """Raise :class:`YarnfortError` for a non-zero facade status."""
     if status != 0:
-        text = message.decode("utf-8", errors="replace").strip()
-        raise YarnfortError(text or f"yarnfort failed with status {status}", int(status), run)
+        text = message.decode("utf-8", errors="replace") if isinstance(message, bytes) \
+            else message
+        text = text.strip()
+        raise YarnfortError(text or f"yarnfort failed with status {status}", int(status),
+                            result)
 
 
 def _parameters(kind: str, law: str, table: dict[str, tuple[str, ...]],
@@ -197,7 +149,7 @@ def force_law(law: str, stretch: ArrayLike, **params: float | str | os.PathLike
     lam = np.asarray(stretch, dtype=float)
     force, dforce, energy, status, message = _facade().force_law_eval(
         law, p1, p2, os.fsencode(table_file), _flat(lam))
-    _check(status, message)
+    check_status(status, message)
     return _shaped((force, dforce, energy), lam.shape)
 
 
@@ -232,30 +184,5 @@ def critical_tension(law: str, tension_min: ArrayLike, angle: ArrayLike, **param
                                          np.asarray(angle, dtype=float))
     critical, d_dtension, d_dangle, status, message = _facade().friction_critical_tension(
         law, mu, beta, w_d, s_d, _flat(tension), _flat(alpha))
-    _check(status, message)
+    check_status(status, message)
     return _shaped((critical, d_dtension, d_dangle), tension.shape)
-
-
-def run_scene(path: str | os.PathLike) -> SceneRun:
-    """Run the scene in a namelist file, as ``yarnfort < path`` does but silently.
-
-    Writes ``curve.csv``, the VTK states and ``input.nml`` to the scene's ``&output``
-    folder (a relative folder is taken from the working directory; relative file names
-    inside the input from the folder of ``path``).
-
-    Returns
-    -------
-    SceneRun
-        The output folder (absolute) and the number of converged steps written (rows of
-        ``curve.csv``, the initial state included).
-
-    Raises
-    ------
-    YarnfortError
-        For bad input (status 2) or a failed solve (status 1; the converged steps written
-        so far are kept and described by the error's ``run``).
-    """
-    status, message, n_steps, folder = _facade().run_scene_file(os.fsencode(path))
-    run = SceneRun(Path.cwd() / os.fsdecode(folder.strip()), int(n_steps))
-    _check(status, message, run if n_steps > 0 else None)
-    return run

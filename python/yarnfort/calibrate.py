@@ -25,12 +25,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import f90nml
 import numpy as np
 from scipy.optimize import least_squares
 
 from ._native import YarnfortError
 from .results import Curve
-from .sweep import run_patched
+from .address import parse_address
+from .sweep import _check_support, run_patched
 
 __all__ = ["CalibrationResult", "calibrate", "read_measured", "simulated_force",
            "plot_fit", "write_synthetic_curve"]
@@ -103,13 +105,25 @@ class CalibrationResult:
         return "\n".join(lines)
 
 
+def _component_index(component: str | int) -> int:
+    """0, 1 or 2 for 'x', 'y', 'z' (or the index itself)."""
+    if isinstance(component, str) and component.lower() in _COMPONENTS:
+        return _COMPONENTS[component.lower()]
+    if not isinstance(component, str) and component in (0, 1, 2):
+        return int(component)
+    raise ValueError(f"component {component!r}: expected 'x', 'y', 'z' or 0, 1, 2")
+
+
 def _branch_value(text: str) -> int:
     word = text.strip().lower()
     if word.startswith("load"):
         return 1
     if word.startswith("unload"):
         return -1
-    value = float(word)
+    try:
+        value = float(word)
+    except ValueError:
+        raise ValueError(f"branch {text!r}: expected loading/unloading or a sign") from None
     if value == 0:
         raise ValueError(f"branch value {text!r}: expected loading/unloading or a sign")
     return 1 if value > 0 else -1
@@ -133,27 +147,59 @@ def read_measured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.n
     +1/-1). Without one, the branch follows the sign of the strain increments. Lines
     starting with ``#`` are comments.
 
+    Parameters
+    ----------
+    path : path
+        The CSV file.
+
     Returns
     -------
     strain, force, branch : numpy.ndarray
         The points, branch +1 loading and -1 unloading.
+
+    Raises
+    ------
+    ValueError
+        For a file without data rows or the columns, or a cell that is not a number
+        (the message names the file and line).
     """
     with open(path, newline="") as stream:
-        rows = list(csv.DictReader(line for line in stream if not line.startswith("#")))
+        numbered = [(number, line) for number, line in enumerate(stream, start=1)
+                    if not line.startswith("#")]
+    reader = csv.DictReader(line for _, line in numbered)
+    rows = list(reader)
+    # The file line of each data row (the header is the first uncommented line).
+    lines = [number for number, line in numbered[1:] if line.strip()]
     if not rows:
         raise ValueError(f"{path}: no data rows")
     header = {name.strip().lower(): name for name in rows[0]}
     missing = [name for name in ("strain", "force") if name not in header]
     if missing:
         raise ValueError(f"{path}: missing column(s) {', '.join(missing)}")
-    strain = np.array([float(row[header["strain"]]) for row in rows])
-    force = np.array([float(row[header["force"]]) for row in rows])
     column = next((header[name] for name in BRANCH_COLUMNS if name in header), None)
-    if column is None:
-        branch = _infer_branch(strain)
-    else:
-        branch = np.array([_branch_value(row[column]) for row in rows])
-    return strain, force, branch
+    strain, force, signs = [], [], []
+    for number, row in zip(lines, rows):
+        try:
+            strain.append(_number(row[header["strain"]], "strain"))
+            force.append(_number(row[header["force"]], "force"))
+            if column is not None:
+                signs.append(_branch_value(row[column] or ""))
+        except ValueError as error:
+            raise ValueError(f"{path}, line {number}: {error}") from None
+    strain_array = np.array(strain)
+    branch = _infer_branch(strain_array) if column is None else np.array(signs)
+    return strain_array, np.array(force), branch
+
+
+def _number(text: str | None, name: str) -> float:
+    """A finite number from a CSV cell, or a ValueError naming the column."""
+    try:
+        value = float(text if text is not None else "")
+    except ValueError:
+        raise ValueError(f"{name} {text!r} is not a number") from None
+    if not np.isfinite(value):
+        raise ValueError(f"{name} {text!r} is not finite")
+    return value
 
 
 def _branch_rows(direction: np.ndarray, sign: int) -> np.ndarray:
@@ -245,8 +291,10 @@ def calibrate(scene_path: str | os.PathLike, measured_csv: str | os.PathLike,
     Raises
     ------
     ValueError
-        For bounds with lower >= upper or an initial value outside them, or fewer
-        measured points than parameters plus one.
+        For bounds with lower >= upper or an initial value outside them, fewer measured
+        points than parameters plus one, a malformed parameter address (an
+        :class:`~yarnfort.AddressError`), an unknown component or support, or an
+        unreadable measured curve.
     YarnfortError
         If a run fails; the message names the parameter values.
     """
@@ -256,7 +304,10 @@ def calibrate(scene_path: str | os.PathLike, measured_csv: str | os.PathLike,
     if np.any(lower >= upper) or np.any(initial < lower) or np.any(initial > upper):
         raise ValueError("each parameter needs lower < upper and initial within them")
     span = upper - lower
-    index = _COMPONENTS[component.lower()] if isinstance(component, str) else int(component)
+    index = _component_index(component)
+    for name in names:
+        parse_address(name)
+    _check_support(f90nml.read(Path(scene_path)), support)
     strain, force, branch = read_measured(measured_csv)
     m, n = force.size, len(names)
     if m <= n:
@@ -275,6 +326,10 @@ def calibrate(scene_path: str | os.PathLike, measured_csv: str | os.PathLike,
                 raise YarnfortError(f"{error} (with {settings})", error.status) from error
 
     def model(curve: Curve) -> np.ndarray:
+        if f"{support}_rx" not in curve.columns:
+            known = [name[:-3] for name in curve.names if name.endswith("_rx")]
+            raise ValueError(f"support {support!r}: the scene's curve has supports "
+                             + (", ".join(known) or "none"))
         return simulated_force(curve, strain, branch, support=support, component=index,
                                x_column=x_column, x_scale=x_scale, force_scale=force_scale)
 
@@ -303,6 +358,15 @@ def calibrate(scene_path: str | os.PathLike, measured_csv: str | os.PathLike,
 def plot_fit(result: CalibrationResult, path: str | os.PathLike,
              title: str = "measured vs fitted") -> Path:
     """Plot the measured points (by branch) and the fitted simulated curve to a file.
+
+    Parameters
+    ----------
+    result : CalibrationResult
+        The fit.
+    path : path
+        The image to write.
+    title : str
+        Title above the fitted values.
 
     Returns
     -------
@@ -346,12 +410,27 @@ def write_synthetic_curve(scene_path: str | os.PathLike, values: Mapping[str, An
     each point's force. The file starts with ``#`` lines saying it is synthetic: it is
     not a measurement.
 
+    Parameters
+    ----------
+    scene_path : path
+        The scene.
+    values : mapping
+        Parameter address -> value of the "true" parameters.
+    path : path
+        The CSV to write.
+    support, component, x_column, x_scale, force_scale
+        As in :func:`calibrate`.
+    noise : float
+        Relative standard deviation of the noise.
+    seed : int
+        Seed of the noise.
+
     Returns
     -------
     pathlib.Path
         The written CSV (columns strain, force, branch).
     """
-    index = _COMPONENTS[component.lower()] if isinstance(component, str) else int(component)
+    index = _component_index(component)
     with tempfile.TemporaryDirectory(prefix="yarnfort-synthetic-") as folder:
         curve = run_patched(scene_path, values, folder)
     strain = x_scale * curve[x_column][1:]

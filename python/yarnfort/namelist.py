@@ -7,31 +7,23 @@ A scene (``inputs/*.nml``, or a run's effective ``input.nml``) is read into an
 ``f90nml`` Cogroup) in file order; a group that appears once is a single Namelist.
 Group and variable names are lower case. Comments are not kept on writing.
 
-Addressing one variable
------------------------
-:func:`set_parameter` and :func:`get_parameter` name a variable as
-``'group.variable'`` or ``'group[index].variable'``:
-
-- ``'solver.max_step'``: the variable of a group that appears once (the same as
-  ``'solver[0].max_step'``);
-- ``'contact[0].friction_coefficient'``: of the first ``&contact`` group; negative
-  indices count from the end (``'yarn[-1].material'``);
-- ``'support[pull].displacement'``: of the group whose ``name`` variable is ``pull``
-  (quotes around the name are optional).
-
-Names are case-insensitive. A whole array is replaced (``displacement = [0, -0.2, 0]``).
+A scene can also be built from plain Python data with :func:`make_namelist` (a dict of
+group name -> dict of variables, or a list of such dicts for a repeated group).
+Variables are addressed with the grammar of :mod:`yarnfort.address`
+(:func:`get_parameter`, :func:`set_parameter`), shared with sweeps and calibration.
 """
 from __future__ import annotations
 
-import re
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import f90nml
 
-__all__ = ["read_scene", "write_scene", "set_parameter", "get_parameter"]
+from .address import AddressError, get_parameter, set_parameter
 
-_ADDRESS = re.compile(r"^\s*(\w+)\s*(?:\[\s*([^\]]*?)\s*\])?\s*\.\s*(\w+)\s*$")
+__all__ = ["read_scene", "write_scene", "make_namelist", "set_parameter", "get_parameter",
+           "AddressError"]
 
 
 def read_scene(path: str | Path) -> f90nml.Namelist:
@@ -54,7 +46,18 @@ def write_scene(nml: f90nml.Namelist, path: str | Path) -> Path:
     """Write ``nml`` as a namelist file that ``./yarnfort < path`` reads.
 
     An existing file is overwritten; missing parent folders are created.
-    Returns the path written.
+
+    Parameters
+    ----------
+    nml : f90nml.Namelist
+        The scene (:func:`read_scene` or :func:`make_namelist`).
+    path : str or Path
+        The file to write.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -62,72 +65,46 @@ def write_scene(nml: f90nml.Namelist, path: str | Path) -> Path:
     return path
 
 
-def _parse(address: str) -> tuple[str, str | None, str]:
-    match = _ADDRESS.match(address)
-    if not match:
-        raise ValueError(f"bad parameter address {address!r}: expected 'group.variable'"
-                         " or 'group[index].variable'")
-    group, index, variable = match.groups()
-    return group.lower(), index, variable.lower()
+def make_namelist(groups: Mapping[str, Mapping[str, Any] | Sequence[Mapping[str, Any]]]
+                  ) -> f90nml.Namelist:
+    """Build a namelist from plain data, repeated groups included.
 
+    ``f90nml.Namelist({'material': [{...}, {...}]})`` cannot be written (f90nml expects
+    its own cogroups for a repeated group); this builds them.
 
-def _group(nml: f90nml.Namelist, group: str, index: str | None) -> f90nml.Namelist:
-    """The one group instance that ``group[index]`` selects."""
-    if group not in nml:
-        raise KeyError(f"the scene has no &{group} group")
-    found = nml[group]
-    instances = list(found) if isinstance(found, list) else [found]
-    if index is None or index == "":
-        if len(instances) != 1:
-            raise KeyError(f"&{group} appears {len(instances)} times: give an index,"
-                           f" e.g. '{group}[0]'")
-        return instances[0]
-    if re.fullmatch(r"[+-]?\d+", index):
-        number = int(index)
-        if not -len(instances) <= number < len(instances):
-            raise IndexError(f"&{group}[{number}]: the scene has {len(instances)}"
-                             f" &{group} group(s)")
-        return instances[number]
-    name = index.strip("'\"")
-    for instance in instances:
-        if str(instance.get("name", "")).lower() == name.lower():
-            return instance
-    names = [str(instance.get("name")) for instance in instances]
-    raise KeyError(f"no &{group} group named {name!r}; names: {', '.join(names)}")
+    Parameters
+    ----------
+    groups : mapping
+        Group name -> a mapping of variables (a group given once), or a sequence of
+        mappings (a repeated group, in order). Group and variable names are lower-cased.
 
-
-def get_parameter(nml: f90nml.Namelist, address: str) -> Any:
-    """The value of one variable (see the module notes for ``address``).
+    Returns
+    -------
+    f90nml.Namelist
+        Groups in the order given; within a group, variables in the order given.
 
     Raises
     ------
-    KeyError
-        If the group, the named group or the variable is missing.
+    TypeError
+        If a group is neither a mapping nor a sequence of mappings.
     """
-    group, index, variable = _parse(address)
-    instance = _group(nml, group, index)
-    if variable not in instance:
-        raise KeyError(f"&{group} has no variable {variable!r} set")
-    return instance[variable]
-
-
-def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Namelist:
-    """Set one variable of one group in place (see the module notes for ``address``).
-
-    A variable not yet in the group is added. An integer given for a variable that
-    holds reals is stored as a real. Returns ``nml``, so calls can be chained.
-
-    Raises
-    ------
-    ValueError
-        If ``address`` is malformed.
-    KeyError, IndexError
-        If the group is missing, the index is out of range or no group has that name.
-    """
-    group, index, variable = _parse(address)
-    instance = _group(nml, group, index)
-    old = instance.get(variable)
-    if isinstance(old, float) and isinstance(value, int) and not isinstance(value, bool):
-        value = float(value)
-    instance[variable] = value
+    nml = f90nml.Namelist()
+    for name, content in groups.items():
+        key = str(name).lower()
+        if isinstance(content, Mapping):
+            nml[key] = _group(content)
+        elif isinstance(content, Sequence) and not isinstance(content, str) and all(
+                isinstance(item, Mapping) for item in content):
+            for item in content:
+                nml.add_cogroup(key, _group(item))
+        else:
+            raise TypeError(f"&{key}: expected a mapping of variables or a list of them,"
+                            f" not {type(content).__name__}")
     return nml
+
+
+def _group(variables: Mapping[str, Any]) -> f90nml.Namelist:
+    group = f90nml.Namelist()
+    for name, value in variables.items():
+        group[str(name).lower()] = value
+    return group

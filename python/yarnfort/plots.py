@@ -21,8 +21,8 @@ from matplotlib.figure import Figure
 
 from .results import Curve, State
 
-__all__ = ["plot_curve", "plot_hysteresis", "plot_network", "plot_fan", "save_figure",
-           "supports", "reaction_component"]
+__all__ = ["plot_curve", "plot_hysteresis", "plot_fabric_hysteresis", "plot_network",
+           "plot_fan", "save_figure", "supports", "reaction_component"]
 
 #: Index of each Cartesian component in a reaction or position row.
 COMPONENTS: dict[str, int] = {"x": 0, "y": 1, "z": 2}
@@ -50,7 +50,18 @@ def _axes(ax: Axes | None) -> Axes:
 
 
 def supports(curve: Curve) -> list[str]:
-    """Names of the support sets with reaction columns in ``curve``, in column order."""
+    """Names of the support sets with reaction columns in ``curve``.
+
+    Parameters
+    ----------
+    curve : Curve
+        A run's curve.
+
+    Returns
+    -------
+    list of str
+        In column order.
+    """
     return [name[:-3] for name in curve.names
             if name.endswith("_rx") and f"{name[:-3]}_ry" in curve.columns
             and f"{name[:-3]}_rz" in curve.columns]
@@ -59,6 +70,20 @@ def supports(curve: Curve) -> list[str]:
 def reaction_component(curve: Curve, support: str, component: str = "y") -> np.ndarray:
     """One component (``'x'``, ``'y'``, ``'z'``) or the Euclidean ``'norm'`` of the
     reaction of a support set, per step.
+
+    Parameters
+    ----------
+    curve : Curve
+        A run's curve.
+    support : str
+        The support set.
+    component : {'y', 'x', 'z', 'norm'}
+        Which component.
+
+    Returns
+    -------
+    numpy.ndarray
+        One value per step (N).
 
     Raises
     ------
@@ -130,6 +155,15 @@ def plot_hysteresis(curve: Curve, support: str, component: str = "y", x: str = "
     without gaps. The lines carry the label and gid ``'loading'`` or ``'unloading'``
     (only the first segment of a branch is labelled, for the legend).
 
+    Parameters
+    ----------
+    curve : Curve
+        The run's ``curve.csv``.
+    support, component, x
+        As in :func:`plot_curve`.
+    ax : Axes, optional
+        Where to draw; a new figure when omitted.
+
     Returns
     -------
     Axes
@@ -147,6 +181,13 @@ def plot_fabric_hysteresis(curve: Curve, ax: Axes | None = None) -> Axes:
     """Effective curve of a generated fabric (``&fabric``): force per unit width
     against macroscopic strain, loading and unloading drawn as in
     :func:`plot_hysteresis`.
+
+    Parameters
+    ----------
+    curve : Curve
+        The curve of a ``&fabric`` run (columns ``strain``, ``force_per_width``).
+    ax : Axes, optional
+        Where to draw; a new figure when omitted.
 
     Returns
     -------
@@ -254,9 +295,21 @@ def plot_fan(curves: dict[str, Curve], support: str, component: str = "y",
 
 
 def save_figure(fig: Figure | Axes, path: str | Path, dpi: int = 150) -> Path:
-    """Write ``fig`` (a Figure, or an Axes whose figure is written) as a PNG.
+    """Write a figure as a PNG.
 
-    Missing parent folders are created. Returns the path written.
+    Parameters
+    ----------
+    fig : Figure or Axes
+        The figure, or an Axes whose figure is written.
+    path : str or Path
+        The PNG to write; missing parent folders are created.
+    dpi : int
+        Resolution.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
     """
     figure = fig.figure if isinstance(fig, Axes) else fig
     path = Path(path)

@@ -1,85 +1,310 @@
 # SPDX-License-Identifier: MIT
-"""Read a run's output folder: ``curve.csv`` and the ``state_NNNNN.vtu`` files."""
+"""Read a run's output folder: ``curve.csv`` and the VTK states (``states.pvd`` and the
+``state_*.vtu`` files it lists).
+
+States are read with :mod:`meshio` when it is installed (any VTK XML encoding: ASCII,
+inline or appended binary); without it, a small reader of the ASCII encoding is used.
+What a state holds: node positions (the VTK points), the two-node elements (the
+``line`` cells) and every point and cell data array of the file, by name. The element
+arrays ``tension``, ``stretch`` and ``L0`` are required; any others (displacement,
+yarn or material ids, contact state, ...) are kept in :attr:`State.point_data` and
+:attr:`State.cell_data`.
+"""
 from __future__ import annotations
 
+import csv
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+
+__all__ = ["Curve", "State", "ResultError", "read_curve", "read_state", "read_states",
+           "read_run"]
+
+
+class ResultError(ValueError):
+    """An output file that cannot be read as yarnfort wrote it; the message names the
+    file and, where it applies, the line and column."""
 
 
 @dataclass
 class Curve:
-    """One row per converged step; ``columns`` maps a column name to a numpy array."""
+    """One row per converged step of ``curve.csv``.
+
+    Attributes
+    ----------
+    columns : dict of str to numpy.ndarray
+        Column name -> values (float), in file order.
+    path : pathlib.Path or None
+        The file read.
+    """
 
     columns: dict[str, np.ndarray]
+    path: Path | None = None
 
     def __getitem__(self, name: str) -> np.ndarray:
-        return self.columns[name]
+        try:
+            return self.columns[name]
+        except KeyError:
+            raise KeyError(f"curve has no column {name!r}; columns: "
+                           + ", ".join(self.columns)) from None
+
+    def __len__(self) -> int:
+        return len(next(iter(self.columns.values()))) if self.columns else 0
 
     @property
     def names(self) -> list[str]:
+        """Column names, in file order."""
         return list(self.columns)
 
     def reaction(self, support: str) -> np.ndarray:
-        """Reaction force (n_steps, 3) applied by the named support set on the net."""
+        """Reaction force of a named support set on the net.
+
+        Parameters
+        ----------
+        support : str
+            The ``&support`` name.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n_steps, 3), N.
+
+        Raises
+        ------
+        KeyError
+            If the curve has no such support set (the message lists those it has).
+        """
+        missing = [f"{support}_r{k}" for k in "xyz" if f"{support}_r{k}" not in self.columns]
+        if missing:
+            known = [name[:-3] for name in self.columns if name.endswith("_rx")]
+            raise KeyError(f"curve has no support {support!r}; supports: "
+                           + (", ".join(known) or "none"))
         return np.column_stack([self.columns[f"{support}_r{k}"] for k in "xyz"])
+
+    def to_array(self) -> np.ndarray:
+        """The curve as a numpy structured array (one field per column)."""
+        dtype = [(name, float) for name in self.columns]
+        table = np.empty(len(self), dtype=dtype)
+        for name, values in self.columns.items():
+            table[name] = values
+        return table
+
+    def to_dataframe(self) -> Any:
+        """The curve as a :class:`pandas.DataFrame` (pandas must be installed).
+
+        Raises
+        ------
+        ImportError
+            If pandas is not installed.
+        """
+        import pandas
+
+        return pandas.DataFrame(self.columns)
 
 
 @dataclass
 class State:
-    """A converged network state: node positions (n, 3) and per-element fields."""
+    """A converged network state.
+
+    Attributes
+    ----------
+    position : numpy.ndarray
+        Node positions, shape (n_nodes, 3), m.
+    elements : numpy.ndarray
+        Node indices (from 0) of each two-node element, shape (n_elements, 2).
+    tension, stretch, length0 : numpy.ndarray
+        Per element: tension (N), stretch l/L0 and reference length L0 (m).
+    point_data, cell_data : dict of str to numpy.ndarray
+        Every array of the file, by name (the three above included in ``cell_data``).
+    """
 
     position: np.ndarray
     elements: np.ndarray
     tension: np.ndarray
     stretch: np.ndarray
     length0: np.ndarray
+    point_data: dict[str, np.ndarray] = field(default_factory=dict)
+    cell_data: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def _curve_file(path: str | Path) -> Path:
+    path = Path(path)
+    return path / "curve.csv" if path.is_dir() else path
 
 
 def read_curve(path: str | Path) -> Curve:
-    """Read ``curve.csv`` (a file, or the output folder holding it)."""
-    path = Path(path)
-    if path.is_dir():
-        path = path / "curve.csv"
-    data = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
-    return Curve({name: np.atleast_1d(data[name]) for name in data.dtype.names})
+    """Read ``curve.csv`` (a file, or the output folder holding it).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file or its folder.
+
+    Returns
+    -------
+    Curve
+        Every column as floats; a file with only its header gives a curve of 0 rows.
+
+    Raises
+    ------
+    ResultError
+        For an empty file, a row with the wrong number of cells, or a cell that is not
+        a number (the message names the file, line and column).
+    OSError
+        If the file cannot be read.
+    """
+    path = _curve_file(path)
+    with open(path, newline="") as stream:
+        rows = list(csv.reader(stream))
+    if not rows or not any(cell.strip() for cell in rows[0]):
+        raise ResultError(f"{path}: empty file (no header line): not a complete"
+                          " yarnfort curve")
+    header = [cell.strip() for cell in rows[0]]
+    values: list[list[float]] = []
+    for number, row in enumerate(rows[1:], start=2):
+        if not row:
+            continue
+        if len(row) != len(header):
+            raise ResultError(f"{path}, line {number}: {len(row)} cells, the header has"
+                              f" {len(header)} (a cut or foreign row)")
+        parsed = []
+        for name, cell in zip(header, row):
+            try:
+                parsed.append(float(cell))
+            except ValueError:
+                raise ResultError(f"{path}, line {number}, column {name!r}: {cell!r} is not"
+                                  " a number") from None
+        values.append(parsed)
+    table = np.array(values, dtype=float).reshape(len(values), len(header))
+    return Curve({name: table[:, k].copy() for k, name in enumerate(header)}, path)
 
 
-def _array(piece: ET.Element, name: str) -> np.ndarray:
-    for node in piece.iter("DataArray"):
-        if node.get("Name") == name:
-            return np.array(node.text.split(), dtype=float)
-    raise KeyError(f"no DataArray named {name!r}")
+def _ascii_array(piece: ET.Element, section: str, name: str | None) -> np.ndarray:
+    for node in piece.iterfind(f"{section}/DataArray"):
+        if name is None or node.get("Name") == name:
+            if node.get("format", "ascii") != "ascii":
+                raise ResultError(f"array {node.get('Name')!r} is {node.get('format')}:"
+                                  " install meshio to read binary VTK files")
+            return np.array((node.text or "").split(), dtype=float)
+    raise KeyError(name)
+
+
+def _read_ascii(path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict]:
+    piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
+    if piece is None:
+        raise ResultError(f"{path}: not a VTK UnstructuredGrid file")
+    points = _ascii_array(piece, "Points", None).reshape(-1, 3)
+    connectivity = _ascii_array(piece, "Cells", "connectivity").astype(int)
+    point_data = {node.get("Name"): _ascii_array(piece, "PointData", node.get("Name"))
+                  for node in piece.iterfind("PointData/DataArray")}
+    cell_data = {node.get("Name"): _ascii_array(piece, "CellData", node.get("Name"))
+                 for node in piece.iterfind("CellData/DataArray")}
+    for data, count in ((point_data, len(points)), (cell_data, len(connectivity) // 2)):
+        for name, values in data.items():
+            if count and values.size != count and values.size % count == 0:
+                data[name] = values.reshape(count, -1)
+    return points, connectivity.reshape(-1, 2), point_data, cell_data
+
+
+def _read_meshio(meshio: Any, path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict]:
+    mesh = meshio.read(path)
+    blocks = [k for k, block in enumerate(mesh.cells) if block.type == "line"]
+    if not blocks:
+        raise ResultError(f"{path}: no line cells (two-node elements)")
+    elements = np.concatenate([mesh.cells[k].data for k in blocks]).astype(int)
+    cell_data = {name: np.concatenate([np.asarray(arrays[k]) for k in blocks])
+                 for name, arrays in mesh.cell_data.items()}
+    point_data = {name: np.asarray(values) for name, values in mesh.point_data.items()}
+    return np.asarray(mesh.points, dtype=float), elements, point_data, cell_data
 
 
 def read_state(path: str | Path) -> State:
-    """Read one ``state_NNNNN.vtu`` file written by yarnfort."""
-    root = ET.parse(path).getroot()
-    piece = root.find("UnstructuredGrid/Piece")
-    points = np.array(piece.find("Points/DataArray").text.split(), dtype=float)
-    connectivity = _array(piece, "connectivity").astype(int)
-    return State(
-        position=points.reshape(-1, 3),
-        elements=connectivity.reshape(-1, 2),
-        tension=_array(piece, "tension"),
-        stretch=_array(piece, "stretch"),
-        length0=_array(piece, "L0"),
-    )
+    """Read one VTK state file (``state_*.vtu``) written by yarnfort: its yarn elements
+    (links, the cells of another ``kind``, are left out).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.vtu`` file.
+
+    Returns
+    -------
+    State
+
+    Raises
+    ------
+    ResultError
+        If the file is not a state of line cells with ``tension``, ``stretch`` and
+        ``L0`` cell data.
+    """
+    path = Path(path)
+    try:
+        import meshio
+    except ImportError:
+        meshio = None
+    try:
+        points, elements, point_data, cell_data = (
+            _read_meshio(meshio, path) if meshio is not None else _read_ascii(path))
+    except (ET.ParseError, KeyError, ValueError) as error:
+        if isinstance(error, ResultError):
+            raise
+        raise ResultError(f"{path}: not a readable yarnfort VTK state ({error})") from None
+    missing = [name for name in ("tension", "stretch", "L0") if name not in cell_data]
+    if missing:
+        raise ResultError(f"{path}: no cell data {', '.join(missing)}")
+    # Links (gap-holders, periodic images) are cells of another `kind`: keep elements.
+    if "kind" in cell_data:
+        element = np.ravel(cell_data["kind"]) == 0
+        elements = elements[element]
+        cell_data = {name: np.asarray(values)[element] for name, values in cell_data.items()}
+    return State(position=points, elements=elements,
+                 tension=np.ravel(cell_data["tension"]),
+                 stretch=np.ravel(cell_data["stretch"]),
+                 length0=np.ravel(cell_data["L0"]),
+                 point_data=point_data, cell_data=cell_data)
 
 
 def read_states(folder: str | Path) -> list[State]:
-    """The VTK states of an output folder, in step order, as listed in its states.pvd
-    (the files of this run only)."""
+    """The VTK states of an output folder, in step order.
+
+    The states are those listed in the folder's ``states.pvd`` (the files of this run
+    only); without a ``states.pvd``, every ``state_*.vtu`` in name order.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The output folder.
+
+    Returns
+    -------
+    list of State
+    """
     folder = Path(folder)
     collection = folder / "states.pvd"
     if collection.exists():
-        root = ET.parse(collection).getroot()
+        try:
+            root = ET.parse(collection).getroot()
+        except ET.ParseError as error:
+            raise ResultError(f"{collection}: not a readable collection ({error})") from None
         return [read_state(folder / d.get("file")) for d in root.iter("DataSet")]
-    return [read_state(p) for p in sorted(folder.glob("state_*.vtu"))]
+    return [read_state(p) for p in sorted(folder.glob("state_*.vtu"),
+                                          key=lambda p: int(p.stem[len("state_"):]))]
 
 
 def read_run(folder: str | Path) -> tuple[Curve, list[State]]:
-    """The curve and every written state of an output folder."""
+    """The curve and every written state of an output folder.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The output folder.
+
+    Returns
+    -------
+    curve : Curve
+    states : list of State
+    """
     return read_curve(folder), read_states(folder)

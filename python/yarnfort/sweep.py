@@ -3,7 +3,7 @@
 
 How runs are made
 -----------------
-Each run is the program ``build/yarnfort`` started as a subprocess (not the in-process
+Each run is the installed program (:func:`yarnfort.program_path`) started as a subprocess (not the in-process
 f2py facade): one process per run keeps runs independent (no shared Fortran module
 state), lets a run that crashes or hangs fail alone (a row with its error, or a
 timeout), and parallelises the same way on local worker processes and on Dask workers.
@@ -12,29 +12,28 @@ A run costs a process start (milliseconds) on top of the solve. Each run gets
 
 For every run the scene is read with f90nml, patched (the swept parameters, an own
 ``&output`` folder, no progress lines) and written as ``input.nml`` into its own folder;
-the program reads it on standard input with the scene's folder as working directory, so
-relative file names of the scene (``table_file``, ``&geometry``) still resolve.
+the program reads it on standard input with the caller's working directory as its own,
+so relative file names of the scene (``table_file``, ``&geometry``) mean what they mean
+for ``yarnfort < scene.nml`` and :func:`yarnfort.run_scene` run from there.
 
 Parameter addresses
 -------------------
-``'group.variable'`` for a group that appears once (``'solver.max_step'``) and
-``'group[i].variable'`` for the i-th (from 0) of a repeated group, in file order
-(``'contact[0].friction_coefficient'``). A group or variable missing from the scene is
-added. Addresses are checked before any run starts (:class:`ValueError`); a value the
-program rejects gives a row with status ``'bad_input'`` and its message.
+The grammar of :mod:`yarnfort.address`: ``'solver.max_step'``,
+``'contact[0].friction_coefficient'``, ``'support[pull].displacement'``. Addresses and
+the summarised support are checked before any run starts (:class:`ValueError`); a value
+the program rejects gives a row with status ``'bad_input'`` and its message.
 
 Dask
 ----
 With ``scheduler='tcp://host:port'`` the tasks go through
-``distributed.Client(scheduler).get_executor()``. Workers must import this package
-(``yarnfort`` on their path) and see the program and the scene at the same paths.
+``distributed.Client(scheduler).get_executor()``. Workers must have this package
+installed and see the scene's files at the same paths (and working directory).
 """
 from __future__ import annotations
 
 import concurrent.futures as cf
 import itertools
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -49,73 +48,20 @@ import f90nml
 import numpy as np
 
 from ._native import YarnfortError
+from ._program import program_path
+from .address import AddressError, parse_address, set_parameter
 from .results import Curve, read_curve
 
-__all__ = ["run_sweep", "run_patched", "set_parameter", "executable", "parameter_grid"]
+__all__ = ["run_sweep", "run_patched", "parameter_grid"]
 
-#: Environment variable naming the yarnfort program (as in the test suite).
-EXECUTABLE_ENV = "YARNFORT_EXE"
 #: Seconds a single run may take before it is stopped and reported as failed.
 DEFAULT_TIMEOUT = 600.0
 #: Status of a row: success, failed solve (exit 1), bad input (exit 2), anything else.
 STATUS = {0: "ok", 1: "solve_failed", 2: "bad_input"}
 
-_TOP = Path(__file__).resolve().parents[2]
-_ADDRESS = re.compile(r"^\s*(\w+)\s*(?:\[\s*(\d+)\s*\])?\s*\.\s*(\w+)\s*$")
 _COMPONENTS = {"x": 0, "y": 1, "z": 2}
-
-
-def executable() -> Path:
-    """The yarnfort program: ``$YARNFORT_EXE``, else ``<top>/build/yarnfort``.
-
-    Raises
-    ------
-    FileNotFoundError
-        If the program is not built.
-    """
-    path = Path(os.environ.get(EXECUTABLE_ENV, _TOP / "build" / "yarnfort"))
-    if not path.is_file():
-        raise FileNotFoundError(f"{path} is missing: build first (./yarnfort --version)")
-    return path.resolve()
-
-
-def set_parameter(scene: f90nml.Namelist, address: str, value: Any) -> None:
-    """Set one variable of a namelist in place.
-
-    Parameters
-    ----------
-    scene : f90nml.Namelist
-        The scene, as read by ``f90nml.read``.
-    address : str
-        ``'group.variable'`` or ``'group[i].variable'`` (i from 0, file order).
-    value
-        The new value (a number, string, bool or list).
-
-    Raises
-    ------
-    ValueError
-        For a malformed address, an index past the groups in the scene, or a repeated
-        group addressed without an index.
-    """
-    match = _ADDRESS.match(address)
-    if not match:
-        raise ValueError(f"parameter {address!r}: expected 'group.variable' or "
-                         "'group[i].variable'")
-    group, index, variable = match[1].lower(), match[2], match[3].lower()
-    if group not in scene:
-        if index not in (None, "0"):
-            raise ValueError(f"parameter {address!r}: the scene has no &{group}")
-        scene[group] = f90nml.Namelist()
-    groups = scene[group]
-    if isinstance(groups, f90nml.Namelist):
-        groups = [groups]
-    elif index is None:
-        raise ValueError(f"parameter {address!r}: &{group} appears {len(groups)} times; "
-                         f"name one as '{group}[i].{variable}'")
-    i = int(index or 0)
-    if i >= len(groups):
-        raise ValueError(f"parameter {address!r}: the scene has {len(groups)} &{group}")
-    groups[i][variable] = value.item() if isinstance(value, np.generic) else value
+#: Row key set when the summarised support is not in a run's curve.
+_UNKNOWN_SUPPORT = "_unknown_support"
 
 
 def _patched_text(scene: f90nml.Namelist, values: Mapping[str, Any], folder: Path,
@@ -123,7 +69,10 @@ def _patched_text(scene: f90nml.Namelist, values: Mapping[str, Any], folder: Pat
     """The scene with ``values`` set and its output sent to ``folder``, as text."""
     patched = f90nml.reads(str(scene))  # an independent copy
     for address, value in values.items():
-        set_parameter(patched, address, value)
+        try:
+            set_parameter(patched, address, value)
+        except AddressError as error:
+            raise ValueError(str(error)) from None
     set_parameter(patched, "output.folder", str(folder))
     set_parameter(patched, "output.progress", False)
     if not vtk:
@@ -135,7 +84,7 @@ def _patched_text(scene: f90nml.Namelist, values: Mapping[str, Any], folder: Pat
 class _Task:
     """One run, self-contained and picklable (sent to worker processes)."""
 
-    program: str
+    program: str | None  # None: the worker's own installation
     cwd: str
     text: str
     folder: str | None
@@ -163,7 +112,8 @@ def _execute(task: _Task) -> dict[str, Any]:
         (folder / "input.nml").write_text(text)
         env = dict(os.environ)
         env.setdefault("OMP_NUM_THREADS", "1")  # one core per run: runs are the parallelism
-        proc = subprocess.run([task.program], input=text, capture_output=True, text=True,
+        program = task.program or str(program_path())
+        proc = subprocess.run([program], input=text, capture_output=True, text=True,
                               cwd=task.cwd, timeout=task.timeout, env=env)
         row["status"] = STATUS.get(proc.returncode, "error")
         if proc.returncode != 0:
@@ -173,7 +123,14 @@ def _execute(task: _Task) -> dict[str, Any]:
         if curve_file.is_file():
             curve = read_curve(curve_file)
             row["n_steps"] = len(curve["step"])
-            if proc.returncode == 0:
+            known = [name[:-3] for name in curve.names if name.endswith("_rx")]
+            if proc.returncode == 0 and task.support not in known:
+                # Only a generated &fabric names supports the scene file does not list.
+                row["status"] = "error"
+                row["error"] = (f"support {task.support!r} is not in the curve; supports: "
+                                + ", ".join(known))
+                row[_UNKNOWN_SUPPORT] = known
+            elif proc.returncode == 0:
                 row["final_reaction"], row["max_reaction"] = _summary(
                     curve, task.support, task.component)
     except subprocess.TimeoutExpired:
@@ -216,15 +173,14 @@ def run_patched(scene_path: str | os.PathLike, values: Mapping[str, Any],
         If the program fails (status 1 failed solve, 2 bad input); the message is the
         program's.
     """
-    scene_path = Path(scene_path).resolve()
-    scene = f90nml.read(scene_path)
+    scene = f90nml.read(Path(scene_path))
     folder = Path(folder).resolve()
     text = _patched_text(scene, values, folder / "out", vtk)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "input.nml").write_text(text)
     try:
-        proc = subprocess.run([str(executable())], input=text, capture_output=True,
-                              text=True, cwd=scene_path.parent, timeout=timeout)
+        proc = subprocess.run([str(program_path())], input=text, capture_output=True,
+                              text=True, cwd=os.getcwd(), timeout=timeout)
     except subprocess.TimeoutExpired as error:
         raise YarnfortError(f"timed out after {timeout} s", 1) from error
     if proc.returncode != 0:
@@ -236,8 +192,19 @@ def run_patched(scene_path: str | os.PathLike, values: Mapping[str, Any],
 
 def parameter_grid(parameters: Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]]
                    ) -> list[dict[str, Any]]:
-    """The runs of a sweep: the Cartesian product of a dict of lists (first key varies
-    slowest), or an explicit list of dicts, as a list of dicts."""
+    """The runs of a sweep.
+
+    Parameters
+    ----------
+    parameters : dict of lists, or list of dicts
+        Address -> values (every combination; the first key varies slowest), or an
+        explicit list of runs.
+
+    Returns
+    -------
+    list of dict
+        One dict address -> value per run.
+    """
     if isinstance(parameters, Mapping):
         names = list(parameters)
         return [dict(zip(names, combo))
@@ -254,12 +221,27 @@ def _column(values: list[Any]) -> np.ndarray:
     return column if column.ndim == 1 else np.array(values, dtype=object)
 
 
-def _first_support(scene: f90nml.Namelist) -> str:
+def _support_names(scene: f90nml.Namelist) -> list[str]:
     groups = scene.get("support")
     if groups is None:
-        raise ValueError("the scene has no &support: name the reaction's support")
-    first = groups if isinstance(groups, f90nml.Namelist) else groups[0]
-    return str(first["name"])
+        return []
+    groups = [groups] if isinstance(groups, f90nml.Namelist) else list(groups)
+    return [str(group["name"]) for group in groups if "name" in group]
+
+
+def _check_support(scene: f90nml.Namelist, support: str | None) -> str:
+    """The support to summarise: checked against the scene's ``&support`` names (a
+    generated ``&fabric`` names its own, which are checked on the first curve)."""
+    names = _support_names(scene)
+    if support is None:
+        if not names:
+            raise ValueError("the scene has no &support: name the support whose reaction"
+                             " is summarised (support=...)")
+        return names[0]
+    if names and "fabric" not in scene and support not in names:
+        raise ValueError(f"support {support!r}: the scene's supports are "
+                         + ", ".join(names))
+    return support
 
 
 class _Progress:
@@ -352,29 +334,35 @@ def run_sweep(scene_path: str | os.PathLike,
     Raises
     ------
     ValueError
-        For a malformed parameter address or an unknown component; the program's
-        failures do not raise (they are rows).
+        For a malformed parameter address, an unknown component, or a support the scene
+        does not have (checked before any run against its ``&support`` groups; for a
+        generated ``&fabric``, on the runs' curves); the program's failures do not raise
+        (they are rows).
     FileNotFoundError
-        If the program is not built.
+        If the installation has no program.
     """
-    scene_path = Path(scene_path).resolve()
-    scene = f90nml.read(scene_path)
+    scene = f90nml.read(Path(scene_path))
     runs = parameter_grid(parameters)
     names = list(dict.fromkeys(name for run in runs for name in run))
-    support = support or _first_support(scene)
+    for name in names:
+        try:
+            parse_address(name)
+        except AddressError as error:
+            raise ValueError(str(error)) from None
+    support = _check_support(scene, support)
     if isinstance(component, str):
         if component.lower() not in _COMPONENTS:
             raise ValueError(f"component {component!r}: expected 'x', 'y' or 'z'")
         component = _COMPONENTS[component.lower()]
     elif component is not None and component not in (0, 1, 2):
         raise ValueError(f"component {component!r}: expected 0, 1 or 2")
-    program = str(executable())
+    program = None if scheduler is not None else str(program_path())
+    cwd = os.getcwd()
     tasks = []
     for i, run in enumerate(runs):
         folder = None if work_dir is None else str(Path(work_dir).resolve() / f"run_{i:05d}")
         text = _patched_text(scene, run, Path("@FOLDER@"), vtk)
-        tasks.append(_Task(program, str(scene_path.parent), text, folder, support,
-                           component, timeout))
+        tasks.append(_Task(program, cwd, text, folder, support, component, timeout))
     bar = _Progress(len(tasks), progress)
     try:
         if scheduler is not None:
@@ -386,6 +374,10 @@ def run_sweep(scene_path: str | os.PathLike,
                 rows = _run_tasks(tasks, executor, bar)
     finally:
         bar.close()
+    unknown = next((row[_UNKNOWN_SUPPORT] for row in rows if _UNKNOWN_SUPPORT in row), None)
+    if unknown is not None:
+        raise ValueError(f"support {support!r}: the scene's runs have supports "
+                         + ", ".join(unknown))
     table = {name: _column([run.get(name) for run in runs]) for name in names}
     for key in ("status", "error", "n_steps", "final_reaction", "max_reaction",
                 "wall_time"):

@@ -8,7 +8,6 @@ program yarnfort_main
     use yarnfort_version, only: yarnfort_version_string
     use yarnfort_input_config, only: config_type
     use yarnfort_input_namelist, only: read_config_from_stdin, check_config
-    use yarnfort_input_echo, only: write_config
     use yarnfort_input_groups, only: input_help_lines => help_lines
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_scene_builder, only: new_scene
@@ -16,6 +15,7 @@ program yarnfort_main
     use yarnfort_app_progress, only: progress_writer_type
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash
+    use yarnfort_output_filesystem, only: ignore_file_size_signal
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
@@ -23,10 +23,11 @@ program yarnfort_main
     type(error_type), allocatable :: error
     type(error_type), allocatable :: finish_error
     type(restart_type) :: restart
-    integer :: unit, status
     logical :: stopped
 
     call handle_arguments()
+    ! A write past a file size limit then fails like any other write (exit 1, message).
+    call ignore_file_size_signal()
 
     call read_config_from_stdin(config, error)
     if (allocated(error)) call fail('input', error, 2)
@@ -49,24 +50,23 @@ program yarnfort_main
     writer%residual_history = config%output%residual_history
     writer%input_hash = get_input_hash(config, scene)
     if (config%control%restart) then
-        ! Check the restart file before touching anything in the folder.
+        ! Lock the folder (no other run may write it meanwhile), then check the restart
+        ! file before touching anything in it.
+        call writer%lock(config%output%folder, error, create=.false.)
+        if (allocated(error)) call fail('output', error, 2)
         call read_restart(trim(config%output%folder), restart, error)
         if (.not. allocated(error)) call check_restart(restart, scene, writer%input_hash, &
             trim(config%output%folder), error)
         if (allocated(error)) call fail('restart', error, 2)
         write(error_unit, '(a, i0, a, g0.6)') 'yarnfort: restarting after step ', restart%step, &
             ' at t = ', restart%time
-        call writer%open(scene, error, resume_step=restart%step)
+        call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time)
     else
         call writer%open(scene, error)
     end if
     if (allocated(error)) call fail('output', error, 2)
-    open(newunit=unit, file=trim(config%output%folder) // '/input.nml', status='replace', &
-        action='write', iostat=status)
-    if (status == 0) then
-        call write_config(unit, config)
-        close(unit)
-    end if
+    call writer%write_input(config, error)
+    if (allocated(error)) call fail('output', error, 2)
 
     if (config%control%restart) then
         call run_scene(scene, writer, error, restart=restart, &
@@ -75,6 +75,7 @@ program yarnfort_main
         call run_scene(scene, writer, error, max_steps=config%control%max_steps, stopped=stopped)
     end if
     call writer%finish(scene, finish_error)
+    if (allocated(error) .and. writer%failed) call fail('output', error, 1)
     if (allocated(error)) call fail('solve', error, 1)
     if (allocated(finish_error)) call fail('output', finish_error, 1)
     if (stopped) then
@@ -125,9 +126,13 @@ contains
         write(output_unit, '(a)') &
             '', &
             'Writes to the &output folder: curve.csv (one row per converged step),', &
-            'state_NNNNN.vtu + states.pvd (ParaView) and input.nml (the effective input).', &
-            'Progress lines go to stderr. Exit code 0 on success, 1 if the solve failed', &
-            '(converged steps are kept), 2 for bad input or an unwritable output folder.', &
+            'state_NNNNN.vtu (5 or more digits; binary, or &output vtk_format = ''ascii'')', &
+            '+ states.pvd (ParaView) and input.nml (the effective input); it lists them in', &
+            '.yarnfort-manifest and deletes only files listed there, and holds the lock', &
+            '.yarnfort-lock while it runs (a second run into the folder stops at once).', &
+            'Progress lines go to stderr. Exit code 0 on success, 1 if the solve or a write', &
+            'failed (e.g. a full disk; converged steps are kept), 2 for bad input, an', &
+            'unwritable or locked output folder, or a restart file that does not fit.', &
             'After every converged step it also writes restart.dat; &control restart =', &
             '.true. continues a stopped or failed run from its last converged step.'
     end subroutine print_help

@@ -11,7 +11,7 @@ import pytest
 from yarnfort.calibrate import (calibrate, plot_fit, read_measured, simulated_force,
                                 write_synthetic_curve)
 from yarnfort.results import Curve
-from yarnfort.sweep import executable
+from yarnfort import program_path
 
 TOP = Path(__file__).resolve().parents[2]
 CAPSTAN = TOP / "inputs" / "capstan.nml"
@@ -31,7 +31,7 @@ COVERAGE = 3.0
 @pytest.fixture(scope="module")
 def synthetic(tmp_path_factory) -> Path:
     try:
-        executable()
+        program_path()
     except FileNotFoundError as error:
         pytest.fail(str(error))
     path = tmp_path_factory.mktemp("calibrate") / "synthetic.csv"

@@ -11,7 +11,7 @@ import pytest
 
 import yarnfort
 from yarnfort import YarnfortError
-from yarnfort._native import native_path
+from yarnfort._native import extension as load_extension
 
 TOP = Path(__file__).resolve().parents[2]
 #: Relative tolerance of identities between closed forms (a few roundings apart).
@@ -21,12 +21,12 @@ SCALE = 1.0
 
 
 @pytest.fixture(scope="module", autouse=True)
-def extension() -> Path:
-    """The built extension; fail with the build command when it is missing."""
+def extension():
+    """The installed extension; fail with the reason when it is missing."""
     try:
-        return native_path()
+        return load_extension()
     except ImportError as error:
-        pytest.fail(str(error))
+        pytest.fail(f"yarnfort is not installed with its extension: {error}")
 
 
 def close(actual, expected, scale: float = SCALE) -> bool:
@@ -89,7 +89,7 @@ def test_empty_input_still_checks_the_law():
 def test_negative_stiffness_raises_naming_the_value():
     with pytest.raises(YarnfortError, match=r"stiffness -2\b") as info:
         yarnfort.force_law("linear", [1.0, 1.1], stiffness=-2.0)
-    assert info.value.status != 0
+    assert (info.value.status, info.value.category) == (2, "bad_input")
 
 
 def test_bad_neo_hookean_area_and_unknown_law_raise():
@@ -201,6 +201,8 @@ def test_failed_solve_raises_and_keeps_the_converged_steps(tmp_path):
     with pytest.raises(YarnfortError, match="^solve: ") as info:
         yarnfort.run_scene(path)
     assert info.value.status == 1
-    assert info.value.run is not None and info.value.run.folder == folder
+    assert info.value.category == "solve_failed"
+    assert info.value.result is not None and info.value.result.folder == folder
+    assert info.value.result.outcome == "failed"
     curve = yarnfort.read_curve(folder)
-    assert len(next(iter(curve.columns.values()))) == info.value.run.n_steps
+    assert len(curve) == info.value.result.n_steps

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from yarnfort.sweep import executable, parameter_grid, run_sweep
+from yarnfort import program_path
+from yarnfort.sweep import parameter_grid, run_sweep
 
 TOP = Path(__file__).resolve().parents[2]
 CAPSTAN = TOP / "inputs" / "capstan.nml"
@@ -25,7 +26,7 @@ IDENTITY = 100 * np.finfo(float).eps
 @pytest.fixture(scope="module", autouse=True)
 def program() -> Path:
     try:
-        return executable()
+        return program_path()
     except FileNotFoundError as error:
         pytest.fail(str(error))
 

@@ -42,7 +42,7 @@ sys.path[:0] = [str(TOP / "tests" / "verification"), str(TOP / "python")]
 from test_hysteresis import Case, ClosedForm, hysteresis_scene  # noqa: E402
 from yarnfort import read_curve  # noqa: E402
 from yarnfort.results import Curve  # noqa: E402
-from yarnfort.sweep import set_parameter  # noqa: E402
+from yarnfort import set_parameter  # noqa: E402
 
 EXECUTABLE = Path(os.environ.get("YARNFORT_EXE", TOP / "build" / "yarnfort"))
 #: Runs faster than this (CPU s) are run REPEATS times and timed by the median. The

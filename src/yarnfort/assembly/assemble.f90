@@ -20,15 +20,20 @@ contains
 
     !> Internal force (gradient of the elastic energy) at every coordinate, (3*n_nodes),
     !> and each element's tension and stretch, for node positions x (3, n_nodes) and
-    !> element reference lengths length0.
-    subroutine assemble_internal_force(scene, x, length0, internal, tension, stretch, error)
+    !> element reference lengths length0. `spring`: weight of the regularising spring
+    !> (get_truss_tension) of a Newton predictor; absent or 0 for the exact law.
+    subroutine assemble_internal_force(scene, x, length0, internal, tension, stretch, error, &
+            spring)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(out) :: internal(:), tension(:), stretch(:)
         type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: spring
         integer :: e, n1, n2
-        real(wp) :: force(3)
+        real(wp) :: force(3), weight
 
+        weight = 0.0_wp
+        if (present(spring)) weight = spring
         internal = 0.0_wp
         do e = 1, scene%network%n_elements()
             n1 = scene%network%element_nodes(1, e)
@@ -36,50 +41,66 @@ contains
             call check_length(scene, x, length0, e, error)
             if (allocated(error)) return
             call get_truss_response(scene%laws(scene%network%element_material(e))%law, &
-                scene%solver%slack_stiffness, length0(e), x(:, n1), x(:, n2), &
-                tension(e), stretch(e), force)
+                weight, length0(e), x(:, n1), x(:, n2), tension(e), stretch(e), force)
             internal(3 * n1 - 2:3 * n1) = internal(3 * n1 - 2:3 * n1) - force
             internal(3 * n2 - 2:3 * n2) = internal(3 * n2 - 2:3 * n2) + force
         end do
     end subroutine assemble_internal_force
 
-    !> Residual on the unknowns: P^T (internal - p_force * external).
-    subroutine assemble_residual(scene, x, length0, p_force, residual, error)
+    !> Residual on the unknowns: P^T (internal - p_force * external); `spring` as for
+    !> assemble_internal_force.
+    subroutine assemble_residual(scene, x, length0, p_force, residual, error, spring)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:), p_force
         real(wp), intent(out) :: residual(:)
         type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: spring
         real(wp), allocatable :: internal(:), tension(:), stretch(:)
 
         allocate(internal(size(scene%external_force)))
         allocate(tension(scene%network%n_elements()), stretch(scene%network%n_elements()))
-        call assemble_internal_force(scene, x, length0, internal, tension, stretch, error)
+        call assemble_internal_force(scene, x, length0, internal, tension, stretch, error, &
+            spring)
         if (allocated(error)) return
         call scene%dofs%gather(internal - p_force * scene%external_force, residual)
     end subroutine assemble_residual
 
-    !> Jacobian values P^T K P in the slots of `pattern` (values are overwritten).
-    subroutine assemble_jacobian(scene, pattern, x, length0, values, error)
+    !> Jacobian values P^T K P in the slots of `pattern` (values are overwritten);
+    !> `spring` and `tangent_spring` as for add_element_tangents.
+    subroutine assemble_jacobian(scene, pattern, x, length0, values, error, spring, &
+            tangent_spring)
         type(scene_type), intent(in) :: scene
         type(pattern_type), intent(in) :: pattern
         real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: spring, tangent_spring
 
         values = 0.0_wp
-        call add_element_tangents(scene, pattern%element_slot, x, length0, values, error)
+        call add_element_tangents(scene, pattern%element_slot, x, length0, values, error, &
+            spring, tangent_spring)
     end subroutine assemble_jacobian
 
     !> Add every element's 6x6 tangent to `values` at element_slot(a, b, e) (entries
     !> a, b <= 6 of each element's slot table: node 1 xyz, node 2 xyz; 0 = skip).
-    subroutine add_element_tangents(scene, element_slot, x, length0, values, error)
+    !> `spring`: the regularising spring in the model (predictor solves); `tangent_spring`:
+    !> the spring in the tangent of slack strings only (get_truss_response). Both absent:
+    !> the exact tangent of the exact law.
+    subroutine add_element_tangents(scene, element_slot, x, length0, values, error, spring, &
+            tangent_spring)
         type(scene_type), intent(in) :: scene
         integer, intent(in) :: element_slot(:, :, :)
         real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(inout) :: values(:)
         type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: spring, tangent_spring
         integer :: e, n1, n2, a, b, slot
-        real(wp) :: force(3), block(3, 3), tension, stretch, sign_ab
+        real(wp) :: force(3), block(3, 3), tension, stretch, sign_ab, weight, tangent_weight
+
+        weight = 0.0_wp
+        if (present(spring)) weight = spring
+        tangent_weight = 0.0_wp
+        if (present(tangent_spring)) tangent_weight = tangent_spring
 
         do e = 1, scene%network%n_elements()
             n1 = scene%network%element_nodes(1, e)
@@ -87,8 +108,8 @@ contains
             call check_length(scene, x, length0, e, error)
             if (allocated(error)) return
             call get_truss_response(scene%laws(scene%network%element_material(e))%law, &
-                scene%solver%slack_stiffness, length0(e), x(:, n1), x(:, n2), &
-                tension, stretch, force, block)
+                weight, length0(e), x(:, n1), x(:, n2), tension, stretch, force, block, &
+                tangent_weight)
             do b = 1, 6
                 do a = 1, 6
                     slot = element_slot(a, b, e)

@@ -13,15 +13,12 @@ module yarnfort_assembly_truss
 
 contains
 
-    !> Tension of an element at `stretch`, with the slack regularisation: the law's
-    !> tension plus that of a weak spring of rest length L0/2, slack_stiffness * k_ref *
-    !> (stretch - 1/2) (k_ref the law's reference stiffness). A string at its reference
-    !> length then still carries slack_stiffness * k_ref / 2, so a slack or straight
-    !> string keeps a small positive transverse stiffness and the tangent stays regular
-    !> and exact (paper 2.6's x^4 degeneracy); an unloaded dangling end rests at half its
-    !> reference length instead of being undetermined. The price is a relative change
-    !> of order slack_stiffness / strain in taut strings. slack_stiffness = 0 gives the
-    !> exact tension-only law.
+    !> Tension of an element at `stretch` under the tension-only law (zero at or below
+    !> stretch 1), plus, when `spring` > 0, that of a weak spring of rest length L0/2,
+    !> spring * k_ref * (stretch - 1/2) (k_ref the law's reference stiffness). The spring
+    !> is a regularisation of the Newton solve only (yarnfort_solver_newton): a solve
+    !> that fails with the exact law is predicted with the spring and corrected without
+    !> it, so no converged answer carries it. spring = 0 is the exact law.
     pure subroutine get_truss_tension(law, slack_stiffness, stretch, tension, dtension)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: slack_stiffness, stretch
@@ -42,19 +39,25 @@ contains
     !> Force on node 2 (node 1 gets its negative) and the 3x3 block Z of the element
     !> tangent K = [Z -Z; -Z Z] (eq. 12) for nodes at x1, x2 and reference length L0:
     !> Z = T/l (I - c c^T) + (dT/dlambda)/L0 c c^T, the exact derivative of the force.
-    pure subroutine get_truss_response(law, slack_stiffness, length0, x1, x2, &
-            tension, stretch, force, block)
+    !> `tangent_spring` > 0 adds to the block of a slack string (stretch <= 1, whose
+    !> exact block is zero) the block of the regularising spring at its reference
+    !> length, k (I - c c^T) / (2 l) + k c c^T / L0 with k = tangent_spring * k_ref: the
+    !> force is unchanged, so a Newton step keeps a regular matrix while the converged
+    !> state is that of the exact law.
+    pure subroutine get_truss_response(law, spring, length0, x1, x2, &
+            tension, stretch, force, block, tangent_spring)
         class(force_law_type), intent(in) :: law
-        real(wp), intent(in) :: slack_stiffness, length0, x1(3), x2(3)
+        real(wp), intent(in) :: spring, length0, x1(3), x2(3)
         real(wp), intent(out) :: tension, stretch, force(3)
         real(wp), intent(out), optional :: block(3, 3)
-        real(wp) :: d(3), length, c(3), dtension, transverse
+        real(wp), intent(in), optional :: tangent_spring
+        real(wp) :: d(3), length, c(3), dtension, transverse, axial, k_tangent
         integer :: k
 
         d = x2 - x1
         length = norm2(d)
         stretch = length / length0
-        call get_truss_tension(law, slack_stiffness, stretch, tension, dtension)
+        call get_truss_tension(law, spring, stretch, tension, dtension)
         if (length > 0.0_wp) then
             c = d / length
         else
@@ -63,8 +66,16 @@ contains
         force = tension * c
         if (present(block)) then
             transverse = tension / length
+            axial = dtension / length0
+            if (present(tangent_spring)) then
+                if (tangent_spring > 0.0_wp .and. stretch <= 1.0_wp) then
+                    k_tangent = tangent_spring * law%get_reference_stiffness()
+                    transverse = transverse + k_tangent * (1.0_wp - slack_rest_stretch) / length
+                    axial = axial + k_tangent / length0
+                end if
+            end if
             do k = 1, 3
-                block(:, k) = (dtension / length0 - transverse) * c * c(k)
+                block(:, k) = (axial - transverse) * c * c(k)
                 block(k, k) = block(k, k) + transverse
             end do
         end if

@@ -3,7 +3,7 @@
 !> unknowns are the free coordinates and one flow s per passage (or the flows alone,
 !> with positions frozen, for the sliding step of the staggered scheme). Rows:
 !>   coordinates: P^T (internal force(x, L0(s)) - p_force * external force);
-!>   stick passage: k (s - s_target), k = force_scale / length_scale;
+!>   stick passage: k (s - s_target), k = the scene's largest force / length_scale;
 !>   slip forward (T_after > T_before, s grows):    T_crit(T_before, alpha) - T_after;
 !>   slip backward (T_before > T_after, s shrinks): T_before - T_crit(T_after, alpha).
 !> (The signs make the residual continuous where the semismooth choice below switches
@@ -13,8 +13,9 @@
 !> low-side tension that would satisfy it. Unweighted, the row cannot reach the residual
 !> tolerance once exp(mu alpha) is large: T_min carries a rounding error of about
 !> EA*epsilon (from lambda - 1 near lambda = 1), which T_crit multiplies by
-!> dT_crit/dT_min (measured: mu alpha = 20 stalled at 5e-8 * force_scale). Weighted, the
-!> tolerance asks for the flow to about residual_tolerance * length_scale. With
+!> dT_crit/dT_min (measured: mu alpha = 20 stalled at 5e-8 of the largest stiffness).
+!> Rows are judged (get_row_levels) against the forces at their node, the passage's
+!> larger tension / w for a slip row, the largest force for a stick row. With
 !> `semismooth` the weights stay 1 (the modes change within a solve).
 !> Tensions enter the friction conditions as max(T, 0) (a slack string pulls nothing).
 !> With `semismooth` (off by default) the mode of each passage is not fixed from outside
@@ -36,13 +37,15 @@ module yarnfort_contact_friction_problem
     use yarnfort_assembly_truss, only: get_truss_tension
     use yarnfort_assembly_pattern, only: build_clique_pattern
     use yarnfort_assembly_assemble, only: assemble_internal_force, add_element_tangents
+    use yarnfort_assembly_scales, only: get_node_force_levels, get_unknown_levels, &
+        get_tension_with_noise, node_level_floor
     use yarnfort_contact_geometry, only: get_wrap_angle
     use yarnfort_solver_problem, only: nonlinear_problem_type
     implicit none
     private
 
     public :: friction_problem_type, new_friction_problem
-    public :: mode_stick, mode_forward, mode_backward, locked_both
+    public :: mode_stick, mode_forward, mode_backward, locked_both, node_level_floor
 
     integer, parameter :: mode_stick = 0, mode_forward = 1, mode_backward = -1
     !> Value of `locked` that holds a passage in stick (chatter damping).
@@ -89,6 +92,11 @@ module yarnfort_contact_friction_problem
         procedure :: evaluate_jacobian
         procedure :: prepare_solve
         procedure :: check_solution
+        procedure :: get_row_levels
+        !> Largest force of the scene at the current state (update_state).
+        procedure :: get_force_level
+        !> Rounding error of an element's tension at the current state.
+        procedure :: get_element_noise
         !> Split unknowns into position unknowns and flows; set the work arrays.
         procedure :: update_state
         !> Tensions (clipped at 0) on both sides and the wrap angle of passage p.
@@ -109,9 +117,8 @@ contains
         self%positions_frozen = positions_frozen
         self%n_x = scene%dofs%n_unknowns
         self%n_p = scene%passages%size()
-        self%force_scale = scene%force_scale
         self%length_scale = scene%length_scale
-        self%stick_scale = scene%force_scale / scene%length_scale
+        self%stick_scale = 1.0_wp / scene%length_scale
         n_elements = scene%network%n_elements()
         allocate(self%mode(self%n_p), source=mode_stick)
         allocate(self%locked(self%n_p), source=0)
@@ -207,7 +214,7 @@ contains
                     self%length0)
             end if
             call assemble_internal_force(scene, self%x, self%length0, self%internal, &
-                self%tension, self%stretch, error)
+                self%tension, self%stretch, error, self%spring)
         end associate
     end subroutine update_state
 
@@ -288,9 +295,12 @@ contains
         real(wp) :: t_before, t_after, angle, t_min, critical, dcrit_dt, dcrit_da
 
         self%slip_weight = 1.0_wp
-        if (self%semismooth .or. all(self%mode == mode_stick)) return
         call self%update_state(u, error)
         if (allocated(error)) return
+        ! Stick rows in units of the scene's forces (it only scales the rows).
+        self%stick_scale = self%get_force_level() / self%length_scale
+        if (.not. (self%stick_scale > 0.0_wp)) self%stick_scale = 1.0_wp / self%length_scale
+        if (self%semismooth .or. all(self%mode == mode_stick)) return
         do p = 1, self%n_p
             if (self%mode(p) == mode_stick) cycle
             call self%get_passage_state(p, t_before, t_after, angle)
@@ -300,6 +310,81 @@ contains
             self%slip_weight(p) = max(1.0_wp, dcrit_dt)
         end do
     end subroutine prepare_solve
+
+    !> Largest force of the scene at the state of the last update_state: the largest
+    !> tension and the largest applied nodal force.
+    real(wp) function get_force_level(self) result(level)
+        class(friction_problem_type), intent(in) :: self
+        integer :: n
+        level = maxval([0.0_wp, abs(self%tension)])
+        do n = 1, self%scene%network%n_nodes()
+            level = max(level, abs(self%p_force) &
+                * norm2(self%scene%external_force(3 * n - 2:3 * n)))
+        end do
+    end function get_force_level
+
+    !> Coordinate rows: the forces meeting at their node. Stick rows k (s - s_target):
+    !> the largest force (a flow to residual_tolerance * length_scale). Slip rows
+    !> (T_crit - T_hi) / w: the passage's larger tension / w, floored like the nodes,
+    !> and the rounding of T_crit - T_hi.
+    subroutine get_row_levels(self, u, level, noise, error)
+        class(friction_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: level(:), noise(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: node_level(:), node_noise(:)
+        real(wp) :: max_force, t_before, t_after, angle, t_lo, critical, dcrit_dt, dcrit_da
+        real(wp) :: noise_lo, noise_hi
+        integer :: p, row, lo, hi
+
+        call self%update_state(u, error)
+        if (allocated(error)) return
+        allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
+        call get_node_force_levels(self%scene, self%x, self%length0, self%p_force, self%spring, &
+            node_level, node_noise, max_force)
+        row = 0
+        if (.not. self%positions_frozen) then
+            call get_unknown_levels(self%scene, node_level, node_noise, level(1:self%n_x), &
+                noise(1:self%n_x))
+            row = self%n_x
+        end if
+        do p = 1, self%n_p
+            noise(row + p) = 0.0_wp
+            if (self%mode(p) == mode_stick) then
+                level(row + p) = self%stick_scale * self%length_scale
+                cycle
+            end if
+            call self%get_passage_state(p, t_before, t_after, angle)
+            if (self%mode(p) == mode_forward) then
+                lo = self%scene%passages%element_before(p)
+                hi = self%scene%passages%element_after(p)
+                t_lo = t_before
+            else
+                lo = self%scene%passages%element_after(p)
+                hi = self%scene%passages%element_before(p)
+                t_lo = t_after
+            end if
+            call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
+                t_lo, angle, critical, dcrit_dt, dcrit_da)
+            level(row + p) = max(t_before, t_after, node_level_floor * max_force) &
+                / self%slip_weight(p)
+            noise_lo = self%get_element_noise(lo)
+            noise_hi = self%get_element_noise(hi)
+            noise(row + p) = (abs(dcrit_dt) * noise_lo + noise_hi) / self%slip_weight(p)
+        end do
+    end subroutine get_row_levels
+
+    !> Rounding error of element e's tension at the state of the last update_state.
+    real(wp) function get_element_noise(self, e) result(noise)
+        class(friction_problem_type), intent(in) :: self
+        integer, intent(in) :: e
+        real(wp) :: tension
+        associate(nodes => self%scene%network%element_nodes(:, e))
+            call get_tension_with_noise(self%scene%laws(self%scene%network%element_material(e))%law, &
+                self%spring, self%x(:, nodes(1)), self%x(:, nodes(2)), self%length0(e), &
+                tension, noise)
+        end associate
+    end function get_element_noise
 
     subroutine evaluate_residual(self, u, residual, error)
         class(friction_problem_type), intent(inout) :: self
@@ -361,7 +446,7 @@ contains
         associate(scene => self%scene, net => self%scene%network)
             if (.not. self%positions_frozen) then
                 call add_element_tangents(scene, self%element_slot, self%x, self%length0, &
-                    values, error)
+                    values, error, self%spring, self%tangent_spring)
                 if (allocated(error)) return
                 do e = 1, net%n_elements()
                     n1 = net%element_nodes(1, e)
@@ -370,7 +455,7 @@ contains
                     length = norm2(self%x(:, n2) - self%x(:, n1))
                     stretch = length / self%length0(e)
                     call get_truss_tension(scene%laws(net%element_material(e))%law, &
-                        scene%solver%slack_stiffness, stretch, tension, dtension)
+                        self%spring, stretch, tension, dtension)
                     c = (self%x(:, n2) - self%x(:, n1)) / length
                     ! L0 changes by share(e) times the flows bounding its segment.
                     dforce_dl0 = -c * dtension * stretch / self%length0(e) &
@@ -450,7 +535,7 @@ contains
                     dt = self%scene%laws(net%element_material(e))%law%get_reference_stiffness()
                 else
                     call get_truss_tension(self%scene%laws(net%element_material(e))%law, &
-                        self%scene%solver%slack_stiffness, lambda, t, dt)
+                        self%spring, lambda, t, dt)
                 end if
                 gradient(first:first + 2) = -dt / self%length0(e) * c
                 gradient(first + 3:first + 5) = dt / self%length0(e) * c

@@ -26,7 +26,7 @@ module yarnfort_contact_friction_stepper
     use yarnfort_solver_state, only: fill_step_state
     use yarnfort_solver_restart, only: restart_type, stepper_friction
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
-        mode_stick, mode_forward, mode_backward, locked_both
+        mode_stick, mode_forward, mode_backward, locked_both, node_level_floor
     implicit none
     private
 
@@ -36,6 +36,9 @@ module yarnfort_contact_friction_stepper
     real(wp), parameter :: min_relaxation = 0.1_wp, max_relaxation = 100.0_wp
     !> Flips of one passage's mode in a step before it is held in stick.
     integer, parameter :: max_flips = 6
+    !> The stick test's dead band, in units of the uncertainty of the passage's
+    !> tensions at convergence (residual_tolerance times their level plus rounding).
+    real(wp), parameter :: dead_band_factor = 10.0_wp
 
     !> Round-off of a reference length locked at its minimum, relative to its initial
     !> length (the lock sets L0 = initial length - flow to the minimum).
@@ -225,7 +228,7 @@ contains
         type(newton_stats_type), intent(out) :: stats
         integer, intent(out) :: iterations
         type(error_type), allocatable, intent(out) :: error
-        real(wp), allocatable :: residual(:)
+        real(wp), allocatable :: residual(:), level(:), noise(:)
         integer, allocatable :: flips(:), mode_before(:)
         logical, allocatable :: locked_forward(:), locked_backward(:)
         integer :: round, inner, changed, new_slips
@@ -285,8 +288,13 @@ contains
                     elastic%length0)
                 call elastic%evaluate_residual(self%u_trial, residual, error)
                 if (allocated(error)) return
-                residual_norm = maxval(abs(residual), mask=.true.) / scene%force_scale
-                if (size(residual) == 0) residual_norm = 0.0_wp
+                allocate(level(size(residual)), noise(size(residual)))
+                call elastic%get_row_levels(self%u_trial, level, noise, error)
+                if (allocated(error)) return
+                level = level + noise / scene%solver%residual_tolerance
+                residual_norm = maxval([0.0_wp, abs(residual) / merge(level, 1.0_wp, &
+                    level > 0.0_wp)])
+                deallocate(level, noise)
                 if (residual_norm <= scene%solver%residual_tolerance &
                         .and. all(self%mode_trial == mode_before)) then
                     self%n_damped = count(flips > max_flips)
@@ -337,18 +345,17 @@ contains
         !> How many did.
         integer, intent(out) :: new_slips
         integer :: p, new_mode, before, after, n_candidates, k
-        real(wp) :: t_before, t_after, angle, critical, d1, d2, slack, tol, min_before, min_after
-        real(wp) :: increment
+        real(wp) :: t_before, t_after, angle, critical, d1, d2, tol, min_before, min_after
+        real(wp) :: increment, floor, band, noise_before, noise_after
         integer, allocatable :: candidate(:), direction(:)
         real(wp), allocatable :: violation(:)
 
         associate(scene => problem%scene, passages => problem%scene%passages)
             tol = scene%solver%friction_tolerance
-            ! Absolute slack: the equilibrium residual's noise level, and the tension of
-            ! slack strings (regularisation spring): a passage whose higher tension is
-            ! below that has nothing to slide it, and its sliding would be undetermined.
-            slack = max(10 * scene%solver%residual_tolerance, &
-                10 * scene%solver%slack_stiffness) * scene%force_scale
+            ! The dead band of the stick test is the uncertainty of the passage's own
+            ! tensions at convergence: the residual tolerance times their level (floored,
+            ! like the nodes', by the scene's largest force) plus their rounding.
+            floor = node_level_floor * problem%get_force_level()
             changed = 0
             new_slips = 0
             n_candidates = 0
@@ -371,17 +378,24 @@ contains
                             + length_round_off * scene%network%length0(after)) &
                         locked_backward(p) = .true.
                     call problem%get_passage_state(p, t_before, t_after, angle)
+                    noise_before = problem%get_element_noise(before)
+                    noise_after = problem%get_element_noise(after)
                     associate(law => scene%friction(passages%law(p))%law)
                         call law%get_critical_tension(t_before, angle, critical, d1, d2)
-                        if (t_after > critical * (1 + tol) + slack .and. &
+                        band = dead_band_factor * (scene%solver%residual_tolerance &
+                            * max(t_before, t_after, floor) + noise_after + abs(d1) * noise_before)
+                        if (t_after > critical * (1 + tol) + band .and. &
                                 .not. locked_forward(p)) then
                             call add_candidate(mode_forward, (t_after - critical) &
-                                / (critical + slack))
+                                / max(critical + band, tiny(1.0_wp)))
                         else
                             call law%get_critical_tension(t_after, angle, critical, d1, d2)
-                            if (t_before > critical * (1 + tol) + slack .and. &
+                            band = dead_band_factor * (scene%solver%residual_tolerance &
+                                * max(t_before, t_after, floor) + noise_before &
+                                + abs(d1) * noise_after)
+                            if (t_before > critical * (1 + tol) + band .and. &
                                     .not. locked_backward(p)) call add_candidate( &
-                                mode_backward, (t_before - critical) / (critical + slack))
+                                mode_backward, (t_before - critical) / max(critical + band, tiny(1.0_wp)))
                         end if
                     end associate
                 case (mode_forward)

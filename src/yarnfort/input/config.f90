@@ -63,11 +63,11 @@ contains
 
     !> The &solver defaults of preset `name` (lower case, one of solver_presets): the type's
     !> defaults with initial_step = max_step, residual_tolerance and scheme of the preset,
-    !> and preset = name. The values come from verification/speed_accuracy: the error of
-    !> the force curve is set by the step (pseudo-time; the example scenes have one unit
-    !> per stretch or release), the tolerance only has to stay well below it, and the
-    !> monolithic scheme was the faster one. `found` is false for an unknown name (then
-    !> the type's defaults).
+    !> and preset = name. The values come from verification/speed_accuracy/presets.py
+    !> (every scene of tests/verification/test_defaults.py against its exact reference):
+    !> at the steps the error follows the tolerance, the step (a fraction of the knot
+    !> interval) sets how finely the curve is drawn, and the monolithic scheme was the
+    !> faster one. `found` is false for an unknown name (then the type's defaults).
     pure subroutine get_solver_preset(name, solver, found)
         character(len=*), intent(in) :: name
         type(solver_config_type), intent(out) :: solver
@@ -77,15 +77,15 @@ contains
         found = .true.
         solver%preset = name
         select case (name)
-        case ('fast')           ! 4 steps per unit of pseudo-time
+        case ('fast')           ! 4 steps per knot interval
             step = 0.25_wp
             tolerance = 1.0e-6_wp
-        case ('balanced')       ! 20 steps per unit
+        case ('balanced')       ! 20 steps per knot interval
             step = 0.05_wp
-            tolerance = 1.0e-8_wp
-        case ('accurate')       ! 200 steps per unit
-            step = 0.005_wp
-            tolerance = 1.0e-10_wp
+            tolerance = 1.0e-9_wp
+        case ('accurate')       ! 100 steps per knot interval
+            step = 0.01_wp
+            tolerance = 1.0e-11_wp
         case default
             found = name == 'custom'
             return

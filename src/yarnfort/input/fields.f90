@@ -347,11 +347,15 @@ contains
         end if
     end subroutine check_name
 
+    !> Write one line. A failed write does not stop the program: the caller that needs
+    !> the file whole checks it when closing it (yarnfort_output_filesystem compares its
+    !> size on disk with what was written).
     subroutine put(unit, line)
         integer, intent(in) :: unit
         character(len=*), intent(in) :: line
+        integer :: status
 
-        write(unit, '(a)') line
+        write(unit, '(a)', iostat=status) line
     end subroutine put
 
     !> `name = v1 v2 ...`, integers_per_line values per line; nothing for no values.

@@ -36,14 +36,20 @@ contains
         type(yarn_config_type), allocatable :: grown(:)
         real(wp) :: xyz(3)
         logical :: ok
+        integer :: stat
+        character(len=256) :: message
 
         content = ''
         call read_whole_file(path, content, error)
         if (allocated(error)) return
         ! Some editors start a UTF-8 file with a byte order mark: not text of the file.
         if (index(content, byte_order_mark) == 1) content = content(len(byte_order_mark) + 1:)
-        allocate(node_ids(1024), node_lines(1024), node_xyz(3, 1024))
-        allocate(yarns(16), yarn_lines(16))
+        allocate(node_ids(1024), node_lines(1024), node_xyz(3, 1024), yarns(16), &
+            yarn_lines(16), stat=stat, errmsg=message)
+        if (stat /= 0) then
+            call out_of_memory()
+            return
+        end if
         n_nodes = 0
         n_yarns = 0
         line_number = 0
@@ -97,9 +103,11 @@ contains
                     end if
                 end do
                 if (n_nodes == size(node_ids)) then
-                    node_ids = [node_ids, node_ids]
-                    node_lines = [node_lines, node_lines]
-                    node_xyz = reshape([node_xyz, node_xyz], [3, 2 * n_nodes])
+                    call grow_nodes(stat)
+                    if (stat /= 0) then
+                        call out_of_memory()
+                        return
+                    end if
                 end if
                 n_nodes = n_nodes + 1
                 node_ids(n_nodes) = id
@@ -118,10 +126,18 @@ contains
                     return
                 end if
                 if (n_yarns == size(yarns)) then
-                    allocate(grown(2 * n_yarns))
+                    allocate(grown(2 * n_yarns), stat=stat, errmsg=message)
+                    if (stat /= 0) then
+                        call out_of_memory()
+                        return
+                    end if
                     grown(:n_yarns) = yarns
                     call move_alloc(grown, yarns)
-                    yarn_lines = [yarn_lines, yarn_lines]
+                    call grow_integers(yarn_lines, stat)
+                    if (stat /= 0) then
+                        call out_of_memory()
+                        return
+                    end if
                 end if
                 n_yarns = n_yarns + 1
                 yarn_lines(n_yarns) = first_line
@@ -132,7 +148,11 @@ contains
                         // "' is not an integer")
                     return
                 end if
-                allocate(yarns(n_yarns)%nodes(size(words) - 3))
+                allocate(yarns(n_yarns)%nodes(size(words) - 3), stat=stat, errmsg=message)
+                if (stat /= 0) then
+                    call out_of_memory()
+                    return
+                end if
                 do k = 4, size(words)
                     call parse_integer(words(k)%text, yarns(n_yarns)%nodes(k - 3), ok)
                     if (.not. ok) then
@@ -154,7 +174,12 @@ contains
         yarns = yarns(:n_yarns)
         id = 0
         if (n_nodes > 0) id = maxval(node_ids(:n_nodes))
-        allocate(node_positions(3, min(id, n_nodes)), defined_on(min(id, n_nodes)))
+        allocate(node_positions(3, min(id, n_nodes)), defined_on(min(id, n_nodes)), stat=stat, &
+            errmsg=message)
+        if (stat /= 0) then
+            call out_of_memory()
+            return
+        end if
         defined_on = 0
         do i = 1, n_nodes
             if (node_ids(i) > size(defined_on)) cycle
@@ -188,6 +213,36 @@ contains
 
     contains
 
+        !> Double the node arrays (explicit allocations, so that a failure is a status).
+        subroutine grow_nodes(stat)
+            integer, intent(out) :: stat
+            real(wp), allocatable :: xyz_grown(:, :)
+
+            call grow_integers(node_ids, stat)
+            if (stat == 0) call grow_integers(node_lines, stat)
+            if (stat /= 0) return
+            allocate(xyz_grown(3, 2 * size(node_xyz, 2)), stat=stat, errmsg=message)
+            if (stat /= 0) return
+            xyz_grown(:, :size(node_xyz, 2)) = node_xyz
+            call move_alloc(xyz_grown, node_xyz)
+        end subroutine grow_nodes
+
+        subroutine grow_integers(values, stat)
+            integer, allocatable, intent(inout) :: values(:)
+            integer, intent(out) :: stat
+            integer, allocatable :: grown_values(:)
+
+            allocate(grown_values(2 * size(values)), stat=stat, errmsg=message)
+            if (stat /= 0) return
+            grown_values(:size(values)) = values
+            call move_alloc(grown_values, values)
+        end subroutine grow_integers
+
+        subroutine out_of_memory()
+            call fatal_error(error, "&geometry: file '" // path // "': not enough memory " &
+                // 'to read it (' // trim(message) // ')')
+        end subroutine out_of_memory
+
         subroutine fail(line, text)
             integer, intent(in) :: line
             character(len=*), intent(in) :: text
@@ -206,6 +261,7 @@ contains
         character(len=512) :: message
         integer :: unit, stat
         integer(int64) :: file_size
+        character(len=20) :: size_text
 
         if (is_folder(path)) then
             call fatal_error(error, "&geometry: file '" // path // "' is a folder, not a file")
@@ -224,7 +280,14 @@ contains
             close(unit)
             return
         end if
-        allocate(character(len=file_size) :: content)
+        allocate(character(len=file_size) :: content, stat=stat, errmsg=message)
+        if (stat /= 0) then
+            close(unit)
+            write(size_text, '(i0)') file_size
+            call fatal_error(error, "&geometry: file '" // path // "' (" // trim(size_text) &
+                // ' bytes) does not fit in memory: ' // trim(message))
+            return
+        end if
         stat = 0
         if (file_size > 0) read(unit, iostat=stat, iomsg=message) content
         close(unit)

@@ -184,23 +184,26 @@ contains
         end if
     end subroutine check_path
 
-    !> Every continuation step (at least min_step) must advance the pseudo-time: min_step
-    !> must not be below the floating-point resolution of the path's times.
+    !> Every continuation step (at least min_step times the shortest knot interval) must
+    !> advance the pseudo-time: it must not be below the floating-point resolution of the
+    !> path's times.
     subroutine check_step_resolution(solver, path, error)
         type(solver_config_type), intent(in) :: solver
         type(path_config_type), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
-        real(wp) :: largest
+        real(wp) :: largest, interval
         character(len=16) :: shortest
 
         largest = maxval(abs(path%time))
-        if (solver%min_step < time_resolution * largest) then
+        interval = minval(path%time(2:) - path%time(:size(path%time) - 1))
+        if (solver%min_step * interval < time_resolution * largest) then
             write(shortest, '(es9.2)') time_resolution * largest
             call fatal_error(error, '&solver: min_step = ' // format_real(solver%min_step) &
                 // ' is below the resolution of &path time (up to ' // format_real(largest) &
-                // ' in magnitude): a step shorter than ' // trim(adjustl(shortest)) &
-                // ' would not advance the pseudo-time; raise min_step (and max_step) or ' &
-                // 'move the path times closer to 0')
+                // ' in magnitude, shortest knot interval ' // format_real(interval) &
+                // '): a step shorter than ' // trim(adjustl(shortest)) &
+                // ' would not advance the pseudo-time; raise min_step (a fraction of the ' &
+                // 'knot interval) or move the path times closer to 0')
         end if
     end subroutine check_step_resolution
 

@@ -50,39 +50,59 @@ GROUPS = [
                 "a matrix is not positive definite. `'auto'` picks from measurements "
                 "(`benchmarks/run`): "
                 "`'cholmod+klu'` for the elastic solves when `slack_stiffness > 0` (the tangent "
-                'is then symmetric positive definite), otherwise KLU up to 2e5 unknowns and '
-                'UMFPACK above; the unsymmetric friction systems never use CHOLMOD.'),
+                'of taut strings is positive semi-definite and slack strings get the '
+                "regularising spring's, see `slack_stiffness`), otherwise KLU up to 2e5 "
+                'unknowns and UMFPACK above; the unsymmetric friction systems never use '
+                'CHOLMOD.'),
         Var('residual_tolerance', 'real', 1e-10, unit='1', range='> 0', preset=True,
-            doc='Newton stops when max \\|residual\\| <= residual_tolerance * force_scale. The '
-                'friction slip rows (T_hi - T_crit(T_lo) = 0) are divided by max(1, '
-                'dT_crit/dT_lo), frozen for each Newton solve. Where exp(mu alpha) is large, '
-                'that asks for the flow to about residual_tolerance * length_scale, not for a '
-                'tension below round-off times exp(mu alpha).'),
+            doc='Relative. Newton stops when every row meets \\|F_i\\| <= residual_tolerance * '
+                'level_i + noise_i. For a node, level_i is the largest force that meets there '
+                '(the tensions of its elements, its applied load), at least 1e-6 times the '
+                "largest force of the scene; noise_i is the rounding of the residual's "
+                'evaluation (8 eps (\\|T\\| + r dT/dlambda) per element, r = (\\|x1\\| + \\|x2\\| + '
+                'l) / L0), which only matters for nearly inextensible yarns. A friction slip row '
+                '(T_crit(T_lo) - T_hi, divided by w = max(1, dT_crit/dT_lo), frozen per Newton '
+                "solve) is judged against the passage's larger tension / w; a stick row asks for "
+                'the flow to residual_tolerance * mean element length. No material stiffness '
+                'enters: a scene gives the same relative answer in any units and whatever the '
+                'stiffness of a part that carries no load.'),
         Var('step_tolerance', 'real', 1e-14, unit='1', range='> 0',
             doc='Newton also stops when the scaled step is below this. The residual tolerance is '
                 'then still checked: a small step alone never counts as convergence.'),
         Var('max_iterations', 'integer', 50, range='>= 1',
-            doc='Newton iterations per step.'),
+            doc='Newton iterations of each attempt of a solve (full steps, then line search; '
+                'see `line_search`).'),
         Var('max_setup_calls', 'integer', 1, range='>= 1',
             doc='Newton iterations between Jacobian updates (1 = full Newton).'),
         Var('line_search', 'logical', True,
-            doc="Line search in Newton's method."),
+            doc='Globalisation. Every Newton solve first takes full Newton steps; with '
+                "`.true.`, a solve that fails is repeated from its start with KINSOL's line "
+                'search, and if that fails too, by pseudo-transient continuation (Newton steps '
+                'on F + mu D du = 0 with mu falling as the residual does, at most 4 * '
+                '`max_iterations` steps), which follows a ring sliding far along a stiff yarn '
+                'where a line search crawls. `.false.`: full Newton steps only.'),
         Var('slack_stiffness', 'real', 1e-06, unit='1', range='>= 0',
-            doc='Regularisation of the tension-only law: every string also carries '
-                '`slack_stiffness * k_ref * (stretch - 1/2)` (a weak spring of rest length L0/2; '
-                "`k_ref` is the law's stiffness at stretch 1), so slack and straight strings "
-                "keep a small transverse stiffness and Newton's tangent stays regular and exact; "
-                'an unloaded dangling yarn end rests at half its reference length. It changes '
-                'tensions by about `slack_stiffness / strain` relative in taut strings; 0 gives '
-                'the exact tension-only law (then a net at zero tension has no stiffness).'),
-        Var('initial_step', 'real', 0.1, unit='pseudo-time', range='> 0', preset=True,
-            doc='First continuation step; at least min_step, capped at max_step.'),
-        Var('min_step', 'real', 1e-06, unit='pseudo-time', range='> 0',
-            doc='Smallest step; min_step <= max_step, and at least `100 * epsilon` times the '
-                'largest absolute `&path time` (a shorter step would not advance the '
+            doc='Regularisation of the Newton solve, never of the answer. The residual is always '
+                'that of the exact tension-only law (a slack string carries exactly zero). A '
+                'slack string (stretch <= 1) adds to the Newton tangent the stiffness of a weak '
+                'spring of rest length L0/2, `slack_stiffness * k_ref` (`k_ref` the law\'s '
+                'stiffness at stretch 1), so the linear systems stay regular. A solve that fails '
+                'with the exact law is predicted with that spring in the model, its weight '
+                'falling from 0.1 to `slack_stiffness` by factors of 10, and then corrected with '
+                'the exact law from there. 0 switches both off (a net at zero tension then has a '
+                'singular tangent).'),
+        Var('initial_step', 'real', 0.1, unit='knot interval', range='> 0', preset=True,
+            doc='First continuation step, as a fraction of the knot interval; at least '
+                'min_step, capped at max_step.'),
+        Var('min_step', 'real', 1e-06, unit='knot interval', range='> 0',
+            doc='Smallest step, as a fraction of the knot interval being followed; min_step <= '
+                'max_step, and min_step times every knot interval at least `100 * epsilon` '
+                'times the largest absolute `&path time` (a shorter step would not advance the '
                 'pseudo-time).'),
-        Var('max_step', 'real', 0.25, unit='pseudo-time', range='> 0', preset=True,
-            doc='Largest step.'),
+        Var('max_step', 'real', 0.25, unit='knot interval', range='> 0', preset=True,
+            doc='Largest step, as a fraction of the knot interval being followed: a path of N '
+                'knot intervals takes at least N / max_step steps, whatever the spacing of its '
+                'knots.'),
         Var('step_growth', 'real', 1.5, unit='1', range='>= 1',
             doc='Step growth factor after an easy step.'),
         Var('step_cut', 'real', 0.5, unit='1', range='(0, 1)',
@@ -109,8 +129,11 @@ GROUPS = [
                 'on the woven benchmark net).'),
         Var('friction_tolerance', 'real', 1e-09, unit='1', range='> 0',
             doc='Friction: relative slack in the stick test T_max <= T_crit (1 + '
-                "friction_tolerance), and the staggered scheme's convergence test on the "
-                'friction conditions.'),
+                'friction_tolerance) + band. The band is 10 times the uncertainty of the '
+                "passage's own tensions at convergence: residual_tolerance times the larger of "
+                'its two tensions (at least 1e-6 times the largest force of the scene), plus '
+                'their rounding. No absolute number and no material stiffness: a frictionless '
+                'passage slips as soon as its tensions differ by more than that.'),
     ]),
     Group('material', 'repeatable',
           'One yarn type and its force law (one group per yarn type).', [
@@ -312,10 +335,16 @@ GROUPS = [
         Var('vtk_every', 'integer', 1, range='>= 0',
             doc='Write a VTK state every this many converged steps. 0 writes none. When it is '
                 'above 0, the last step is always written.'),
+        Var('vtk_format', 'character', 'binary', length=8, lower=True,
+            choices=['binary', 'ascii'],
+            doc="Encoding of the VTK state files: `'binary'` (appended, base64-encoded, VTK "
+                "XML 1.0) or `'ascii'` (inline text, 17 significant digits: the same values)."),
         Var('progress', 'logical', True,
             doc='Progress lines on stderr.'),
         Var('residual_history', 'logical', False,
-            doc='Also print, per step, the scaled residual max\\|F\\|/force_scale of every Newton '
-                'iterate (to see the convergence rate).'),
+            doc='Also print, per step, the scaled residual of every Newton iterate, max '
+                '\\|F_i\\| / (level_i + noise_i / residual_tolerance) (see `&solver '
+                'residual_tolerance`; converged at <= residual_tolerance), to see the '
+                'convergence rate.'),
     ]),
 ]

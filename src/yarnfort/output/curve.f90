@@ -5,7 +5,8 @@ module yarnfort_output_curve
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
-    use yarnfort_output_filesystem, only: rename_file
+    use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, &
+        flush_checked, truncate_file
     implicit none
     private
 
@@ -15,11 +16,13 @@ module yarnfort_output_curve
 
     type :: curve_writer_type
         integer :: unit = -1
+        character(len=:), allocatable :: path
     contains
         procedure :: open => open_curve
         !> Keep the rows up to a step of an existing curve file and append after them.
         procedure :: resume => resume_curve
         procedure :: write_step
+        procedure :: put_line
         procedure :: close => close_curve
     end type curve_writer_type
 
@@ -36,32 +39,66 @@ contains
         character(len=*), intent(in) :: folder
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
+        character(len=256) :: message
         integer :: status
 
-        open(newunit=self%unit, file=folder // '/' // curve_file_name, status='replace', &
-            action='write', iostat=status)
+        self%path = folder // '/' // curve_file_name
+        message = ''
+        open(newunit=self%unit, file=self%path, status='replace', action='write', &
+            iostat=status, iomsg=message)
         if (status /= 0) then
-            call fatal_error(error, "cannot write '" // folder // '/' // curve_file_name // "'")
+            self%unit = -1
+            call fatal_error(error, "cannot write '" // self%path // "': " // trim(message))
             return
         end if
-        write(self%unit, '(a)') get_header(scene)
-        flush(self%unit)
+        call self%put_line(get_header(scene), error)
     end subroutine open_curve
+
+    !> Write a line and flush it to the file. A failure closes the file, cuts off what
+    !> reached it of the line (so the file keeps whole rows only) and says why.
+    subroutine put_line(self, line, error)
+        class(curve_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: line
+        type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: ignored
+        character(len=256) :: message
+        integer :: status
+        integer(8) :: whole
+
+        inquire(unit=self%unit, size=whole)
+        message = ''
+        write(self%unit, '(a)', iostat=status, iomsg=message) line
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // self%path // "': " // trim(message))
+        else
+            call flush_checked(self%unit, self%path, error)
+        end if
+        if (allocated(error)) then
+            close(self%unit, iostat=status)
+            self%unit = -1
+            if (whole >= 0) call truncate_file(self%path, whole, ignored)
+        end if
+    end subroutine put_line
 
     !> Continue folder/curve.csv after `step` (a restart): keep its header and its rows
     !> up to that step, drop the later ones (written after the restart snapshot), and
     !> append from there. The kept rows go to a temporary file renamed over the old one,
     !> so an interruption leaves the old file. Fails if the file is missing, has other
     !> columns than `scene` writes, or has no row for `step`.
-    subroutine resume_curve(self, folder, scene, step, error)
+    !> The row of `step` must have the pseudo-time `time` (that of the restart file).
+    subroutine resume_curve(self, folder, scene, step, error, time)
         class(curve_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: folder
         type(scene_type), intent(in) :: scene
         integer, intent(in) :: step
         type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: time
+        type(error_type), allocatable :: ignored
         character(len=:), allocatable :: path, temporary, line, header
         character(len=32) :: text
-        integer :: old, new, status, row_step, comma, last_kept
+        character(len=256) :: message
+        integer :: old, new, status, row_step, comma, last_kept, write_status
+        real(wp) :: row_time
 
         path = folder // '/' // curve_file_name
         temporary = path // '.tmp'
@@ -78,14 +115,17 @@ contains
                 // 'than this scene writes')
             return
         end if
-        open(newunit=new, file=temporary, status='replace', action='write', iostat=status)
+        message = ''
+        open(newunit=new, file=temporary, status='replace', action='write', iostat=status, &
+            iomsg=message)
         if (status /= 0) then
             close(old)
-            call fatal_error(error, "cannot write '" // temporary // "'")
+            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
             return
         end if
-        write(new, '(a)') header
+        write(new, '(a)', iostat=write_status, iomsg=message) header
         last_kept = -1
+        row_time = -huge(row_time)
         do
             call read_line(old, line, status)
             if (status /= 0) exit
@@ -96,24 +136,55 @@ contains
             read(line(:comma - 1), *, iostat=status) row_step
             if (status /= 0) cycle
             if (row_step > step) cycle
-            write(new, '(a)') line
+            if (write_status == 0) write(new, '(a)', iostat=write_status, iomsg=message) line
             last_kept = row_step
+            if (row_step == step) then
+                ! The time field is the second one (list-directed: up to the comma).
+                read(line(comma + 1:), *, iostat=status) row_time
+                if (status /= 0) row_time = -huge(row_time)
+            end if
         end do
         close(old)
-        close(new)
+        if (write_status == 0) then
+            call close_checked(new, temporary, error)
+        else
+            close(new)
+            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
+        end if
+        if (allocated(error)) then
+            call remove_file(temporary, ignored)
+            return
+        end if
         if (last_kept /= step) then
-            open(newunit=new, file=temporary, status='old', iostat=status)
-            if (status == 0) close(new, status='delete')
+            call remove_file(temporary, ignored)
             write(text, '(i0)') step
             call fatal_error(error, "&control restart: '" // path // "' has no row for step " &
                 // trim(text) // ', the step of the restart file')
             return
         end if
+        ! The row was written from the same double with 17 significant digits: it reads
+        ! back to within a unit in the last place.
+        if (present(time)) then
+            if (.not. abs(row_time - time) <= 2 * spacing(max(abs(time), tiny(time)))) then
+                call remove_file(temporary, ignored)
+                write(text, '(i0)') step
+                call fatal_error(error, "&control restart: the restart file's time " &
+                    // format_real_text(time) // ' is not that of step ' // trim(text) &
+                    // " in '" // path // "' (" // format_real_text(row_time) &
+                    // '): the two files are not of the same run')
+                return
+            end if
+        end if
         call rename_file(temporary, path, error)
         if (allocated(error)) return
+        self%path = path
+        message = ''
         open(newunit=self%unit, file=path, status='old', position='append', action='write', &
-            iostat=status)
-        if (status /= 0) call fatal_error(error, "cannot write '" // path // "'")
+            iostat=status, iomsg=message)
+        if (status /= 0) then
+            self%unit = -1
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+        end if
     contains
         pure integer function count_commas(text)
             character(len=*), intent(in) :: text
@@ -159,10 +230,11 @@ contains
         header = header // ',direction,slipping,passages,newton_iterations,residual,step_cuts,wall_time'
     end function get_header
 
-    subroutine write_step(self, scene, state)
+    subroutine write_step(self, scene, state, error)
         class(curve_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(step_state_type), intent(in) :: state
+        type(error_type), allocatable, intent(out) :: error
         character(len=32) :: field
         character(len=:), allocatable :: row
         integer :: s, k
@@ -188,8 +260,11 @@ contains
         write(field, '(i0)') state%step_cuts
         row = row // ',' // trim(field)
         call append(state%wall_time)
-        write(self%unit, '(a)') row
-        flush(self%unit)
+        if (self%unit == -1) then
+            call fatal_error(error, "cannot write '" // self%path // "': it is not open")
+            return
+        end if
+        call self%put_line(row, error)
     contains
         subroutine append(value)
             real(wp), intent(in) :: value
@@ -198,10 +273,25 @@ contains
         end subroutine append
     end subroutine write_step
 
-    subroutine close_curve(self)
+    !> Close the file; `error` says if the last data could not be written.
+    subroutine close_curve(self, error)
         class(curve_writer_type), intent(inout) :: self
-        if (self%unit /= -1) close(self%unit)
+        type(error_type), allocatable, intent(out), optional :: error
+        type(error_type), allocatable :: close_error
+
+        if (self%unit == -1) return
+        call close_checked(self%unit, self%path, close_error)
         self%unit = -1
+        if (present(error) .and. allocated(close_error)) call move_alloc(close_error, error)
     end subroutine close_curve
+
+    !> A real with 17 significant digits (the curve file's format).
+    pure function format_real_text(value) result(text)
+        real(wp), intent(in) :: value
+        character(len=:), allocatable :: text
+        character(len=32) :: buffer
+        write(buffer, '(es24.16e3)') value
+        text = trim(adjustl(buffer))
+    end function format_real_text
 
 end module yarnfort_output_curve

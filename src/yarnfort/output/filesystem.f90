@@ -1,13 +1,30 @@
 ! SPDX-License-Identifier: MIT
-!> Folder creation and file renaming through the C library (Fortran has no portable
-!> mkdir or rename).
+!> File-system calls Fortran has no portable statement for, through the C library and a
+!> small C shim (filesystem_shim.c): folder creation, atomic rename, removal, fsync, and
+!> the exclusive lock of an output folder.
 module yarnfort_output_filesystem
-    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_long_long
     use yarnfort_error, only: error_type, fatal_error
     implicit none
     private
 
-    public :: make_folder, rename_file
+    public :: make_folder, rename_file, remove_file, sync_file, folder_lock_type
+    public :: close_checked, flush_checked, truncate_file, ignore_file_size_signal
+    public :: lock_file_name
+
+    !> The lock file of an output folder (kept; the lock is the kernel's, not the file).
+    character(len=*), parameter :: lock_file_name = '.yarnfort-lock'
+
+    !> An exclusive lock on an output folder, held from `acquire` to `release` (or the end
+    !> of the process, however it ends: a killed run leaves no stale lock).
+    type :: folder_lock_type
+        integer(c_int) :: fd = -1
+    contains
+        procedure :: acquire => acquire_lock
+        procedure :: release => release_lock
+        procedure :: held => is_held
+        final :: finalize_lock
+    end type folder_lock_type
 
     interface
         function c_mkdir(path, mode) result(status) bind(C, name='mkdir')
@@ -22,10 +39,75 @@ module yarnfort_output_filesystem
             character(kind=c_char), intent(in) :: old(*), new(*)
             integer(c_int) :: status
         end function c_rename
+
+        function c_lock_file(path, fd, holder, holder_length) result(status) &
+                bind(C, name='yarnfort_lock_file')
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), intent(out) :: fd
+            character(kind=c_char), intent(out) :: holder(*)
+            integer(c_int), value :: holder_length
+            integer(c_int) :: status
+        end function c_lock_file
+
+        function c_unlock_file(fd) result(status) bind(C, name='yarnfort_unlock_file')
+            import :: c_int
+            integer(c_int), value :: fd
+            integer(c_int) :: status
+        end function c_unlock_file
+
+        function c_sync_file(path) result(status) bind(C, name='yarnfort_sync_file')
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: status
+        end function c_sync_file
+
+        function c_remove_file(path) result(status) bind(C, name='yarnfort_remove_file')
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: status
+        end function c_remove_file
+
+        subroutine ignore_file_size_signal() bind(C, name='yarnfort_ignore_file_size_signal')
+        end subroutine ignore_file_size_signal
+
+        function c_truncate_file(path, bytes) result(status) &
+                bind(C, name='yarnfort_truncate_file')
+            import :: c_int, c_char, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long), value :: bytes
+            integer(c_int) :: status
+        end function c_truncate_file
+
+        function c_file_size_limit() result(bytes) bind(C, name='yarnfort_file_size_limit')
+            import :: c_long_long
+            integer(c_long_long) :: bytes
+        end function c_file_size_limit
+
+        function c_file_size(path) result(bytes) bind(C, name='yarnfort_file_size')
+            import :: c_char, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long) :: bytes
+        end function c_file_size
+
+        function c_free_space(path) result(bytes) bind(C, name='yarnfort_free_space')
+            import :: c_char, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long) :: bytes
+        end function c_free_space
+
+        subroutine c_last_error(text, length) bind(C, name='yarnfort_last_error')
+            import :: c_int, c_char
+            character(kind=c_char), intent(out) :: text(*)
+            integer(c_int), value :: length
+        end subroutine c_last_error
     end interface
 
     !> Permissions of new folders (rwxr-xr-x before the umask).
     integer(c_int), parameter :: folder_mode = int(o'755', c_int)
+
+    !> Longest text kept from a C call (the reason, the lock holder).
+    integer, parameter :: text_length = 512
 
 contains
 
@@ -36,6 +118,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer :: i, status, unit
         character(len=:), allocatable :: probe
+        character(len=text_length) :: message
 
         do i = 2, len_trim(path)
             if (path(i:i) == '/') status = c_mkdir(path(1:i - 1) // c_null_char, folder_mode)
@@ -43,10 +126,11 @@ contains
         status = c_mkdir(trim(path) // c_null_char, folder_mode)
         ! Whatever mkdir said, the folder is usable if a file can be created in it.
         probe = trim(path) // '/.yarnfort-write-test'
-        open(newunit=unit, file=probe, status='replace', action='write', iostat=status)
+        open(newunit=unit, file=probe, status='replace', action='write', iostat=status, &
+            iomsg=message)
         if (status /= 0) then
             call fatal_error(error, "&output: folder '" // trim(path) &
-                // "' cannot be created or written")
+                // "' cannot be created or written: " // trim(message))
             return
         end if
         close(unit, status='delete')
@@ -59,7 +143,172 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         if (c_rename(old // c_null_char, new // c_null_char) /= 0) &
-            call fatal_error(error, "cannot rename '" // old // "' to '" // new // "'")
+            call fatal_error(error, "cannot rename '" // old // "' to '" // new // "': " &
+                // get_reason())
     end subroutine rename_file
+
+    !> Remove the file `path`; a missing file is fine.
+    subroutine remove_file(path, error)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+
+        if (c_remove_file(path // c_null_char) /= 0) &
+            call fatal_error(error, "cannot remove '" // path // "': " // get_reason())
+    end subroutine remove_file
+
+    !> Flush the closed file `path` to its device (fsync), so that a rename after it
+    !> cannot leave an empty file after a power cut.
+    subroutine sync_file(path, error)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+
+        if (c_sync_file(path // c_null_char) /= 0) &
+            call fatal_error(error, "cannot write '" // path // "' to disk: " // get_reason())
+    end subroutine sync_file
+
+    !> Cut the (closed) file `path` back to `bytes` bytes, e.g. to drop a line that could
+    !> be written only in part.
+    subroutine truncate_file(path, bytes, error)
+        character(len=*), intent(in) :: path
+        integer(8), intent(in) :: bytes
+        type(error_type), allocatable, intent(out) :: error
+
+        if (c_truncate_file(path // c_null_char, int(bytes, c_long_long)) /= 0) &
+            call fatal_error(error, "cannot cut '" // path // "' back to its last whole " &
+                // 'line: ' // get_reason())
+    end subroutine truncate_file
+
+    !> Close `unit`, connected to the file `path`, and check that every byte written
+    !> reached the file. (gfortran's CLOSE and FLUSH report no error when the buffered
+    !> data cannot be written, e.g. on a full disk: the file's size tells.)
+    subroutine close_checked(unit, path, error)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        character(len=256) :: message
+        integer(8) :: expected
+        integer :: status
+
+        inquire(unit=unit, size=expected)
+        message = ''
+        close(unit, iostat=status, iomsg=message)
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+            return
+        end if
+        call check_size(path, expected, error)
+    end subroutine close_checked
+
+    !> Flush `unit`, connected to the file `path`, and check that every byte written so
+    !> far reached the file (see close_checked).
+    subroutine flush_checked(unit, path, error)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        character(len=256) :: message
+        integer(8) :: expected
+        integer :: status
+
+        message = ''
+        flush(unit, iostat=status, iomsg=message)
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+            return
+        end if
+        inquire(unit=unit, size=expected)
+        call check_size(path, expected, error)
+    end subroutine flush_checked
+
+    !> Fail unless the file `path` has `expected` bytes; the error says whether its
+    !> device is full.
+    subroutine check_size(path, expected, error)
+        character(len=*), intent(in) :: path
+        integer(8), intent(in) :: expected
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_long_long) :: actual, free, limit
+        character(len=64) :: counts, limit_text
+
+        if (expected < 0) return
+        actual = c_file_size(path // c_null_char)
+        if (actual == expected) return
+        write(counts, '(i0, " of its ", i0)') max(actual, 0_c_long_long), expected
+        free = c_free_space(path // c_null_char)
+        limit = c_file_size_limit()
+        if (limit >= 0 .and. expected > limit) then
+            write(limit_text, '(i0)') limit
+            call fatal_error(error, "cannot write '" // path // "': File too large (the " &
+                // 'file size limit, ulimit -f, is ' // trim(limit_text) // ' bytes; the ' &
+                // 'file got ' // trim(counts) // ' bytes)')
+        else if (free == 0) then
+            call fatal_error(error, "cannot write '" // path // "': No space left on " &
+                // 'device (the file got ' // trim(counts) // ' bytes)')
+        else
+            call fatal_error(error, "cannot write '" // path // "': the file got " &
+                // trim(counts) // ' bytes (the device failed or is full)')
+        end if
+    end subroutine check_size
+
+    !> Take the lock of `folder` (its file .yarnfort-lock). If another process holds it
+    !> the error says who (pid, host, since when); the lock then stays theirs.
+    subroutine acquire_lock(self, folder, error)
+        class(folder_lock_type), intent(inout) :: self
+        character(len=*), intent(in) :: folder
+        type(error_type), allocatable, intent(out) :: error
+        character(kind=c_char, len=text_length) :: holder
+        integer(c_int) :: status, fd
+        integer :: n
+
+        if (self%fd >= 0) return
+        holder = ''
+        status = c_lock_file(folder // '/' // lock_file_name // c_null_char, fd, holder, &
+            int(text_length, c_int))
+        select case (status)
+        case (0)
+            self%fd = fd
+        case (1)
+            n = index(holder, c_null_char) - 1
+            if (n < 0) n = len_trim(holder)
+            if (n == 0) holder = 'a process that has not written its name yet'
+            if (n == 0) n = len_trim(holder)
+            call fatal_error(error, "&output: folder '" // folder // "' is in use by another " &
+                // 'yarnfort run (' // holder(:n) // '); wait for it to end or choose ' &
+                // 'another &output folder')
+        case default
+            call fatal_error(error, "&output: cannot lock folder '" // folder // "' (file " &
+                // lock_file_name // '): ' // get_reason())
+        end select
+    end subroutine acquire_lock
+
+    subroutine release_lock(self)
+        class(folder_lock_type), intent(inout) :: self
+        integer(c_int) :: status
+
+        if (self%fd < 0) return
+        status = c_unlock_file(self%fd)
+        self%fd = -1
+    end subroutine release_lock
+
+    pure logical function is_held(self)
+        class(folder_lock_type), intent(in) :: self
+        is_held = self%fd >= 0
+    end function is_held
+
+    subroutine finalize_lock(self)
+        type(folder_lock_type), intent(inout) :: self
+        call self%release()
+    end subroutine finalize_lock
+
+    !> The C library's text for the reason of the last failed call.
+    function get_reason() result(reason)
+        character(len=:), allocatable :: reason
+        character(kind=c_char, len=text_length) :: text
+        integer :: n
+
+        text = ''
+        call c_last_error(text, int(text_length, c_int))
+        n = index(text, c_null_char) - 1
+        if (n < 0) n = len_trim(text)
+        reason = text(:n)
+    end function get_reason
 
 end module yarnfort_output_filesystem

@@ -16,13 +16,15 @@
 !> Integers are default integers (4 bytes), reals 8 bytes.
 module yarnfort_output_restart
     use, intrinsic :: iso_fortran_env, only: int8, int64
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, control_config_type, output_config_type
     use yarnfort_input_echo, only: write_config
     use yarnfort_scene_scene, only: scene_type
-    use yarnfort_solver_restart, only: restart_type
-    use yarnfort_output_filesystem, only: rename_file
+    use yarnfort_input_text, only: resolve_path
+    use yarnfort_solver_restart, only: restart_type, stepper_elastic, stepper_friction
+    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, close_checked
     implicit none
     private
 
@@ -41,6 +43,15 @@ module yarnfort_output_restart
     integer(int64), parameter :: hash_basis(2) = [2166136261_int64, 3735928559_int64]
     integer(int64), parameter :: two_32 = 4294967296_int64
 
+    !> Pseudo-times closer than this, relative to the path's length, are the same knot
+    !> (the continuation's rule).
+    real(wp), parameter :: knot_tolerance = 1.0e-12_wp
+    !> Load factors of a restart file and of the path at its time may differ by this,
+    !> relative to the path's largest factor (they are computed the same way).
+    real(wp), parameter :: factor_tolerance = 64 * epsilon(1.0_wp)
+    !> Bytes read at a time when an input file's content is hashed.
+    integer, parameter :: hash_chunk = 65536
+
 contains
 
     !> Write `snapshot` (stamped with `input_hash`) to folder/restart.dat atomically.
@@ -51,20 +62,24 @@ contains
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: path, temporary
         character(len=16) :: stamp, stepper
+        character(len=256) :: message
+        type(error_type), allocatable :: ignored
         integer :: unit, status
 
         path = folder // '/' // restart_file_name
         temporary = path // '.tmp'
+        message = ''
         open(newunit=unit, file=temporary, access='stream', form='unformatted', &
-            status='replace', action='write', iostat=status)
+            status='replace', action='write', iostat=status, iomsg=message)
         if (status /= 0) then
-            call fatal_error(error, "cannot write '" // temporary // "'")
+            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
             return
         end if
         stamp = input_hash
         stepper = snapshot%stepper
         associate(s => snapshot)
-            write(unit, iostat=status) magic, format_version, stamp, s%n_nodes, s%n_elements, &
+            write(unit, iostat=status, iomsg=message) magic, format_version, stamp, &
+                s%n_nodes, s%n_elements, &
                 s%n_unknowns, s%n_passages, s%step, s%knot, s%time, s%next_step, &
                 s%previous_load, stepper, s%p_force, s%p_disp, s%load_old, &
                 merge(1, 0, s%have_old)
@@ -75,41 +90,58 @@ contains
             if (status == 0) call put_reals(s%flow_old, s%n_passages)
             if (status == 0) then
                 if (allocated(s%mode)) then
-                    write(unit, iostat=status) s%mode
+                    write(unit, iostat=status, iomsg=message) s%mode
                 else
-                    write(unit, iostat=status) [integer :: ]
+                    write(unit, iostat=status, iomsg=message) [integer :: ]
                 end if
             end if
-            if (status == 0) write(unit, iostat=status) end_marker
+            if (status == 0) write(unit, iostat=status, iomsg=message) end_marker
         end associate
         if (status /= 0) then
             close(unit, status='delete')
-            call fatal_error(error, "cannot write '" // temporary // "'")
+            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message) &
+                // kept())
             return
         end if
-        close(unit, iostat=status)
-        if (status /= 0) then
-            call fatal_error(error, "cannot write '" // temporary // "'")
+        call close_checked(unit, temporary, error)
+        if (allocated(error)) then
+            call remove_file(temporary, ignored)
+            error%message = error%message // kept()
             return
         end if
-        call rename_file(temporary, path, error)
+        ! On disk before it replaces the previous file: a crash of the machine cannot
+        ! leave an empty restart file behind.
+        call sync_file(temporary, error)
+        if (.not. allocated(error)) call rename_file(temporary, path, error)
+        if (allocated(error)) call remove_file(temporary, ignored)
     contains
+        !> What the failure leaves: the previous restart file, if there is one.
+        function kept() result(text)
+            character(len=:), allocatable :: text
+            logical :: exists
+            inquire(file=path, exist=exists)
+            text = ''
+            if (exists) text = " (the previous '" // path // "' is kept)"
+        end function kept
+
         !> The array, or zeros when the snapshot has none (e.g. no previous state).
         subroutine put_reals(values, n)
             real(wp), allocatable, intent(in) :: values(:)
             integer, intent(in) :: n
             if (allocated(values)) then
                 if (size(values) == n) then
-                    write(unit, iostat=status) values
+                    write(unit, iostat=status, iomsg=message) values
                     return
                 end if
             end if
-            write(unit, iostat=status) spread(0.0_wp, 1, n)
+            write(unit, iostat=status, iomsg=message) spread(0.0_wp, 1, n)
         end subroutine put_reals
     end subroutine write_restart
 
     !> Read folder/restart.dat into `snapshot`. The error says whether the file is
-    !> missing, not a restart file, of another version, or cut short.
+    !> missing, not a restart file, of another version, cut short or too long, or holds
+    !> sizes that do not fit its length (checked before anything is allocated, so a
+    !> damaged size field cannot ask for memory).
     subroutine read_restart(folder, snapshot, error)
         character(len=*), intent(in) :: folder
         type(restart_type), intent(out) :: snapshot
@@ -117,7 +149,9 @@ contains
         character(len=:), allocatable :: path
         character(len=16) :: header, marker
         character(len=32) :: text
+        character(len=256) :: message
         integer :: unit, status, version, have_old
+        integer(int64) :: file_size, position, expected
         logical :: exists
 
         path = folder // '/' // restart_file_name
@@ -128,10 +162,12 @@ contains
                 // "to start from the beginning)")
             return
         end if
+        message = ''
         open(newunit=unit, file=path, access='stream', form='unformatted', status='old', &
-            action='read', iostat=status)
+            action='read', iostat=status, iomsg=message)
         if (status /= 0) then
-            call fatal_error(error, "&control restart: cannot read '" // path // "'")
+            call fatal_error(error, "&control restart: cannot read '" // path // "': " &
+                // trim(message))
             return
         end if
         read(unit, iostat=status) header
@@ -153,15 +189,43 @@ contains
             read(unit, iostat=status) s%input_hash, s%n_nodes, s%n_elements, s%n_unknowns, &
                 s%n_passages, s%step, s%knot, s%time, s%next_step, s%previous_load, &
                 s%stepper, s%p_force, s%p_disp, s%load_old, have_old
-            if (status == 0 .and. min(s%n_nodes, s%n_elements, s%n_unknowns, &
-                    s%n_passages) < 0) status = -1
-            if (status == 0) then
-                s%have_old = have_old /= 0
-                allocate(s%u(s%n_unknowns), s%u_old(s%n_unknowns), s%length0(s%n_elements))
-                allocate(s%flow(s%n_passages), s%flow_old(s%n_passages), s%mode(s%n_passages))
-                read(unit, iostat=status) s%u, s%u_old, s%length0, s%flow, s%flow_old, s%mode, &
-                    marker
+            if (status /= 0) then
+                close(unit)
+                call fatal_error(error, "&control restart: '" // path &
+                    // "' is cut short or unreadable")
+                return
             end if
+            if (min(s%n_nodes, s%n_elements, s%n_unknowns, s%n_passages) < 0 .or. &
+                    (have_old /= 0 .and. have_old /= 1)) then
+                close(unit)
+                call fatal_error(error, "&control restart: '" // path // "' is damaged: " &
+                    // 'a size or flag field holds an impossible value')
+                return
+            end if
+            ! What follows must be exactly the arrays of these sizes and the end marker.
+            inquire(unit=unit, size=file_size, pos=position)
+            expected = 8_int64 * (2_int64 * s%n_unknowns + s%n_elements &
+                + 2_int64 * s%n_passages) + 4_int64 * s%n_passages + len(end_marker)
+            if (file_size - (position - 1) /= expected) then
+                close(unit)
+                write(text, '(i0)') file_size
+                call fatal_error(error, "&control restart: '" // path // "' is cut short " &
+                    // 'or unreadable: its ' // trim(text) // ' bytes do not fit the sizes ' &
+                    // 'it records')
+                return
+            end if
+            s%have_old = have_old /= 0
+            allocate(s%u(s%n_unknowns), s%u_old(s%n_unknowns), s%length0(s%n_elements), &
+                s%flow(s%n_passages), s%flow_old(s%n_passages), s%mode(s%n_passages), &
+                stat=status, errmsg=message)
+            if (status /= 0) then
+                close(unit)
+                call fatal_error(error, "&control restart: not enough memory to read '" &
+                    // path // "': " // trim(message))
+                return
+            end if
+            read(unit, iostat=status) s%u, s%u_old, s%length0, s%flow, s%flow_old, s%mode, &
+                marker
             if (status == 0 .and. marker /= end_marker) status = -1
         end associate
         close(unit)
@@ -172,15 +236,21 @@ contains
         end if
     end subroutine read_restart
 
-    !> Fail unless `snapshot` was written for this scene: the same sizes and the same
-    !> input fingerprint (`input_hash`, from get_input_hash).
+    !> Fail unless `snapshot` was written for this scene and its path: the same sizes,
+    !> the same input fingerprint (`input_hash`, from get_input_hash), the stepper of the
+    !> scene, and fields that a run of this scene can have written: a step >= 0, a time
+    !> on the path with the knot it heads for, a next step size in (0, max_step], the
+    !> load factors of the path at that time, finite unknowns and flows, positive
+    !> reference lengths and known passage modes.
     subroutine check_restart(snapshot, scene, input_hash, folder, error)
         type(restart_type), intent(in) :: snapshot
         type(scene_type), intent(in) :: scene
         character(len=*), intent(in) :: input_hash, folder
         type(error_type), allocatable, intent(out) :: error
         character(len=200) :: file_sizes, scene_sizes
-        character(len=:), allocatable :: path
+        character(len=:), allocatable :: path, expected_stepper
+        real(wp) :: t_start, t_end, span, p_force, p_disp, scale
+        integer :: n_knots
 
         path = folder // '/' // restart_file_name
         write(file_sizes, '(i0, " nodes, ", i0, " elements, ", i0, " unknowns, ", i0, &
@@ -202,22 +272,134 @@ contains
                 // 'between a run and its restart')
             return
         end if
+        expected_stepper = stepper_elastic
+        if (scene%passages%size() > 0) expected_stepper = stepper_friction
+        if (trim(snapshot%stepper) /= expected_stepper) then
+            call damaged("its stepper '" // trim(snapshot%stepper) // "' is not '" &
+                // expected_stepper // "', that of this scene")
+            return
+        end if
+        if (snapshot%step < 0) then
+            call damaged('step ' // format_integer_text(snapshot%step) // ' is negative')
+            return
+        end if
+        associate(knots => scene%path%time)
+            n_knots = size(knots)
+            t_start = knots(1)
+            t_end = knots(n_knots)
+            span = t_end - t_start
+            if (.not. (snapshot%time >= t_start .and. snapshot%time <= t_end)) then
+                call damaged('time ' // format_real_text(snapshot%time) // ' is not on ' &
+                    // 'the load path (' // format_real_text(t_start) // ' to ' &
+                    // format_real_text(t_end) // ')')
+                return
+            end if
+            if (snapshot%knot < 2 .or. snapshot%knot > n_knots) then
+                call damaged('knot ' // format_integer_text(snapshot%knot) // ' is not 2..' &
+                    // format_integer_text(n_knots))
+                return
+            end if
+            if (knots(snapshot%knot - 1) > snapshot%time + knot_tolerance * span .or. &
+                    knots(snapshot%knot) < snapshot%time - knot_tolerance * span) then
+                call damaged('time ' // format_real_text(snapshot%time) // ' is not ' &
+                    // 'before knot ' // format_integer_text(snapshot%knot) &
+                    // ', the knot it heads for')
+                return
+            end if
+        end associate
+        if (.not. (snapshot%next_step > 0.0_wp .and. &
+                snapshot%next_step <= scene%solver%max_step)) then
+            call damaged('next step ' // format_real_text(snapshot%next_step) &
+                // ' is not in (0, max_step = ' // format_real_text(scene%solver%max_step) &
+                // ']')
+            return
+        end if
+        ! The run computed these factors from the same time by the same code: they agree
+        ! to round-off of the path's own factors.
+        call scene%path%get_factors(snapshot%time, p_force, p_disp)
+        scale = max(maxval(abs(scene%path%p_force)), maxval(abs(scene%path%p_disp)), &
+            tiny(1.0_wp))
+        if (.not. (abs(snapshot%p_force - p_force) <= factor_tolerance * scale .and. &
+                abs(snapshot%p_disp - p_disp) <= factor_tolerance * scale)) then
+            call damaged('its load factors p_force = ' // format_real_text(snapshot%p_force) &
+                // ', p_disp = ' // format_real_text(snapshot%p_disp) // ' are not those ' &
+                // 'of the path at its time (' // format_real_text(p_force) // ', ' &
+                // format_real_text(p_disp) // ')')
+            return
+        end if
+        if (.not. abs(snapshot%previous_load - (p_force + p_disp)) <= factor_tolerance &
+                * 2 * scale) then
+            call damaged('its previous load ' // format_real_text(snapshot%previous_load) &
+                // ' is not p_force + p_disp')
+            return
+        end if
+        if (.not. (all(ieee_is_finite(snapshot%u)) .and. all(ieee_is_finite(snapshot%flow)))) &
+                then
+            call damaged('it holds a position or flow that is not a finite number')
+            return
+        end if
+        if (.not. all(snapshot%length0 > 0.0_wp .and. ieee_is_finite(snapshot%length0))) then
+            call damaged('it holds a reference length that is not a positive number')
+            return
+        end if
+        if (.not. all(abs(snapshot%mode) <= 1)) then
+            call damaged('it holds an unknown passage mode')
+            return
+        end if
+        if (snapshot%have_old) then
+            if (.not. (ieee_is_finite(snapshot%load_old) .and. &
+                    all(ieee_is_finite(snapshot%u_old)) .and. &
+                    all(ieee_is_finite(snapshot%flow_old)))) then
+                call damaged('its previous state holds a value that is not a finite number')
+                return
+            end if
+        end if
+    contains
+        subroutine damaged(reason)
+            character(len=*), intent(in) :: reason
+            call fatal_error(error, "&control restart: '" // path // "' is damaged or not " &
+                // 'of this scene: ' // reason)
+        end subroutine damaged
     end subroutine check_restart
 
-    !> Delete folder/restart.dat if there is one (a new run starts from the beginning).
+    pure function format_integer_text(value) result(text)
+        integer, intent(in) :: value
+        character(len=:), allocatable :: text
+        character(len=16) :: buffer
+        write(buffer, '(i0)') value
+        text = trim(buffer)
+    end function format_integer_text
+
+    pure function format_real_text(value) result(text)
+        real(wp), intent(in) :: value
+        character(len=:), allocatable :: text
+        character(len=32) :: buffer
+        write(buffer, '(es13.6e2)') value
+        text = trim(adjustl(buffer))
+    end function format_real_text
+
+    !> Delete folder/restart.dat if there is one and it is a yarnfort restart file (a
+    !> new run starts from the beginning); any other file of that name is left alone.
     subroutine remove_restart(folder)
         character(len=*), intent(in) :: folder
+        character(len=16) :: header
         integer :: unit, status
 
         open(newunit=unit, file=folder // '/' // restart_file_name, status='old', &
-            iostat=status)
-        if (status == 0) close(unit, status='delete')
+            access='stream', form='unformatted', action='read', iostat=status)
+        if (status /= 0) return
+        read(unit, iostat=status) header
+        if (status == 0 .and. header == magic) then
+            close(unit, status='delete')
+        else
+            close(unit)
+        end if
     end subroutine remove_restart
 
     !> Fingerprint (16 hex digits) of what determines a run's path: the effective input
-    !> without &control and &output (as written by write_config), and the built scene's
-    !> node positions, elements, reference lengths, external forces and load path (which
-    !> also covers the contents of a geometry file).
+    !> without &control and &output (as written by write_config), the content of every
+    !> file it names (material tables, the geometry file), and the built scene's node
+    !> positions, elements, reference lengths, external forces and load path.
     function get_input_hash(config, scene) result(hash)
         type(config_type), intent(in) :: config
         type(scene_type), intent(in) :: scene
@@ -225,7 +407,7 @@ contains
         type(config_type) :: copy
         integer(int64) :: state(2)
         character(len=1024) :: chunk
-        integer :: unit, status, n
+        integer :: unit, status, n, m
 
         state = hash_basis
         copy = config
@@ -246,6 +428,14 @@ contains
             end do
             close(unit)
         end if
+        if (allocated(config%materials)) then
+            do m = 1, size(config%materials)
+                if (len_trim(config%materials(m)%table_file) > 0) call add_file( &
+                    resolve_path(config%materials(m)%table_file, config%input_folder))
+            end do
+        end if
+        if (len_trim(config%geometry%file) > 0) &
+            call add_file(resolve_path(config%geometry%file, config%input_folder))
         call add_bytes(transfer(scene%network%position, [0_int8]))
         call add_bytes(transfer(scene%network%element_nodes, [0_int8]))
         call add_bytes(transfer(scene%network%length0, [0_int8]))
@@ -263,6 +453,36 @@ contains
                     * hash_prime, two_32)
             end do
         end subroutine add_bytes
+
+        !> The bytes of a file, then its length; an unreadable file adds a marker (its
+        !> fingerprint then differs from that of any readable content).
+        subroutine add_file(path)
+            character(len=*), intent(in) :: path
+            integer(int8) :: bytes(hash_chunk)
+            integer(int64) :: file_size, done
+            integer :: file, stat, n
+
+            open(newunit=file, file=path, access='stream', form='unformatted', &
+                status='old', action='read', iostat=stat)
+            if (stat /= 0) then
+                call add_bytes(transfer('unreadable file', [0_int8]))
+                return
+            end if
+            inquire(unit=file, size=file_size)
+            done = 0
+            do while (done < file_size)
+                n = int(min(int(hash_chunk, int64), file_size - done))
+                read(file, iostat=stat) bytes(:n)
+                if (stat /= 0) then
+                    call add_bytes(transfer('unreadable file', [0_int8]))
+                    exit
+                end if
+                call add_bytes(bytes(:n))
+                done = done + n
+            end do
+            close(file)
+            call add_bytes(transfer(file_size, [0_int8]))
+        end subroutine add_file
     end function get_input_hash
 
 end module yarnfort_output_restart

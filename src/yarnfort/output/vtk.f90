@@ -1,184 +1,428 @@
 ! SPDX-License-Identifier: MIT
-!> Network states as VTK XML unstructured grids (.vtu, one per step) for ParaView, and a
-!> states.pvd collection listing them with their pseudo-time.
+!> Network states as VTK XML unstructured grids (.vtu, one per written step) for
+!> ParaView, and the states.pvd collection listing them with their pseudo-time.
+!>
+!> Each state holds the nodes (points: current positions) and, as cells, the yarn
+!> elements followed by the links (gap-holders and periodic images, so that a fabric
+!> shows connected). Arrays:
+!> - field data: time, step, p_force, p_disp; for a fabric also strain and
+!>   force_per_width (as in curve.csv);
+!> - point data: displacement (from the initial position), position, and for scenes
+!>   with sliding passages contact_state (0 no passage, 1 all stick, 2 a passage slips);
+!> - cell data: kind (0 yarn element, 1 gap-holder, 2 periodic link), yarn and material
+!>   (1-based, in input order; 0 for links), tension (N; 0 for links), stretch
+!>   (current over reference length) and L0 (reference length).
+!> The data are appended base64-encoded binary (VTK XML 1.0, UInt64 headers) by
+!> default, or inline ASCII (&output vtk_format).
 module yarnfort_output_vtk
+    use, intrinsic :: iso_fortran_env, only: int8, int32, int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
+    use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked
     implicit none
     private
 
-    public :: vtk_writer_type
+    public :: vtk_writer_type, get_state_name, collection_file_name
+
+    character(len=*), parameter :: collection_file_name = 'states.pvd'
 
     type :: vtk_writer_type
         character(len=:), allocatable :: folder
+        !> Inline ASCII data instead of appended base64 binary.
+        logical :: ascii = .false.
         !> Files written so far and their times, for the collection file.
-        character(len=32), allocatable :: files(:)
+        character(len=64), allocatable :: files(:)
         real(wp), allocatable :: times(:)
+        !> Entries of states.pvd when it was last rewritten.
+        integer :: listed = -1
     contains
         procedure :: write_state
-        !> Delete the states a previous run listed in folder/states.pvd.
-        procedure :: remove_previous
-        !> Keep the states of folder/states.pvd up to a step, delete the later ones.
-        procedure :: resume => resume_states
+        !> Rewrite states.pvd (atomically) with every state written so far.
+        procedure :: write_collection
     end type vtk_writer_type
 
-    integer, parameter :: vtk_line = 3
+    integer(int8), parameter :: vtk_line = 3_int8
+    integer, parameter :: kind_element = 0, kind_gap = 1, kind_periodic = 2
+    integer, parameter :: contact_none = 0, contact_stick = 1, contact_slip = 2
+
+    !> states.pvd is rewritten after a state when it then misses more than this fraction
+    !> of the states (and always while it lists fewer than `collection_always`): the cost
+    !> of the rewrites stays linear in the number of states.
+    real(wp), parameter :: collection_lag = 0.05_wp
+    integer, parameter :: collection_always = 100
+
+    character(len=64), parameter :: base64_alphabet = &
+        'ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/'
+
+    !> The XML text and appended data of one file being built.
+    type :: vtu_builder_type
+        logical :: ascii = .false.
+        character(len=:), allocatable :: xml, appended
+    end type vtu_builder_type
 
 contains
 
-    !> Write state_<step>.vtu with node positions and, per element, tension (N),
-    !> stretch and reference length L0; then rewrite states.pvd.
-    subroutine write_state(self, scene, state, error)
+    !> The file name of the state of `step`: state_NNNNN.vtu, with as many digits as the
+    !> step needs (at least 5), so that no number can overflow the field.
+    pure function get_state_name(step) result(name)
+        integer, intent(in) :: step
+        character(len=:), allocatable :: name
+        character(len=32) :: buffer
+        write(buffer, '("state_", i0.5, ".vtu")') step
+        name = trim(buffer)
+    end function get_state_name
+
+    !> Write the state file of `state` (`mode`: stick/slip mode of each passage, may be
+    !> empty), then states.pvd when due (collection_lag). A failed write removes the
+    !> incomplete state file and says why.
+    subroutine write_state(self, scene, state, mode, error)
         class(vtk_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(step_state_type), intent(in) :: state
+        integer, intent(in) :: mode(:)
         type(error_type), allocatable, intent(out) :: error
-        character(len=32) :: name
-        integer :: unit, status, n_nodes, n_elements, e
+        type(vtu_builder_type) :: vtu
+        character(len=:), allocatable :: name, path
+        integer :: n_nodes, n_elements, n_links, n_cells, e, l, p, node, y
+        integer(int64), allocatable :: connectivity(:), offsets(:)
+        integer(int32), allocatable :: cell_kind(:), yarn(:), material(:), contact(:)
+        real(wp), allocatable :: tension(:), stretch(:), length0(:)
+        real(wp) :: now(3), before(3)
 
-        write(name, '("state_", i5.5, ".vtu")') state%step
-        open(newunit=unit, file=self%folder // '/' // trim(name), status='replace', &
-            action='write', iostat=status)
-        if (status /= 0) then
-            call fatal_error(error, "cannot write '" // self%folder // '/' // trim(name) // "'")
-            return
-        end if
+        name = get_state_name(state%step)
+        path = self%folder // '/' // name
         n_nodes = size(state%position, 2)
         n_elements = size(state%tension)
-        write(unit, '(a)') '<?xml version="1.0"?>'
-        write(unit, '(a)') '<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian">'
-        write(unit, '(a)') '<UnstructuredGrid>'
-        write(unit, '(a, i0, a, i0, a)') '<Piece NumberOfPoints="', n_nodes, &
-            '" NumberOfCells="', n_elements, '">'
-        write(unit, '(a)') '<Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">'
-        write(unit, '(3(1x, es24.16e3))') state%position
-        write(unit, '(a)') '</DataArray></Points>'
-        write(unit, '(a)') '<Cells><DataArray type="Int64" Name="connectivity" format="ascii">'
-        write(unit, '(2(i0, 1x))') (scene%network%element_nodes(:, e) - 1, e = 1, n_elements)
-        write(unit, '(a)') '</DataArray><DataArray type="Int64" Name="offsets" format="ascii">'
-        write(unit, '(10(i0, 1x))') (2 * e, e = 1, n_elements)
-        write(unit, '(a)') '</DataArray><DataArray type="UInt8" Name="types" format="ascii">'
-        write(unit, '(20(i0, 1x))') (vtk_line, e = 1, n_elements)
-        write(unit, '(a)') '</DataArray></Cells>'
-        write(unit, '(a)') '<CellData Scalars="tension">'
-        call write_cell_array('tension', state%tension)
-        call write_cell_array('stretch', state%stretch)
-        call write_cell_array('L0', state%length0)
-        write(unit, '(a)') '</CellData>'
-        write(unit, '(a)') '</Piece></UnstructuredGrid></VTKFile>'
-        close(unit)
+        n_links = 0
+        if (allocated(scene%link_nodes)) n_links = size(scene%link_nodes, 2)
+        n_cells = n_elements + n_links
+
+        allocate(connectivity(2 * n_cells), offsets(n_cells))
+        allocate(cell_kind(n_cells), yarn(n_cells), material(n_cells))
+        allocate(tension(n_cells), stretch(n_cells), length0(n_cells))
+        do e = 1, n_elements
+            connectivity(2 * e - 1:2 * e) = scene%network%element_nodes(:, e) - 1
+        end do
+        cell_kind(:n_elements) = kind_element
+        do y = 1, scene%network%n_yarns()
+            yarn(scene%network%yarn_first_element(y):scene%network%yarn_first_element(y + 1) &
+                - 1) = y
+        end do
+        material(:n_elements) = scene%network%element_material
+        tension(:n_elements) = state%tension
+        stretch(:n_elements) = state%stretch
+        length0(:n_elements) = state%length0
+        do l = 1, n_links
+            associate(pair => scene%link_nodes(:, l))
+                e = n_elements + l
+                connectivity(2 * e - 1:2 * e) = pair - 1
+                cell_kind(e) = merge(kind_gap, kind_periodic, scene%link_is_gap(l))
+                yarn(e) = 0
+                material(e) = 0
+                tension(e) = 0.0_wp
+                now = state%position(:, pair(2)) - state%position(:, pair(1))
+                before = scene%network%position(:, pair(2)) - scene%network%position(:, pair(1))
+                length0(e) = norm2(before)
+                stretch(e) = 1.0_wp
+                if (length0(e) > 0.0_wp) stretch(e) = norm2(now) / length0(e)
+            end associate
+        end do
+        offsets = [(2_int64 * e, e = 1, n_cells)]
+
+        vtu%ascii = self%ascii
+        vtu%xml = '<?xml version="1.0"?>' // new_line('a') &
+            // '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="' &
+            // get_byte_order() // '" header_type="UInt64">' // new_line('a') &
+            // '<UnstructuredGrid>' // new_line('a') // '<FieldData>' // new_line('a')
+        vtu%appended = ''
+        call add_reals(vtu, 'time', [state%time], 1, field=.true.)
+        call add_int32(vtu, 'step', [int(state%step, int32)], field=.true.)
+        call add_reals(vtu, 'p_force', [state%p_force], 1, field=.true.)
+        call add_reals(vtu, 'p_disp', [state%p_disp], 1, field=.true.)
+        if (scene%fabric_set > 0) then
+            call add_reals(vtu, 'strain', [state%p_disp * scene%fabric_strain], 1, field=.true.)
+            call add_reals(vtu, 'force_per_width', &
+                [state%reaction(1, scene%fabric_set) / scene%fabric_width], 1, field=.true.)
+        end if
+        call add_text(vtu, '</FieldData>')
+        call add_text(vtu, '<Piece NumberOfPoints="' // format_integer(n_nodes) &
+            // '" NumberOfCells="' // format_integer(n_cells) // '">')
+        call add_text(vtu, '<PointData Vectors="displacement">')
+        call add_reals(vtu, 'displacement', &
+            reshape(state%position - scene%network%position, [3 * n_nodes]), 3)
+        call add_reals(vtu, 'position', reshape(state%position, [3 * n_nodes]), 3)
+        if (scene%passages%size() > 0) then
+            allocate(contact(n_nodes), source=int(contact_none, int32))
+            do p = 1, scene%passages%size()
+                node = scene%passages%node(p)
+                if (contact(node) == contact_none) contact(node) = contact_stick
+                if (p <= size(mode)) then
+                    if (mode(p) /= 0) contact(node) = contact_slip
+                end if
+            end do
+            call add_int32(vtu, 'contact_state', contact)
+        end if
+        call add_text(vtu, '</PointData>')
+        call add_text(vtu, '<CellData Scalars="tension">')
+        call add_reals(vtu, 'tension', tension, 1)
+        call add_reals(vtu, 'stretch', stretch, 1)
+        call add_reals(vtu, 'L0', length0, 1)
+        call add_int32(vtu, 'kind', cell_kind)
+        call add_int32(vtu, 'yarn', yarn)
+        call add_int32(vtu, 'material', material)
+        call add_text(vtu, '</CellData>')
+        call add_text(vtu, '<Points>')
+        call add_reals(vtu, 'Points', reshape(state%position, [3 * n_nodes]), 3)
+        call add_text(vtu, '</Points>')
+        call add_text(vtu, '<Cells>')
+        call add_int64(vtu, 'connectivity', connectivity)
+        call add_int64(vtu, 'offsets', offsets)
+        call add_uint8(vtu, 'types', spread(vtk_line, 1, n_cells))
+        call add_text(vtu, '</Cells>')
+        call add_text(vtu, '</Piece>')
+        call add_text(vtu, '</UnstructuredGrid>')
+        if (.not. vtu%ascii) then
+            call add_text(vtu, '<AppendedData encoding="base64">')
+            vtu%xml = vtu%xml // '_' // vtu%appended // new_line('a')
+            call add_text(vtu, '</AppendedData>')
+        end if
+        call add_text(vtu, '</VTKFile>')
+        call write_text_file(path, vtu%xml, error)
+        if (allocated(error)) return
 
         if (.not. allocated(self%files)) allocate(self%files(0), self%times(0))
-        self%files = [self%files, name]
+        self%files = [self%files, [character(len=64) :: name]]
         self%times = [self%times, state%time]
-        call write_collection(self, error)
-    contains
-        subroutine write_cell_array(label, values)
-            character(len=*), intent(in) :: label
-            real(wp), intent(in) :: values(:)
-            write(unit, '(a)') '<DataArray type="Float64" Name="' // label // '" format="ascii">'
-            write(unit, '(4(1x, es24.16e3))') values
-            write(unit, '(a)') '</DataArray>'
-        end subroutine write_cell_array
+        if (size(self%files) <= collection_always .or. &
+                real(size(self%files) - self%listed, wp) > collection_lag * size(self%files)) &
+            call self%write_collection(error)
     end subroutine write_state
 
-    subroutine remove_previous(self)
-        class(vtk_writer_type), intent(in) :: self
-        character(len=1024) :: line
-        character(len=:), allocatable :: name
-        integer :: unit, status, old
-
-        open(newunit=unit, file=self%folder // '/states.pvd', status='old', action='read', &
-            iostat=status)
-        if (status /= 0) return
-        do
-            read(unit, '(a)', iostat=status) line
-            if (status /= 0) exit
-            name = get_attribute(line, 'file')
-            ! Only plain file names written by this writer (no paths).
-            if (len(name) == 0 .or. index(name, '/') > 0) cycle
-            open(newunit=old, file=self%folder // '/' // name, status='old', iostat=status)
-            if (status == 0) close(old, status='delete')
-        end do
-        close(unit, status='delete')
-    end subroutine remove_previous
-
-    !> Continue the states of folder/states.pvd after `step` (a restart): keep the
-    !> listed states of steps up to `step`, delete the files of later ones, and rewrite
-    !> the collection with the kept ones. No states.pvd: no states to keep.
-    subroutine resume_states(self, step, error)
-        class(vtk_writer_type), intent(inout) :: self
-        integer, intent(in) :: step
-        type(error_type), allocatable, intent(out) :: error
-        character(len=1024) :: line
-        character(len=:), allocatable :: name, value
-        integer :: unit, status, old, state_step
-        real(wp) :: time
-
-        allocate(self%files(0), self%times(0))
-        open(newunit=unit, file=self%folder // '/states.pvd', status='old', action='read', &
-            iostat=status)
-        if (status /= 0) return
-        do
-            read(unit, '(a)', iostat=status) line
-            if (status /= 0) exit
-            name = get_attribute(line, 'file')
-            ! Only the plain state_NNNNN.vtu names written by this writer.
-            if (len(name) /= len('state_00000.vtu') .or. name(1:6) /= 'state_' .or. &
-                    name(12:) /= '.vtu') cycle
-            read(name(7:11), '(i5)', iostat=status) state_step
-            if (status /= 0) cycle
-            if (state_step <= step) then
-                value = get_attribute(line, 'timestep')
-                read(value, *, iostat=status) time
-                if (status /= 0) cycle
-                self%files = [self%files, [character(len=32) :: name]]
-                self%times = [self%times, time]
-            else
-                open(newunit=old, file=self%folder // '/' // name, status='old', iostat=status)
-                if (status == 0) close(old, status='delete')
-            end if
-        end do
-        close(unit)
-        call write_collection(self, error)
-    end subroutine resume_states
-
-    !> The value of attribute `key="..."` in a line of states.pvd ('' if absent or empty).
-    pure function get_attribute(line, key) result(value)
-        character(len=*), intent(in) :: line, key
-        character(len=:), allocatable :: value
-        integer :: first, last
-
-        value = ''
-        first = index(line, key // '="')
-        if (first == 0) return
-        first = first + len(key) + 2
-        last = index(line(first:), '"') + first - 2
-        if (last >= first) value = line(first:last)
-    end function get_attribute
-
+    !> Write states.pvd.tmp and rename it over states.pvd.
     subroutine write_collection(self, error)
-        type(vtk_writer_type), intent(in) :: self
+        class(vtk_writer_type), intent(inout) :: self
         type(error_type), allocatable, intent(out) :: error
-        integer :: unit, status, i
+        character(len=:), allocatable :: text
+        character(len=32) :: time
+        integer :: i
 
-        open(newunit=unit, file=self%folder // '/states.pvd', status='replace', &
-            action='write', iostat=status)
-        if (status /= 0) then
-            call fatal_error(error, "cannot write '" // self%folder // "/states.pvd'")
+        if (.not. allocated(self%files)) allocate(self%files(0), self%times(0))
+        text = '<?xml version="1.0"?>' // new_line('a') &
+            // '<VTKFile type="Collection" version="0.1">' // new_line('a') &
+            // '<Collection>' // new_line('a')
+        do i = 1, size(self%files)
+            write(time, '(es24.16e3)') self%times(i)
+            text = text // '<DataSet timestep="' // trim(adjustl(time)) // '" file="' &
+                // trim(self%files(i)) // '"/>' // new_line('a')
+        end do
+        text = text // '</Collection></VTKFile>' // new_line('a')
+        call write_text_file(self%folder // '/' // collection_file_name, text, error, &
+            atomic=.true.)
+        if (allocated(error)) return
+        self%listed = size(self%files)
+    end subroutine write_collection
+
+    !> Write `text` to `path` (a stream, so lines of any length), checking every write
+    !> and the close; with `atomic`, through path.tmp renamed over path. On failure the
+    !> incomplete file is removed.
+    subroutine write_text_file(path, text, error, atomic)
+        character(len=*), intent(in) :: path, text
+        type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: atomic
+        type(error_type), allocatable :: ignored
+        character(len=:), allocatable :: target
+        character(len=256) :: message
+        integer :: unit, status
+        logical :: through_temporary
+
+        through_temporary = .false.
+        if (present(atomic)) through_temporary = atomic
+        target = path
+        if (through_temporary) target = path // '.tmp'
+        message = ''
+        open(newunit=unit, file=target, access='stream', form='unformatted', &
+            status='replace', action='write', iostat=status, iomsg=message)
+        if (status == 0) then
+            write(unit, iostat=status, iomsg=message) text
+            if (status == 0) then
+                call close_checked(unit, target, error)
+            else
+                close(unit)
+            end if
+        end if
+        if (status /= 0) call fatal_error(error, "cannot write '" // target // "': " &
+            // trim(message))
+        if (allocated(error)) then
+            call remove_file(target, ignored)
             return
         end if
-        write(unit, '(a)') '<?xml version="1.0"?>'
-        write(unit, '(a)') '<VTKFile type="Collection" version="0.1">'
-        write(unit, '(a)') '<Collection>'
-        do i = 1, size(self%files)
-            write(unit, '(a, es24.16e3, a)') '<DataSet timestep="', self%times(i), &
-                '" file="' // trim(self%files(i)) // '"/>'
+        if (through_temporary) then
+            call rename_file(target, path, error)
+            if (allocated(error)) call remove_file(target, ignored)
+        end if
+    end subroutine write_text_file
+
+    subroutine add_text(vtu, text)
+        type(vtu_builder_type), intent(inout) :: vtu
+        character(len=*), intent(in) :: text
+        vtu%xml = vtu%xml // text // new_line('a')
+    end subroutine add_text
+
+    !> The DataArray element of an array: inline ASCII values, or an offset into the
+    !> appended data (where the byte count and the bytes go, each base64-encoded).
+    subroutine add_array(vtu, type_name, label, components, n_tuples, field, bytes, ascii)
+        type(vtu_builder_type), intent(inout) :: vtu
+        character(len=*), intent(in) :: type_name, label
+        integer, intent(in) :: components, n_tuples
+        logical, intent(in) :: field
+        integer(int8), intent(in) :: bytes(:)
+        character(len=*), intent(in) :: ascii
+        character(len=:), allocatable :: attributes
+
+        attributes = '<DataArray type="' // type_name // '" Name="' // label // '"'
+        if (components > 1) attributes = attributes // ' NumberOfComponents="' &
+            // format_integer(components) // '"'
+        if (field) attributes = attributes // ' NumberOfTuples="' &
+            // format_integer(n_tuples) // '"'
+        if (vtu%ascii) then
+            call add_text(vtu, attributes // ' format="ascii">' // ascii // '</DataArray>')
+        else
+            call add_text(vtu, attributes // ' format="appended" offset="' &
+                // format_integer(len(vtu%appended)) // '"/>')
+            vtu%appended = vtu%appended &
+                // encode_base64(transfer(int(size(bytes), int64), [0_int8])) &
+                // encode_base64(bytes)
+        end if
+    end subroutine add_array
+
+    subroutine add_reals(vtu, label, values, components, field)
+        type(vtu_builder_type), intent(inout) :: vtu
+        character(len=*), intent(in) :: label
+        real(wp), intent(in) :: values(:)
+        integer, intent(in) :: components
+        logical, intent(in), optional :: field
+        character(len=:), allocatable :: text
+        integer :: status
+
+        if (vtu%ascii) then
+            allocate(character(len=25 * size(values) + 1) :: text)
+            write(text, '(*(1x, es24.16e3))', iostat=status) values
+            call add_array(vtu, 'Float64', label, components, size(values) / components, &
+                is_field(field), [integer(int8) :: ], trim(text))
+        else
+            call add_array(vtu, 'Float64', label, components, size(values) / components, &
+                is_field(field), transfer(values, [0_int8], 8 * size(values)), '')
+        end if
+    end subroutine add_reals
+
+    subroutine add_int32(vtu, label, values, field)
+        type(vtu_builder_type), intent(inout) :: vtu
+        character(len=*), intent(in) :: label
+        integer(int32), intent(in) :: values(:)
+        logical, intent(in), optional :: field
+        character(len=:), allocatable :: text
+        integer :: status
+
+        if (vtu%ascii) then
+            allocate(character(len=12 * size(values) + 1) :: text)
+            write(text, '(*(1x, i0))', iostat=status) values
+            call add_array(vtu, 'Int32', label, 1, size(values), is_field(field), &
+                [integer(int8) :: ], trim(text))
+        else
+            call add_array(vtu, 'Int32', label, 1, size(values), is_field(field), &
+                transfer(values, [0_int8], 4 * size(values)), '')
+        end if
+    end subroutine add_int32
+
+    subroutine add_int64(vtu, label, values)
+        type(vtu_builder_type), intent(inout) :: vtu
+        character(len=*), intent(in) :: label
+        integer(int64), intent(in) :: values(:)
+        character(len=:), allocatable :: text
+        integer :: status
+
+        if (vtu%ascii) then
+            allocate(character(len=21 * size(values) + 1) :: text)
+            write(text, '(*(1x, i0))', iostat=status) values
+            call add_array(vtu, 'Int64', label, 1, size(values), .false., &
+                [integer(int8) :: ], trim(text))
+        else
+            call add_array(vtu, 'Int64', label, 1, size(values), .false., &
+                transfer(values, [0_int8], 8 * size(values)), '')
+        end if
+    end subroutine add_int64
+
+    subroutine add_uint8(vtu, label, values)
+        type(vtu_builder_type), intent(inout) :: vtu
+        character(len=*), intent(in) :: label
+        integer(int8), intent(in) :: values(:)
+        character(len=:), allocatable :: text
+        integer :: status
+
+        if (vtu%ascii) then
+            allocate(character(len=5 * size(values) + 1) :: text)
+            write(text, '(*(1x, i0))', iostat=status) values
+            call add_array(vtu, 'UInt8', label, 1, size(values), .false., &
+                [integer(int8) :: ], trim(text))
+        else
+            call add_array(vtu, 'UInt8', label, 1, size(values), .false., values, '')
+        end if
+    end subroutine add_uint8
+
+    pure logical function is_field(field)
+        logical, intent(in), optional :: field
+        is_field = .false.
+        if (present(field)) is_field = field
+    end function is_field
+
+    !> Base64 (RFC 4648, with '=' padding) of `bytes`.
+    pure function encode_base64(bytes) result(text)
+        integer(int8), intent(in) :: bytes(:)
+        character(len=:), allocatable :: text
+        integer :: i, j, n, b1, b2, b3, group
+
+        n = size(bytes)
+        allocate(character(len=4 * ((n + 2) / 3)) :: text)
+        j = 0
+        do i = 1, n, 3
+            b1 = iand(int(bytes(i)), 255)
+            b2 = 0
+            b3 = 0
+            if (i + 1 <= n) b2 = iand(int(bytes(i + 1)), 255)
+            if (i + 2 <= n) b3 = iand(int(bytes(i + 2)), 255)
+            group = ior(ior(ishft(b1, 16), ishft(b2, 8)), b3)
+            text(j + 1:j + 1) = base64_alphabet(ishft(group, -18) + 1:ishft(group, -18) + 1)
+            text(j + 2:j + 2) = base64_alphabet(iand(ishft(group, -12), 63) + 1: &
+                iand(ishft(group, -12), 63) + 1)
+            text(j + 3:j + 3) = base64_alphabet(iand(ishft(group, -6), 63) + 1: &
+                iand(ishft(group, -6), 63) + 1)
+            text(j + 4:j + 4) = base64_alphabet(iand(group, 63) + 1:iand(group, 63) + 1)
+            if (i + 1 > n) text(j + 3:j + 3) = '='
+            if (i + 2 > n) text(j + 4:j + 4) = '='
+            j = j + 4
         end do
-        write(unit, '(a)') '</Collection></VTKFile>'
-        close(unit)
-    end subroutine write_collection
+    end function encode_base64
+
+    !> 'LittleEndian' or 'BigEndian': the byte order of this machine.
+    pure function get_byte_order() result(order)
+        character(len=:), allocatable :: order
+        integer(int8) :: bytes(4)
+        bytes = transfer(1_int32, bytes)
+        if (bytes(1) == 1_int8) then
+            order = 'LittleEndian'
+        else
+            order = 'BigEndian'
+        end if
+    end function get_byte_order
+
+    pure function format_integer(value) result(text)
+        integer, intent(in) :: value
+        character(len=:), allocatable :: text
+        character(len=16) :: buffer
+        write(buffer, '(i0)') value
+        text = trim(buffer)
+    end function format_integer
 
 end module yarnfort_output_vtk

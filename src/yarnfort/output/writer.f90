@@ -1,34 +1,57 @@
 ! SPDX-License-Identifier: MIT
 !> The step observer that writes a run's files: curve.csv after every converged step, a
-!> VTK state every `vtk_every` steps (and always the last one written by `finish`), and
-!> the restart file of every converged step.
+!> VTK state every `vtk_every` steps (and always the last one, written by `finish`), and
+!> the restart file of every converged step. It holds the output folder's lock from
+!> `open` (or `lock`) to `finish`, and lists every file it writes in the folder's
+!> manifest (yarnfort_output_manifest): a new run deletes only files listed there.
+!> Every write is checked; a failed one ends the run with an error (`failed` is then
+!> set), and what was written before it stays.
 module yarnfort_output_writer
     use yarnfort_kinds, only: wp
-    use yarnfort_error, only: error_type
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_input_config, only: config_type
+    use yarnfort_input_echo, only: write_config
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_observer_type, step_state_type
     use yarnfort_output_curve, only: curve_writer_type
     use yarnfort_output_vtk, only: vtk_writer_type
-    use yarnfort_output_filesystem, only: make_folder
+    use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
+        remove_file, lock_file_name, close_checked
+    use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_output_restart, only: write_restart, remove_restart
     implicit none
     private
 
-    public :: output_writer_type
+    public :: output_writer_type, input_file_name
+
+    !> The effective input, echoed for provenance.
+    character(len=*), parameter :: input_file_name = 'input.nml'
 
     type, extends(step_observer_type) :: output_writer_type
         character(len=:), allocatable :: folder
         integer :: vtk_every = 1
         type(curve_writer_type) :: curve
         type(vtk_writer_type) :: vtk
-        !> The last state, kept to write it as VTK at the end when it was skipped.
+        type(manifest_type) :: manifest
+        type(folder_lock_type) :: folder_lock
+        !> The last converged state and the passage modes of its snapshot; whether its
+        !> VTK state is due (written with the snapshot, on_checkpoint) or was skipped
+        !> (written by finish).
         type(step_state_type) :: last
+        integer, allocatable :: last_mode(:)
+        logical :: state_due = .false.
         logical :: last_written = .true.
         !> Fingerprint of the input, stamped on the restart files (get_input_hash).
         character(len=16) :: input_hash = ''
+        !> A write to the folder failed (the error of on_step or on_checkpoint).
+        logical :: failed = .false.
     contains
+        !> Create the folder if needed and take its lock (also done by open).
+        procedure :: lock => lock_writer
         procedure :: open => open_writer
+        !> Echo the effective input to folder/input.nml.
+        procedure :: write_input
         procedure :: on_step
         procedure :: on_cut
         procedure :: on_checkpoint
@@ -37,31 +60,170 @@ module yarnfort_output_writer
 
 contains
 
-    !> Create the output folder and the curve file; with `resume_step` (a restart),
-    !> continue the folder's curve file and VTK states after that step instead.
-    subroutine open_writer(self, scene, error, resume_step)
+    !> Take the lock of the scene's output folder (created when missing, unless
+    !> `create` is false: then a missing folder is left alone and not locked).
+    subroutine lock_writer(self, folder, error, create)
+        class(output_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: folder
+        type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: create
+        logical :: exists
+
+        self%folder = trim(folder)
+        if (self%folder_lock%held()) return
+        if (present(create)) then
+            if (.not. create) then
+                inquire(file=self%folder // '/.', exist=exists)
+                if (.not. exists) return
+            end if
+        end if
+        call make_folder(self%folder, error)
+        if (allocated(error)) return
+        call self%folder_lock%acquire(self%folder, error)
+    end subroutine lock_writer
+
+    !> Lock the output folder, delete the files an earlier run listed in its manifest,
+    !> and start the curve file; with `resume_step` (a restart), continue the folder's
+    !> curve file and VTK states after that step instead (`resume_time`: the restart's
+    !> time, which the curve row of that step must have).
+    subroutine open_writer(self, scene, error, resume_step, resume_time)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
         integer, intent(in), optional :: resume_step
+        real(wp), intent(in), optional :: resume_time
+        logical :: found
 
-        self%folder = trim(scene%output%folder)
         self%vtk_every = scene%output%vtk_every
-        call make_folder(self%folder, error)
-        if (allocated(error)) return
-        self%vtk%folder = self%folder
-        if (present(resume_step)) then
-            call self%curve%resume(self%folder, scene, resume_step, error)
+        self%vtk%ascii = trim(scene%output%vtk_format) == 'ascii'
+        call self%lock(scene%output%folder, error)
+        if (.not. allocated(error)) then
+            self%vtk%folder = self%folder
+            call self%manifest%load(self%folder, found)
+            if (present(resume_step)) then
+                call resume_files(self, scene, resume_step, error, resume_time)
+            else
+                call start_files(self, scene, error)
+            end if
+        end if
+        if (allocated(error)) call self%folder_lock%release()
+    end subroutine open_writer
+
+    !> A new run: delete what the manifest lists (the files of an earlier run) and a
+    !> restart file of ours, then list the fixed names and start the curve file.
+    subroutine start_files(self, scene, error)
+        class(output_writer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        type(error_type), allocatable, intent(out) :: error
+        integer :: i
+
+        do i = 1, size(self%manifest%states)
+            call remove_file(self%folder // '/' // trim(self%manifest%states(i)), error)
             if (allocated(error)) return
-            call self%vtk%resume(resume_step, error)
+        end do
+        do i = 1, size(self%manifest%files)
+            call remove_file(self%folder // '/' // trim(self%manifest%files(i)), error)
+            if (allocated(error)) return
+        end do
+        ! A restart file of an earlier version (no manifest) must not survive either:
+        ! removed when it is one of ours.
+        call remove_restart(self%folder)
+        self%manifest%states = self%manifest%states(:0)
+        self%manifest%steps = self%manifest%steps(:0)
+        self%manifest%times = self%manifest%times(:0)
+        call self%manifest%list_fixed_files()
+        call self%manifest%save(error)
+        if (allocated(error)) return
+        if (allocated(self%vtk%files)) deallocate(self%vtk%files, self%vtk%times)
+        allocate(self%vtk%files(0), self%vtk%times(0))
+        call self%curve%open(self%folder, scene, error)
+    end subroutine start_files
+
+    !> A restart after `step`: keep curve rows and the listed states up to that step,
+    !> delete the listed states after it (and any that is incomplete), and rewrite the
+    !> manifest and states.pvd with what is kept.
+    subroutine resume_files(self, scene, step, error, time)
+        class(output_writer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        integer, intent(in) :: step
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: time
+        logical, allocatable :: keep(:)
+        integer :: i
+
+        call self%curve%resume(self%folder, scene, step, error, time)
+        if (allocated(error)) return
+        allocate(keep(size(self%manifest%states)))
+        do i = 1, size(keep)
+            keep(i) = self%manifest%steps(i) <= step
+            if (keep(i)) keep(i) = is_complete(self%folder // '/' &
+                // trim(self%manifest%states(i)))
+            if (keep(i)) keep(i) = .not. any(self%manifest%states(i + 1:) &
+                == self%manifest%states(i))
+            if (.not. keep(i)) then
+                call remove_file(self%folder // '/' // trim(self%manifest%states(i)), error)
+                if (allocated(error)) return
+            end if
+        end do
+        self%manifest%states = pack(self%manifest%states, keep)
+        self%manifest%steps = pack(self%manifest%steps, keep)
+        self%manifest%times = pack(self%manifest%times, keep)
+        call self%manifest%list_fixed_files()
+        call self%manifest%save(error)
+        if (allocated(error)) return
+        self%vtk%files = self%manifest%states
+        self%vtk%times = self%manifest%times
+        call self%vtk%write_collection(error)
+    end subroutine resume_files
+
+    !> Whether a state file is whole: it ends with the closing tag.
+    logical function is_complete(path)
+        character(len=*), intent(in) :: path
+        character(len=*), parameter :: closing = '</VTKFile>' // achar(10)
+        character(len=len(closing)) :: tail
+        integer :: unit, status
+        integer(8) :: file_size
+
+        is_complete = .false.
+        open(newunit=unit, file=path, access='stream', form='unformatted', status='old', &
+            action='read', iostat=status)
+        if (status /= 0) return
+        inquire(unit=unit, size=file_size)
+        if (file_size >= len(closing)) then
+            read(unit, pos=file_size - len(closing) + 1, iostat=status) tail
+            is_complete = status == 0 .and. tail == closing
+        end if
+        close(unit)
+    end function is_complete
+
+    !> Write folder/input.nml (through input.nml.tmp, renamed when complete).
+    subroutine write_input(self, config, error)
+        class(output_writer_type), intent(inout) :: self
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: ignored
+        character(len=:), allocatable :: path, temporary
+        character(len=256) :: message
+        integer :: unit, status
+
+        path = self%folder // '/' // input_file_name
+        temporary = path // '.tmp'
+        message = ''
+        open(newunit=unit, file=temporary, status='replace', action='write', iostat=status, &
+            iomsg=message)
+        if (status == 0) then
+            ! A failed write shows when closing: the file is shorter than what was written.
+            call write_config(unit, config)
+            call close_checked(unit, temporary, error)
+        end if
+        if (status /= 0) call fatal_error(error, "cannot write '" // temporary // "': " &
+            // trim(message))
+        if (allocated(error)) then
+            call remove_file(temporary, ignored)
             return
         end if
-        ! A rerun into the same folder must not leave states of the earlier run behind,
-        ! nor its restart file.
-        call self%vtk%remove_previous()
-        call remove_restart(self%folder)
-        call self%curve%open(self%folder, scene, error)
-    end subroutine open_writer
+        call rename_file(temporary, path, error)
+    end subroutine write_input
 
     subroutine on_step(self, scene, state, error)
         class(output_writer_type), intent(inout) :: self
@@ -69,15 +231,17 @@ contains
         type(step_state_type), intent(in) :: state
         type(error_type), allocatable, intent(out) :: error
 
-        call self%curve%write_step(scene, state)
+        call self%curve%write_step(scene, state, error)
+        if (allocated(error)) then
+            self%failed = .true.
+            return
+        end if
+        self%state_due = .false.
         self%last_written = .true.
         if (self%vtk_every > 0) then
-            if (mod(state%step, self%vtk_every) == 0) then
-                call self%vtk%write_state(scene, state, error)
-            else
-                self%last = state
-                self%last_written = .false.
-            end if
+            self%last = state
+            self%state_due = mod(state%step, self%vtk_every) == 0
+            self%last_written = .false.
         end if
     end subroutine on_step
 
@@ -87,26 +251,69 @@ contains
         character(len=*), intent(in) :: reason
     end subroutine on_cut
 
-    !> Write the restart file of the step just written.
+    !> Write the VTK state of the step just written when due (it needs the snapshot's
+    !> passage modes), then the restart file.
     subroutine on_checkpoint(self, scene, snapshot, error)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(restart_type), intent(in) :: snapshot
         type(error_type), allocatable, intent(out) :: error
 
+        if (allocated(snapshot%mode)) then
+            self%last_mode = snapshot%mode
+        else
+            self%last_mode = [integer :: ]
+        end if
+        if (self%state_due) then
+            call write_last_state(self, scene, error)
+            if (allocated(error)) return
+        end if
         call write_restart(self%folder, snapshot, self%input_hash, error)
+        if (allocated(error)) self%failed = .true.
     end subroutine on_checkpoint
 
-    !> Write the last converged state if it was skipped, and close the curve file.
+    !> The VTK state of the last step: listed in the manifest, then written.
+    subroutine write_last_state(self, scene, error)
+        class(output_writer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        type(error_type), allocatable, intent(out) :: error
+        character(len=32) :: name
+
+        write(name, '("state_", i0.5, ".vtu")') self%last%step
+        call self%manifest%add_state(trim(name), self%last%step, self%last%time, error)
+        if (.not. allocated(error)) then
+            if (.not. allocated(self%last_mode)) self%last_mode = [integer :: ]
+            call self%vtk%write_state(scene, self%last, self%last_mode, error)
+        end if
+        if (allocated(error)) then
+            self%failed = .true.
+            return
+        end if
+        self%state_due = .false.
+        self%last_written = .true.
+    end subroutine write_last_state
+
+    !> Write the last converged state if it was skipped and states.pvd complete, close
+    !> the files and release the folder's lock.
     subroutine finish(self, scene, error)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: close_error
 
-        if (.not. self%last_written .and. self%vtk_every > 0) then
-            call self%vtk%write_state(scene, self%last, error)
+        if (.not. self%last_written .and. self%vtk_every > 0 .and. allocated(self%last%position)) &
+            call write_last_state(self, scene, error)
+        if (.not. allocated(error) .and. self%vtk_every > 0 .and. allocated(self%vtk%files)) then
+            if (self%vtk%listed /= size(self%vtk%files)) call self%vtk%write_collection(error)
+            if (allocated(error)) self%failed = .true.
         end if
-        call self%curve%close()
+        call self%curve%close(close_error)
+        if (allocated(close_error) .and. .not. allocated(error)) then
+            self%failed = .true.
+            call move_alloc(close_error, error)
+        end if
+        call self%manifest%close()
+        call self%folder_lock%release()
     end subroutine finish
 
 end module yarnfort_output_writer

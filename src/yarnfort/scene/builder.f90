@@ -63,10 +63,6 @@ contains
         scene%path%time = config%path%time
         scene%path%p_force = config%path%p_force
         scene%path%p_disp = config%path%p_disp
-        scene%force_scale = 0.0_wp
-        do m = 1, size(scene%laws)
-            scene%force_scale = max(scene%force_scale, scene%laws(m)%law%get_reference_stiffness())
-        end do
         scene%length_scale = sum(scene%network%length0) / size(scene%network%length0)
     end subroutine new_scene
 
@@ -298,8 +294,12 @@ contains
             scene%dofs%gap_p_disp = config%fabric%gap_factor_p_disp
             scene%dofs%gap_factor = config%fabric%gap_factor
         end if
+        allocate(scene%link_nodes(2, 0), scene%link_is_gap(0))
         if (.not. allocated(config%links)) return
         if (size(config%links) == 0) return
+        scene%link_nodes = reshape([(config%links(l)%leader, config%links(l)%follower, &
+            l = 1, size(config%links))], [2, size(config%links)])
+        scene%link_is_gap = config%links%gap
         allocate(leader(n_nodes), link_of(n_nodes), source=0)
         do l = 1, size(config%links)
             n = config%links(l)%follower
@@ -408,15 +408,16 @@ contains
 
     !> Friction laws from the &contact groups and the passages that use them: every
     !> time a yarn passes (does not end) at a node that another yarn (or another pass of
-    !> the same yarn) also visits. Passages whose pair of yarn types is 'bonded' are
-    !> plain shared nodes and get no passage. The law of a passage is that of its yarn's
-    !> type paired with the type of the first other yarn at the node.
+    !> the same yarn) also visits. The law of a passage is the &contact of its yarn's
+    !> type paired with the types of the node's other visits; it must be the same for
+    !> every pair that has one (else an error), so the order of the input never matters.
+    !> 'bonded' pairs, and nodes with no &contact for any pair, are plain shared nodes.
     subroutine build_passages(scene, config, error)
         type(scene_type), intent(inout) :: scene
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
-        integer :: c, y, e, node, n_nodes, n_passages, other, law, n_yarns, k
-        integer, allocatable :: visits(:), first_yarn(:), second_yarn(:), contact_of(:, :)
+        integer :: c, y, e, node, n_nodes, n_passages, n_yarns, k
+        integer, allocatable :: visits(:), visitor(:), visit_index(:), filled(:), contact_of(:, :)
         integer, allocatable :: root(:)
         integer :: m
         integer, allocatable :: yarn(:), at_node(:), before(:), after(:), laws(:)
@@ -452,13 +453,10 @@ contains
             return
         end if
 
-        ! Yarns visiting each original node (the first two distinct visits suffice). Nodes
-        ! joined by links (gap-holders, periodic images) count as one contact: visits are
+        ! Visits of each original node by the yarns, listed per node (CSR). Nodes joined
+        ! by links (gap-holders, periodic images) count as one contact: visits are
         ! counted at the root of each node's chain of links.
         n_nodes = size(config%node_positions, 2)
-        allocate(visits(n_nodes), source=0)
-        allocate(first_yarn(n_nodes), source=0)
-        allocate(second_yarn(n_nodes), source=0)
         allocate(root(n_nodes))
         root = [(node, node = 1, n_nodes)]
         if (allocated(config%links)) then
@@ -472,27 +470,37 @@ contains
                 root(node) = root(root(node))
             end do
         end do
+        allocate(visits(n_nodes + 1), source=0)
         do y = 1, n_yarns
             do k = 1, size(config%yarns(y)%nodes)
                 node = root(config%yarns(y)%nodes(k))
-                visits(node) = visits(node) + 1
-                if (visits(node) == 1) then
-                    first_yarn(node) = y
-                else if (visits(node) == 2) then
-                    second_yarn(node) = y
-                end if
+                visits(node + 1) = visits(node + 1) + 1
             end do
         end do
-        ! Passages: interior nodes of a yarn's list that are visited more than once.
+        do node = 1, n_nodes
+            visits(node + 1) = visits(node + 1) + visits(node)
+        end do
+        allocate(visitor(visits(n_nodes + 1)), visit_index(visits(n_nodes + 1)))
+        allocate(filled(n_nodes), source=0)
+        do y = 1, n_yarns
+            do k = 1, size(config%yarns(y)%nodes)
+                node = root(config%yarns(y)%nodes(k))
+                filled(node) = filled(node) + 1
+                visitor(visits(node) + filled(node)) = y
+                visit_index(visits(node) + filled(node)) = k
+            end do
+        end do
+        ! Passages: interior nodes of a yarn's list that are visited more than once. The
+        ! law of a passage: the &contact of its yarn's type paired with the type of each
+        ! other visit of the node (other yarns, or other passes of the same yarn); pairs
+        ! without a &contact do not count. None: a plain shared node. Several different
+        ! ones: an error (the law would depend on the order of the input).
         n_passages = 0
         do y = 1, n_yarns
             do k = 2, size(config%yarns(y)%nodes) - 1
                 node = config%yarns(y)%nodes(k)
-                if (visits(root(node)) < 2) cycle
-                other = first_yarn(root(node))
-                if (other == y) other = second_yarn(root(node))
-                c = contact_of(find_material(config, config%yarns(y)%material), &
-                    find_material(config, config%yarns(other)%material))
+                call find_passage_contact(root(node), y, k, c, error)
+                if (allocated(error)) return
                 if (c == 0) cycle
                 if (trim(config%contacts(c)%law) == 'bonded') cycle
                 ! The elements before and after the node along the yarn.
@@ -524,6 +532,34 @@ contains
         scene%passages%element_before = before
         scene%passages%element_after = after
         scene%passages%law = laws
+    contains
+        !> The &contact of yarn y's k-th listed node (visits at `node`, a root), or 0.
+        subroutine find_passage_contact(node, y, k, contact, error)
+            integer, intent(in) :: node, y, k
+            integer, intent(out) :: contact
+            type(error_type), allocatable, intent(out) :: error
+            integer :: v, candidate, own
+            character(len=300) :: message
+
+            contact = 0
+            own = find_material(config, config%yarns(y)%material)
+            do v = visits(node) + 1, visits(node + 1)
+                if (visitor(v) == y .and. visit_index(v) == k) cycle
+                candidate = contact_of(own, find_material(config, config%yarns(visitor(v))%material))
+                if (candidate == 0 .or. candidate == contact) cycle
+                if (contact /= 0) then
+                    write(message, '("node ", i0, ": &yarn ", i0, " (type ''", a, "'') meets ", &
+                        &"yarns whose types pair with it under two different &contact groups (#", &
+                        &i0, " and #", i0, "): give one law for the node, e.g. the same &contact ", &
+                        &"for both pairs")') config%yarns(y)%nodes(k), y, &
+                        trim(config%yarns(y)%material), min(contact, candidate), &
+                        max(contact, candidate)
+                    call fatal_error(error, trim(message))
+                    return
+                end if
+                contact = candidate
+            end do
+        end subroutine find_passage_contact
     end subroutine build_passages
 
     !> The friction law of a &contact group ('bonded' gets none: it never slides).

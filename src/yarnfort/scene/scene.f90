@@ -46,9 +46,9 @@ module yarnfort_scene_scene
         type(friction_holder_type), allocatable :: friction(:)
         type(solver_config_type) :: solver
         type(output_config_type) :: output
-        !> Scales for the solver: a force (largest reference stiffness) and a length
-        !> (mean element length).
-        real(wp) :: force_scale = 1.0_wp
+        !> Length scale of the solver's unknowns (mean element length). Forces are
+        !> judged against the forces present (yarnfort_assembly_scales), never against a
+        !> material stiffness.
         real(wp) :: length_scale = 1.0_wp
         !> Generated fabrics (&fabric): the width (m) across which the fabric carries its
         !> x force, the macroscopic strain at p_disp = 1, and the set of `supports` whose
@@ -56,6 +56,10 @@ module yarnfort_scene_scene
         real(wp) :: fabric_width = 0.0_wp
         real(wp) :: fabric_strain = 0.0_wp
         integer :: fabric_set = 0
+        !> Links (gap-holders and periodic images), for the output: (leader, follower)
+        !> node pairs (2, n_links), and whether each is a gap-holder.
+        integer, allocatable :: link_nodes(:, :)
+        logical, allocatable :: link_is_gap(:)
     end type scene_type
 
 contains

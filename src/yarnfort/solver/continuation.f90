@@ -1,7 +1,9 @@
 ! SPDX-License-Identifier: MIT
 !> Continuation along the load path (paper section 2.6): steps in pseudo-time from knot
 !> to knot, each solved from the previous converged state; a failed step is cut, an
-!> easy one lets the next step grow. Every converged step goes to the observer before
+!> easy one lets the next step grow. Step sizes (initial_step, min_step, max_step and
+!> the step carried on) are fractions of the knot interval being followed, so a long
+!> path takes as many steps per interval as a short one. Every converged step goes to the observer before
 !> the next one starts, then a restart snapshot of it (on_checkpoint): a run started
 !> from that snapshot takes the same steps as one that never stopped.
 module yarnfort_solver_continuation
@@ -68,6 +70,7 @@ contains
         integer, intent(in), optional :: max_steps
         logical, intent(out), optional :: stopped
         real(wp) :: t, t_end, dt, t_next, p_force, p_disp, span, start, previous_load
+        real(wp) :: interval
         integer :: step, cuts, knot, iterations, first_step
         type(newton_stats_type) :: stats
         type(step_state_type) :: state
@@ -131,21 +134,23 @@ contains
                 do while (path%time(knot) <= t + knot_tolerance * span)
                     knot = knot + 1
                 end do
-                t_next = min(t + dt, path%time(knot))
+                ! dt is a fraction of the interval of the knot ahead.
+                interval = path%time(knot) - path%time(knot - 1)
+                t_next = min(t + dt * interval, path%time(knot))
                 ! Do not leave a sliver before the knot; but never after a cut, whose
                 ! shorter step that stretch would undo (step_cut > 0.8: no cut at all).
-                if (cuts == 0 .and. path%time(knot) - t_next < 0.25_wp * dt) &
+                if (cuts == 0 .and. path%time(knot) - t_next < 0.25_wp * dt * interval) &
                     t_next = path%time(knot)
                 call path%get_factors(t_next, p_force, p_disp)
                 call stepper%try_step(p_force, p_disp, stats, iterations, step_error)
                 if (allocated(step_error)) then
                     cuts = cuts + 1
                     call observer%on_cut(t, t_next - t, step_error%message)
-                    dt = (t_next - t) * scene%solver%step_cut
+                    dt = (t_next - t) / interval * scene%solver%step_cut
                     if (dt < scene%solver%min_step .or. cuts > scene%solver%max_step_cuts) then
                         write(buffer, '("step from time ", g0.6, " failed after ", i0, &
-                            & " cuts (step ", es9.2, ", min_step ", es9.2, "); last error")') &
-                            t, cuts, dt, scene%solver%min_step
+                            & " cuts (step ", es9.2, " of the knot interval, min_step ", es9.2, &
+                            & "); last error")') t, cuts, dt, scene%solver%min_step
                         call fatal_error(error, trim(buffer) // ': ' // step_error%message)
                         return
                     end if
@@ -156,9 +161,10 @@ contains
                 step = step + 1
                 state%time = t_next
                 if (iterations <= scene%solver%easy_iterations .and. cuts == 0) then
-                    dt = min((t_next - t) * scene%solver%step_growth, scene%solver%max_step)
+                    dt = min((t_next - t) / interval * scene%solver%step_growth, &
+                        scene%solver%max_step)
                 else
-                    dt = min(max(dt, t_next - t), scene%solver%max_step)
+                    dt = min(max(dt, (t_next - t) / interval), scene%solver%max_step)
                 end if
                 call report(cuts)
                 if (allocated(error)) return

@@ -7,6 +7,7 @@ module yarnfort_solver_elastic_problem
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_assembly_pattern, only: pattern_type, new_pattern
     use yarnfort_assembly_assemble, only: assemble_residual, assemble_jacobian
+    use yarnfort_assembly_scales, only: get_node_force_levels, get_unknown_levels
     use yarnfort_solver_problem, only: nonlinear_problem_type
     implicit none
     private
@@ -26,6 +27,7 @@ module yarnfort_solver_elastic_problem
         procedure :: copy_pattern
         procedure :: evaluate_residual
         procedure :: evaluate_jacobian
+        procedure :: get_row_levels
     end type elastic_problem_type
 
 contains
@@ -39,7 +41,6 @@ contains
         call new_pattern(self%pattern, scene%network, scene%dofs)
         self%length0 = scene%network%length0
         allocate(self%x(3, scene%network%n_nodes()))
-        self%force_scale = scene%force_scale
         self%length_scale = scene%length_scale
     end subroutine new_elastic_problem
 
@@ -66,7 +67,8 @@ contains
         real(wp), intent(out) :: residual(:)
         type(error_type), allocatable, intent(out) :: error
         call self%scene%dofs%expand(u, self%p_disp, self%x)
-        call assemble_residual(self%scene, self%x, self%length0, self%p_force, residual, error)
+        call assemble_residual(self%scene, self%x, self%length0, self%p_force, residual, error, &
+            self%spring)
     end subroutine evaluate_residual
 
     subroutine evaluate_jacobian(self, u, values, error)
@@ -75,7 +77,24 @@ contains
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         call self%scene%dofs%expand(u, self%p_disp, self%x)
-        call assemble_jacobian(self%scene, self%pattern, self%x, self%length0, values, error)
+        call assemble_jacobian(self%scene, self%pattern, self%x, self%length0, values, error, &
+            self%spring, self%tangent_spring)
     end subroutine evaluate_jacobian
+
+    !> Each coordinate row is judged against the forces meeting at its node.
+    subroutine get_row_levels(self, u, level, noise, error)
+        class(elastic_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: level(:), noise(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: node_level(:), node_noise(:)
+        real(wp) :: max_force
+
+        allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
+        call self%scene%dofs%expand(u, self%p_disp, self%x)
+        call get_node_force_levels(self%scene, self%x, self%length0, self%p_force, self%spring, &
+            node_level, node_noise, max_force)
+        call get_unknown_levels(self%scene, node_level, node_noise, level, noise)
+    end subroutine get_row_levels
 
 end module yarnfort_solver_elastic_problem

@@ -3,6 +3,17 @@
 !> without sliding), driven by SUNDIALS KINSOL (line search globalisation) with the
 !> analytic sparse Jacobian and a yarnfort linear solver behind a Fortran
 !> SUNLinearSolver.
+!> Convergence: row i is converged when |F_i| <= residual_tolerance * level_i + noise_i,
+!> with the problem's row levels (the forces meeting at a node, a passage's tensions)
+!> and the rounding level of the row's evaluation; levels are taken at the initial
+!> guess and checked again at the solution (KINSOL goes on if they changed).
+!> Regularisation: every solve is first tried with the exact tension-only law (the
+!> regularising spring, weight slack_stiffness, only in the tangent of slack strings).
+!> If that fails, it is predicted with the spring in the model (weight falling from 0.1
+!> to slack_stiffness by factors of 10, each solve from the last) and corrected from
+!> there with the exact law, so the answer is always that of the exact law. A solve
+!> whose full Newton steps fail is repeated with a line search, and then by
+!> pseudo-transient continuation (solve_transient).
 module yarnfort_solver_newton
     use, intrinsic :: iso_c_binding
     use fsundials_context_mod
@@ -24,6 +35,19 @@ module yarnfort_solver_newton
 
     public :: newton_solver_type, newton_stats_type, new_newton_solver
 
+    !> Times KINSOL goes on from its solution when the row levels taken there ask for
+    !> a smaller residual than those of the initial guess.
+    integer, parameter :: max_level_rounds = 4
+    !> Iterations of the pseudo-transient fallback, in units of max_iterations.
+    integer, parameter :: transient_iterations = 4
+    !> The fallback gives up when its shift exceeds this multiple of the row levels per
+    !> length (steps too short to matter).
+    real(wp), parameter :: max_transient_shift = 1.0e12_wp
+    !> First weight of the regularising spring when a solve needs the predictor: a net
+    !> of strings that all carry a tenth of their reference stiffness is regular and
+    !> well conditioned from any start; the weight then falls by factors of 10.
+    real(wp), parameter :: predictor_weight = 0.1_wp
+
     interface
         !> C's strlen, for KINSOL's messages.
         function c_strlen(text) result(length) bind(C, name='strlen')
@@ -38,8 +62,8 @@ module yarnfort_solver_newton
         integer :: iterations = 0
         integer :: residual_evaluations = 0
         integer :: jacobian_evaluations = 0
-        !> Scaled max-norm of the residual, max|F| / force_scale, at each iterate
-        !> (iterate 0 is the initial guess) and at the end.
+        !> Scaled max-norm of the residual, max |F_i| / (level_i + noise_i / tol), at
+        !> each iterate (iterate 0 is the initial guess) and at the end: converged <= tol.
         real(wp), allocatable :: residual_history(:)
         real(wp) :: residual_norm = huge(1.0_wp)
         !> KINSOL's return flag.
@@ -53,6 +77,8 @@ module yarnfort_solver_newton
         integer(ik) :: n = 0, nnz = 0
         real(wp), allocatable :: history(:)
         integer :: n_history = 0
+        !> KINSOL's residual scaling, 1 / (level_i + noise_i / tol).
+        real(c_double), pointer :: row_weight(:) => null()
         type(error_type), allocatable :: error
         character(len=:), allocatable :: kinsol_message
         !> Accumulated wall time of residual and Jacobian assembly.
@@ -120,7 +146,8 @@ contains
         allocate(self%u(n), self%u_scale_data(n), self%f_scale_data(n))
         self%u = 0.0_wp
         self%u_scale_data = 1.0_wp / problem%length_scale
-        self%f_scale_data = 1.0_wp / problem%force_scale
+        self%f_scale_data = 1.0_wp
+        self%problem%row_weight => self%f_scale_data
         self%u_vector => FN_VMake_Serial(n, self%u, self%sunctx)
         self%u_scale => FN_VMake_Serial(n, self%u_scale_data, self%sunctx)
         self%f_scale => FN_VMake_Serial(n, self%f_scale_data, self%sunctx)
@@ -174,48 +201,137 @@ contains
         end if
     end subroutine check
 
+    !> Solve from the initial guess u: with the exact law; if that fails and
+    !> slack_stiffness > 0, predicted with the regularising spring and corrected with
+    !> the exact law from the prediction (module notes). stats add up all attempts.
     subroutine solve(self, u, stats, error)
         class(newton_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: u(:)
         type(newton_stats_type), intent(out) :: stats
         type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: exact_error
+        real(wp), allocatable :: guess(:)
+        real(wp) :: weight
+        associate(problem => self%problem%problem, spring => self%options%slack_stiffness)
+            problem%spring = 0.0_wp
+            problem%tangent_spring = spring
+            call solve_once(self, u, stats, exact_error)
+            if (.not. allocated(exact_error)) return
+            if (.not. (spring > 0.0_wp)) then
+                call move_alloc(exact_error, error)
+                return
+            end if
+            ! Predict with the spring in the model, weight driven down from
+            ! predictor_weight to slack_stiffness by factors of 10 (each solve from the
+            ! last), then correct with the exact law.
+            guess = u
+            weight = max(predictor_weight, spring)
+            do
+                problem%spring = weight
+                problem%tangent_spring = 0.0_wp
+                call solve_once(self, guess, stats, error)
+                if (allocated(error)) then
+                    problem%spring = 0.0_wp
+                    problem%tangent_spring = spring
+                    call combine(error, '; with the regularised law as predictor: ')
+                    return
+                end if
+                if (weight <= spring) exit
+                weight = max(spring, weight / 10)
+            end do
+            problem%spring = 0.0_wp
+            problem%tangent_spring = spring
+            call solve_once(self, guess, stats, error)
+            if (allocated(error)) then
+                call combine(error, '; corrected from the regularised prediction: ')
+                return
+            end if
+            u = guess
+        end associate
+    contains
+        subroutine combine(later, link)
+            type(error_type), intent(inout) :: later
+            character(len=*), intent(in) :: link
+            later%message = exact_error%message // link // later%message
+        end subroutine combine
+    end subroutine solve
+
+    !> One Newton solve with the problem's current spring weights. Rows are scaled by
+    !> their levels at the initial guess; at the end the levels are taken again at the
+    !> solution and, should the residual not meet them, KINSOL goes on from there.
+    subroutine solve_once(self, u, stats, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: u(:)
+        type(newton_stats_type), intent(inout) :: stats
+        type(error_type), allocatable, intent(out) :: error
         integer(c_int) :: ierr, strategy
         integer(c_long) :: count(1)
         real(c_double) :: residual(size(u))
+        integer :: round, attempt, n_attempts
+        logical :: converged
         character(len=200) :: buffer
 
-        self%problem%n_history = 0
-        if (allocated(self%problem%error)) deallocate(self%problem%error)
-        if (allocated(self%problem%kinsol_message)) deallocate(self%problem%kinsol_message)
-        call self%problem%problem%prepare_solve(u, error)
-        if (allocated(error)) return
-        self%u = u
-        strategy = merge(KIN_LINESEARCH, KIN_NONE, self%options%line_search)
-        ierr = FKINSol(self%kinsol, self%u_vector, strategy, self%u_scale, self%f_scale)
-        stats%flag = ierr
-
-        if (FKINGetNumNonlinSolvIters(self%kinsol, count) == 0) stats%iterations = int(count(1))
-        if (FKINGetNumFuncEvals(self%kinsol, count) == 0) stats%residual_evaluations = int(count(1))
-        if (FKINGetNumJacEvals(self%kinsol, count) == 0) stats%jacobian_evaluations = int(count(1))
-
-        ! Judge convergence by our own residual check on the final iterate.
-        call self%problem%problem%evaluate_residual(self%u, residual, error)
-        if (allocated(error)) return
-        stats%residual_norm = maxval(abs(residual)) / self%problem%problem%force_scale
+        ! Full Newton steps first; with line_search, a failed attempt is repeated from
+        ! the initial guess with KINSOL's line search (back-tracking where needed only).
+        n_attempts = merge(2, 1, self%options%line_search)
+        do attempt = 1, n_attempts
+            strategy = merge(KIN_NONE, KIN_LINESEARCH, attempt == 1)
+            self%problem%n_history = 0
+            if (allocated(self%problem%error)) deallocate(self%problem%error)
+            if (allocated(self%problem%kinsol_message)) deallocate(self%problem%kinsol_message)
+            if (allocated(self%adapter%error)) deallocate(self%adapter%error)
+            call self%problem%problem%prepare_solve(u, error)
+            if (allocated(error)) return
+            self%u = u
+            call set_row_weights(self, .true., error)
+            if (allocated(error)) return
+            converged = .false.
+            do round = 1, max_level_rounds
+                ierr = FKINSol(self%kinsol, self%u_vector, strategy, self%u_scale, self%f_scale)
+                stats%flag = ierr
+                if (FKINGetNumNonlinSolvIters(self%kinsol, count) == 0) &
+                    stats%iterations = stats%iterations + int(count(1))
+                if (FKINGetNumFuncEvals(self%kinsol, count) == 0) &
+                    stats%residual_evaluations = stats%residual_evaluations + int(count(1))
+                if (FKINGetNumJacEvals(self%kinsol, count) == 0) &
+                    stats%jacobian_evaluations = stats%jacobian_evaluations + int(count(1))
+                if (allocated(self%problem%error)) then
+                    if (attempt < n_attempts) exit
+                    call move_alloc(self%problem%error, error)
+                    return
+                end if
+                if (allocated(self%adapter%error) .and. ierr < 0) then
+                    if (attempt < n_attempts) exit
+                    call fatal_error(error, 'linear solver (' // self%linear%get_name() // &
+                        '): ' // self%adapter%error%message)
+                    return
+                end if
+                ! Judge convergence by our own test on the final iterate, with its levels.
+                call set_row_weights(self, .false., error)
+                if (allocated(error)) return
+                call self%problem%problem%evaluate_residual(self%u, residual, error)
+                if (allocated(error)) then
+                    if (attempt == n_attempts) return
+                    deallocate(error)
+                    exit
+                end if
+                stats%residual_norm = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+                ! Our test decides: a line search that stalls at a converged iterate is fine.
+                converged = stats%residual_norm <= self%options%residual_tolerance
+                if (ierr < 0 .or. converged) exit
+            end do
+            if (converged) exit
+        end do
+        if (.not. converged .and. self%options%line_search) then
+            ! Neither full nor line-searched Newton steps: pseudo-transient continuation.
+            call solve_transient(self, u, stats, converged, error)
+            if (allocated(error)) return
+        end if
         self%problem%n_history = min(self%problem%n_history + 1, size(self%problem%history))
         self%problem%history(self%problem%n_history) = stats%residual_norm
         stats%residual_history = self%problem%history(1:self%problem%n_history)
 
-        if (allocated(self%problem%error)) then
-            call move_alloc(self%problem%error, error)
-            return
-        end if
-        if (allocated(self%adapter%error) .and. ierr < 0) then
-            call fatal_error(error, 'linear solver (' // self%linear%get_name() // '): ' &
-                // self%adapter%error%message)
-            return
-        end if
-        if (ierr < 0 .or. .not. (stats%residual_norm <= self%options%residual_tolerance)) then
+        if (.not. converged) then
             write(buffer, '("Newton did not converge: KINSOL flag ", i0, ", ", i0, &
                 & " iterations, scaled residual ", es10.3, " > tolerance ", es10.3)') &
                 ierr, stats%iterations, stats%residual_norm, self%options%residual_tolerance
@@ -229,7 +345,129 @@ contains
         call self%problem%problem%check_solution(self%u, error)
         if (allocated(error)) return
         u = self%u
-    end subroutine solve
+    end subroutine solve_once
+
+    !> Pseudo-transient continuation (switched evolution relaxation): Newton steps on
+    !> F(u) + mu D du = 0, D_i = level_i / length_scale, with mu falling as the scaled
+    !> residual f does (mu <- mu f_new / f_old) and a step that raises f rejected (mu
+    !> times 10). Far from the solution it follows a damped, implicit-Euler path that
+    !> handles stiff directions (an inextensible yarn) and slow ones (a ring sliding
+    !> along it) together, where a line search on |F| crawls; as mu -> 0 it is Newton.
+    !> Works on self%u from u; on success self%u is the solution, `converged` is set.
+    subroutine solve_transient(self, u, stats, converged, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        type(newton_stats_type), intent(inout) :: stats
+        logical, intent(out) :: converged
+        type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: trial_error
+        real(wp), allocatable :: residual(:), trial(:), values(:), step(:), shift(:)
+        real(wp), allocatable :: level(:), noise(:)
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        integer, allocatable :: diagonal(:)
+        integer :: i, k, iteration
+        real(wp) :: mu, f, merit, merit_trial
+
+        converged = .false.
+        associate(problem => self%problem%problem, n => size(u))
+            allocate(col_ptr(n + 1), row_index(self%problem%nnz), values(self%problem%nnz))
+            call problem%copy_pattern(col_ptr, row_index)
+            allocate(diagonal(n), source=0)
+            do i = 1, n
+                do k = int(col_ptr(i)) + 1, int(col_ptr(i + 1))
+                    if (row_index(k) == i - 1) diagonal(i) = k
+                end do
+            end do
+            if (any(diagonal == 0)) return
+            if (.not. self%adapter%analysed) then
+                call self%linear%analyse(int(n, ik), col_ptr, row_index, error)
+                if (allocated(error)) return
+                self%adapter%analysed = .true.
+            end if
+            call problem%prepare_solve(u, error)
+            if (allocated(error)) return
+            self%u = u
+            allocate(residual(n), step(n), level(n), noise(n), shift(n))
+            call problem%get_row_levels(self%u, level, noise, error)
+            if (allocated(error)) return
+            shift = max(level, tiny(1.0_wp)) / problem%length_scale
+            call set_row_weights(self, .false., error)
+            if (allocated(error)) return
+            call problem%evaluate_residual(self%u, residual, error)
+            if (allocated(error)) return
+            f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+            merit = norm2(residual * self%f_scale_data)
+            mu = 1.0_wp
+            do iteration = 1, transient_iterations * self%options%max_iterations
+                if (f <= self%options%residual_tolerance) exit
+                call problem%evaluate_jacobian(self%u, values, error)
+                if (allocated(error)) return
+                values(diagonal) = values(diagonal) + mu * shift
+                call self%linear%factor(values, trial_error)
+                stats%jacobian_evaluations = stats%jacobian_evaluations + 1
+                if (.not. allocated(trial_error)) then
+                    step = -residual
+                    call self%linear%solve(step, trial_error)
+                end if
+                if (.not. allocated(trial_error)) then
+                    trial = self%u + step
+                    call problem%evaluate_residual(trial, residual, trial_error)
+                    stats%residual_evaluations = stats%residual_evaluations + 1
+                end if
+                ! Accept a step that lowers the weighted 2-norm of the residual (a smooth
+                ! merit: the max-norm test stalls on steps that trade one row for another).
+                if (allocated(trial_error)) then
+                    deallocate(trial_error)
+                    merit_trial = huge(1.0_wp)
+                else
+                    merit_trial = norm2(residual * self%f_scale_data)
+                end if
+                if (merit_trial < merit) then
+                    stats%iterations = stats%iterations + 1
+                    self%u = trial
+                    mu = mu * merit_trial / merit
+                    ! The levels follow the state (as in solve_once).
+                    call set_row_weights(self, .false., error)
+                    if (allocated(error)) return
+                    f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+                    merit = norm2(residual * self%f_scale_data)
+                else
+                    mu = 10 * mu
+                    if (mu > max_transient_shift) exit
+                    call problem%evaluate_residual(self%u, residual, error)
+                    if (allocated(error)) return
+                end if
+            end do
+            stats%residual_norm = f
+            converged = f <= self%options%residual_tolerance
+        end associate
+    end subroutine solve_transient
+
+    !> KINSOL's residual scaling from the problem's row levels at the current iterate:
+    !> 1 / (level + noise / tol), so that |F_i| * weight_i <= tol is the row's test. A
+    !> row with no force and no rounding (a scene without any force, whose exact
+    !> residual is zero) gets weight 1. `uniform`: every row gets the weight of the
+    !> largest level instead, for the first pass of KINSOL from an initial guess (the
+    !> levels there may be far from those at the solution, and a line search on rows
+    !> weighted by them stalls: measured on a yarn through two free contact nodes
+    !> whose slack posts start at the floor level); the rows' own levels then finish.
+    subroutine set_row_weights(self, uniform, error)
+        class(newton_solver_type), intent(inout) :: self
+        logical, intent(in) :: uniform
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: level(:), noise(:)
+
+        allocate(level(size(self%u)), noise(size(self%u)))
+        call self%problem%problem%get_row_levels(self%u, level, noise, error)
+        if (allocated(error)) return
+        level = level + noise / self%options%residual_tolerance
+        if (uniform) level = maxval([0.0_wp, level])
+        where (level > 0.0_wp)
+            self%f_scale_data = 1.0_wp / level
+        elsewhere
+            self%f_scale_data = 1.0_wp
+        end where
+    end subroutine set_row_weights
 
     !> KINSOL residual callback F(u).
     integer(c_int) function residual_callback(sunvec_u, sunvec_f, user_data) &
@@ -275,7 +513,7 @@ contains
         f => FN_VGetArrayPointer(sunvec_f)
         if (problem%n_history < size(problem%history)) then
             problem%n_history = problem%n_history + 1
-            problem%history(problem%n_history) = maxval(abs(f)) / problem%problem%force_scale
+            problem%history(problem%n_history) = maxval(abs(f) * problem%row_weight)
         end if
         start = wall_time()
         n = problem%n

@@ -10,10 +10,14 @@ module yarnfort_solver_problem
     public :: nonlinear_problem_type
 
     type, abstract :: nonlinear_problem_type
-        !> Scales: residual entries are compared with force_scale, unknowns with
-        !> length_scale (KINSOL's scaling vectors).
-        real(wp) :: force_scale = 1.0_wp
+        !> Scale of the unknowns (KINSOL's scaling vector of u); residual rows are
+        !> scaled by get_row_levels.
         real(wp) :: length_scale = 1.0_wp
+        !> Set by the Newton solver before each solve: the weight of the regularising
+        !> spring in the model (a predictor solve; 0 for the exact law) and in the
+        !> tangent of slack strings only (see yarnfort_assembly_truss).
+        real(wp) :: spring = 0.0_wp
+        real(wp) :: tangent_spring = 0.0_wp
     contains
         !> Number of unknowns.
         procedure(get_size_interface), deferred :: get_size
@@ -26,6 +30,9 @@ module yarnfort_solver_problem
         procedure(evaluate_residual_interface), deferred :: evaluate_residual
         !> Jacobian values in the order of the pattern.
         procedure(evaluate_jacobian_interface), deferred :: evaluate_jacobian
+        !> The force level of each residual row at u and the rounding level of its
+        !> evaluation: row i is converged when |F_i| <= tol * level_i + noise_i.
+        procedure(get_row_levels_interface), deferred :: get_row_levels
         !> Called by the Newton solver before each solve with its initial guess: a problem
         !> may fix there what must stay constant during one solve (default: nothing).
         procedure :: prepare_solve
@@ -66,6 +73,14 @@ module yarnfort_solver_problem
             real(wp), intent(out) :: values(:)
             type(error_type), allocatable, intent(out) :: error
         end subroutine evaluate_jacobian_interface
+
+        subroutine get_row_levels_interface(self, u, level, noise, error)
+            import :: nonlinear_problem_type, wp, error_type
+            class(nonlinear_problem_type), intent(inout) :: self
+            real(wp), intent(in) :: u(:)
+            real(wp), intent(out) :: level(:), noise(:)
+            type(error_type), allocatable, intent(out) :: error
+        end subroutine get_row_levels_interface
     end interface
 
 contains

@@ -113,6 +113,18 @@ contains
         call check_close(error, block(2, 2), ratio * ea * 0.5_wp, 1.0e-14_wp, &
             'transverse stiffness at the reference length')
         if (allocated(error)) return
+        ! The spring in the tangent only: the force stays that of the exact law.
+        call get_truss_response(law, 0.0_wp, 1.0_wp, [0.0_wp, 0.0_wp, 0.0_wp], &
+            [0.5_wp, 0.0_wp, 0.0_wp], tension, stretch, force, block, tangent_spring=ratio)
+        call check(error, tension == 0.0_wp .and. all(force == 0.0_wp), &
+            'tangent-only spring: a slack element still carries nothing')
+        if (allocated(error)) return
+        call check_close(error, block(1, 1), ratio * ea / 1.0_wp, 1.0e-14_wp, &
+            'tangent-only spring: axial stiffness of a slack element')
+        if (allocated(error)) return
+        call check_close(error, block(2, 2), ratio * ea * 0.5_wp / 0.5_wp, 1.0e-14_wp, &
+            'tangent-only spring: transverse stiffness k / (2 l) of a slack element')
+        if (allocated(error)) return
         call get_truss_response(law, 0.0_wp, 1.0_wp, [0.0_wp, 0.0_wp, 0.0_wp], &
             [0.5_wp, 0.0_wp, 0.0_wp], tension, stretch, force, block)
         call check(error, abs(tension) + maxval(abs(block)) <= 0.0_wp, &

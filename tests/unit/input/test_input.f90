@@ -1171,7 +1171,7 @@ contains
 
         call check_bad_input(error, 'bad_path_time_resolution.nml', [character(len=72) :: &
             '&solver: min_step = 1.0e-6 is below the resolution of &path time', &
-            '(up to 2.0e20 in magnitude)'])
+            '(up to 1.0000000001e20 in magnitude, shortest knot interval'])
     end subroutine test_bad_path_time_resolution
 
     subroutine test_bad_elements_per_segment_huge(error)

@@ -1,0 +1,100 @@
+! SPDX-License-Identifier: MIT
+!> Force levels that the equilibrium residual is judged against: at each node, the
+!> largest force that meets there (the tensions of its elements and its applied load),
+!> and the rounding level of the residual's evaluation. They depend only on the forces
+!> present, so convergence tests and dead bands scale with the scene's own forces and
+!> not with a material stiffness or a choice of units.
+module yarnfort_assembly_scales
+    use yarnfort_kinds, only: wp
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_assembly_truss, only: get_truss_tension
+    use yarnfort_material_law, only: force_law_type
+    implicit none
+    private
+
+    public :: get_node_force_levels, get_unknown_levels, get_tension_with_noise, node_level_floor
+
+    !> A node where no force meets (a slack region) is judged against this fraction of
+    !> the largest force of the scene.
+    real(wp), parameter :: node_level_floor = 1.0e-6_wp
+    !> Rounding of one element force, in units of eps * (|T| + r dT/dlambda) where
+    !> r = (|x1| + |x2| + l) / L0: the tension is computed from lambda = l/L0, and l
+    !> from coordinate differences that carry the rounding of the coordinates.
+    real(wp), parameter :: rounding_factor = 8.0_wp
+
+contains
+
+    !> For nodes at x (3, n_nodes), reference lengths length0 and load factor p_force:
+    !> level(n) = max(largest |tension| of the elements at n, |applied force at n|),
+    !> floored at node_level_floor * the largest such force of the scene (max_force);
+    !> noise(n) = the rounding error of the residual at n (sum over its elements of
+    !> rounding_factor * eps * (|T| + lambda dT/dlambda)). `spring` as in
+    !> get_truss_tension. With no force anywhere (max_force = 0) every level is 0.
+    pure subroutine get_node_force_levels(scene, x, length0, p_force, spring, level, noise, &
+            max_force)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: x(:, :), length0(:), p_force, spring
+        real(wp), intent(out) :: level(:), noise(:), max_force
+        integer :: e, n, k
+        real(wp) :: tension, rounding
+
+        level = 0.0_wp
+        noise = 0.0_wp
+        do e = 1, scene%network%n_elements()
+            associate(nodes => scene%network%element_nodes(:, e))
+                call get_tension_with_noise(scene%laws(scene%network%element_material(e))%law, &
+                    spring, x(:, nodes(1)), x(:, nodes(2)), length0(e), tension, rounding)
+                do k = 1, 2
+                    level(nodes(k)) = max(level(nodes(k)), abs(tension))
+                    noise(nodes(k)) = noise(nodes(k)) + rounding
+                end do
+            end associate
+        end do
+        do n = 1, size(level)
+            level(n) = max(level(n), abs(p_force) * norm2(scene%external_force(3 * n - 2:3 * n)))
+        end do
+        max_force = maxval([0.0_wp, level])
+        level = max(level, node_level_floor * max_force)
+    end subroutine get_node_force_levels
+
+    !> Tension of an element with nodes at x1, x2 and its rounding error: the tension is
+    !> computed from lambda = l/L0, and l from coordinate differences, which carry the
+    !> rounding of the coordinates: noise = rounding_factor * eps * (|T| + r |dT/dlambda|)
+    !> with r = (|x1| + |x2| + l) / L0. A string within that rounding of stretch 1 (the
+    !> kink of the tension-only law) counts with the slope of its taut side.
+    pure subroutine get_tension_with_noise(law, spring, x1, x2, length0, tension, noise)
+        class(force_law_type), intent(in) :: law
+        real(wp), intent(in) :: spring, x1(3), x2(3), length0
+        real(wp), intent(out) :: tension, noise
+        real(wp) :: length, stretch, dtension, r
+
+        length = norm2(x2 - x1)
+        stretch = length / length0
+        call get_truss_tension(law, spring, stretch, tension, dtension)
+        r = (norm2(x1) + norm2(x2) + length) / length0
+        if (dtension == 0.0_wp .and. stretch > 1.0_wp - rounding_factor * epsilon(1.0_wp) * r) &
+            dtension = law%get_reference_stiffness()
+        noise = rounding_factor * epsilon(1.0_wp) * (abs(tension) + r * abs(dtension))
+    end subroutine get_tension_with_noise
+
+    !> The levels of the equilibrium rows (one per unknown coordinate) from the node
+    !> levels: a row that gathers several nodes (linked nodes share unknowns) takes the
+    !> largest of their levels and the sum of their noise.
+    pure subroutine get_unknown_levels(scene, level, noise, row_level, row_noise)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: level(:), noise(:)
+        real(wp), intent(out) :: row_level(:), row_noise(:)
+        integer :: c, i, n
+
+        row_level = 0.0_wp
+        row_noise = 0.0_wp
+        do c = 1, size(scene%dofs%unknown)
+            i = scene%dofs%unknown(c)
+            if (i == 0) cycle
+            n = (c - 1) / 3 + 1
+            row_level(i) = max(row_level(i), level(n))
+            row_noise(i) = row_noise(i) + noise(n)
+        end do
+    end subroutine get_unknown_levels
+
+end module yarnfort_assembly_scales

@@ -1,0 +1,144 @@
+/* SPDX-License-Identifier: MIT */
+/* POSIX calls Fortran cannot make portably (yarnfort_output_filesystem): an exclusive
+ * advisory lock on a file (flock: the kernel drops it when the process ends, however it
+ * ends, so a killed run leaves no stale lock), fsync of a written file, and the error
+ * text of the last failed call. Every function returns 0 on success. */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/file.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+#include <time.h>
+#include <unistd.h>
+
+/* Lock `path` (created if missing) for this process. On success *fd is the open file
+ * that holds the lock and the file holds "pid <pid> host <host> since <UTC time>".
+ * Returns 0 when locked, 1 when another process holds the lock (its line is copied to
+ * holder, at most holder_length - 1 bytes, NUL-terminated), -1 on any other failure
+ * (errno set). */
+int yarnfort_lock_file(const char *path, int *fd, char *holder, int holder_length)
+{
+    char line[512], host[256];
+    time_t now;
+    struct tm utc;
+    ssize_t n;
+    int file, length;
+
+    *fd = -1;
+    if (holder_length > 0) holder[0] = '\0';
+    file = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (file < 0) return -1;
+    if (flock(file, LOCK_EX | LOCK_NB) != 0) {
+        int saved = errno;
+        if (saved == EWOULDBLOCK) {
+            n = pread(file, line, sizeof line - 1, 0);
+            if (n < 0) n = 0;
+            line[n] = '\0';
+            line[strcspn(line, "\n")] = '\0';
+            if (holder_length > 0) {
+                strncpy(holder, line, (size_t)holder_length - 1);
+                holder[holder_length - 1] = '\0';
+            }
+            close(file);
+            return 1;
+        }
+        close(file);
+        errno = saved;
+        return -1;
+    }
+    if (gethostname(host, sizeof host) != 0) strcpy(host, "unknown");
+    host[sizeof host - 1] = '\0';
+    now = time(NULL);
+    gmtime_r(&now, &utc);
+    length = snprintf(line, sizeof line, "pid %ld host %s since %04d-%02d-%02d %02d:%02d:%02d UTC\n",
+                      (long)getpid(), host, utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday,
+                      utc.tm_hour, utc.tm_min, utc.tm_sec);
+    if (ftruncate(file, 0) != 0 || pwrite(file, line, (size_t)length, 0) != length) {
+        int saved = errno;
+        close(file);
+        errno = saved;
+        return -1;
+    }
+    *fd = file;
+    return 0;
+}
+
+/* Release a lock taken by yarnfort_lock_file (the file stays). */
+int yarnfort_unlock_file(int fd)
+{
+    if (fd < 0) return 0;
+    return close(fd);
+}
+
+/* Flush a closed file's data to the device (fsync through a new descriptor). */
+int yarnfort_sync_file(const char *path)
+{
+    int file = open(path, O_RDONLY | O_CLOEXEC);
+    int status;
+    if (file < 0) return -1;
+    status = fsync(file);
+    if (status != 0) {
+        int saved = errno;
+        close(file);
+        errno = saved;
+        return -1;
+    }
+    return close(file);
+}
+
+/* Remove a file; a missing file is no error. */
+int yarnfort_remove_file(const char *path)
+{
+    if (unlink(path) == 0 || errno == ENOENT) return 0;
+    return -1;
+}
+
+/* Make a write past the file size limit (ulimit -f) fail with EFBIG, reported like any
+ * failed write, instead of killing the process with SIGXFSZ. */
+void yarnfort_ignore_file_size_signal(void)
+{
+    signal(SIGXFSZ, SIG_IGN);
+}
+
+/* The largest file this process may write (ulimit -f), in bytes; -1 for no limit. */
+long long yarnfort_file_size_limit(void)
+{
+    struct rlimit limit;
+    if (getrlimit(RLIMIT_FSIZE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return -1;
+    return (long long)limit.rlim_cur;
+}
+
+/* Cut the file `path` to `size` bytes. */
+int yarnfort_truncate_file(const char *path, long long size)
+{
+    return truncate(path, (off_t)size);
+}
+
+/* The size in bytes of the file `path` on its device, -1 if it cannot be told. */
+long long yarnfort_file_size(const char *path)
+{
+    struct stat info;
+    if (stat(path, &info) != 0) return -1;
+    return (long long)info.st_size;
+}
+
+/* Bytes still free for this user on the device of `path`, -1 if it cannot be told. */
+long long yarnfort_free_space(const char *path)
+{
+    struct statvfs info;
+    if (statvfs(path, &info) != 0) return -1;
+    return (long long)info.f_bavail * (long long)info.f_frsize;
+}
+
+/* The text of errno (the reason of the last failed call), NUL-terminated. */
+void yarnfort_last_error(char *text, int length)
+{
+    if (length <= 0) return;
+    strncpy(text, strerror(errno), (size_t)length - 1);
+    text[length - 1] = '\0';
+}

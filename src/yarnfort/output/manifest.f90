@@ -1,0 +1,216 @@
+! SPDX-License-Identifier: MIT
+!> The manifest of an output folder, folder/.yarnfort-manifest: every file a run wrote
+!> there, so that a later run deletes only files of its own (never one named in a file
+!> another tool may have written, such as a foreign states.pvd). One entry a line:
+!>
+!>     file <name>
+!>     state <name> <step> <time>
+!>
+!> A state is listed before its file is written (a kill in between leaves a listed file
+!> that is incomplete or missing, never an unlisted one). Only names this program writes
+!> are ever taken from the file (is_own_name), so a damaged or foreign manifest cannot
+!> make it delete anything else. The whole file is replaced atomically (tmp + rename);
+!> states are appended one line at a time.
+module yarnfort_output_manifest
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, &
+        close_checked, flush_checked
+    implicit none
+    private
+
+    public :: manifest_type, manifest_file_name, is_own_name, is_state_name
+
+    character(len=*), parameter :: manifest_file_name = '.yarnfort-manifest'
+
+    !> The fixed names a run may write (and their temporaries).
+    character(len=*), parameter :: fixed_names(*) = [character(len=16) :: 'curve.csv', &
+        'curve.csv.tmp', 'input.nml', 'input.nml.tmp', 'restart.dat', 'restart.dat.tmp', &
+        'states.pvd', 'states.pvd.tmp']
+
+    !> Longest file name kept (state names are far shorter).
+    integer, parameter :: entry_length = 64
+
+    type :: manifest_type
+        character(len=:), allocatable :: folder
+        !> Fixed files listed, and states with their step and pseudo-time.
+        character(len=entry_length), allocatable :: files(:), states(:)
+        integer, allocatable :: steps(:)
+        real(wp), allocatable :: times(:)
+        integer :: unit = -1
+    contains
+        !> Read folder's manifest (none: empty); `found` tells whether there was one.
+        procedure :: load
+        !> Replace the folder's manifest by this one, atomically, and keep it open for
+        !> add_state.
+        procedure :: save
+        !> Append a state about to be written.
+        procedure :: add_state
+        procedure :: close => close_manifest
+        !> Set the fixed files to every name a run may write.
+        procedure :: list_fixed_files
+    end type manifest_type
+
+contains
+
+    subroutine load(self, folder, found)
+        class(manifest_type), intent(inout) :: self
+        character(len=*), intent(in) :: folder
+        logical, intent(out) :: found
+        character(len=512) :: line
+        character(len=16) :: kind
+        character(len=entry_length) :: name
+        integer :: unit, status, step
+        real(wp) :: time
+
+        call self%close()
+        self%folder = folder
+        allocate(character(len=entry_length) :: self%files(0), self%states(0))
+        self%steps = [integer :: ]
+        self%times = [real(wp) :: ]
+        open(newunit=unit, file=folder // '/' // manifest_file_name, status='old', &
+            action='read', iostat=status)
+        found = status == 0
+        if (.not. found) return
+        do
+            read(unit, '(a)', iostat=status) line
+            if (status /= 0) exit
+            read(line, *, iostat=status) kind, name
+            if (status /= 0) cycle
+            if (.not. is_own_name(name)) cycle
+            select case (kind)
+            case ('file')
+                if (any(self%files == name)) cycle
+                self%files = [self%files, name]
+            case ('state')
+                if (.not. is_state_name(name)) cycle
+                read(line, *, iostat=status) kind, name, step, time
+                ! A line cut short by a kill still names a file to delete.
+                if (status /= 0) then
+                    step = huge(step)
+                    time = 0.0_wp
+                end if
+                self%states = [self%states, name]
+                self%steps = [self%steps, step]
+                self%times = [self%times, time]
+            end select
+        end do
+        close(unit)
+    end subroutine load
+
+    subroutine list_fixed_files(self)
+        class(manifest_type), intent(inout) :: self
+        integer :: i
+        self%files = [(fixed_names(i), i = 1, size(fixed_names))]
+    end subroutine list_fixed_files
+
+    subroutine save(self, error)
+        class(manifest_type), intent(inout) :: self
+        type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: ignored
+        character(len=:), allocatable :: path, temporary
+        character(len=256) :: message
+        integer :: unit, status, i
+
+        call self%close()
+        path = self%folder // '/' // manifest_file_name
+        temporary = path // '.tmp'
+        open(newunit=unit, file=temporary, status='replace', action='write', iostat=status, &
+            iomsg=message)
+        if (status == 0) then
+            do i = 1, size(self%files)
+                if (status == 0) write(unit, '(a)', iostat=status, iomsg=message) &
+                    'file ' // trim(self%files(i))
+            end do
+            do i = 1, size(self%states)
+                if (status == 0) call put_state(unit, self%states(i), self%steps(i), &
+                    self%times(i), status, message)
+            end do
+            if (status == 0) then
+                call close_checked(unit, temporary, error)
+            else
+                close(unit, status='delete')
+            end if
+        end if
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
+            return
+        end if
+        if (.not. allocated(error)) call sync_file(temporary, error)
+        if (.not. allocated(error)) call rename_file(temporary, path, error)
+        if (allocated(error)) then
+            call remove_file(temporary, ignored)
+            return
+        end if
+        open(newunit=self%unit, file=path, status='old', position='append', action='write', &
+            iostat=status, iomsg=message)
+        if (status /= 0) then
+            self%unit = -1
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+        end if
+    end subroutine save
+
+    subroutine add_state(self, name, step, time, error)
+        class(manifest_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: step
+        real(wp), intent(in) :: time
+        type(error_type), allocatable, intent(out) :: error
+        character(len=256) :: message
+        integer :: status
+
+        if (self%unit == -1) then
+            call fatal_error(error, "'" // self%folder // '/' // manifest_file_name &
+                // "' is not open")
+            return
+        end if
+        call put_state(self%unit, name, step, time, &
+            status, message)
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // self%folder // '/' &
+                // manifest_file_name // "': " // trim(message))
+            return
+        end if
+        call flush_checked(self%unit, self%folder // '/' // manifest_file_name, error)
+        if (allocated(error)) return
+        self%states = [self%states, [character(len=entry_length) :: name]]
+        self%steps = [self%steps, step]
+        self%times = [self%times, time]
+    end subroutine add_state
+
+    subroutine put_state(unit, name, step, time, status, message)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: step
+        real(wp), intent(in) :: time
+        integer, intent(out) :: status
+        character(len=*), intent(inout) :: message
+        write(unit, '("state ", a, 1x, i0, 1x, es24.16e3)', iostat=status, iomsg=message) &
+            trim(name), step, time
+    end subroutine put_state
+
+    subroutine close_manifest(self)
+        class(manifest_type), intent(inout) :: self
+        integer :: status
+        if (self%unit /= -1) close(self%unit, iostat=status)
+        self%unit = -1
+    end subroutine close_manifest
+
+    !> A name this program writes into an output folder: a fixed name, or a state file.
+    pure logical function is_own_name(name)
+        character(len=*), intent(in) :: name
+        is_own_name = any(fixed_names == name) .or. is_state_name(name)
+    end function is_own_name
+
+    !> state_<at least 5 digits>.vtu
+    pure logical function is_state_name(name)
+        character(len=*), intent(in) :: name
+        integer :: n
+        n = len_trim(name)
+        is_state_name = .false.
+        if (n < len('state_00000.vtu')) return
+        if (name(1:6) /= 'state_' .or. name(n - 3:n) /= '.vtu') return
+        is_state_name = verify(name(7:n - 4), '0123456789') == 0
+    end function is_state_name
+
+end module yarnfort_output_manifest

@@ -1,0 +1,226 @@
+# SPDX-License-Identifier: MIT
+"""VTK states for ParaView, checked with two independent readers (meshio and VTK's own
+XML reader): point data (displacement, position, contact state), cell data (tension,
+stretch, L0, kind, yarn, material), the links of a fabric as cells of their own (the
+belt is one connected net), field data (time, step, load factors, a fabric's strain),
+appended base64 binary by default and inline ASCII on request, and states.pvd times."""
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import f90nml
+# The two readers are test dependencies (python/requirements.txt): missing, the tests
+# fail rather than skip.
+import meshio
+import numpy as np
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+
+from yarnfort import read_curve, read_state
+
+TOP = Path(__file__).resolve().parents[2]
+INPUTS = TOP / "inputs"
+TIMEOUT = 300
+
+#: Kinds of cells in a state file.
+ELEMENT, GAP_HOLDER, PERIODIC = 0, 1, 2
+#: Positions and lengths come from the same doubles: a length computed from positions
+#: agrees with stretch * L0 to round-off of the length itself.
+ROUND_OFF = 1e-12
+
+
+def scene(name: str, folder: str, output: str = "") -> str:
+    """An example scene with absolute table paths, writing to `folder`."""
+    text = (INPUTS / f"{name}.nml").read_text()
+    text = text.replace("'inputs/data/", f"'{INPUTS}/data/")
+    lines = []
+    for line in text.splitlines():
+        if line.strip().startswith("folder ="):
+            line = f"    folder = '{folder}'" + (f"\n    {output}" if output else "")
+        lines.append(line)
+    return "\n".join(lines) + "\n"
+
+
+def vtk_read(path: Path):
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    assert reader.GetErrorCode() == 0, path
+    return reader.GetOutput()
+
+
+def vtk_arrays(grid) -> dict[str, np.ndarray]:
+    """Every point, cell and field array of a grid read by VTK, by name."""
+    arrays = {}
+    for data in (grid.GetPointData(), grid.GetCellData()):
+        for i in range(data.GetNumberOfArrays()):
+            arrays[data.GetArrayName(i)] = vtk_to_numpy(data.GetArray(i))
+    field = grid.GetFieldData()
+    for i in range(field.GetNumberOfArrays()):
+        arrays[field.GetArrayName(i)] = vtk_to_numpy(field.GetArray(i))
+    return arrays
+
+
+def meshio_arrays(mesh) -> dict[str, np.ndarray]:
+    arrays = {name: np.asarray(v) for name, v in mesh.point_data.items()}
+    arrays.update({name: np.concatenate(v) for name, v in mesh.cell_data.items()})
+    arrays.update({name: np.asarray(v) for name, v in mesh.field_data.items()})
+    return arrays
+
+
+def collection(folder: Path) -> list[tuple[str, float]]:
+    root = ET.parse(folder / "states.pvd").getroot()
+    return [(d.get("file"), float(d.get("timestep"))) for d in root.iter("DataSet")]
+
+
+def components(n_points: int, pairs: np.ndarray) -> int:
+    """Connected parts of the graph of `pairs` over the nodes that any pair uses."""
+    parent = list(range(n_points))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for a, b in pairs:
+        parent[root(a)] = root(b)
+    used = set(pairs.ravel())
+    return len({root(i) for i in used})
+
+
+def check_state(path: Path, initial: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Read a state with both readers, check they agree with each other and with the
+    geometry of the file (displacement from `initial`, lengths); return the arrays."""
+    mesh = meshio.read(path)
+    grid = vtk_read(path)
+    a, b = meshio_arrays(mesh), vtk_arrays(grid)
+    assert set(a) == set(b)
+    for name in a:
+        np.testing.assert_array_equal(a[name].ravel(), b[name].ravel(), err_msg=name)
+    points = vtk_to_numpy(grid.GetPoints().GetData())
+    np.testing.assert_array_equal(points, mesh.points)
+    assert grid.GetNumberOfCells() == sum(len(c.data) for c in mesh.cells)
+    assert {c.type for c in mesh.cells} == {"line"}
+    np.testing.assert_array_equal(b["position"], points)
+    if initial is not None:
+        # The subtraction was made once in the program: equal to round-off.
+        np.testing.assert_allclose(b["displacement"], points - initial, rtol=0,
+                                   atol=ROUND_OFF * np.abs(points).max())
+    pairs = np.concatenate([c.data for c in mesh.cells])
+    length = np.linalg.norm(points[pairs[:, 1]] - points[pairs[:, 0]], axis=1)
+    scale = length.max()
+    np.testing.assert_allclose(b["stretch"] * b["L0"], length, rtol=0, atol=ROUND_OFF * scale)
+    b["pairs"] = pairs
+    b["points"] = points
+    return b
+
+
+def test_capstan_states_read_by_meshio_and_vtk(run_yarnfort, tmp_path):
+    run = run_yarnfort(scene("capstan", "out"), timeout=TIMEOUT)
+    assert run.returncode == 0, run.stderr
+    out = tmp_path / "out"
+    curve = read_curve(out)
+    listed = collection(out)
+    assert [name for name, _ in listed] == [f"state_{k:05d}.vtu" for k in range(len(listed))]
+    np.testing.assert_array_equal([t for _, t in listed], curve["time"])
+    initial = np.reshape(f90nml.read(INPUTS / "capstan.nml")["nodes"]["xyz"], (-1, 3))
+    for k, (name, time) in enumerate(listed):
+        text = (out / name).read_text()
+        assert 'format="appended"' in text and 'encoding="base64"' in text
+        arrays = check_state(out / name, initial)
+        assert arrays["time"][0] == time and arrays["step"][0] == k
+        assert arrays["p_disp"][0] == curve["p_disp"][k]
+        assert np.all(arrays["kind"] == ELEMENT)
+        # The capstan scene: yarn 1 (material 1, 'yarn', 4 elements) over three pegs,
+        # each held by a yarn of material 2 ('peg', 1 element).
+        np.testing.assert_array_equal(arrays["yarn"], [1, 1, 1, 1, 2, 3, 4])
+        np.testing.assert_array_equal(arrays["material"], [1, 1, 1, 1, 2, 2, 2])
+        # Contact state per node: 0 (no passage), 1 (all stick), 2 (a passage slips);
+        # the nodes with a slipping passage are at most the slipping passages.
+        state = arrays["contact_state"]
+        assert set(state) <= {0, 1, 2} and np.count_nonzero(state) == 3
+        assert np.count_nonzero(state == 2) <= curve["slipping"][k]
+        assert (np.count_nonzero(state == 2) > 0) == (curve["slipping"][k] > 0)
+        # The yarn package reads the same values as VTK.
+        own = read_state(out / name)
+        np.testing.assert_array_equal(own.tension, arrays["tension"])
+        np.testing.assert_array_equal(own.position, arrays["points"])
+
+
+def test_ascii_states_hold_the_same_values(run_yarnfort, tmp_path):
+    assert run_yarnfort(scene("capstan", "binary"), timeout=TIMEOUT).returncode == 0
+    run = run_yarnfort(scene("capstan", "ascii", "vtk_format = 'ascii'"), timeout=TIMEOUT)
+    assert run.returncode == 0, run.stderr
+    assert "vtk_format = 'ascii'" in (tmp_path / "ascii" / "input.nml").read_text()
+    names = [name for name, _ in collection(tmp_path / "binary")]
+    assert names == [name for name, _ in collection(tmp_path / "ascii")]
+    initial = np.reshape(f90nml.read(INPUTS / "capstan.nml")["nodes"]["xyz"], (-1, 3))
+    for name in (names[0], names[len(names) // 2], names[-1]):
+        text = (tmp_path / "ascii" / name).read_text()
+        assert 'format="appended"' not in text and 'format="ascii"' in text
+        a = check_state(tmp_path / "ascii" / name, initial)
+        b = check_state(tmp_path / "binary" / name, initial)
+        # 17 significant digits read back to the same doubles.
+        for key in b:
+            np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+        np.testing.assert_array_equal(read_state(tmp_path / "ascii" / name).tension,
+                                      b["tension"][b["kind"] == ELEMENT])
+
+
+def test_unknown_vtk_format_is_refused(run_yarnfort, tmp_path):
+    run = run_yarnfort(scene("capstan", "out", "vtk_format = 'hdf5'"), timeout=TIMEOUT)
+    assert run.returncode == 2
+    assert "&output: vtk_format = 'hdf5' is unknown (use 'binary' or 'ascii')" in run.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_belt_is_connected_by_its_gap_holders(run_yarnfort, tmp_path):
+    """The twill belt: gap-holders are cells of their own kind and join warp and weft
+    into one net; their stretch is the gap factor of the path (belt.nml's table)."""
+    run = run_yarnfort(scene("belt", "out"), timeout=TIMEOUT)
+    assert run.returncode == 0, run.stderr
+    out = tmp_path / "out"
+    curve = read_curve(out)
+    listed = collection(out)
+    first = check_state(out / listed[0][0])
+    initial = first["points"] - first["displacement"]
+    for name, _ in (listed[0], listed[len(listed) // 2], listed[-1]):
+        # Every state's displacement is from the same initial (generated) geometry.
+        arrays = check_state(out / name, initial)
+        kind, pairs = arrays["kind"], arrays["pairs"]
+        assert set(kind) == {ELEMENT, GAP_HOLDER}
+        n_points = len(arrays["points"])
+        # 12 weft and 8 warp yarns: 20 parts without the gap-holders, one with them.
+        assert components(n_points, pairs[kind == ELEMENT]) == 20
+        assert components(n_points, pairs) == 1
+        assert set(arrays["yarn"][kind == ELEMENT]) == set(range(1, 21))
+        assert np.all(arrays["yarn"][kind != ELEMENT] == 0)
+        assert np.all(arrays["material"][kind != ELEMENT] == 0)
+        assert np.all(arrays["tension"][kind != ELEMENT] == 0)
+        p_disp = arrays["p_disp"][0]
+        factor = np.interp(p_disp, [0.0, 0.5, 1.0], [1.0, 0.8, 0.7])
+        np.testing.assert_allclose(arrays["stretch"][kind == GAP_HOLDER], factor,
+                                   rtol=ROUND_OFF * 1e3)
+        # The fabric's strain and force per width, as in curve.csv.
+        step = int(arrays["step"][0])
+        assert arrays["strain"][0] == curve["strain"][step]
+        assert arrays["force_per_width"][0] == curve["force_per_width"][step]
+
+
+def test_knit_cell_has_periodic_links(run_yarnfort, tmp_path):
+    run = run_yarnfort(scene("knit", "out"), timeout=TIMEOUT)
+    assert run.returncode == 0, run.stderr
+    out = tmp_path / "out"
+    listed = collection(out)
+    curve = read_curve(out)
+    first = check_state(out / listed[0][0])
+    name = listed[len(listed) // 4][0]
+    arrays = check_state(out / name, first["points"] - first["displacement"])
+    kind = arrays["kind"]
+    assert PERIODIC in set(kind) and GAP_HOLDER in set(kind)
+    assert components(len(arrays["points"]), arrays["pairs"]) == 1
+    step = int(arrays["step"][0])
+    assert arrays["strain"][0] == curve["strain"][step]
+    assert np.count_nonzero(arrays["contact_state"]) > 0
