@@ -96,16 +96,6 @@ def wrap_statement(text: str, indent: str) -> list[str]:
             for i, line in enumerate(lines)]
 
 
-def wrap_strings(text: str, indent: str, width: int = WIDTH) -> list[str]:
-    """A Fortran string expression of `text`, over several lines if needed."""
-    chunks = textwrap.wrap(text, width - len(indent) - 10, drop_whitespace=False,
-                           break_long_words=True, break_on_hyphens=False) or [""]
-    quoted = ["'" + c.replace("'", "''") + "'" for c in chunks]
-    return [indent + q + (" &" if i < len(quoted) - 1 else "") if i == 0 else
-            indent + "// " + q + (" &" if i < len(quoted) - 1 else "")
-            for i, q in enumerate(quoted)]
-
-
 def doc_comment(text: str, indent: str) -> list[str]:
     first = re.split(r"(?<=[.:;])\s", text.replace("`", ""), maxsplit=1)[0]
     return [indent + "!> " + line for line in textwrap.wrap(first, WIDTH - len(indent) - 4)]
