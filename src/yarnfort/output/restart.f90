@@ -22,7 +22,7 @@ module yarnfort_output_restart
     use yarnfort_input_config, only: config_type, control_config_type, output_config_type
     use yarnfort_input_echo, only: write_config
     use yarnfort_scene_scene, only: scene_type
-    use yarnfort_input_text, only: resolve_path
+    use yarnfort_text, only: resolve_path
     use yarnfort_solver_restart, only: restart_type, stepper_elastic, stepper_friction
     use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, close_checked
     implicit none
