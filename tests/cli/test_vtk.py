@@ -172,7 +172,7 @@ def test_ascii_states_hold_the_same_values(run_yarnfort, tmp_path):
 def test_unknown_vtk_format_is_refused(run_yarnfort, tmp_path):
     run = run_yarnfort(scene("capstan", "out", "vtk_format = 'hdf5'"), timeout=TIMEOUT)
     assert run.returncode == 2
-    assert "&output: vtk_format = 'hdf5' is unknown (use 'binary' or 'ascii')" in run.stderr
+    assert "&output: vtk_format = 'hdf5' is unknown (use binary, ascii)" in run.stderr
     assert not (tmp_path / "out").exists()
 
 
