@@ -19,9 +19,9 @@ REFERENCE = TOP / "inputs" / "REFERENCE.md"
 PRESETS = {
     "fast": dict(initial_step=0.25, max_step=0.25, residual_tolerance=1e-6,
                  scheme="monolithic"),
-    "balanced": dict(initial_step=0.05, max_step=0.05, residual_tolerance=1e-8,
+    "balanced": dict(initial_step=0.05, max_step=0.05, residual_tolerance=1e-9,
                      scheme="monolithic"),
-    "accurate": dict(initial_step=0.005, max_step=0.005, residual_tolerance=1e-10,
+    "accurate": dict(initial_step=0.01, max_step=0.01, residual_tolerance=1e-11,
                      scheme="monolithic"),
 }
 #: The individual defaults (preset 'custom', or none given).
@@ -82,7 +82,7 @@ def test_explicit_values_override_the_preset(run_yarnfort):
                               " scheme = 'staggered', friction_tolerance = 1e-6")
     assert solver["preset"] == "accurate"
     assert_values(solver, dict(max_step=0.1, scheme="staggered", friction_tolerance=1e-6,
-                               initial_step=0.005, residual_tolerance=1e-10))
+                               initial_step=0.01, residual_tolerance=1e-11))
 
 
 def test_explicit_value_equal_to_the_default_still_overrides(run_yarnfort):
