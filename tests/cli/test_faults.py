@@ -282,16 +282,57 @@ def test_killed_run_leaves_no_stale_lock(tmp_path):
 
 # ------------------------------------------------------------------ step numbers
 
-#: Byte offsets of the fields of restart.dat (format version 1, see output/restart.f90).
+#: Byte offsets of the fields of restart.dat (format version 2, see output/restart.f90).
 OFFSET = {"n_nodes": 36, "n_elements": 40, "n_unknowns": 44, "n_passages": 48, "step": 52,
           "knot": 56, "time": 60, "next_step": 68, "previous_load": 76, "stepper": 84,
           "p_force": 100, "p_disp": 108, "load_old": 116, "have_old": 124, "u": 128}
+#: The file ends with a checksum (16 hex digits) of every byte before it.
+CHECKSUM_LENGTH = 16
 
 
-def patch(path: Path, field: str, fmt: str, value) -> None:
+def checksum(data: bytes) -> bytes:
+    """The restart file's checksum, written here from its description (two 32-bit
+    FNV-1a-like hashes, primes 16777619 and 1000003, bases 2166136261 and 3735928559,
+    over the bytes and then their count as a little-endian int64)."""
+    state = [2166136261, 3735928559]
+    primes = (16777619, 1000003)
+    for byte in data + struct.pack("<q", len(data)):
+        state = [((h ^ byte) * p) % 2**32 for h, p in zip(state, primes)]
+    return f"{state[0]:08X}{state[1]:08X}".encode()
+
+
+def patch(path: Path, field: str, fmt: str, value, restamp: bool = True) -> None:
+    """Overwrite a field; with `restamp`, write the matching checksum too (a file that a
+    faulty writer could have made whole), else leave the old one (damage after it was
+    written)."""
     data = bytearray(path.read_bytes())
     struct.pack_into(fmt, data, OFFSET[field], value)
+    if restamp:
+        data[-CHECKSUM_LENGTH:] = checksum(bytes(data[:-CHECKSUM_LENGTH]))
     path.write_bytes(bytes(data))
+
+
+def test_checksum_of_this_file_format(tmp_path):
+    """The checksum written here from the format's description is the program's."""
+    assert run(with_output(VNET, "out", control="max_steps = 2"), tmp_path).returncode == 0
+    data = (tmp_path / "out" / "restart.dat").read_bytes()
+    assert data[-CHECKSUM_LENGTH:] == checksum(data[:-CHECKSUM_LENGTH])
+
+
+@pytest.mark.parametrize("field, fmt, value", [("u", "<d", 0.123), ("time", "<d", 0.3),
+                                               ("step", "<i", 2)])
+def test_damage_after_writing_is_refused_by_the_checksum(tmp_path, field, fmt, value):
+    """A value changed in the file (any field, also one no other check could judge,
+    such as a position) is refused: exit 2, the checksum named, nothing changed."""
+    assert run(with_output(CAPSTAN, "out", control="max_steps = 4"),
+               tmp_path).returncode == 0
+    restart = tmp_path / "out" / "restart.dat"
+    patch(restart, field, fmt, value, restamp=False)
+    before = (tmp_path / "out" / "curve.csv").read_bytes()
+    again = run(with_output(CAPSTAN, "out", control="restart = .true."), tmp_path)
+    assert again.returncode == 2, again.stderr
+    assert "checksum does not match" in again.stderr
+    assert (tmp_path / "out" / "curve.csv").read_bytes() == before
 
 
 def unpack(path: Path, field: str, fmt: str):
@@ -381,7 +422,7 @@ def test_restart_with_a_changed_geometry_file_is_refused(tmp_path):
 def corrupt(path: Path, field: str, how: str) -> None:
     if field in ("time", "next_step", "p_force", "p_disp", "previous_load"):
         value = unpack(path, field, "<d")
-        new = {"nan": float("nan"), "negative": -abs(value) - 1.0, "zero": 0.0,
+        new = {"nan": float("nan"), "negative": -abs(value) - 1.0, "zero": 0.0, "tiny": 1e-300,
                "huge": 1e300, "shifted": value + 0.0123}[how]
         patch(path, field, "<d", new)
     elif field == "stepper":
@@ -402,10 +443,12 @@ def corrupt(path: Path, field: str, how: str) -> None:
     ("time", "nan", "time NaN is not on the load path"),
     ("time", "huge", "is not on the load path"),
     ("time", "shifted", "are not those of the path at its time"),
-    ("next_step", "zero", "next step 0.000000E+00 is not in (0, max_step = 5.000000E-02]"),
-    ("next_step", "negative", "is not in (0, max_step"),
+    ("next_step", "zero", "next step 0.000000E+00 is not in [min_step = 1.000000E-06, "
+                          "max_step = 5.000000E-02]"),
+    ("next_step", "tiny", "is not in [min_step"),
+    ("next_step", "negative", "is not in [min_step"),
     ("next_step", "nan", "next step NaN is not in"),
-    ("next_step", "huge", "is not in (0, max_step"),
+    ("next_step", "huge", "is not in [min_step"),
     ("p_disp", "shifted", "are not those of the path at its time"),
     ("previous_load", "huge", "is not p_force + p_disp"),
     ("stepper", "", "its stepper 'elastic' is not 'friction'"),

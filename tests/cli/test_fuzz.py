@@ -6,7 +6,11 @@ table laws made linear) are mutated at random
 with a fixed seed: characters and lines deleted, inserted, duplicated or swapped, the text
 truncated, numbers replaced by extreme values (0, -1, 1e300, nan, huge integers, ...),
 small integers or scaled ones, names replaced by garbage, group names changed, '=', '/'
-and ',' swapped, quotes broken, subscripts and repeat counts added. Most cases only read
+and ',' swapped, quotes broken, subscripts and repeat counts added; and the families of
+issue 14: other encodings (a UTF-8 byte order mark, CR-only or CRLF line ends, bytes that
+are not ASCII, a NUL), long lines (a group or the whole input on one line, a comment line
+of 200 kB), an entry set again by a later subscript, and the reader's own "not set"
+markers as values (-huge, -2147483647). Most cases only read
 and check the input (``check_only = .true.`` put first in &control: reading, checks and
 scene set-up, no solve, no output); a few hundred run in full, bounded by
 ``max_steps = RUN_MAX_STEPS`` in &control and a per-case timeout. For every case:
@@ -15,7 +19,15 @@ scene set-up, no solve, no output); a few hundred run in full, bounded by
 - stderr has exactly one ``yarnfort: error (...)`` line when the exit code is not 0 and
   none when it is 0, and never a Fortran runtime error or a backtrace;
 - a case that fails on its input writes nothing, nor does a check-only case;
-- no output file (curve.csv, states.pvd, *.vtu) holds NaN or Infinity.
+- no output file (curve.csv, states.pvd, *.vtu) holds NaN or Infinity (the VTK states
+  are read with yarnfort.read_state, whatever their encoding).
+
+A third family damages restart files: a run of each seed stops after a few steps
+(``max_steps``), then bytes or whole fields of its ``restart.dat`` are overwritten at
+random (sizes, step, time, knot, next step, load factors, flags, values) and the run is
+continued with ``restart = .true.``. Beyond the rules above, a restart that is accepted
+(exit code 0) must give the curve of the uninterrupted run (1e-6 relative): a damaged
+file is refused or harmless, never silently used.
 
 Cases run in batches (one pytest item per batch) on ``FUZZ_WORKERS`` processes (default
 2), each case in a folder of its own under the test's tmp folder; file names in the
@@ -33,6 +45,7 @@ import os
 import random
 import re
 import shutil
+import struct
 import subprocess
 import sys
 import threading
@@ -41,7 +54,11 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+from test_faults import CHECKSUM_LENGTH, checksum
+from yarnfort.results import read_curve, read_state
 
 TOP = Path(__file__).resolve().parents[2]
 SEEDS = {name: (TOP / "inputs" / f"{name}.nml").read_text() for name in ("vnet", "capstan")}
@@ -100,11 +117,17 @@ VARIABLES = ("title", "check_only", "restart", "max_steps", "linear_solver",
              "p_force", "p_disp", "folder", "vtk_every", "progress", "residual_history", "kind",
              "cells", "spacing")
 GARBAGE_CHARACTERS = ("abcdefghijklmnopqrstuvwxyzABCXYZ0123456789_ &/=!'\",*()$;.:%\t-+")
+#: Values equal to the reader's internal "not set" markers, and their neighbours.
+MARKER_VALUES = ("-1.7976931348623157e308", "-1.7976931348623157d308", "-1.797e308",
+                 "1.7976931348623157e308", "-2147483647", "-2147483648", "2147483647",
+                 "-1", "-1.0")
+#: Text that is not plain ASCII: accented letters, a byte order mark, a NUL, a tab.
+FOREIGN_TEXT = ("\u00e9", "\u00b5m", "\ufeff", "\x00", "\t", "\u2013", "\x7f")
 
 NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?(?![\w.])")
 WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 GROUP_NAME = re.compile(r"[&$]([A-Za-z_]\w*)")
-ASSIGNMENT = re.compile(r"([A-Za-z_]\w*)(\s*=)")
+ASSIGNMENT = re.compile(r"\b([A-Za-z_]\w{0,63})(\s*=)")
 DELIMITER = re.compile(r"[=/,]")
 QUOTE = re.compile(r"['\"]")
 
@@ -112,7 +135,6 @@ ERROR_LINE = re.compile(r"^yarnfort: error \([a-z]+\): \S", re.MULTILINE)
 CRASH_MARKERS = ("Fortran runtime", "Program received signal", "Backtrace", "ERROR STOP",
                  "Error termination", "Segmentation fault", "malloc", "core dumped")
 NON_FINITE = re.compile(r"(?<![A-Za-z_])[-+]?(?:nan|inf(?:inity)?)(?![A-Za-z_])", re.IGNORECASE)
-DATA_ARRAY = re.compile(r"<DataArray[^>]*>(.*?)</DataArray>", re.DOTALL)
 
 
 # ---------------------------------------------------------------- mutations
@@ -262,11 +284,66 @@ def long_value(rng: random.Random, text: str) -> str:
     return _replace(text, match, value) if match else text
 
 
+def byte_order_mark(rng: random.Random, text: str) -> str:
+    return "\ufeff" + text
+
+
+def line_ends(rng: random.Random, text: str) -> str:
+    """CR-only (old Mac) or CRLF line ends, everywhere or from a random line on."""
+    end = rng.choice(("\r", "\r\n"))
+    lines = text.split("\n")
+    start = rng.randrange(len(lines)) if rng.random() < 0.3 else 0
+    return "\n".join(lines[:start]) + ("\n" if start else "") + end.join(lines[start:])
+
+
+def foreign_text(rng: random.Random, text: str) -> str:
+    i = rng.randint(0, len(text))
+    return text[:i] + rng.choice(FOREIGN_TEXT) + text[i:]
+
+
+def one_line(rng: random.Random, text: str) -> str:
+    """A group, or the whole input, on one line (comments dropped: they would swallow
+    the rest of the line)."""
+    body = re.sub(r"!.*", "", text)
+    if rng.random() < 0.5:
+        return " ".join(body.splitlines())
+    groups = list(re.finditer(r"[&$]\w+.*?^\s*/", body, flags=re.MULTILINE | re.DOTALL))
+    if not groups:
+        return body
+    g = rng.choice(groups)
+    return body[:g.start()] + " ".join(g.group(0).splitlines()) + body[g.end():]
+
+
+def long_comment(rng: random.Random, text: str) -> str:
+    lines = text.splitlines(keepends=True)
+    lines.insert(rng.randint(0, len(lines)), "! " + "x" * 200_000 + "\n")
+    return "".join(lines)
+
+
+def subscript_again(rng: random.Random, text: str) -> str:
+    """An entry of an assigned list set again by a later subscript in the same group
+    (documented "set only once"; e.g. p_force = 0, 1, 0 then p_force(2) = 3)."""
+    match = _pick(rng, ASSIGNMENT, text)
+    if not match:
+        return text
+    end = text.find("/", match.end())
+    if end < 0:
+        return text
+    value = rng.choice(("3", "0.5", "1", "'x'", ".true."))
+    return text[:end] + f" {match.group(1)}({rng.randint(1, 3)}) = {value} " + text[end:]
+
+
+def marker_value(rng: random.Random, text: str) -> str:
+    match = _pick(rng, NUMBER, text)
+    return _replace(text, match, rng.choice(MARKER_VALUES)) if match else text
+
+
 MUTATIONS = (delete_character, insert_character, delete_line, duplicate_line, swap_lines,
              extreme_number, extreme_number, extreme_number, small_integer, small_integer,
              scale_number, swap_numbers, truncate, garbage_name, rename_group, swap_delimiter,
              add_subscript, add_repeat_count, break_quote, long_value, add_assignment,
-             add_assignment)
+             add_assignment, byte_order_mark, line_ends, foreign_text, one_line, long_comment,
+             subscript_again, subscript_again, marker_value, marker_value)
 
 
 def sanitize(text: str) -> str:
@@ -344,12 +421,16 @@ def non_finite_in_outputs(folder: Path) -> list[str]:
                     if not finite:
                         bad.append(f"{path.name}: {value}")
                         break
-        elif path.suffix == ".vtu":
-            for block in DATA_ARRAY.findall(text):
-                match = NON_FINITE.search(block)
-                if match:
-                    bad.append(f"{path.name}: {match.group(0)}")
-                    break
+        elif path.suffix == ".vtu" and not path.name.endswith(".tmp"):
+            try:
+                state = read_state(path)
+            except Exception as error:          # noqa: BLE001 (any unreadable state)
+                bad.append(f"{path.name}: unreadable ({error})")
+                continue
+            arrays = [state.position, state.tension, state.stretch, state.length0,
+                      *state.point_data.values(), *state.cell_data.values()]
+            if not all(np.all(np.isfinite(np.asarray(a, dtype=float))) for a in arrays):
+                bad.append(f"{path.name}: a non-finite value")
         elif path.suffix == ".pvd":
             match = NON_FINITE.search(" ".join(re.findall(r'timestep="([^"]*)"', text)))
             if match:
@@ -454,6 +535,133 @@ def test_fuzz_check_only(executable, tmp_path, batch):
 def test_fuzz_full_run(executable, tmp_path, batch):
     """Mutated inputs, run in full: never a crash or a hang, no NaN in any output."""
     run_batch(executable, "run", batch, RUN_CASES_PER_BATCH, tmp_path)
+
+
+# ---------------------------------------------------------------- damaged restart files
+
+#: Restart cases per batch, and batches.
+RESTART_BATCHES, RESTART_CASES_PER_BATCH = 2, 40
+#: Byte offsets and types of the header fields of restart.dat (format version 1, see
+#: src/yarnfort/output/restart.f90): after the 16-byte magic, the version and the
+#: 16-byte fingerprint come n_nodes, n_elements, n_unknowns, n_passages, step, knot
+#: (int32), time, next_step, previous_load (float64), the stepper (16 bytes), p_force,
+#: p_disp, load_old (float64) and have_old (int32); the arrays follow.
+RESTART_FIELDS = ([(36 + 4 * k, "<i") for k in range(6)]
+                  + [(60 + 8 * k, "<d") for k in range(3)]
+                  + [(100 + 8 * k, "<d") for k in range(3)] + [(124, "<i")])
+INT_DAMAGE = (0, -1, 1, 2, 7, 1000, 2**31 - 1, -2**31, 123456)
+REAL_DAMAGE = (0.0, -1.0, 1e-300, 1e300, -1e300, float("nan"), float("inf"), 0.5, 2.0,
+               1e8, -0.0)
+#: Curve columns compared between an accepted restart and the uninterrupted run.
+CURVE_RTOL = 1e-6
+
+
+def output_folder(text: str) -> str:
+    match = re.search(r"folder\s*=\s*'([^']*)'", text)
+    return match.group(1) if match else "out"
+
+
+def damage_restart(rng: random.Random, path: Path) -> str:
+    """Overwrite a header field with a damaging value (its checksum made to match in
+    half the cases: a file a faulty writer could have made, which the field checks must
+    refuse), or change bytes anywhere (the checksum must refuse them); returns what was
+    done."""
+    data = bytearray(path.read_bytes())
+    if rng.random() < 0.6:
+        offset, kind = rng.choice(RESTART_FIELDS)
+        value = rng.choice(INT_DAMAGE if kind == "<i" else REAL_DAMAGE)
+        data[offset:offset + struct.calcsize(kind)] = struct.pack(kind, value)
+        what = f"field at byte {offset} = {value}"
+        if rng.random() < 0.5:
+            data[-CHECKSUM_LENGTH:] = checksum(bytes(data[:-CHECKSUM_LENGTH]))
+            what += " (checksum restamped)"
+    else:
+        offsets = [rng.randrange(len(data)) for _ in range(rng.randint(1, 4))]
+        for offset in offsets:
+            data[offset] = rng.randrange(256)
+        what = f"bytes at {offsets} changed"
+    if rng.random() < 0.1:
+        data = data[:rng.randrange(len(data))]
+        what += ", then truncated"
+    path.write_bytes(bytes(data))
+    return what
+
+
+def curve_columns(folder: Path) -> dict[str, np.ndarray]:
+    curve = read_curve(folder)
+    return {name: np.asarray(curve[name]) for name in curve.columns
+            if name in ("step", "p_force", "p_disp") or "_r" in name}
+
+
+def run_restart_batch(executable: Path, batch: int, count: int, tmp_path: Path) -> None:
+    rng = random.Random(f"{SEED}-restart-{batch}")
+    references: dict[str, dict[str, np.ndarray]] = {}
+    for name, text in SEEDS.items():
+        folder = tmp_path / f"full_{name}"
+        outcome = run_case(executable, Case("restart", batch, -1, name, [], text), folder)
+        assert outcome.returncode == 0 and not outcome.problems, outcome.stderr
+        references[name] = curve_columns(folder / output_folder(text))
+    problems, codes, accepted = [], {0: 0, 1: 0, 2: 0}, 0
+    for index in range(count):
+        if Budget.remaining() <= 0:
+            break
+        seed_name = rng.choice(sorted(SEEDS))
+        text = SEEDS[seed_name]
+        folder = tmp_path / f"restart_{batch}_{index}"
+        stop = run_case(executable, Case("restart", batch, index, seed_name, [],
+                                         with_control(text, f"max_steps = {rng.randint(1, 8)}")),
+                        folder)
+        restart = folder / output_folder(text) / "restart.dat"
+        if stop.returncode != 0 or not restart.exists():
+            problems.append(f"case {index}: the stopping run failed: {stop.stderr[-300:]}")
+            continue
+        what = damage_restart(rng, restart)
+        case = Case("restart", batch, index, seed_name, [what],
+                    with_control(text, "restart = .true."))
+        outcome = Outcome(case)
+        start = time.monotonic()
+        try:
+            proc = subprocess.run([str(executable)], input=case.text.encode(),
+                                  capture_output=True, cwd=folder, timeout=CASE_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            problems.append(f"case {index} ({seed_name}, {what}): timeout")
+            continue
+        outcome.seconds = time.monotonic() - start
+        stderr = proc.stderr.decode(errors="replace")
+        codes[proc.returncode] = codes.get(proc.returncode, 0) + 1
+        errors = ERROR_LINE.findall(stderr)
+        bad = [f"exit code {proc.returncode}"] if proc.returncode not in (0, 1, 2) else []
+        bad += [f"'{m}' on stderr" for m in CRASH_MARKERS if m in stderr]
+        if (proc.returncode == 0) == bool(errors) or len(errors) > 1:
+            bad.append(f"exit code {proc.returncode} with {len(errors)} error lines")
+        bad += non_finite_in_outputs(folder)
+        if proc.returncode == 0:
+            accepted += 1
+            got = curve_columns(folder / output_folder(text))
+            want = references[seed_name]
+            if any(got[k].shape != want[k].shape or not np.allclose(
+                    got[k], want[k], rtol=CURVE_RTOL, atol=CURVE_RTOL * np.max(np.abs(want[k])))
+                    for k in want):
+                bad.append("accepted, but its curve is not the uninterrupted run's")
+        if bad:
+            problems.append(f"case {index} ({seed_name}, {what}): {'; '.join(bad)}; "
+                            f"stderr: {stderr.strip()[-300:]}")
+        else:
+            shutil.rmtree(folder, ignore_errors=True)
+    print(f"fuzz restart batch {batch}: {sum(codes.values())} damaged restarts, exit codes "
+          f"{codes}, {accepted} accepted (each with the uninterrupted curve), "
+          f"{len(problems)} failed")
+    if not sum(codes.values()):
+        pytest.skip("wall-clock budget used up before any restart case")
+    assert not problems, "\n".join(problems[:8])
+    assert codes.get(2, 0) > 0, "no damaged restart file was refused: does the damage reach?"
+
+
+@pytest.mark.parametrize("batch", range(RESTART_BATCHES))
+def test_fuzz_damaged_restart(executable, tmp_path, batch):
+    """Damaged restart.dat files: refused with a message, or harmless; never a crash, a
+    hang, or a silently different curve."""
+    run_restart_batch(executable, batch, RESTART_CASES_PER_BATCH, tmp_path)
 
 
 def test_fuzz_cases_are_reproducible():

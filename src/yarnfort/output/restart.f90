@@ -4,7 +4,7 @@
 !> restart.dat.tmp and renamed over restart.dat, so a run killed at any moment leaves
 !> either the previous complete file or the new one.
 !>
-!> Binary (unformatted stream, native byte order, full precision), version 1:
+!> Binary (unformatted stream, native byte order, full precision), version 2:
 !>     'yarnfort-restart' (16 characters), version (integer),
 !>     input fingerprint (16 characters),
 !>     n_nodes, n_elements, n_unknowns, n_passages, step, knot (integers),
@@ -12,7 +12,8 @@
 !>     p_force, p_disp, load_old (reals), have_old (integer 0 or 1),
 !>     u(n_unknowns), u_old(n_unknowns), length0(n_elements),
 !>     flow(n_passages), flow_old(n_passages) (reals), mode(n_passages) (integers),
-!>     'end-of-restart' (16 characters).
+!>     'end-of-restart' (16 characters), then the checksum of every byte before it
+!>     (16 hex digits), so a file damaged after it was written is refused.
 !> Integers are default integers (4 bytes), reals 8 bytes.
 module yarnfort_output_restart
     use, intrinsic :: iso_fortran_env, only: int8, int64
@@ -34,7 +35,7 @@ module yarnfort_output_restart
     character(len=*), parameter :: restart_file_name = 'restart.dat'
     character(len=16), parameter :: magic = 'yarnfort-restart'
     character(len=16), parameter :: end_marker = 'end-of-restart'
-    integer, parameter :: format_version = 1
+    integer, parameter :: format_version = 2
 
     !> Two 32-bit multiplicative hashes of the FNV-1a kind (FNV's offset basis and prime,
     !> and a second basis and prime) make the 64-bit fingerprint. Values stay below
@@ -104,6 +105,7 @@ contains
             return
         end if
         call close_checked(unit, temporary, error)
+        if (.not. allocated(error)) call append_checksum(temporary, error)
         if (allocated(error)) then
             call remove_file(temporary, ignored)
             error%message = error%message // kept()
@@ -147,8 +149,9 @@ contains
         type(restart_type), intent(out) :: snapshot
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: path
-        character(len=16) :: header, marker
+        character(len=16) :: header, marker, checksum, digest
         character(len=32) :: text
+        integer(int64) :: state(2)
         character(len=256) :: message
         integer :: unit, status, version, have_old
         integer(int64) :: file_size, position, expected
@@ -182,7 +185,8 @@ contains
             close(unit)
             write(text, '(i0)') version
             call fatal_error(error, "&control restart: '" // path // "' has format version " &
-                // trim(text) // ', this yarnfort reads version 1')
+                // trim(text) // ', this yarnfort reads version ' &
+                // format_integer_text(format_version))
             return
         end if
         associate(s => snapshot)
@@ -205,7 +209,8 @@ contains
             ! What follows must be exactly the arrays of these sizes and the end marker.
             inquire(unit=unit, size=file_size, pos=position)
             expected = 8_int64 * (2_int64 * s%n_unknowns + s%n_elements &
-                + 2_int64 * s%n_passages) + 4_int64 * s%n_passages + len(end_marker)
+                + 2_int64 * s%n_passages) + 4_int64 * s%n_passages + len(end_marker) &
+                + len(checksum)
             if (file_size - (position - 1) /= expected) then
                 close(unit)
                 write(text, '(i0)') file_size
@@ -225,7 +230,7 @@ contains
                 return
             end if
             read(unit, iostat=status) s%u, s%u_old, s%length0, s%flow, s%flow_old, s%mode, &
-                marker
+                marker, checksum
             if (status == 0 .and. marker /= end_marker) status = -1
         end associate
         close(unit)
@@ -234,12 +239,20 @@ contains
                 // "' is cut short or unreadable")
             return
         end if
+        state = hash_basis
+        call add_file_bytes(state, path, file_size - len(checksum))
+        write(digest, '(z8.8, z8.8)') state(1), state(2)
+        if (digest /= checksum) then
+            call fatal_error(error, "&control restart: '" // path // "' is damaged: its " &
+                // 'checksum does not match its content')
+            return
+        end if
     end subroutine read_restart
 
     !> Fail unless `snapshot` was written for this scene and its path: the same sizes,
     !> the same input fingerprint (`input_hash`, from get_input_hash), the stepper of the
     !> scene, and fields that a run of this scene can have written: a step >= 0, a time
-    !> on the path with the knot it heads for, a next step size in (0, max_step], the
+    !> on the path with the knot it heads for, a next step size in [min_step, max_step], the
     !> load factors of the path at that time, finite unknowns and flows, positive
     !> reference lengths and known passage modes.
     subroutine check_restart(snapshot, scene, input_hash, folder, error)
@@ -307,11 +320,11 @@ contains
                 return
             end if
         end associate
-        if (.not. (snapshot%next_step > 0.0_wp .and. &
+        if (.not. (snapshot%next_step >= scene%solver%min_step .and. &
                 snapshot%next_step <= scene%solver%max_step)) then
             call damaged('next step ' // format_real_text(snapshot%next_step) &
-                // ' is not in (0, max_step = ' // format_real_text(scene%solver%max_step) &
-                // ']')
+                // ' is not in [min_step = ' // format_real_text(scene%solver%min_step) &
+                // ', max_step = ' // format_real_text(scene%solver%max_step) // ']')
             return
         end if
         ! The run computed these factors from the same time by the same code: they agree
@@ -447,42 +460,80 @@ contains
     contains
         subroutine add_bytes(bytes)
             integer(int8), intent(in) :: bytes(:)
-            integer :: i
-            do i = 1, size(bytes)
-                state = mod(ieor(state, iand(int(bytes(i), int64), 255_int64)) &
-                    * hash_prime, two_32)
-            end do
+            call add_hash_bytes(state, bytes)
         end subroutine add_bytes
 
-        !> The bytes of a file, then its length; an unreadable file adds a marker (its
-        !> fingerprint then differs from that of any readable content).
         subroutine add_file(path)
             character(len=*), intent(in) :: path
-            integer(int8) :: bytes(hash_chunk)
-            integer(int64) :: file_size, done
-            integer :: file, stat, n
-
-            open(newunit=file, file=path, access='stream', form='unformatted', &
-                status='old', action='read', iostat=stat)
-            if (stat /= 0) then
-                call add_bytes(transfer('unreadable file', [0_int8]))
-                return
-            end if
-            inquire(unit=file, size=file_size)
-            done = 0
-            do while (done < file_size)
-                n = int(min(int(hash_chunk, int64), file_size - done))
-                read(file, iostat=stat) bytes(:n)
-                if (stat /= 0) then
-                    call add_bytes(transfer('unreadable file', [0_int8]))
-                    exit
-                end if
-                call add_bytes(bytes(:n))
-                done = done + n
-            end do
-            close(file)
-            call add_bytes(transfer(file_size, [0_int8]))
+            call add_file_bytes(state, path)
         end subroutine add_file
     end function get_input_hash
+
+    !> Add `bytes` to the two 32-bit FNV-1a-like hashes of `state`.
+    pure subroutine add_hash_bytes(state, bytes)
+        integer(int64), intent(inout) :: state(2)
+        integer(int8), intent(in) :: bytes(:)
+        integer :: i
+        do i = 1, size(bytes)
+            state = mod(ieor(state, iand(int(bytes(i), int64), 255_int64)) * hash_prime, two_32)
+        end do
+    end subroutine add_hash_bytes
+
+    !> Add the bytes of a file (its first `limit` bytes if given), then their count; an
+    !> unreadable file adds a marker (its hash then differs from that of any content).
+    subroutine add_file_bytes(state, path, limit)
+        integer(int64), intent(inout) :: state(2)
+        character(len=*), intent(in) :: path
+        integer(int64), intent(in), optional :: limit
+        integer(int8) :: bytes(hash_chunk)
+        integer(int64) :: file_size, done
+        integer :: file, stat, n
+
+        open(newunit=file, file=path, access='stream', form='unformatted', &
+            status='old', action='read', iostat=stat)
+        if (stat /= 0) then
+            call add_hash_bytes(state, transfer('unreadable file', [0_int8]))
+            return
+        end if
+        inquire(unit=file, size=file_size)
+        if (present(limit)) file_size = min(file_size, limit)
+        done = 0
+        do while (done < file_size)
+            n = int(min(int(hash_chunk, int64), file_size - done))
+            read(file, iostat=stat) bytes(:n)
+            if (stat /= 0) then
+                call add_hash_bytes(state, transfer('unreadable file', [0_int8]))
+                exit
+            end if
+            call add_hash_bytes(state, bytes(:n))
+            done = done + n
+        end do
+        close(file)
+        call add_hash_bytes(state, transfer(file_size, [0_int8]))
+    end subroutine add_file_bytes
+
+    !> Append to the restart file `path` (closed, complete up to its end marker) the
+    !> checksum of its bytes.
+    subroutine append_checksum(path, error)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        integer(int64) :: state(2)
+        character(len=16) :: digest
+        character(len=256) :: message
+        integer :: unit, status
+
+        state = hash_basis
+        call add_file_bytes(state, path)
+        write(digest, '(z8.8, z8.8)') state(1), state(2)
+        message = ''
+        open(newunit=unit, file=path, access='stream', form='unformatted', status='old', &
+            position='append', action='write', iostat=status, iomsg=message)
+        if (status == 0) write(unit, iostat=status, iomsg=message) digest
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+            return
+        end if
+        call close_checked(unit, path, error)
+    end subroutine append_checksum
 
 end module yarnfort_output_restart

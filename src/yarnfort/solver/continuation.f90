@@ -166,6 +166,8 @@ contains
                 else
                     dt = min(max(dt, (t_next - t) / interval), scene%solver%max_step)
                 end if
+                ! A short step to a knot does not make the next one shorter than min_step.
+                dt = max(dt, scene%solver%min_step)
                 call report(cuts)
                 if (allocated(error)) return
                 call checkpoint(t_next)
