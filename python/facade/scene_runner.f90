@@ -14,7 +14,6 @@ module yarnfort_facade_scene_runner
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_input_config, only: config_type
     use yarnfort_input_namelist, only: read_config, check_config
-    use yarnfort_input_echo, only: write_config
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_output_writer, only: output_writer_type
     use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash
@@ -122,12 +121,18 @@ contains
                 call set_stage(error, 'restart', status_input)
                 return
             end if
-            call writer%open(scene, error, resume_step=restart%step)
+            call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time)
         else
             call writer%open(scene, error)
         end if
-        if (.not. allocated(error)) call write_effective_input(config, error)
         if (allocated(error)) then
+            call set_stage(error, 'output', status_input)
+            return
+        end if
+        ! The effective input, written as the program writes it (checked, atomic).
+        call writer%write_input(config, error)
+        if (allocated(error)) then
+            call writer%finish(scene, finish_error)     ! releases the folder's lock
             call set_stage(error, 'output', status_input)
             return
         end if
@@ -208,24 +213,6 @@ contains
         call fatal_error(error, 'stopped on request')
         error%stat = status_stop_request
     end subroutine on_checkpoint
-
-    !> Echo the effective input to <folder>/input.nml, as the program does.
-    subroutine write_effective_input(config, error)
-        type(config_type), intent(in) :: config
-        type(error_type), allocatable, intent(out) :: error
-        character(len=:), allocatable :: file
-        character(len=iomsg_length) :: iomsg
-        integer :: unit, stat
-
-        file = trim(config%output%folder) // '/input.nml'
-        open(newunit=unit, file=file, status='replace', action='write', iostat=stat, &
-            iomsg=iomsg)
-        if (stat == 0) then
-            call write_config(unit, config)
-            close(unit, iostat=stat, iomsg=iomsg)
-        end if
-        if (stat /= 0) call fatal_error(error, "cannot write '" // file // "': " // trim(iomsg))
-    end subroutine write_effective_input
 
     !> Name the stage in front of the message and set the status.
     subroutine set_stage(error, stage, status)

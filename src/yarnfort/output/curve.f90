@@ -5,6 +5,7 @@ module yarnfort_output_curve
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
+    use yarnfort_text, only: read_line
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, &
         flush_checked, truncate_file
     implicit none
@@ -98,6 +99,7 @@ contains
         character(len=32) :: text
         character(len=256) :: message
         integer :: old, new, status, row_step, comma, last_kept, write_status
+        character(len=256) :: read_message
         real(wp) :: row_time
 
         path = folder // '/' // curve_file_name
@@ -108,7 +110,7 @@ contains
             return
         end if
         header = get_header(scene)
-        call read_line(old, line, status)
+        call read_line(old, line, status, read_message)
         if (status /= 0 .or. line /= header) then
             close(old)
             call fatal_error(error, "&control restart: '" // path // "' has other columns " &
@@ -127,7 +129,7 @@ contains
         last_kept = -1
         row_time = -huge(row_time)
         do
-            call read_line(old, line, status)
+            call read_line(old, line, status, read_message)
             if (status /= 0) exit
             ! A complete row has as many fields as the header (a row cut short by a kill
             ! has fewer) and starts with its step number.
@@ -195,24 +197,6 @@ contains
             end do
         end function count_commas
     end subroutine resume_curve
-
-    !> One whole line of a formatted sequential unit, however long; status /= 0 at the
-    !> end of the file.
-    subroutine read_line(unit, line, status)
-        integer, intent(in) :: unit
-        character(len=:), allocatable, intent(out) :: line
-        integer, intent(out) :: status
-        character(len=1024) :: chunk
-        integer :: n
-
-        line = ''
-        do
-            read(unit, '(a)', advance='no', size=n, iostat=status) chunk
-            line = line // chunk(:n)
-            if (status /= 0) exit
-        end do
-        if (is_iostat_eor(status)) status = 0
-    end subroutine read_line
 
     !> The header line of the curve file for `scene` (columns: see open_curve).
     function get_header(scene) result(header)
