@@ -2,6 +2,7 @@
 !> Global assembly: internal forces, residual and sparse Jacobian of the equilibrium
 !> equations (paper eq. 46 with constraints eliminated, eqs. 51-52).
 module yarnfort_assembly_assemble
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
@@ -42,9 +43,24 @@ contains
             if (allocated(error)) return
             call get_truss_response(scene%laws(scene%network%element_material(e))%law, &
                 weight, length0(e), x(:, n1), x(:, n2), tension(e), stretch(e), force)
+            if (.not. ieee_is_finite(tension(e))) then
+                call overflow(e, stretch(e))
+                return
+            end if
             internal(3 * n1 - 2:3 * n1) = internal(3 * n1 - 2:3 * n1) - force
             internal(3 * n2 - 2:3 * n2) = internal(3 * n2 - 2:3 * n2) + force
         end do
+    contains
+        subroutine overflow(element, element_stretch)
+            integer, intent(in) :: element
+            real(wp), intent(in) :: element_stretch
+            character(len=200) :: buffer
+            write(buffer, '("element ", i0, " (material ''", a, "''): its tension at stretch ", &
+                &es10.3, " is not a finite number (the force law''s scale is too large ", &
+                &"for double precision)")') element, &
+                trim(scene%laws(scene%network%element_material(element))%name), element_stretch
+            call fatal_error(error, trim(buffer))
+        end subroutine overflow
     end subroutine assemble_internal_force
 
     !> Residual on the unknowns: P^T (internal - p_force * external); `spring` as for

@@ -16,6 +16,7 @@
 !> pseudo-transient continuation (solve_transient).
 module yarnfort_solver_newton
     use, intrinsic :: iso_c_binding
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use fsundials_context_mod
     use fkinsol_mod
     use fnvector_serial_mod
@@ -486,9 +487,10 @@ contains
         problem%residual_time = problem%residual_time + (wall_time() - start)
         ierr = 0
         if (allocated(problem%error)) ierr = -1
-        if (ierr == 0 .and. any(f /= f)) then
+        if (ierr == 0 .and. .not. all(ieee_is_finite(f))) then
             ierr = -1
-            call fatal_error(problem%error, 'the residual is not a number (NaN)')
+            call fatal_error(problem%error, 'the residual is not a finite number (NaN or ' &
+                // 'an overflow)')
         end if
     end function residual_callback
 
