@@ -1,8 +1,9 @@
 ! SPDX-License-Identifier: MIT
 !> Fill a step state (positions, tensions, reactions) from unknowns and reference lengths.
 module yarnfort_solver_state
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
-    use yarnfort_error, only: error_type
+    use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_assembly_assemble, only: assemble_internal_force
     use yarnfort_solver_stepper, only: step_state_type
@@ -45,6 +46,13 @@ contains
                 k = mod(c - 1, 3) + 1
                 state%reaction(k, s) = state%reaction(k, s) + internal(c)
             end do
+            if (.not. all(ieee_is_finite(state%reaction(:, s)))) then
+                call fatal_error(error, "the reaction of support set '" &
+                    // trim(scene%supports(s)%name) // "' is not a finite number (its " &
+                    // "tensions add up beyond double precision: the force law's scale is " &
+                    // 'too large)')
+                return
+            end if
         end do
     end subroutine fill_step_state
 
