@@ -54,6 +54,14 @@ contains
                 return
             end if
         end do
+        if (scene%fabric_set > 0) then
+            if (.not. ieee_is_finite(state%reaction(1, scene%fabric_set) &
+                    / scene%fabric_width)) then
+                call fatal_error(error, 'the force per width of the fabric is not a finite ' &
+                    // "number (the force law's scale is too large for double precision)")
+                return
+            end if
+        end if
     end subroutine fill_step_state
 
 end module yarnfort_solver_state
