@@ -23,7 +23,7 @@ module yarnfort_output_restart
     use yarnfort_input_config, only: config_type, control_config_type, output_config_type
     use yarnfort_input_echo, only: write_config
     use yarnfort_scene_scene, only: scene_type
-    use yarnfort_text, only: resolve_path
+    use yarnfort_text, only: resolve_path, format_integer, format_real
     use yarnfort_solver_restart, only: restart_type, stepper_elastic, stepper_friction
     use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, close_checked
     implicit none
@@ -186,7 +186,7 @@ contains
             write(text, '(i0)') version
             call fatal_error(error, "&control restart: '" // path // "' has format version " &
                 // trim(text) // ', this yarnfort reads version ' &
-                // format_integer_text(format_version))
+                // format_integer(format_version))
             return
         end if
         associate(s => snapshot)
@@ -293,7 +293,7 @@ contains
             return
         end if
         if (snapshot%step < 0) then
-            call damaged('step ' // format_integer_text(snapshot%step) // ' is negative')
+            call damaged('step ' // format_integer(snapshot%step) // ' is negative')
             return
         end if
         associate(knots => scene%path%time)
@@ -302,29 +302,29 @@ contains
             t_end = knots(n_knots)
             span = t_end - t_start
             if (.not. (snapshot%time >= t_start .and. snapshot%time <= t_end)) then
-                call damaged('time ' // format_real_text(snapshot%time) // ' is not on ' &
-                    // 'the load path (' // format_real_text(t_start) // ' to ' &
-                    // format_real_text(t_end) // ')')
+                call damaged('time ' // format_real(snapshot%time) // ' is not on ' &
+                    // 'the load path (' // format_real(t_start) // ' to ' &
+                    // format_real(t_end) // ')')
                 return
             end if
             if (snapshot%knot < 2 .or. snapshot%knot > n_knots) then
-                call damaged('knot ' // format_integer_text(snapshot%knot) // ' is not 2..' &
-                    // format_integer_text(n_knots))
+                call damaged('knot ' // format_integer(snapshot%knot) // ' is not 2..' &
+                    // format_integer(n_knots))
                 return
             end if
             if (knots(snapshot%knot - 1) > snapshot%time + knot_tolerance * span .or. &
                     knots(snapshot%knot) < snapshot%time - knot_tolerance * span) then
-                call damaged('time ' // format_real_text(snapshot%time) // ' is not ' &
-                    // 'before knot ' // format_integer_text(snapshot%knot) &
+                call damaged('time ' // format_real(snapshot%time) // ' is not ' &
+                    // 'before knot ' // format_integer(snapshot%knot) &
                     // ', the knot it heads for')
                 return
             end if
         end associate
         if (.not. (snapshot%next_step >= scene%solver%min_step .and. &
                 snapshot%next_step <= scene%solver%max_step)) then
-            call damaged('next step ' // format_real_text(snapshot%next_step) &
-                // ' is not in [min_step = ' // format_real_text(scene%solver%min_step) &
-                // ', max_step = ' // format_real_text(scene%solver%max_step) // ']')
+            call damaged('next step ' // format_real(snapshot%next_step) &
+                // ' is not in [min_step = ' // format_real(scene%solver%min_step) &
+                // ', max_step = ' // format_real(scene%solver%max_step) // ']')
             return
         end if
         ! The run computed these factors from the same time by the same code: they agree
@@ -334,15 +334,15 @@ contains
             tiny(1.0_wp))
         if (.not. (abs(snapshot%p_force - p_force) <= factor_tolerance * scale .and. &
                 abs(snapshot%p_disp - p_disp) <= factor_tolerance * scale)) then
-            call damaged('its load factors p_force = ' // format_real_text(snapshot%p_force) &
-                // ', p_disp = ' // format_real_text(snapshot%p_disp) // ' are not those ' &
-                // 'of the path at its time (' // format_real_text(p_force) // ', ' &
-                // format_real_text(p_disp) // ')')
+            call damaged('its load factors p_force = ' // format_real(snapshot%p_force) &
+                // ', p_disp = ' // format_real(snapshot%p_disp) // ' are not those ' &
+                // 'of the path at its time (' // format_real(p_force) // ', ' &
+                // format_real(p_disp) // ')')
             return
         end if
         if (.not. abs(snapshot%previous_load - (p_force + p_disp)) <= factor_tolerance &
                 * 2 * scale) then
-            call damaged('its previous load ' // format_real_text(snapshot%previous_load) &
+            call damaged('its previous load ' // format_real(snapshot%previous_load) &
                 // ' is not p_force + p_disp')
             return
         end if
@@ -374,22 +374,6 @@ contains
                 // 'of this scene: ' // reason)
         end subroutine damaged
     end subroutine check_restart
-
-    pure function format_integer_text(value) result(text)
-        integer, intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=16) :: buffer
-        write(buffer, '(i0)') value
-        text = trim(buffer)
-    end function format_integer_text
-
-    pure function format_real_text(value) result(text)
-        real(wp), intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=32) :: buffer
-        write(buffer, '(es13.6e2)') value
-        text = trim(adjustl(buffer))
-    end function format_real_text
 
     !> Delete folder/restart.dat if there is one and it is a yarnfort restart file (a
     !> new run starts from the beginning); any other file of that name is left alone.
