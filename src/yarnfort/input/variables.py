@@ -170,11 +170,12 @@ GROUPS = [
             doc='Required: the two yarn types, names of `&material` groups (`materials = '
                 "'cotton', 'wool'`)."),
         Var('law', 'character', '', length=32, lower=True,
-            choices=['bonded', 'coulomb', 'adhesion', 'decaying_adhesion'], selects=True,
+            choices=['bonded', 'coulomb', 'adhesion', 'decaying_adhesion', 'general'],
+            selects=True,
             doc='Required (case-insensitive).'),
         Var('friction_coefficient', 'real', -1.0, unit='1', range='>= 0',
             laws=['coulomb', 'adhesion', 'decaying_adhesion'], default_doc='`-1` (not set)',
-            doc='Friction coefficient mu. Every law but `bonded`.'),
+            doc='Friction coefficient mu. Every law but `bonded` and `general`.'),
         Var('adhesion', 'real', -1.0, unit='N', range='>= 0',
             laws=['adhesion', 'decaying_adhesion'], default_doc='`-1` (not set)',
             doc='Adhesion beta (per radian of wrap angle). `adhesion` and `decaying_adhesion`.'),
@@ -184,6 +185,14 @@ GROUPS = [
         Var('decay_end', 'real', -1.0, unit='N', range='>= 0', laws=['decaying_adhesion'],
             default_doc='`-1` (not set)', type_doc='real > `decay_start`',
             doc='Tension s_d where the adhesion has vanished. `decaying_adhesion`.'),
+        Var('rate_table', 'character', '', length='path_length', adjust=False, laws=['general'],
+            default_doc="`''` (none)",
+            doc='`general`: CSV file of (T in N, g in N/rad), the rate of the general law T\' = '
+                'g(T) (paper eqs. 37-39), read like a `&material table_file` (same CSV rules; '
+                "a relative name is taken relative to the input file's folder). The first row "
+                'is T = 0 with g >= 0, T strictly increasing, g > 0 for T > 0, all finite; g is '
+                'linear between rows and continues with the last slope beyond the last row, '
+                'which therefore may not fall. See *The general friction law* below.'),
     ]),
     Group('fabric', 'singleton',
           'A generated fabric (knitted with inlay, or woven) instead of &nodes, &yarn and '
