@@ -350,6 +350,14 @@ GROUPS = [
                 "XML 1.0) or `'ascii'` (inline text, 17 significant digits: the same values)."),
         Var('progress', 'logical', True,
             doc='Progress lines on stderr.'),
+        Var('node_reactions', 'logical', False,
+            doc='Also write `reactions.csv`: the reaction of every constrained node at every '
+                'converged step, in long format (columns `step,support,node,rx,ry,rz`; one row '
+                'per node of each `&support` set, in the order the set lists them; N, the force '
+                'the support applies on the net; 0 for a component the set does not fix). The '
+                'rows of a set add up to its columns of `curve.csv`. Written, flushed and '
+                'resumed on restart like `curve.csv` (a restart with it needs the file of the '
+                'first run; one without it deletes the file).'),
         Var('residual_history', 'logical', False,
             doc='Also print, per step, the scaled residual of every Newton iterate, max '
                 '\\|F_i\\| / (level_i + noise_i / residual_tolerance) (see `&solver '

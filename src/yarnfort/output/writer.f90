@@ -14,6 +14,8 @@ module yarnfort_output_writer
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_observer_type, step_state_type
     use yarnfort_output_curve, only: curve_writer_type
+    use yarnfort_output_reactions, only: reactions_file_name, reactions_header, &
+        get_reaction_rows
     use yarnfort_output_vtk, only: vtk_writer_type
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
         remove_file, lock_file_name, close_checked
@@ -32,6 +34,9 @@ module yarnfort_output_writer
         character(len=:), allocatable :: folder
         integer :: vtk_every = 1
         type(curve_writer_type) :: curve
+        !> reactions.csv (`&output node_reactions`), written like the curve.
+        type(curve_writer_type) :: reactions
+        logical :: node_reactions = .false.
         type(vtk_writer_type) :: vtk
         type(manifest_type) :: manifest
         type(folder_lock_type) :: folder_lock
@@ -95,6 +100,7 @@ contains
         logical :: found
 
         self%vtk_every = scene%output%vtk_every
+        self%node_reactions = scene%output%node_reactions
         self%vtk%ascii = trim(scene%output%vtk_format) == 'ascii'
         call self%lock(scene%output%folder, error)
         if (.not. allocated(error)) then
@@ -137,6 +143,9 @@ contains
         if (allocated(self%vtk%files)) deallocate(self%vtk%files, self%vtk%times)
         allocate(self%vtk%files(0), self%vtk%times(0))
         call self%curve%open(self%folder, scene, error)
+        if (allocated(error) .or. .not. self%node_reactions) return
+        call self%reactions%open_table(self%folder, reactions_file_name, reactions_header, &
+            error)
     end subroutine start_files
 
     !> A restart after `step`: keep curve rows and the listed states up to that step,
@@ -152,6 +161,14 @@ contains
         integer :: i
 
         call self%curve%resume(self%folder, scene, step, error, time)
+        if (allocated(error)) return
+        if (self%node_reactions) then
+            call self%reactions%resume_table(self%folder, reactions_file_name, &
+                reactions_header, step, error, row_required=has_constrained_nodes(scene))
+        else
+            ! Rows of the first run beyond this step would contradict this one's.
+            call remove_file(self%folder // '/' // reactions_file_name, error)
+        end if
         if (allocated(error)) return
         allocate(keep(size(self%manifest%states)))
         do i = 1, size(keep)
@@ -232,6 +249,10 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         call self%curve%write_step(scene, state, error)
+        if (.not. allocated(error) .and. self%node_reactions) then
+            if (has_constrained_nodes(scene)) &
+                call self%reactions%put_line(get_reaction_rows(scene, state), error)
+        end if
         if (allocated(error)) then
             self%failed = .true.
             return
@@ -312,8 +333,24 @@ contains
             self%failed = .true.
             call move_alloc(close_error, error)
         end if
+        call self%reactions%close(close_error)
+        if (allocated(close_error) .and. .not. allocated(error)) then
+            self%failed = .true.
+            call move_alloc(close_error, error)
+        end if
         call self%manifest%close()
         call self%folder_lock%release()
     end subroutine finish
+
+    !> Whether any support set prescribes a coordinate (reactions.csv has rows).
+    pure logical function has_constrained_nodes(scene)
+        type(scene_type), intent(in) :: scene
+        integer :: s
+
+        has_constrained_nodes = .false.
+        do s = 1, size(scene%supports)
+            if (size(scene%supports(s)%coordinates) > 0) has_constrained_nodes = .true.
+        end do
+    end function has_constrained_nodes
 
 end module yarnfort_output_writer
