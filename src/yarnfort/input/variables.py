@@ -358,6 +358,19 @@ GROUPS = [
                 'rows of a set add up to its columns of `curve.csv`. Written, flushed and '
                 'resumed on restart like `curve.csv` (a restart with it needs the file of the '
                 'first run; one without it deletes the file).'),
+        Var('contact_state', 'logical', True,
+            doc='Write `contacts.csv` when the scene has sliding passages (a yarn through a '
+                'contact node with a friction law): per converged step and passage, in long '
+                'format, `step,passage,node,yarn,flow,mode,tension_min,tension_max,'
+                'critical_tension,wrap_angle`. flow (m) is the reference length moved through '
+                'the node since the start, from the element before the node (along the yarn) '
+                "to the one after it; mode is `stick`, `forward` or `backward` (sliding towards "
+                'the element after / before the node) or `locked` (stuck because the element '
+                'on its low-tension side is at its minimum length, see `&solver '
+                'min_length_ratio`); tensions in N (clipped at 0), critical_tension = '
+                'T_crit(tension_min, wrap_angle), wrap_angle in rad. Written, flushed and '
+                'resumed on restart like `curve.csv` (a restart with it needs the file of the '
+                'first run; one without it deletes the file).'),
         Var('residual_history', 'logical', False,
             doc='Also print, per step, the scaled residual of every Newton iterate, max '
                 '\\|F_i\\| / (level_i + noise_i / residual_tolerance) (see `&solver '
