@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from yarnfort.results import read_reactions as read_reactions_table
+
 from test_restart import SCENES, compare_curves, read_rows, with_output
 
 #: Per-node reactions summed vs the per-set sums of curve.csv: the same doubles added in
@@ -67,6 +69,11 @@ def test_node_reactions_sum_to_the_set_reactions(run_yarnfort, tmp_path):
     assert by_set["plane"] == {2, 3, 4} and by_set["anchors"] == {6, 7, 8}
     assert any(float(r["rz"]) != 0.0 or float(r["rx"]) != 0.0 for r in rows)
     print(f"{len(rows)} rows, largest relative difference of the sums {worst:.1e}")
+    # The package's reader gives the same table.
+    table = read_reactions_table(tmp_path / "full")
+    assert len(table) == len(rows) and list(table["support"]) == [r["support"] for r in rows]
+    np.testing.assert_array_equal(table["rz"], [float(r["rz"]) for r in rows])
+    assert table.to_array()["support"][0] == rows[0]["support"]
     # A run without the option deletes the earlier run's file.
     run = run_yarnfort(with_output(text, "full"))
     assert run.returncode == 0, run.stderr

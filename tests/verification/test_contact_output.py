@@ -14,6 +14,7 @@ import pytest
 
 from test_hysteresis import CASES, Case, hysteresis_scene
 from yarnfort import read_curve, read_states
+from yarnfort.results import read_contacts as read_contacts_table
 
 #: Slack of the stick test (&solver friction_tolerance 1e-9, plus its band) and the
 #: agreement of a slipping passage with its law at residual_tolerance = 1e-13.
@@ -70,6 +71,11 @@ def test_contact_state_on_the_hysteresis_scene(run_yarnfort, tmp_path, name, sch
     np.testing.assert_allclose(flow, case.length_a - length0_a, rtol=0,
                                atol=1e-14 * case.length_a)
     assert np.max(flow) > 0.01 * case.length_a
+    # The package's reader gives the same table.
+    table = read_contacts_table(out)
+    assert table.names == COLUMNS and list(table["mode"]) == modes
+    np.testing.assert_array_equal(table["flow"], flow)
+    np.testing.assert_array_equal(table["step"], curve["step"])
     print(f"{name} {scheme}: {len(rows)} rows, modes {sorted(set(modes))}, "
           f"max slip error {np.max(slip_error):.1e}")
 
