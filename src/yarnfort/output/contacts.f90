@@ -44,12 +44,16 @@ contains
         integer, intent(in) :: mode(:)
         real(wp), intent(in) :: flow(:)
         character(len=:), allocatable :: rows
-        character(len=:), allocatable :: step_text, mode_text
+        character(len=:), allocatable :: step_text, mode_text, buffer
         character(len=32) :: field
         real(wp) :: t_before, t_after, angle, critical, d1, d2, dangle(3, 3)
-        integer :: p, before, after
+        integer :: p, before, after, used
 
-        rows = ''
+        ! Filled in place (appending to a growing string would copy it for every field):
+        ! a row has 4 integers and 5 reals of at most 32 characters and a mode word.
+        allocate(character(len=max(scene%passages%size(), 1) * (10 * (len(field) + 1) + 1)) :: &
+            buffer)
+        used = 0
         write(field, '(i0)') state%step
         step_text = trim(field)
         associate(passages => scene%passages, net => scene%network)
@@ -76,23 +80,30 @@ contains
                 else
                     mode_text = 'stick'
                 end if
-                if (len(rows) > 0) rows = rows // achar(10)
+                if (used > 0) call put(achar(10))
                 write(field, '(i0, ",", i0, ",", i0)') p, passages%node(p), passages%yarn(p)
-                rows = rows // step_text // ',' // trim(field)
+                call put(step_text // ',' // trim(field))
                 call append(flow(p))
-                rows = rows // ',' // mode_text
+                call put(',' // mode_text)
                 call append(min(t_before, t_after))
                 call append(max(t_before, t_after))
                 call append(critical)
                 call append(angle)
             end do
         end associate
+        rows = buffer(:used)
     contains
         subroutine append(value)
             real(wp), intent(in) :: value
             write(field, '(es24.16e3)') value
-            rows = rows // ',' // trim(adjustl(field))
+            call put(',' // trim(adjustl(field)))
         end subroutine append
+
+        subroutine put(text)
+            character(len=*), intent(in) :: text
+            buffer(used + 1:used + len(text)) = text
+            used = used + len(text)
+        end subroutine put
 
         !> Whether element e's reference length is at its minimum.
         logical function at_minimum(e)

@@ -25,13 +25,17 @@ contains
         type(scene_type), intent(in) :: scene
         type(step_state_type), intent(in) :: state
         character(len=:), allocatable :: rows
-        character(len=:), allocatable :: step_text
+        character(len=:), allocatable :: step_text, buffer
         real(wp) :: force(3)
-        integer :: s, i, j, first, node, c
+        integer :: s, i, j, first, node, c, used
         character(len=32) :: field
         logical, allocatable :: done(:)
 
-        rows = ''
+        ! Filled in place (appending to a growing string would copy it for every field):
+        ! a row has at most one per coordinate, a set name and 5 numbers of <= 32 characters.
+        allocate(character(len=max(size(state%coordinate_reaction), 1) &
+            * (len(scene%supports(1)%name) + 6 * (len(field) + 1) + 1)) :: buffer)
+        used = 0
         write(field, '(i0)') state%step
         step_text = trim(field)
         first = 0
@@ -48,19 +52,26 @@ contains
                         force(mod(c - 1, 3) + 1) = state%coordinate_reaction(first + j)
                         done(j) = .true.
                     end do
-                    if (len(rows) > 0) rows = rows // achar(10)
+                    if (used > 0) call put(achar(10))
                     write(field, '(i0)') node
-                    rows = rows // step_text // ',' // trim(scene%supports(s)%name) // ',' &
-                        // trim(field)
+                    call put(step_text // ',' // trim(scene%supports(s)%name) // ',' &
+                        // trim(field))
                     do j = 1, 3
                         write(field, '(es24.16e3)') force(j)
-                        rows = rows // ',' // trim(adjustl(field))
+                        call put(',' // trim(adjustl(field)))
                     end do
                 end do
                 first = first + size(coordinates)
                 deallocate(done)
             end associate
         end do
+        rows = buffer(:used)
+    contains
+        subroutine put(text)
+            character(len=*), intent(in) :: text
+            buffer(used + 1:used + len(text)) = text
+            used = used + len(text)
+        end subroutine put
     end function get_reaction_rows
 
 end module yarnfort_output_reactions
