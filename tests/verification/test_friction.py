@@ -13,6 +13,7 @@ import pytest
 
 from scenes import group, scene
 from yarnfort import read_curve, read_states
+from yarnfort.results import read_contacts
 
 #: Agreement required with closed forms at convergence.
 CLOSED_FORM_RTOL = 1e-8
@@ -595,6 +596,15 @@ def test_material_running_out_of_an_element(run_yarnfort, tmp_path, scheme):
     assert len(locked) > 0 and curve["time"][locked[0]] <= 1.0 + 1e-12
     assert np.all(far_l0[locked[0]:] == pytest.approx(ratio, rel=1e-9))
     assert states[-1].tension[2] == pytest.approx(1.0, rel=1e-9)   # the yarn carries F
+    # contacts.csv reports the lock: passage 1 (at the far peg, node 2) is 'locked' from
+    # the step its element ran out on, and never before.
+    contacts = read_contacts(tmp_path / "run_out" / "out")
+    first = contacts["passage"] == 1
+    assert np.array_equal(contacts["step"][first], curve["step"])
+    modes = contacts["mode"][first]
+    assert np.all(modes[locked[0]:] == "locked")
+    assert not np.any(modes[:locked[0]] == "locked")
+    assert not np.any(contacts["mode"][~first] == "locked")
 
 
 @pytest.mark.parametrize("offset", [0.0, 1e-10, 1e-7])
