@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
-"""Read a run's output folder: ``curve.csv`` and the VTK states (``states.pvd`` and the
-``state_*.vtu`` files it lists).
+"""Read a run's output folder: ``curve.csv``, ``reactions.csv`` and ``contacts.csv``, and
+the VTK states (``states.pvd`` and the ``state_*.vtu`` files it lists).
 
 States are read with :mod:`meshio` when it is installed (any VTK XML encoding: ASCII,
 inline or appended binary); without it, a small reader of the ASCII encoding is used.
@@ -20,8 +20,11 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Curve", "State", "ResultError", "read_curve", "read_state", "read_states",
-           "read_run"]
+__all__ = ["Curve", "State", "ResultError", "read_curve", "read_reactions", "read_contacts",
+           "read_state", "read_states", "read_run"]
+
+#: Columns of text (not numbers) in the long-format step files.
+_TEXT_COLUMNS = {"reactions.csv": ("support",), "contacts.csv": ("mode",)}
 
 
 class ResultError(ValueError):
@@ -31,12 +34,14 @@ class ResultError(ValueError):
 
 @dataclass
 class Curve:
-    """One row per converged step of ``curve.csv``.
+    """One row per converged step of ``curve.csv`` (or, for ``reactions.csv`` and
+    ``contacts.csv``, one row per node or passage and step).
 
     Attributes
     ----------
     columns : dict of str to numpy.ndarray
-        Column name -> values (float), in file order.
+        Column name -> values (float; str for the text columns ``support`` of
+        ``reactions.csv`` and ``mode`` of ``contacts.csv``), in file order.
     path : pathlib.Path or None
         The file read.
     """
@@ -86,7 +91,7 @@ class Curve:
 
     def to_array(self) -> np.ndarray:
         """The curve as a numpy structured array (one field per column)."""
-        dtype = [(name, float) for name in self.columns]
+        dtype = [(name, values.dtype) for name, values in self.columns.items()]
         table = np.empty(len(self), dtype=dtype)
         for name, values in self.columns.items():
             table[name] = values
@@ -130,9 +135,60 @@ class State:
     cell_data: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-def _curve_file(path: str | Path) -> Path:
+def _curve_file(path: str | Path, name: str = "curve.csv") -> Path:
     path = Path(path)
-    return path / "curve.csv" if path.is_dir() else path
+    return path / name if path.is_dir() else path
+
+
+def read_reactions(path: str | Path) -> Curve:
+    """Read ``reactions.csv`` (``&output node_reactions``): the reaction of every
+    constrained node per step.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file or its folder.
+
+    Returns
+    -------
+    Curve
+        Columns ``step``, ``support`` (str), ``node``, ``rx``, ``ry``, ``rz`` (N), one
+        row per node of each support set and step.
+
+    Raises
+    ------
+    ResultError
+        As :func:`read_curve`.
+    OSError
+        If the file cannot be read.
+    """
+    return _read_csv(_curve_file(path, "reactions.csv"), _TEXT_COLUMNS["reactions.csv"])
+
+
+def read_contacts(path: str | Path) -> Curve:
+    """Read ``contacts.csv`` (``&output contact_state``): the state of every sliding
+    passage per step.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file or its folder.
+
+    Returns
+    -------
+    Curve
+        Columns ``step``, ``passage``, ``node``, ``yarn``, ``flow`` (m), ``mode`` (str:
+        stick, forward, backward, locked), ``tension_min``, ``tension_max``,
+        ``critical_tension`` (N), ``wrap_angle`` (rad), one row per passage and step.
+
+    Raises
+    ------
+    ResultError
+        As :func:`read_curve`.
+    OSError
+        If the file cannot be read.
+    """
+    return _read_csv(_curve_file(path, "contacts.csv"), _TEXT_COLUMNS["contacts.csv"])
 
 
 def read_curve(path: str | Path) -> Curve:
@@ -156,13 +212,20 @@ def read_curve(path: str | Path) -> Curve:
     OSError
         If the file cannot be read.
     """
-    path = _curve_file(path)
+    return _read_csv(_curve_file(path), ())
+
+
+def _read_csv(path: Path, text_columns: tuple[str, ...]) -> Curve:
+    """A step file of the run: a header line, then rows of numbers (text in the named
+    `text_columns`, kept as str)."""
     with open(path, newline="") as stream:
         rows = list(csv.reader(stream))
     if not rows or not any(cell.strip() for cell in rows[0]):
         raise ResultError(f"{path}: empty file (no header line): not a complete"
                           " yarnfort curve")
     header = [cell.strip() for cell in rows[0]]
+    numeric = [name for name in header if name not in text_columns]
+    texts: dict[str, list[str]] = {name: [] for name in header if name in text_columns}
     values: list[list[float]] = []
     for number, row in enumerate(rows[1:], start=2):
         if not row:
@@ -172,14 +235,19 @@ def read_curve(path: str | Path) -> Curve:
                               f" {len(header)} (a cut or foreign row)")
         parsed = []
         for name, cell in zip(header, row):
+            if name in texts:
+                texts[name].append(cell.strip())
+                continue
             try:
                 parsed.append(float(cell))
             except ValueError:
                 raise ResultError(f"{path}, line {number}, column {name!r}: {cell!r} is not"
                                   " a number") from None
         values.append(parsed)
-    table = np.array(values, dtype=float).reshape(len(values), len(header))
-    return Curve({name: table[:, k].copy() for k, name in enumerate(header)}, path)
+    table = np.array(values, dtype=float).reshape(len(values), len(numeric))
+    columns = {name: table[:, k].copy() for k, name in enumerate(numeric)}
+    columns.update({name: np.array(cells, dtype=str) for name, cells in texts.items()})
+    return Curve({name: columns[name] for name in header}, path)
 
 
 def _ascii_array(piece: ET.Element, section: str, name: str | None) -> np.ndarray:

@@ -13,6 +13,7 @@ import pytest
 
 from scenes import group, scene
 from yarnfort import read_curve, read_states
+from yarnfort.results import read_contacts
 
 #: Agreement required with closed forms at convergence.
 CLOSED_FORM_RTOL = 1e-8
@@ -595,6 +596,15 @@ def test_material_running_out_of_an_element(run_yarnfort, tmp_path, scheme):
     assert len(locked) > 0 and curve["time"][locked[0]] <= 1.0 + 1e-12
     assert np.all(far_l0[locked[0]:] == pytest.approx(ratio, rel=1e-9))
     assert states[-1].tension[2] == pytest.approx(1.0, rel=1e-9)   # the yarn carries F
+    # contacts.csv reports the lock: passage 1 (at the far peg, node 2) is 'locked' from
+    # the step its element ran out on, and never before.
+    contacts = read_contacts(tmp_path / "run_out" / "out")
+    first = contacts["passage"] == 1
+    assert np.array_equal(contacts["step"][first], curve["step"])
+    modes = contacts["mode"][first]
+    assert np.all(modes[locked[0]:] == "locked")
+    assert not np.any(modes[:locked[0]] == "locked")
+    assert not np.any(contacts["mode"][~first] == "locked")
 
 
 @pytest.mark.parametrize("offset", [0.0, 1e-10, 1e-7])
@@ -651,3 +661,90 @@ def test_yarn_folded_back_around_a_peg(run_yarnfort, tmp_path, scheme, offset):
           f"{max(errors):.1e}, Newton iterations {int(curve['newton_iterations'].sum())}")
     assert len(errors) >= 5
     assert max(errors) <= CLOSED_FORM_RTOL
+
+
+# --------------------------------------------------------------------------------------
+# The general law T' = g(T) from a rate table (paper eqs. 37-39).
+
+#: A rate table (T in N, g in N/rad) with a falling piece, a steep rise and a last piece
+#: that the law continues beyond the table: g > 0 everywhere, kinks at every row.
+RATE_TABLE = np.array([[0.0, 0.03], [0.05, 0.045], [0.1, 0.04], [0.2, 0.07], [0.4, 0.15],
+                       [0.8, 0.3]])
+
+
+def table_critical(t0: float, angle: float) -> float:
+    """T_crit(T0, alpha) of the table law by integrating T' = g(T) with scipy's DOP853,
+    g linear between the rows of RATE_TABLE and with the last slope beyond the last row.
+    The integration restarts at each row (a kink of g, which an embedded error estimate
+    does not see) by a terminal event, and each stretch integrates the smooth extension
+    of its own piece, so that no stage samples g across a kink."""
+    from scipy.integrate import solve_ivp
+    tension, rate = RATE_TABLE.T
+    slope = np.diff(rate) / np.diff(tension)
+    start, t = 0.0, t0
+    while start < angle:
+        i = min(np.searchsorted(tension, t, side="right") - 1, len(slope) - 1)
+        end = tension[i + 1] if i + 1 < len(tension) - 1 else np.inf
+
+        def event(_, y):
+            return y[0] - end
+        event.terminal, event.direction = True, 1
+        sol = solve_ivp(lambda _, y: [rate[i] + slope[i] * (y[0] - tension[i])],
+                        (start, angle), [t], method="DOP853", rtol=1e-13, atol=1e-16,
+                        events=event)
+        assert sol.status >= 0, sol.message
+        if sol.status == 1:     # on the row (the event's root, up to its tolerance)
+            start, t = sol.t_events[0][0], end
+        else:
+            start, t = angle, sol.y[0, -1]
+    return t
+
+
+def test_table_reference_integration():
+    """The reference integrator on a piece where g is linear has the exact solution
+    T = T_a + g_a (exp(m alpha) - 1) / m, and passes kinks: over the first two pieces
+    the angle is the sum of the two exact piece angles log(g_b / g_a) / m."""
+    (t_a, g_a), (t_b, g_b), (t_c, g_c) = RATE_TABLE[:3]
+    m = (g_b - g_a) / (t_b - t_a)
+    angle = 0.3
+    assert table_critical(t_a, angle) == pytest.approx(
+        t_a + g_a * np.expm1(m * angle) / m, rel=1e-12)
+    m2 = (g_c - g_b) / (t_c - t_b)
+    to_c = np.log(g_b / g_a) / m + np.log(g_c / g_b) / m2
+    assert table_critical(0.0, to_c) == pytest.approx(t_c, rel=1e-12)
+
+
+@pytest.mark.parametrize("scheme", ["monolithic", "staggered"])
+@pytest.mark.parametrize("k", [1, 3])
+def test_capstan_gross_slip_general_law(run_yarnfort, tmp_path, k, scheme):
+    """As test_capstan_gross_slip, with law = 'general' and its rate table from a CSV
+    file: whenever every passage slips, T_hi = T_crit(T_lo, A) with A the summed wrap
+    angle, T_crit from the test's own integration of T' = g(T)."""
+    table = tmp_path / "rate.csv"
+    table.write_text("# T (N), g (N/rad)\nT,g\n"
+                     + "".join(f"{t!r},{g!r}\n" for t, g in RATE_TABLE.tolist()))
+    net = peg_net(arc_pegs(k), [-1, -1, 0], [1, -1, 0])
+    law = dict(law="general", rate_table=str(table))
+    text = namelist(net, [contact("yarn", "peg", law)], scheme)
+    run, curve, states = run_scene(run_yarnfort, tmp_path, "capstan", text)
+    scale = max(np.max(s.tension) for s in states)
+    errors, directions, lows, highs = [], set(), [], []
+    for i, state in enumerate(states):
+        if curve["slipping"][i] != k or curve["direction"][i] == 0:
+            continue
+        angle = wrap_angles(state.position, range(k + 2)).sum()
+        t_first, t_last = state.tension[[0, k]]
+        t_lo, t_hi = (t_first, t_last) if curve["direction"][i] > 0 else (t_last, t_first)
+        if t_hi < 1e-3 * scale:
+            continue
+        errors.append(abs(t_hi - table_critical(t_lo, angle)) / t_hi)
+        directions.add(int(curve["direction"][i]))
+        lows.append(t_lo)
+        highs.append(t_hi)
+    print(f"K={k} general {scheme}: {len(errors)} gross-slip steps (directions "
+          f"{sorted(directions)}), T_lo {min(lows):.3g}..{max(lows):.3g}, T_hi up to "
+          f"{max(highs):.3g}, max rel. error {max(errors):.1e}")
+    assert 1 in directions and len(errors) >= 5
+    assert max(errors) <= CLOSED_FORM_RTOL
+    # The tensions pass several rows of the table (several kinks of g are used).
+    assert np.sum((RATE_TABLE[:, 0] > min(lows)) & (RATE_TABLE[:, 0] < max(highs))) >= 2

@@ -29,13 +29,14 @@ module yarnfort_friction_general
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_csv, only: csv_row_type, read_csv_pairs
     use yarnfort_friction_law, only: friction_law_type, tension_limit, rate_limit, no_kink, &
         scaled_exp, capped_product, capped_quotient, expm1, cap_critical_tension, format_real
     implicit none
     private
 
     public :: general_law_type, table_law_type, numerical_law_type
-    public :: new_table_law, new_numerical_law, check_integration_controls
+    public :: new_table_law, read_rate_table, new_numerical_law, check_integration_controls
     public :: default_relative_tolerance, default_max_steps
     public :: integration_converged, integration_capped, integration_out_of_steps
 
@@ -213,6 +214,74 @@ contains
         self%rate = rate
         self%slope = (rate(2:) - rate(:n - 1)) / (tension(2:) - tension(:n - 1))
     end subroutine new_table_law
+
+    !> Read the rate table of the general law from a CSV file of rows "T,g" (tension in N,
+    !> rate in N/rad; the CSV rules of `yarnfort_csv`). Stricter than `new_table_law`, as
+    !> the input asks of every friction law: the first row is T = 0 with g >= 0, T
+    !> increases strictly, g > 0 at every T > 0, all finite, and the last piece does not
+    !> fall (the rate continues with it beyond the table and would reach zero). Messages
+    !> name the file, the line and the value.
+    subroutine read_rate_table(self, path, error)
+        type(table_law_type), intent(out) :: self
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: context
+        real(wp), allocatable :: tension(:), rate(:)
+        integer, allocatable :: lines(:)
+        integer :: n
+
+        context = "rate_table '" // path // "'"
+        call read_csv_pairs(path, context, [character(len=1) :: 'T', 'g'], check_rate_row, &
+            tension, rate, lines, error)
+        if (allocated(error)) return
+        n = size(tension)
+        if (n < 2) then
+            call fatal_error(error, context // ': found ' // itoa(n) // ' data rows, at ' &
+                // 'least 2 are needed (the first at T = 0)')
+            return
+        end if
+        if (rate(n) < rate(n - 1)) then
+            call fatal_error(error, context // ', line ' // itoa(lines(n)) // ': the last ' &
+                // 'piece falls (g = ' // format_real(rate(n - 1)) // ' to ' &
+                // format_real(rate(n)) // '); g continues with that slope beyond the ' &
+                // 'table and would reach 0: add a row where g no longer falls')
+            return
+        end if
+        call new_table_law(self, tension, rate, error)
+        if (allocated(error)) error%message = context // ': ' // error%message
+    end subroutine read_rate_table
+
+    !> One row of a rate table on its own (the first: T = 0, g >= 0) or after the previous.
+    pure subroutine check_rate_row(row, previous, error)
+        type(csv_row_type), intent(in) :: row
+        type(csv_row_type), intent(in), optional :: previous
+        type(error_type), allocatable, intent(out) :: error
+
+        if (.not. (ieee_is_finite(row%value(1)) .and. abs(row%value(1)) <= tension_limit)) then
+            call fatal_error(error, 'T ' // row%first_text // ' must be finite and <= ' &
+                // format_real(tension_limit))
+        else if (.not. (ieee_is_finite(row%value(2)) .and. abs(row%value(2)) <= tension_limit)) &
+                then
+            call fatal_error(error, 'g ' // row%second_text // ' must be finite and <= ' &
+                // format_real(tension_limit))
+        else if (.not. present(previous)) then
+            if (abs(row%value(1)) > 0.0_wp) then
+                call fatal_error(error, 'the first row must be at T = 0 (g is needed for all ' &
+                    // 'T >= 0), found T = ' // row%first_text)
+            else if (row%value(2) < 0.0_wp) then
+                call fatal_error(error, 'g(0) = ' // row%second_text // ' is negative (g >= 0 ' &
+                    // 'at T = 0)')
+            end if
+        else if (.not. row%value(1) > previous%value(1)) then
+            call fatal_error(error, 'T ' // row%first_text // ' is not greater than ' &
+                // previous%first_text // ' on ' // previous%place &
+                // ' (T must increase strictly)')
+        else if (.not. row%value(2) > 0.0_wp) then
+            call fatal_error(error, 'g ' // row%second_text // ' at T = ' // row%first_text &
+                // ' is not positive (g > 0 for T > 0: a zero would be a tension the ' &
+                // 'passage can never exceed)')
+        end if
+    end subroutine check_rate_row
 
     !> Create the numerical twin of `law`: integrates law%get_rate with the given tolerance.
     subroutine new_numerical_law(self, law, error, relative_tolerance, max_steps)

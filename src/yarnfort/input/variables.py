@@ -170,11 +170,12 @@ GROUPS = [
             doc='Required: the two yarn types, names of `&material` groups (`materials = '
                 "'cotton', 'wool'`)."),
         Var('law', 'character', '', length=32, lower=True,
-            choices=['bonded', 'coulomb', 'adhesion', 'decaying_adhesion'], selects=True,
+            choices=['bonded', 'coulomb', 'adhesion', 'decaying_adhesion', 'general'],
+            selects=True,
             doc='Required (case-insensitive).'),
         Var('friction_coefficient', 'real', -1.0, unit='1', range='>= 0',
             laws=['coulomb', 'adhesion', 'decaying_adhesion'], default_doc='`-1` (not set)',
-            doc='Friction coefficient mu. Every law but `bonded`.'),
+            doc='Friction coefficient mu. Every law but `bonded` and `general`.'),
         Var('adhesion', 'real', -1.0, unit='N', range='>= 0',
             laws=['adhesion', 'decaying_adhesion'], default_doc='`-1` (not set)',
             doc='Adhesion beta (per radian of wrap angle). `adhesion` and `decaying_adhesion`.'),
@@ -184,6 +185,14 @@ GROUPS = [
         Var('decay_end', 'real', -1.0, unit='N', range='>= 0', laws=['decaying_adhesion'],
             default_doc='`-1` (not set)', type_doc='real > `decay_start`',
             doc='Tension s_d where the adhesion has vanished. `decaying_adhesion`.'),
+        Var('rate_table', 'character', '', length='path_length', adjust=False, laws=['general'],
+            default_doc="`''` (none)",
+            doc='`general`: CSV file of (T in N, g in N/rad), the rate of the general law T\' = '
+                'g(T) (paper eqs. 37-39), read like a `&material table_file` (same CSV rules; '
+                "a relative name is taken relative to the input file's folder). The first row "
+                'is T = 0 with g >= 0, T strictly increasing, g > 0 for T > 0, all finite; g is '
+                'linear between rows and continues with the last slope beyond the last row, '
+                'which therefore may not fall. See *The general friction law* below.'),
     ]),
     Group('fabric', 'singleton',
           'A generated fabric (knitted with inlay, or woven) instead of &nodes, &yarn and '
@@ -341,6 +350,27 @@ GROUPS = [
                 "XML 1.0) or `'ascii'` (inline text, 17 significant digits: the same values)."),
         Var('progress', 'logical', True,
             doc='Progress lines on stderr.'),
+        Var('node_reactions', 'logical', False,
+            doc='Also write `reactions.csv`: the reaction of every constrained node at every '
+                'converged step, in long format (columns `step,support,node,rx,ry,rz`; one row '
+                'per node of each `&support` set, in the order the set lists them; N, the force '
+                'the support applies on the net; 0 for a component the set does not fix). The '
+                'rows of a set add up to its columns of `curve.csv`. Written, flushed and '
+                'resumed on restart like `curve.csv` (a restart with it needs the file of the '
+                'first run; one without it deletes the file).'),
+        Var('contact_state', 'logical', True,
+            doc='Write `contacts.csv` when the scene has sliding passages (a yarn through a '
+                'contact node with a friction law): per converged step and passage, in long '
+                'format, `step,passage,node,yarn,flow,mode,tension_min,tension_max,'
+                'critical_tension,wrap_angle`. flow (m) is the reference length moved through '
+                'the node since the start, from the element before the node (along the yarn) '
+                "to the one after it; mode is `stick`, `forward` or `backward` (sliding towards "
+                'the element after / before the node) or `locked` (stuck because the element '
+                'on its low-tension side is at its minimum length, see `&solver '
+                'min_length_ratio`); tensions in N (clipped at 0), critical_tension = '
+                'T_crit(tension_min, wrap_angle), wrap_angle in rad. Written, flushed and '
+                'resumed on restart like `curve.csv` (a restart with it needs the file of the '
+                'first run; one without it deletes the file).'),
         Var('residual_history', 'logical', False,
             doc='Also print, per step, the scaled residual of every Newton iterate, max '
                 '\\|F_i\\| / (level_i + noise_i / residual_tolerance) (see `&solver '

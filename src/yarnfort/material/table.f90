@@ -22,12 +22,11 @@
 !> increasing, energy quadratic). For lambda <= 1 the string is slack (f = 0).
 module yarnfort_material_table
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use, intrinsic :: iso_fortran_env, only: iostat_end
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_material_law, only: force_law_type
-    use yarnfort_text, only: format_real, format_integer, read_line, is_folder, &
-        byte_order_mark
+    use yarnfort_text, only: format_real, format_integer
+    use yarnfort_csv, only: csv_row_type, read_csv_pairs
     implicit none
     private
 
@@ -42,18 +41,6 @@ module yarnfort_material_table
 
     !> Fewest rows in a table: (0, 0) and one more.
     integer, parameter :: min_rows = 2
-
-    !> Rows allocated before the first growth while reading a file.
-    integer, parameter :: initial_rows = 16
-
-    !> Longest piece of an input line quoted in a message.
-    integer, parameter :: max_quote = 60
-
-    !> Characters that may start a data row of a CSV table.
-    character(len=*), parameter :: numeric_start = '0123456789+-.'
-
-    !> Outcomes of parsing one CSV line.
-    integer, parameter :: line_row = 0, line_skip = 1, line_bad = 2
 
     !> Tabulated string; the components are set by `new_table_law` / `read_table_law`.
     type, extends(force_law_type) :: table_law_type
@@ -73,15 +60,6 @@ module yarnfort_material_table
         procedure :: get_reference_stiffness
     end type table_law_type
 
-    !> One row while it is checked: values, their text, and where it came from.
-    type :: row_type
-        real(wp) :: strain = 0.0_wp
-        real(wp) :: force = 0.0_wp
-        character(len=:), allocatable :: strain_text, force_text
-        !> 'row 3' or 'line 7'.
-        character(len=:), allocatable :: place
-    end type row_type
-
 contains
 
     !> Create a table law from knot strains (lambda - 1) and forces in N. The first row must
@@ -94,7 +72,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(in), optional :: end_slope_ratio
         character(len=*), parameter :: context = 'table'
-        type(row_type) :: row, previous
+        type(csv_row_type) :: row, previous
         integer :: i, bad
 
         if (size(strain) /= size(force)) then
@@ -103,10 +81,9 @@ contains
             return
         end if
         do i = 1, size(strain)
-            row%strain = strain(i)
-            row%force = force(i)
-            row%strain_text = format_real(strain(i))
-            row%force_text = format_real(force(i))
+            row%value = [strain(i), force(i)]
+            row%first_text = format_real(strain(i))
+            row%second_text = format_real(force(i))
             row%place = 'row ' // format_integer(i)
             call check_in_order(row, previous, i == 1, context, error)
             if (allocated(error)) return
@@ -135,67 +112,26 @@ contains
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(in), optional :: end_slope_ratio
-        character(len=:), allocatable :: context, line, message
-        character(len=512) :: iomsg
+        character(len=:), allocatable :: context
         real(wp), allocatable :: strain(:), force(:)
         integer, allocatable :: lines(:)
-        type(row_type) :: row, previous
-        integer :: unit, stat, line_number, nrow, outcome, bad
+        integer :: nrow, bad
 
         context = "table '" // path // "'"
-        if (is_folder(path)) then
-            call fatal_error(error, context // ': is a folder, not a file')
-            return
-        end if
-        open(newunit=unit, file=path, status='old', action='read', form='formatted', &
-            access='sequential', iostat=stat, iomsg=iomsg)
-        if (stat /= 0) then
-            call fatal_error(error, context // ': cannot open the file (' // trim(iomsg) // ')')
-            return
-        end if
-
-        allocate(strain(initial_rows), force(initial_rows), lines(initial_rows))
-        nrow = 0
-        line_number = 0
-        do
-            call read_line(unit, line, stat, iomsg)
-            if (stat == iostat_end) exit
-            line_number = line_number + 1
-            if (stat /= 0) then
-                call fatal_error(error, context // ', line ' // format_integer(line_number) &
-                    // ': cannot read the line (' // trim(iomsg) // ')')
-                exit
-            end if
-            ! Some editors start a UTF-8 file with a byte order mark: not text of the table.
-            if (line_number == 1 .and. index(line, byte_order_mark) == 1) &
-                line = line(len(byte_order_mark) + 1:)
-            call parse_line(line, row, outcome, message)
-            if (outcome == line_skip) cycle
-            if (outcome == line_bad) then
-                if (nrow == 0 .and. is_header(line)) cycle
-                call fatal_error(error, context // ', line ' // format_integer(line_number) &
-                    // ': ' // message)
-                exit
-            end if
-            row%place = 'line ' // format_integer(line_number)
-            call check_in_order(row, previous, nrow == 0, context, error)
-            if (allocated(error)) exit
-            call append_row(strain, force, lines, nrow, row%strain, row%force, line_number)
-            previous = row
-        end do
-        close(unit)
+        call read_csv_pairs(path, context, [character(len=6) :: 'strain', 'force'], &
+            check_row, strain, force, lines, error)
         if (allocated(error)) return
-
+        nrow = size(strain)
         if (nrow < min_rows) then
             call fatal_error(error, context // ': ' // too_few_rows(nrow))
             return
         end if
         call set_ratio(self, end_slope_ratio, context, error)
         if (allocated(error)) return
-        call setup_table(self, strain(:nrow), force(:nrow), bad)
+        call setup_table(self, strain, force, bad)
         if (bad > 0) then
             call fatal_error(error, context // ', line ' // format_integer(lines(bad + 1)) // ': ' &
-                // slope_range_message(strain(:nrow), force(:nrow), bad))
+                // slope_range_message(strain, force, bad))
         end if
     end subroutine read_table_law
 
@@ -362,26 +298,26 @@ contains
 
     !> Check one row on its own (first row: must be 0, 0) or against the previous row.
     pure subroutine check_row(row, previous, error)
-        type(row_type), intent(in) :: row
-        type(row_type), intent(in), optional :: previous
+        type(csv_row_type), intent(in) :: row
+        type(csv_row_type), intent(in), optional :: previous
         type(error_type), allocatable, intent(out) :: error
 
-        if (.not. ieee_is_finite(row%strain)) then
-            call fatal_error(error, 'strain ' // row%strain_text // ' is not finite')
-        else if (.not. ieee_is_finite(row%force)) then
-            call fatal_error(error, 'force ' // row%force_text // ' is not finite')
+        if (.not. ieee_is_finite(row%value(1))) then
+            call fatal_error(error, 'strain ' // row%first_text // ' is not finite')
+        else if (.not. ieee_is_finite(row%value(2))) then
+            call fatal_error(error, 'force ' // row%second_text // ' is not finite')
         else if (.not. present(previous)) then
-            if (abs(row%strain) > 0.0_wp .or. abs(row%force) > 0.0_wp) then
+            if (abs(row%value(1)) > 0.0_wp .or. abs(row%value(2)) > 0.0_wp) then
                 call fatal_error(error, 'the first row must be strain 0, force 0 (f = 0 at ' &
-                    // 'lambda = 1), found ' // row%strain_text // ', ' // row%force_text)
+                    // 'lambda = 1), found ' // row%first_text // ', ' // row%second_text)
             end if
-        else if (.not. row%strain > previous%strain) then
-            call fatal_error(error, 'strain ' // row%strain_text // ' is not greater than ' &
-                // previous%strain_text // ' on ' // previous%place &
+        else if (.not. row%value(1) > previous%value(1)) then
+            call fatal_error(error, 'strain ' // row%first_text // ' is not greater than ' &
+                // previous%first_text // ' on ' // previous%place &
                 // ' (strains must increase strictly)')
-        else if (.not. row%force > previous%force) then
-            call fatal_error(error, 'force ' // row%force_text // ' is not greater than ' &
-                // previous%force_text // ' on ' // previous%place &
+        else if (.not. row%value(2) > previous%value(2)) then
+            call fatal_error(error, 'force ' // row%second_text // ' is not greater than ' &
+                // previous%second_text // ' on ' // previous%place &
                 // ' (forces must increase strictly)')
         end if
     end subroutine check_row
@@ -426,104 +362,10 @@ contains
             // ' rows are needed (the first row 0,0 and more)'
     end function too_few_rows
 
-    !> Parse one CSV line into a row, or report it as skipped (blank, '#') or bad.
-    pure subroutine parse_line(line, row, outcome, message)
-        character(len=*), intent(in) :: line
-        type(row_type), intent(out) :: row
-        integer, intent(out) :: outcome
-        character(len=:), allocatable, intent(out) :: message
-        character(len=:), allocatable :: text
-        integer :: comma
-        logical :: ok
-
-        text = clean_line(line)
-        outcome = line_skip
-        if (len(text) == 0) return
-        if (text(1:1) == '#') return
-
-        outcome = line_bad
-        comma = index(text, ',')
-        if (comma == 0) then
-            message = 'expected "strain,force", found ' // quote(text)
-            return
-        end if
-        if (index(text(comma + 1:), ',') /= 0) then
-            message = 'expected 2 comma-separated values "strain,force", found ' // quote(text)
-            return
-        end if
-        call read_value(text(:comma - 1), row%strain, row%strain_text, ok)
-        if (.not. ok) then
-            message = 'strain ' // quote(row%strain_text) // ' is not a number'
-            return
-        end if
-        call read_value(text(comma + 1:), row%force, row%force_text, ok)
-        if (.not. ok) then
-            message = 'force ' // quote(row%force_text) // ' is not a number'
-            return
-        end if
-        outcome = line_row
-    end subroutine parse_line
-
-    !> Read one real from a CSV field (surrounding blanks allowed).
-    pure subroutine read_value(field, value, text, ok)
-        character(len=*), intent(in) :: field
-        real(wp), intent(out) :: value
-        character(len=:), allocatable, intent(out) :: text
-        logical, intent(out) :: ok
-        integer :: stat
-
-        text = trim(adjustl(field))
-        value = 0.0_wp
-        ! Characters list-directed input would treat specially (separators, repeat counts).
-        ok = len(text) > 0 .and. scan(text, ' */;"''') == 0
-        if (.not. ok) return
-        read(text, *, iostat=stat) value
-        ok = stat == 0
-    end subroutine read_value
-
-    !> A line with tabs and carriage returns turned into blanks, leading and trailing
-    !> blanks removed.
-    pure function clean_line(line) result(text)
-        character(len=*), intent(in) :: line
-        character(len=:), allocatable :: text
-        character(len=len(line)) :: buffer
-        integer :: i
-
-        buffer = line
-        do i = 1, len(buffer)
-            if (buffer(i:i) == achar(9) .or. buffer(i:i) == achar(13)) buffer(i:i) = ' '
-        end do
-        text = trim(adjustl(buffer))
-    end function clean_line
-
-    !> Whether a line that is not a data row may be a header: its first character is not
-    !> one that starts a number.
-    pure function is_header(line) result(header)
-        character(len=*), intent(in) :: line
-        logical :: header
-        character(len=:), allocatable :: text
-
-        text = clean_line(line)
-        header = len(text) > 0
-        if (header) header = verify(text(1:1), numeric_start) /= 0
-    end function is_header
-
-    !> Text in single quotes, shortened to `max_quote` characters.
-    pure function quote(text) result(quoted)
-        character(len=*), intent(in) :: text
-        character(len=:), allocatable :: quoted
-
-        if (len(text) > max_quote) then
-            quoted = "'" // text(:max_quote) // "...'"
-        else
-            quoted = "'" // text // "'"
-        end if
-    end function quote
-
     !> Check a row, after `previous` unless it is the `first`; the message names the
     !> table (`context`) and the row's place.
     subroutine check_in_order(row, previous, first, context, error)
-        type(row_type), intent(in) :: row, previous
+        type(csv_row_type), intent(in) :: row, previous
         logical, intent(in) :: first
         character(len=*), intent(in) :: context
         type(error_type), allocatable, intent(out) :: error
@@ -536,32 +378,5 @@ contains
         if (allocated(error)) error%message = context // ', ' // row%place // ': ' &
             // error%message
     end subroutine check_in_order
-
-    !> Append one row, growing the arrays geometrically.
-    pure subroutine append_row(strain, force, lines, nrow, new_strain, new_force, new_line)
-        real(wp), allocatable, intent(inout) :: strain(:), force(:)
-        integer, allocatable, intent(inout) :: lines(:)
-        integer, intent(inout) :: nrow
-        real(wp), intent(in) :: new_strain, new_force
-        integer, intent(in) :: new_line
-        real(wp), allocatable :: real_buffer(:)
-        integer, allocatable :: int_buffer(:)
-
-        if (nrow == size(strain)) then
-            allocate(real_buffer(2 * nrow))
-            real_buffer(:nrow) = strain(:nrow)
-            call move_alloc(real_buffer, strain)
-            allocate(real_buffer(2 * nrow))
-            real_buffer(:nrow) = force(:nrow)
-            call move_alloc(real_buffer, force)
-            allocate(int_buffer(2 * nrow))
-            int_buffer(:nrow) = lines(:nrow)
-            call move_alloc(int_buffer, lines)
-        end if
-        nrow = nrow + 1
-        strain(nrow) = new_strain
-        force(nrow) = new_force
-        lines(nrow) = new_line
-    end subroutine append_row
 
 end module yarnfort_material_table

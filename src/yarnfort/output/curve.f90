@@ -1,5 +1,8 @@
 ! SPDX-License-Identifier: MIT
 !> The curve file: one CSV row per converged step, flushed as soon as it is written.
+!> `curve_writer_type` is also the writer of the other per-step CSV files of a run (a
+!> header, then the rows of each step appended and flushed together, resumed on restart):
+!> `open_table`, `resume_table` and `put_line` with the file's own name and header.
 module yarnfort_output_curve
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
@@ -22,6 +25,9 @@ module yarnfort_output_curve
         procedure :: open => open_curve
         !> Keep the rows up to a step of an existing curve file and append after them.
         procedure :: resume => resume_curve
+        !> The same for any per-step CSV file of the folder, by name and header.
+        procedure :: open_table
+        procedure :: resume_table
         procedure :: write_step
         procedure :: put_line
         procedure :: close => close_curve
@@ -40,10 +46,19 @@ contains
         character(len=*), intent(in) :: folder
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
+
+        call self%open_table(folder, curve_file_name, get_header(scene), error)
+    end subroutine open_curve
+
+    !> Create folder/name and write its header line.
+    subroutine open_table(self, folder, name, header, error)
+        class(curve_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: folder, name, header
+        type(error_type), allocatable, intent(out) :: error
         character(len=256) :: message
         integer :: status
 
-        self%path = folder // '/' // curve_file_name
+        self%path = folder // '/' // name
         message = ''
         open(newunit=self%unit, file=self%path, status='replace', action='write', &
             iostat=status, iomsg=message)
@@ -52,8 +67,8 @@ contains
             call fatal_error(error, "cannot write '" // self%path // "': " // trim(message))
             return
         end if
-        call self%put_line(get_header(scene), error)
-    end subroutine open_curve
+        call self%put_line(header, error)
+    end subroutine open_table
 
     !> Write a line and flush it to the file. A failure closes the file, cuts off what
     !> reached it of the line (so the file keeps whole rows only) and says why.
@@ -94,22 +109,36 @@ contains
         integer, intent(in) :: step
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(in), optional :: time
+
+        call self%resume_table(folder, curve_file_name, get_header(scene), step, error, time)
+    end subroutine resume_curve
+
+    !> Continue folder/name (header `header`) after `step` as resume_curve does: rows are
+    !> lines whose first field is their step; a step may have several rows (long format).
+    !> With `row_required` false (default true), a step without rows is accepted (a
+    !> file that has none for any step, e.g. of a scene with nothing to report).
+    subroutine resume_table(self, folder, name, header, step, error, time, row_required)
+        class(curve_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: folder, name, header
+        integer, intent(in) :: step
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: time
+        logical, intent(in), optional :: row_required
         type(error_type), allocatable :: ignored
-        character(len=:), allocatable :: path, temporary, line, header
+        character(len=:), allocatable :: path, temporary, line
         character(len=32) :: text
         character(len=256) :: message
         integer :: old, new, status, row_step, comma, last_kept, write_status
         character(len=256) :: read_message
         real(wp) :: row_time
 
-        path = folder // '/' // curve_file_name
+        path = folder // '/' // name
         temporary = path // '.tmp'
         open(newunit=old, file=path, status='old', action='read', iostat=status)
         if (status /= 0) then
             call fatal_error(error, "&control restart: cannot read '" // path // "'")
             return
         end if
-        header = get_header(scene)
         call read_line(old, line, status, read_message)
         if (status /= 0 .or. line /= header) then
             close(old)
@@ -157,6 +186,9 @@ contains
             call remove_file(temporary, ignored)
             return
         end if
+        if (present(row_required)) then
+            if (.not. row_required) last_kept = step
+        end if
         if (last_kept /= step) then
             call remove_file(temporary, ignored)
             write(text, '(i0)') step
@@ -196,7 +228,7 @@ contains
                 if (text(i:i) == ',') count_commas = count_commas + 1
             end do
         end function count_commas
-    end subroutine resume_curve
+    end subroutine resume_table
 
     !> The header line of the curve file for `scene` (columns: see open_curve).
     function get_header(scene) result(header)

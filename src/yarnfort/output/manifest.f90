@@ -26,7 +26,8 @@ module yarnfort_output_manifest
     !> The fixed names a run may write (and their temporaries).
     character(len=*), parameter :: fixed_names(*) = [character(len=16) :: 'curve.csv', &
         'curve.csv.tmp', 'input.nml', 'input.nml.tmp', 'restart.dat', 'restart.dat.tmp', &
-        'states.pvd', 'states.pvd.tmp']
+        'states.pvd', 'states.pvd.tmp', 'reactions.csv', 'reactions.csv.tmp', &
+        'contacts.csv', 'contacts.csv.tmp']
 
     !> Longest file name kept (state names are far shorter).
     integer, parameter :: entry_length = 64

@@ -431,6 +431,12 @@ contains
                     resolve_path(config%materials(m)%table_file, config%input_folder))
             end do
         end if
+        if (allocated(config%contacts)) then
+            do m = 1, size(config%contacts)
+                if (len_trim(config%contacts(m)%rate_table) > 0) call add_file( &
+                    resolve_path(config%contacts(m)%rate_table, config%input_folder))
+            end do
+        end if
         if (len_trim(config%geometry%file) > 0) &
             call add_file(resolve_path(config%geometry%file, config%input_folder))
         call add_bytes(transfer(scene%network%position, [0_int8]))

@@ -14,6 +14,10 @@ module yarnfort_output_writer
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_observer_type, step_state_type
     use yarnfort_output_curve, only: curve_writer_type
+    use yarnfort_output_reactions, only: reactions_file_name, reactions_header, &
+        get_reaction_rows
+    use yarnfort_output_contacts, only: contacts_file_name, contacts_header, &
+        get_contact_rows
     use yarnfort_output_vtk, only: vtk_writer_type
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
         remove_file, lock_file_name, close_checked
@@ -32,6 +36,13 @@ module yarnfort_output_writer
         character(len=:), allocatable :: folder
         integer :: vtk_every = 1
         type(curve_writer_type) :: curve
+        !> reactions.csv (`&output node_reactions`), written like the curve.
+        type(curve_writer_type) :: reactions
+        logical :: node_reactions = .false.
+        !> contacts.csv (`&output contact_state` and sliding passages), written like the
+        !> curve, from the snapshot of each step (on_checkpoint).
+        type(curve_writer_type) :: contacts
+        logical :: contact_state = .false.
         type(vtk_writer_type) :: vtk
         type(manifest_type) :: manifest
         type(folder_lock_type) :: folder_lock
@@ -95,6 +106,8 @@ contains
         logical :: found
 
         self%vtk_every = scene%output%vtk_every
+        self%node_reactions = scene%output%node_reactions
+        self%contact_state = scene%output%contact_state .and. scene%passages%size() > 0
         self%vtk%ascii = trim(scene%output%vtk_format) == 'ascii'
         call self%lock(scene%output%folder, error)
         if (.not. allocated(error)) then
@@ -104,6 +117,7 @@ contains
                 call resume_files(self, scene, resume_step, error, resume_time)
             else
                 call start_files(self, scene, error)
+                if (.not. allocated(error)) call start_contacts(self, error)
             end if
         end if
         if (allocated(error)) call self%folder_lock%release()
@@ -137,7 +151,19 @@ contains
         if (allocated(self%vtk%files)) deallocate(self%vtk%files, self%vtk%times)
         allocate(self%vtk%files(0), self%vtk%times(0))
         call self%curve%open(self%folder, scene, error)
+        if (allocated(error) .or. .not. self%node_reactions) return
+        call self%reactions%open_table(self%folder, reactions_file_name, reactions_header, &
+            error)
     end subroutine start_files
+
+    !> Start contacts.csv when it is asked for.
+    subroutine start_contacts(self, error)
+        class(output_writer_type), intent(inout) :: self
+        type(error_type), allocatable, intent(out) :: error
+
+        if (self%contact_state) call self%contacts%open_table(self%folder, &
+            contacts_file_name, contacts_header, error)
+    end subroutine start_contacts
 
     !> A restart after `step`: keep curve rows and the listed states up to that step,
     !> delete the listed states after it (and any that is incomplete), and rewrite the
@@ -152,6 +178,21 @@ contains
         integer :: i
 
         call self%curve%resume(self%folder, scene, step, error, time)
+        if (allocated(error)) return
+        if (self%node_reactions) then
+            call self%reactions%resume_table(self%folder, reactions_file_name, &
+                reactions_header, step, error, row_required=has_constrained_nodes(scene))
+        else
+            ! Rows of the first run beyond this step would contradict this one's.
+            call remove_file(self%folder // '/' // reactions_file_name, error)
+        end if
+        if (allocated(error)) return
+        if (self%contact_state) then
+            call self%contacts%resume_table(self%folder, contacts_file_name, &
+                contacts_header, step, error)
+        else
+            call remove_file(self%folder // '/' // contacts_file_name, error)
+        end if
         if (allocated(error)) return
         allocate(keep(size(self%manifest%states)))
         do i = 1, size(keep)
@@ -232,12 +273,17 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         call self%curve%write_step(scene, state, error)
+        if (.not. allocated(error) .and. self%node_reactions) then
+            if (has_constrained_nodes(scene)) &
+                call self%reactions%put_line(get_reaction_rows(scene, state), error)
+        end if
         if (allocated(error)) then
             self%failed = .true.
             return
         end if
         self%state_due = .false.
         self%last_written = .true.
+        if (self%contact_state .and. self%vtk_every <= 0) self%last = state
         if (self%vtk_every > 0) then
             self%last = state
             self%state_due = mod(state%step, self%vtk_every) == 0
@@ -263,6 +309,19 @@ contains
             self%last_mode = snapshot%mode
         else
             self%last_mode = [integer :: ]
+        end if
+        if (self%contact_state) then
+            if (.not. allocated(snapshot%flow) .or. .not. allocated(snapshot%mode)) then
+                call fatal_error(error, "cannot write '" // self%contacts%path // "': the " &
+                    // 'step has no friction state')
+            else
+                call self%contacts%put_line(get_contact_rows(scene, self%last, &
+                    snapshot%mode, snapshot%flow), error)
+            end if
+            if (allocated(error)) then
+                self%failed = .true.
+                return
+            end if
         end if
         if (self%state_due) then
             call write_last_state(self, scene, error)
@@ -312,8 +371,29 @@ contains
             self%failed = .true.
             call move_alloc(close_error, error)
         end if
+        call self%contacts%close(close_error)
+        if (allocated(close_error) .and. .not. allocated(error)) then
+            self%failed = .true.
+            call move_alloc(close_error, error)
+        end if
+        call self%reactions%close(close_error)
+        if (allocated(close_error) .and. .not. allocated(error)) then
+            self%failed = .true.
+            call move_alloc(close_error, error)
+        end if
         call self%manifest%close()
         call self%folder_lock%release()
     end subroutine finish
+
+    !> Whether any support set prescribes a coordinate (reactions.csv has rows).
+    pure logical function has_constrained_nodes(scene)
+        type(scene_type), intent(in) :: scene
+        integer :: s
+
+        has_constrained_nodes = .false.
+        do s = 1, size(scene%supports)
+            if (size(scene%supports(s)%coordinates) > 0) has_constrained_nodes = .true.
+        end do
+    end function has_constrained_nodes
 
 end module yarnfort_output_writer

@@ -16,6 +16,9 @@ module yarnfort_scene_builder
     use yarnfort_friction_adhesion, only: adhesion_law_type, new_adhesion_law
     use yarnfort_friction_decaying_adhesion, only: decaying_adhesion_law_type, &
         new_decaying_adhesion_law
+    use yarnfort_friction_general, only: rate_table_law_type => table_law_type, &
+        read_rate_table
+    use yarnfort_text, only: resolve_path
     implicit none
     private
 
@@ -428,7 +431,8 @@ contains
         ! contact_of(type_a, type_b): index of the &contact group, 0 for none.
         allocate(contact_of(size(config%materials), size(config%materials)), source=0)
         do c = 1, size(config%contacts)
-            call new_friction_law(scene%friction(c)%law, config%contacts(c), error)
+            call new_friction_law(scene%friction(c)%law, config%contacts(c), error, &
+                config%input_folder)
             if (allocated(error)) then
                 write(buffer, '("&contact #", i0)') c
                 call prefix_error(error, trim(buffer))
@@ -562,11 +566,13 @@ contains
         end subroutine find_passage_contact
     end subroutine build_passages
 
-    !> The friction law of a &contact group ('bonded' gets none: it never slides).
-    subroutine new_friction_law(law, contact, error)
+    !> The friction law of a &contact group ('bonded' gets none: it never slides). A
+    !> relative rate_table is taken relative to `folder` (as a &material table_file).
+    subroutine new_friction_law(law, contact, error, folder)
         class(friction_law_type), allocatable, intent(out) :: law
         type(contact_config_type), intent(in) :: contact
         type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: folder
 
         select case (trim(contact%law))
         case ('bonded')
@@ -592,6 +598,13 @@ contains
                 call new_decaying_adhesion_law(decaying, contact%friction_coefficient, &
                     contact%adhesion, contact%decay_start, contact%decay_end, error)
                 call move_alloc(decaying, law)
+            end block
+        case ('general')
+            block
+                type(rate_table_law_type), allocatable :: general
+                allocate(general)
+                call read_rate_table(general, resolve_path(contact%rate_table, folder), error)
+                call move_alloc(general, law)
             end block
         case default
             call fatal_error(error, "law '" // trim(contact%law) // "' is unknown")

@@ -22,7 +22,7 @@ contains
         type(step_state_type), intent(inout) :: state
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: internal(:)
-        integer :: s, i, c, k, n_elements
+        integer :: s, i, c, k, n_elements, n_coordinates
 
         n_elements = scene%network%n_elements()
         state%p_force = p_force
@@ -40,11 +40,20 @@ contains
         internal = internal - p_force * scene%external_force
         if (allocated(state%reaction)) deallocate(state%reaction)
         allocate(state%reaction(3, size(scene%supports)), source=0.0_wp)
+        if (allocated(state%coordinate_reaction)) deallocate(state%coordinate_reaction)
+        n_coordinates = 0
+        do s = 1, size(scene%supports)
+            n_coordinates = n_coordinates + size(scene%supports(s)%coordinates)
+        end do
+        allocate(state%coordinate_reaction(n_coordinates))
+        n_coordinates = 0
         do s = 1, size(scene%supports)
             do i = 1, size(scene%supports(s)%coordinates)
                 c = scene%supports(s)%coordinates(i)
                 k = mod(c - 1, 3) + 1
                 state%reaction(k, s) = state%reaction(k, s) + internal(c)
+                n_coordinates = n_coordinates + 1
+                state%coordinate_reaction(n_coordinates) = internal(c)
             end do
             if (.not. all(ieee_is_finite(state%reaction(:, s)))) then
                 call fatal_error(error, "the reaction of support set '" &

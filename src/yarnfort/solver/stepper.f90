@@ -19,6 +19,9 @@ module yarnfort_solver_stepper
         real(wp), allocatable :: position(:, :), tension(:), stretch(:), length0(:)
         !> Force applied by each support set on the net, (3, n_supports).
         real(wp), allocatable :: reaction(:, :)
+        !> The same per prescribed coordinate: the force on coordinate
+        !> scene%supports(s)%coordinates(i), for s = 1, 2, ... and i in order, concatenated.
+        real(wp), allocatable :: coordinate_reaction(:)
         !> Figures of the step's (last) Newton solve; total Newton iterations of the step.
         type(newton_stats_type) :: newton
         integer :: newton_iterations = 0

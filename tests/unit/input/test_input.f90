@@ -1057,7 +1057,7 @@ contains
 
         call check_bad_input(error, 'bad_contact_law.nml', [character(len=78) :: &
             '&contact #1 (''wool'', ''cotton''): law = ''colomb'' is unknown', &
-            '(use bonded, coulomb, adhesion, decaying_adhesion)', &
+            '(use bonded, coulomb, adhesion, decaying_adhesion, general)', &
             'did you mean ''coulomb''?'])
     end subroutine test_bad_contact_law
 

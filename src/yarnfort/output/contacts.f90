@@ -1,0 +1,116 @@
+! SPDX-License-Identifier: MIT
+!> The rows of contacts.csv (`&output contact_state`): per converged step, the state of
+!> every sliding passage (a yarn through a contact node) in long format. The file itself
+!> is written by a `curve_writer_type` (header, rows appended and flushed per step,
+!> resumed on restart).
+module yarnfort_output_contacts
+    use yarnfort_kinds, only: wp
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_solver_continuation, only: step_state_type
+    use yarnfort_contact_geometry, only: get_wrap_angle
+    use yarnfort_contact_friction_problem, only: mode_forward, mode_backward
+    implicit none
+    private
+
+    public :: contacts_file_name, contacts_header, get_contact_rows
+
+    character(len=*), parameter :: contacts_file_name = 'contacts.csv'
+
+    !> Columns: step, passage, contact node, yarn, flow (m of reference length moved from
+    !> the element before the node to the one after it since the start), mode, the
+    !> smaller and larger of the two tensions (N, clipped at 0), T_crit(T_min, alpha) (N)
+    !> and the wrap angle alpha (rad).
+    character(len=*), parameter :: contacts_header = 'step,passage,node,yarn,flow,mode,' &
+        // 'tension_min,tension_max,critical_tension,wrap_angle'
+
+    !> Only the wrap angle's derivative uses its floor of sin(gamma): any value will do.
+    real(wp), parameter :: unused_min_sine = 1.0e-8_wp
+
+    !> Round-off of a reference length at its minimum, relative to its initial length
+    !> (as the friction stepper judges it).
+    real(wp), parameter :: length_round_off = 64 * epsilon(1.0_wp)
+
+contains
+
+    !> The rows of one step, joined by newlines (no newline after the last). `mode` and
+    !> `flow` are the snapshot's. Mode: 'forward' / 'backward' while the yarn slides
+    !> towards the element after / before the node; 'locked' for a stick passage whose
+    !> element on its low-tension side is at its minimum length (`&solver
+    !> min_length_ratio`): it would slide but has no material left to give; 'stick'
+    !> otherwise.
+    function get_contact_rows(scene, state, mode, flow) result(rows)
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: mode(:)
+        real(wp), intent(in) :: flow(:)
+        character(len=:), allocatable :: rows
+        character(len=:), allocatable :: step_text, mode_text, buffer
+        character(len=32) :: field
+        real(wp) :: t_before, t_after, angle, critical, d1, d2, dangle(3, 3)
+        integer :: p, before, after, used
+
+        ! Filled in place (appending to a growing string would copy it for every field):
+        ! a row has 4 integers and 5 reals of at most 32 characters and a mode word.
+        allocate(character(len=max(scene%passages%size(), 1) * (10 * (len(field) + 1) + 1)) :: &
+            buffer)
+        used = 0
+        write(field, '(i0)') state%step
+        step_text = trim(field)
+        associate(passages => scene%passages, net => scene%network)
+            do p = 1, passages%size()
+                before = passages%element_before(p)
+                after = passages%element_after(p)
+                t_before = max(state%tension(before), 0.0_wp)
+                t_after = max(state%tension(after), 0.0_wp)
+                call get_wrap_angle(state%position(:, net%element_nodes(1, before)), &
+                    state%position(:, passages%node(p)), &
+                    state%position(:, net%element_nodes(2, after)), unused_min_sine, &
+                    angle, dangle)
+                associate(law => scene%friction(passages%law(p))%law)
+                    call law%get_critical_tension(min(t_before, t_after), angle, critical, &
+                        d1, d2)
+                end associate
+                if (mode(p) == mode_forward) then
+                    mode_text = 'forward'
+                else if (mode(p) == mode_backward) then
+                    mode_text = 'backward'
+                else if ((t_after >= t_before .and. at_minimum(before)) &
+                        .or. (t_before >= t_after .and. at_minimum(after))) then
+                    mode_text = 'locked'
+                else
+                    mode_text = 'stick'
+                end if
+                if (used > 0) call put(achar(10))
+                write(field, '(i0, ",", i0, ",", i0)') p, passages%node(p), passages%yarn(p)
+                call put(step_text // ',' // trim(field))
+                call append(flow(p))
+                call put(',' // mode_text)
+                call append(min(t_before, t_after))
+                call append(max(t_before, t_after))
+                call append(critical)
+                call append(angle)
+            end do
+        end associate
+        rows = buffer(:used)
+    contains
+        subroutine append(value)
+            real(wp), intent(in) :: value
+            write(field, '(es24.16e3)') value
+            call put(',' // trim(adjustl(field)))
+        end subroutine append
+
+        subroutine put(text)
+            character(len=*), intent(in) :: text
+            buffer(used + 1:used + len(text)) = text
+            used = used + len(text)
+        end subroutine put
+
+        !> Whether element e's reference length is at its minimum.
+        logical function at_minimum(e)
+            integer, intent(in) :: e
+            at_minimum = state%length0(e) <= (scene%solver%min_length_ratio &
+                + length_round_off) * scene%network%length0(e)
+        end function at_minimum
+    end function get_contact_rows
+
+end module yarnfort_output_contacts

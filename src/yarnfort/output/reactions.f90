@@ -1,0 +1,77 @@
+! SPDX-License-Identifier: MIT
+!> The rows of reactions.csv (`&output node_reactions`): per converged step, the reaction
+!> of every node of every support set, in long format. The file itself is written by a
+!> `curve_writer_type` (header, rows appended and flushed per step, resumed on restart).
+module yarnfort_output_reactions
+    use yarnfort_kinds, only: wp
+    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_solver_continuation, only: step_state_type
+    implicit none
+    private
+
+    public :: reactions_file_name, reactions_header, get_reaction_rows
+
+    character(len=*), parameter :: reactions_file_name = 'reactions.csv'
+
+    !> Columns: step, support set name, node id, force (N) the support applies on the node.
+    character(len=*), parameter :: reactions_header = 'step,support,node,rx,ry,rz'
+
+contains
+
+    !> The rows of one step, joined by newlines (no newline after the last), or '' if the
+    !> scene has no constrained node. One row per node of each set, in the order of the
+    !> set's coordinates; components the set does not fix are 0.
+    function get_reaction_rows(scene, state) result(rows)
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        character(len=:), allocatable :: rows
+        character(len=:), allocatable :: step_text, buffer
+        real(wp) :: force(3)
+        integer :: s, i, j, first, node, c, used
+        character(len=32) :: field
+        logical, allocatable :: done(:)
+
+        ! Filled in place (appending to a growing string would copy it for every field):
+        ! a row has at most one per coordinate, a set name and 5 numbers of <= 32 characters.
+        allocate(character(len=max(size(state%coordinate_reaction), 1) &
+            * (len(scene%supports(1)%name) + 6 * (len(field) + 1) + 1)) :: buffer)
+        used = 0
+        write(field, '(i0)') state%step
+        step_text = trim(field)
+        first = 0
+        do s = 1, size(scene%supports)
+            associate(coordinates => scene%supports(s)%coordinates)
+                allocate(done(size(coordinates)), source=.false.)
+                do i = 1, size(coordinates)
+                    if (done(i)) cycle
+                    node = (coordinates(i) - 1) / 3 + 1
+                    force = 0.0_wp
+                    do j = i, size(coordinates)
+                        c = coordinates(j)
+                        if ((c - 1) / 3 + 1 /= node) cycle
+                        force(mod(c - 1, 3) + 1) = state%coordinate_reaction(first + j)
+                        done(j) = .true.
+                    end do
+                    if (used > 0) call put(achar(10))
+                    write(field, '(i0)') node
+                    call put(step_text // ',' // trim(scene%supports(s)%name) // ',' &
+                        // trim(field))
+                    do j = 1, 3
+                        write(field, '(es24.16e3)') force(j)
+                        call put(',' // trim(adjustl(field)))
+                    end do
+                end do
+                first = first + size(coordinates)
+                deallocate(done)
+            end associate
+        end do
+        rows = buffer(:used)
+    contains
+        subroutine put(text)
+            character(len=*), intent(in) :: text
+            buffer(used + 1:used + len(text)) = text
+            used = used + len(text)
+        end subroutine put
+    end function get_reaction_rows
+
+end module yarnfort_output_reactions
