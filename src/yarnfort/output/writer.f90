@@ -18,7 +18,7 @@ module yarnfort_output_writer
         get_reaction_rows
     use yarnfort_output_contacts, only: contacts_file_name, contacts_header, &
         get_contact_rows
-    use yarnfort_output_vtk, only: vtk_writer_type
+    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
         remove_file, lock_file_name, close_checked
     use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name
@@ -336,10 +336,9 @@ contains
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
-        character(len=32) :: name
 
-        write(name, '("state_", i0.5, ".vtu")') self%last%step
-        call self%manifest%add_state(trim(name), self%last%step, self%last%time, error)
+        call self%manifest%add_state(get_state_name(self%last%step), self%last%step, &
+            self%last%time, error)
         if (.not. allocated(error)) then
             if (.not. allocated(self%last_mode)) self%last_mode = [integer :: ]
             call self%vtk%write_state(scene, self%last, self%last_mode, error)
