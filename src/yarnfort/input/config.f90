@@ -9,7 +9,8 @@ module yarnfort_input_config
     use yarnfort_input_groups, only: control_config_type, solver_config_type, &
         material_config_type, contact_config_type, fabric_config_type, geometry_config_type, &
         yarn_config_type, support_config_type, load_config_type, path_config_type, &
-        output_config_type, name_length, path_length, solver_presets => solver_preset_choices
+        output_config_type, obstacle_config_type, ring_config_type, name_length, path_length, &
+        solver_presets => solver_preset_choices
     implicit none
     private
 
@@ -17,6 +18,7 @@ module yarnfort_input_config
     public :: yarn_config_type, support_config_type, load_config_type, path_config_type
     public :: output_config_type, geometry_config_type, name_length, path_length
     public :: contact_config_type, fabric_config_type, link_config_type
+    public :: obstacle_config_type, ring_config_type
     public :: solver_presets, get_solver_preset
 
     !> A node that follows another one: a periodic image (eq. 53) or the other side of
@@ -45,6 +47,9 @@ module yarnfort_input_config
         type(support_config_type), allocatable :: supports(:)
         type(load_config_type), allocatable :: loads(:)
         type(contact_config_type), allocatable :: contacts(:)
+        !> Contact nodes of one or more yarns: fixed obstacles and free rings.
+        type(obstacle_config_type), allocatable :: obstacles(:)
+        type(ring_config_type), allocatable :: rings(:)
         !> &fabric group (kind = '': none) and the links its generator made.
         type(fabric_config_type) :: fabric
         type(link_config_type), allocatable :: links(:)

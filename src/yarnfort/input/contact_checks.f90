@@ -9,6 +9,7 @@ module yarnfort_input_contact_checks
     use yarnfort_input_groups, only: check_contact_variables
     use yarnfort_input_fields, only: suggestion, quoted_list
     use yarnfort_input_network_checks, only: yarn_label
+    use yarnfort_input_contact_node_checks, only: check_node_contact, get_contact_node_sets
     use yarnfort_text, only: format_integer, format_real
     implicit none
     private
@@ -36,24 +37,31 @@ contains
         do c = 1, size(config%contacts)
             associate(contact => config%contacts(c))
                 label = '&contact #' // format_integer(c)
-                do i = 1, 2
-                    call check_contact_material(error, label, i, contact%materials(i), &
-                        material_names)
+                if (len_trim(contact%at) > 0) then
+                    ! The law of an obstacle or ring.
+                    call check_node_contact(config, c, error)
                     if (allocated(error)) return
-                end do
-                a = findloc(material_names, contact%materials(1), dim=1)
-                b = findloc(material_names, contact%materials(2), dim=1)
-                label = label // ' (' // pair_text(contact) // ')'
-                if (pair(a, b) /= 0) then
-                    call fatal_error(error, '&contact #' // format_integer(c) &
-                        // ': materials = ' // pair_text(contact) // ' is the same pair as ' &
-                        // '&contact #' // format_integer(pair(a, b)) // ' (materials = ' &
-                        // pair_text(config%contacts(pair(a, b))) // '; the order does not ' &
-                        // 'matter): give one &contact per pair of yarn types')
-                    return
+                    label = label // " (at = '" // trim(contact%at) // "')"
+                else
+                    do i = 1, 2
+                        call check_contact_material(error, label, i, contact%materials(i), &
+                            material_names)
+                        if (allocated(error)) return
+                    end do
+                    a = findloc(material_names, contact%materials(1), dim=1)
+                    b = findloc(material_names, contact%materials(2), dim=1)
+                    label = label // ' (' // pair_text(contact) // ')'
+                    if (pair(a, b) /= 0) then
+                        call fatal_error(error, '&contact #' // format_integer(c) &
+                            // ': materials = ' // pair_text(contact) // ' is the same pair ' &
+                            // 'as &contact #' // format_integer(pair(a, b)) // ' (materials = ' &
+                            // pair_text(config%contacts(pair(a, b))) // '; the order does ' &
+                            // 'not matter): give one &contact per pair of yarn types')
+                        return
+                    end if
+                    pair(a, b) = c
+                    pair(b, a) = c
                 end if
-                pair(a, b) = c
-                pair(b, a) = c
                 call check_contact_variables(contact, label, error)
                 if (allocated(error)) return
                 if (contact%law == 'decaying_adhesion' &
@@ -101,12 +109,15 @@ contains
 
     !> With any &contact, every pair of yarn types meeting at a node needs one. A node
     !> meets when two different yarns list it (yarns of two types, or two of one type).
+    !> The nodes of an &obstacle or &ring have the laws of their own (`at`) instead.
     subroutine check_contacts_complete(config, pair, error)
         type(config_type), intent(in) :: config
         integer, intent(in) :: pair(:, :)
         type(error_type), allocatable, intent(out) :: error
         integer, allocatable :: material_of(:), first(:), yarns_at(:), last_yarn(:), filled(:)
-        integer :: n_nodes, y, i, node, j, k, a, b
+        integer, allocatable :: set_of(:)
+        character(len=name_length), allocatable :: set_names(:)
+        integer :: n_nodes, y, i, node, j, k, a, b, n_obstacles
 
         n_nodes = size(config%node_positions, 2)
         allocate(material_of(size(config%yarns)))
@@ -141,7 +152,9 @@ contains
                 filled(node) = filled(node) + 1
             end do
         end do
+        call get_contact_node_sets(config, set_of, set_names, n_obstacles)
         do node = 1, n_nodes
+            if (set_of(node) /= 0) cycle
             do j = first(node), first(node + 1) - 1
                 do k = j + 1, first(node + 1) - 1
                     a = material_of(yarns_at(j))

@@ -9,7 +9,7 @@ module yarnfort_input_echo
     use yarnfort_input_groups, only: nodes_config_type, write_control, write_solver, &
         write_material_groups, write_contact_groups, write_fabric, write_nodes, &
         write_geometry, write_yarn_groups, write_support_groups, write_load_groups, &
-        write_path, write_output
+        write_path, write_output, write_obstacle_groups, write_ring_groups
     use yarnfort_input_fields, only: put
     use yarnfort_text, only: quote_string
     implicit none
@@ -50,6 +50,8 @@ contains
             end if
             call write_support_groups(unit, config%supports)
             call write_load_groups(unit, config%loads)
+            call write_obstacle_groups(unit, config%obstacles)
+            call write_ring_groups(unit, config%rings)
         end if
         if (allocated(config%path%time)) call write_path(unit, config%path)
         call write_output(unit, config%output)

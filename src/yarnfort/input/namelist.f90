@@ -17,7 +17,7 @@ module yarnfort_input_namelist
         read_control_groups, read_solver_groups, read_material_groups, read_contact_groups, &
         read_fabric_groups, read_nodes_groups, read_geometry_groups, read_yarn_groups, &
         read_support_groups, read_load_groups, read_path_groups, read_output_groups, &
-        apply_solver_preset
+        read_obstacle_groups, read_ring_groups, apply_solver_preset
     use yarnfort_input_fields, only: max_list, max_coordinates, message_length, &
         post_read_error
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
@@ -33,7 +33,7 @@ module yarnfort_input_namelist
 
     !> Groups a generated fabric replaces.
     character(len=*), parameter :: generated_names(*) = [character(len=8) :: 'nodes', &
-        'geometry', 'yarn', 'support', 'load']
+        'geometry', 'yarn', 'support', 'load', 'obstacle', 'ring']
 
 contains
 
@@ -170,6 +170,10 @@ contains
             if (size(config%path%p_disp) == 0) config%path%p_disp = spread(0.0_wp, 1, n)
         end if
         call read_output_groups(unit, scan, config%output, error)
+        if (allocated(error)) return
+        call read_obstacle_groups(unit, scan, config%obstacles, error)
+        if (allocated(error)) return
+        call read_ring_groups(unit, scan, config%rings, error)
     end subroutine read_groups
 
     !> Read the namelist input from the file `path`; relative file names in it are

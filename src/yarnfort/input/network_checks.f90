@@ -17,7 +17,7 @@ module yarnfort_input_network_checks
     private
 
     public :: check_nodes, check_yarns, check_duplicate_segments, check_supports
-    public :: check_loads, yarn_label, coincidence_tolerance
+    public :: check_loads, yarn_label, coincidence_tolerance, check_node_list
 
     !> A segment between consecutive yarn nodes is of zero length when it is not longer
     !> than this times the diagonal of the box around all nodes.

@@ -18,6 +18,7 @@ module yarnfort_input_validate
     use yarnfort_input_network_checks, only: check_nodes, check_yarns, &
         check_duplicate_segments, check_supports, check_loads, coincidence_tolerance
     use yarnfort_input_contact_checks, only: check_contacts
+    use yarnfort_input_contact_node_checks, only: check_contact_nodes, check_contact_node_laws
     use yarnfort_text, only: format_integer, format_real
     implicit none
     private
@@ -52,7 +53,11 @@ contains
         if (allocated(error)) return
         call check_duplicate_segments(config, error)
         if (allocated(error)) return
+        call check_contact_nodes(config, error)
+        if (allocated(error)) return
         call check_contacts(config, error)
+        if (allocated(error)) return
+        call check_contact_node_laws(config, error)
         if (allocated(error)) return
         call check_supports(config, owner, error)
         if (allocated(error)) return

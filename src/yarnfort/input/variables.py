@@ -193,6 +193,11 @@ GROUPS = [
                 'is T = 0 with g >= 0, T strictly increasing, g > 0 for T > 0, all finite; g is '
                 'linear between rows and continues with the last slope beyond the last row, '
                 'which therefore may not fall. See *The general friction law* below.'),
+        Var('at', 'character', '', length='name_length', default_doc="`''` (a pair of types)",
+            doc='The law of an `&obstacle` or `&ring` instead of a pair of yarn types: the name '
+                'of that group. `materials(1)` then names the yarn type it applies to, or is '
+                'left empty for every yarn type; `materials(2)` stays empty. See *Obstacles and '
+                'rings* below.'),
     ]),
     Group('fabric', 'singleton',
           'A generated fabric (knitted with inlay, or woven) instead of &nodes, &yarn and '
@@ -376,5 +381,28 @@ GROUPS = [
                 '\\|F_i\\| / (level_i + noise_i / residual_tolerance) (see `&solver '
                 'residual_tolerance`; converged at <= residual_tolerance), to see the '
                 'convergence rate.'),
+    ]),
+    Group('obstacle', 'repeatable',
+          'Fixed obstacles (pins, guides, capstan pegs): nodes at a prescribed position that '
+          'yarns slide through.', [
+        Var('name', 'character', '', length='name_length',
+            doc='Required and unique among `&obstacle`, `&ring` and `&support` names. One word '
+                'of letters, digits, `_`, `-`, `.`. `&contact at` names it; it also names the '
+                "reaction-force columns of the coordinates it holds (as a `&support`'s)."),
+        Var('nodes', 'integer', None, shape='list',
+            doc='At least one node id, each in 1..n_nodes, no repeats, each passed through '
+                '(not ended at) by every yarn that lists it. Every coordinate of these nodes '
+                'that no `&support` prescribes is held at its initial position; a `&support` '
+                'that lists the node moves it (a moving pin).'),
+    ]),
+    Group('ring', 'repeatable',
+          'Free rings: nodes of free position that yarns slide through.', [
+        Var('name', 'character', '', length='name_length',
+            doc='Required and unique among `&obstacle`, `&ring` and `&support` names. One word '
+                'of letters, digits, `_`, `-`, `.`. `&contact at` names it.'),
+        Var('nodes', 'integer', None, shape='list',
+            doc='At least one node id, each in 1..n_nodes, no repeats, each passed through '
+                '(not ended at) by every yarn that lists it. The position is free; a `&load` '
+                'on the node is the force applied to the ring.'),
     ]),
 ]

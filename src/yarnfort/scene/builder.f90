@@ -19,6 +19,8 @@ module yarnfort_scene_builder
     use yarnfort_friction_general, only: rate_table_law_type => table_law_type, &
         read_rate_table
     use yarnfort_text, only: resolve_path
+    use yarnfort_input_config, only: name_length
+    use yarnfort_input_contact_node_checks, only: get_contact_node_sets, find_node_contact
     implicit none
     private
 
@@ -238,6 +240,7 @@ contains
                 end do
             end associate
         end do
+        call hold_obstacles(scene, config, owner)
         allocate(scene%dofs%unknown(n_coordinates), source=0)
         count = 0
         do c = 1, n_coordinates
@@ -248,6 +251,36 @@ contains
         end do
         scene%dofs%n_unknowns = count
     end subroutine build_constraints
+
+    !> Obstacles: every coordinate of an &obstacle's nodes that no &support prescribes is
+    !> held at its initial position, by a support set named after the obstacle (its
+    !> reaction is the force of the yarns on those coordinates). A &support that lists an
+    !> obstacle's node moves it like any supported node.
+    subroutine hold_obstacles(scene, config, owner)
+        type(scene_type), intent(inout) :: scene
+        type(config_type), intent(in) :: config
+        integer, intent(inout) :: owner(:)
+        type(support_set_type) :: held
+        integer :: o, i, k, c
+
+        if (.not. allocated(config%obstacles)) return
+        do o = 1, size(config%obstacles)
+            held%name = config%obstacles(o)%name
+            allocate(held%coordinates(0))
+            do i = 1, size(config%obstacles(o)%nodes)
+                do k = 1, 3
+                    c = 3 * (config%obstacles(o)%nodes(i) - 1) + k
+                    if (owner(c) /= 0) cycle
+                    owner(c) = size(config%supports) + o
+                    scene%dofs%base(c) = scene%network%position(k, config%obstacles(o)%nodes(i))
+                    scene%dofs%delta(c) = 0.0_wp
+                    held%coordinates = [held%coordinates, c]
+                end do
+            end do
+            if (size(held%coordinates) > 0) scene%supports = [scene%supports, held]
+            deallocate(held%coordinates)
+        end do
+    end subroutine hold_obstacles
 
     !> Pre-stress: elements of a yarn type with prestress > 0 get the reference length
     !> at which they carry that tension in the initial geometry.
@@ -415,6 +448,8 @@ contains
     !> type paired with the types of the node's other visits; it must be the same for
     !> every pair that has one (else an error), so the order of the input never matters.
     !> 'bonded' pairs, and nodes with no &contact for any pair, are plain shared nodes.
+    !> At a node of an &obstacle or &ring every pass of a yarn is a passage, even the
+    !> only one, and its law is the node's (find_node_contact); pair laws do not apply.
     subroutine build_passages(scene, config, error)
         type(scene_type), intent(inout) :: scene
         type(config_type), intent(in) :: config
@@ -424,6 +459,9 @@ contains
         integer, allocatable :: root(:)
         integer :: m
         integer, allocatable :: yarn(:), at_node(:), before(:), after(:), laws(:)
+        integer, allocatable :: set_of(:)
+        character(len=name_length), allocatable :: set_names(:)
+        integer :: n_obstacles
         character(len=200) :: buffer
 
         n_yarns = size(config%yarns)
@@ -438,6 +476,7 @@ contains
                 call prefix_error(error, trim(buffer))
                 return
             end if
+            if (len_trim(config%contacts(c)%at) > 0) cycle     ! an obstacle's or ring's
             associate(a => find_material(config, config%contacts(c)%materials(1)), &
                     b => find_material(config, config%contacts(c)%materials(2)))
                 contact_of(a, b) = c
@@ -457,6 +496,8 @@ contains
             return
         end if
 
+        ! Obstacles and rings: every passage there takes the node's own law.
+        call get_contact_node_sets(config, set_of, set_names, n_obstacles)
         ! Visits of each original node by the yarns, listed per node (CSR). Nodes joined
         ! by links (gap-holders, periodic images) count as one contact: visits are
         ! counted at the root of each node's chain of links.
@@ -546,6 +587,14 @@ contains
             character(len=300) :: message
 
             contact = 0
+            if (set_of(node) /= 0) then
+                contact = find_node_contact(config, set_names(set_of(node)), &
+                    config%yarns(y)%material)
+                if (contact == 0) call fatal_error(error, "no &contact for yarn type '" &
+                    // trim(config%yarns(y)%material) // "' at '" &
+                    // trim(set_names(set_of(node))) // "'")
+                return
+            end if
             own = find_material(config, config%yarns(y)%material)
             do v = visits(node) + 1, visits(node + 1)
                 if (visitor(v) == y .and. visit_index(v) == k) cycle
