@@ -129,3 +129,72 @@ def test_known_mutations(tmp_path, scene, old, new, words):
     assert old in text
     proc = run(text.replace(old, new, 1).encode(), tmp_path)
     assert words in proc.stderr.decode(), proc.stderr.decode()
+
+
+#: Named errors of the contact-node kinds (&obstacle, &ring, &contact at), made from the
+#: examples by replacing texts: (scene, [(old, new), ...], words of the one error line).
+#: Each must exit with code 2 before anything is written (the scenes run for real).
+NODE_SCENES = {name: (TOP / "inputs" / f"{name}.nml").read_text()
+               for name in ("capstan_pins", "clothesline", "knit")}
+EXTRA_NODE = "1.0,       -1.0, 0.0 ! 5: B, pulled end\n          0.0, 0.0, 0.0"
+CONTACT_NODE_ERRORS = [
+    ("capstan_pins", [("nodes = 2, 3, 4", "nodes = 1, 2, 3, 4")],
+     "&yarn #1 ends at node 1, a node of &obstacle 'pins': a yarn passes through"),
+    ("clothesline", [("nodes = 2\n/\n\n&support", "nodes = 3\n/\n\n&support"),
+                     ("nodes = 1, 3", "nodes = 1")],
+     "&yarn #1 ends at node 3, a node of &ring 'ring'"),
+    ("capstan_pins", [("1.0,       -1.0, 0.0 ! 5: B, pulled end", EXTRA_NODE),
+                      ("&support\n    name = 'fixed'", "&ring name = 'loose', nodes = 6 /\n"
+                       "&support\n    name = 'fixed'")],
+     "&ring 'loose': no yarn passes through node 6 (nodes(1); a ring needs at least one "
+     "yarn through it)"),
+    ("capstan_pins", [("1.0,       -1.0, 0.0 ! 5: B, pulled end", EXTRA_NODE),
+                      ("nodes = 2, 3, 4", "nodes = 2, 3, 4, 6")],
+     "&obstacle 'pins': no yarn passes through node 6 (nodes(4); an obstacle"),
+    ("capstan_pins", [("\n    at = 'pins'", "\n    at = 'pin'")],
+     "&contact #1: at = 'pin' is not the name of an &obstacle or &ring (defined: 'pins'); "
+     "did you mean 'pins'?"),
+    ("clothesline", [("\n    at = 'ring'", "\n    at = 'rings'")],
+     "&contact #1: at = 'rings' is not the name of an &obstacle or &ring"),
+    ("capstan_pins", [("\n    at = 'pins'", "\n    materials = 'yarn', 'yarn'")],
+     "no &contact for yarn type 'yarn' at &obstacle 'pins' (&yarn #1 passes through its "
+     "node 2)"),
+    ("capstan_pins", [("\n    at = 'pins'", "\n    at = 'pins', materials = 'yarn', 'yarn'")],
+     "&contact #1: at = 'pins' with materials(2) = 'yarn': a law at an obstacle or ring "
+     "takes one yarn type"),
+    ("capstan_pins", [("\n    at = 'pins'", "\n    at = 'pins', materials = 'wool'")],
+     "&contact #1: materials(1) = 'wool' is not defined by any &material"),
+    ("clothesline", [("&path", "&contact at = 'ring', law = 'bonded' /\n&path")],
+     "&contact #2: at = 'ring' for every yarn type is also &contact #1"),
+    ("capstan_pins", [("&path", "&contact at = 'pins', materials = 'yarn', law = 'bonded' /\n"
+                       "&contact at = 'pins', materials = 'yarn', law = 'bonded' /\n&path")],
+     "&contact #3: at = 'pins', materials = 'yarn' is also &contact #2"),
+    ("capstan_pins", [("name = 'pins'", "name = 'pull'"), ("\n    at = 'pins'", "\n    at = 'pull'")],
+     "&obstacle: name = 'pull' is also the name of &support #2"),
+    ("capstan_pins", [("&path", "&ring name = 'pins', nodes = 1 /\n&path")],
+     "&ring: name = 'pins' is used twice (&obstacle #1 and &ring #1"),
+    ("capstan_pins", [("&path", "&ring name = 'r', nodes = 3 /\n&path")],
+     "&ring 'r': node 3 is already a node of &obstacle 'pins'"),
+    ("capstan_pins", [("nodes = 2, 3, 4", "nodes = 2, 3, 9")],
+     "&obstacle 'pins': nodes(3) = 9"),
+    ("capstan_pins", [("name = 'pins'", "name = ''")], "&obstacle #1: name is empty"),
+    ("capstan_pins", [("&path", "&load nodes = 3, force = 0, 1, 0 /\n&path")],
+     "&load #1: node 3 has force(2) = 1.0 but it is a node of &obstacle 'pins', held in place"),
+    ("knit", [("&path", "&ring name = 'r', nodes = 1 /\n&path")],
+     "&ring: not allowed together with &fabric"),
+]
+
+
+@pytest.mark.parametrize("scene, replacements, words", CONTACT_NODE_ERRORS)
+def test_contact_node_errors(tmp_path, scene, replacements, words):
+    text = NODE_SCENES[scene]
+    for old, new in replacements:
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    proc = run(text.encode(), tmp_path)
+    stderr = proc.stderr.decode()
+    assert proc.returncode == 2, stderr
+    errors = [line for line in stderr.splitlines() if line.startswith("yarnfort: error")]
+    assert len(errors) == 1 and errors[0].startswith("yarnfort: error (input): "), stderr
+    assert words in errors[0], stderr
+    assert not any(tmp_path.iterdir()), stderr

@@ -159,6 +159,7 @@ contains
             associate(list => config%yarns(y)%nodes)
                 do i = 1, size(list)
                     node = list(i)
+                    if (node < 1 .or. node > n_nodes) cycle     ! check_yarns reports it
                     if (set_of(node) == 0) cycle
                     if (i == 1 .or. i == size(list)) then
                         call fatal_error(error, yarn_label(config, y) // ' ends at node ' &

@@ -49,11 +49,12 @@ contains
         if (allocated(error)) return
         call check_scene_size(config, error)
         if (allocated(error)) return
+        ! Before check_yarns, whose "node on no yarn" would hide a ring with no yarn.
+        call check_contact_nodes(config, error)
+        if (allocated(error)) return
         call check_yarns(config, error)
         if (allocated(error)) return
         call check_duplicate_segments(config, error)
-        if (allocated(error)) return
-        call check_contact_nodes(config, error)
         if (allocated(error)) return
         call check_contacts(config, error)
         if (allocated(error)) return
