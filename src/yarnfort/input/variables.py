@@ -167,8 +167,8 @@ GROUPS = [
     Group('contact', 'repeatable',
           'The friction law where yarns of two types cross (one group per unordered pair).', [
         Var('materials', 'character', '', length='name_length', shape=2,
-            doc='Required: the two yarn types, names of `&material` groups (`materials = '
-                "'cotton', 'wool'`)."),
+            doc='The two yarn types, names of `&material` groups (`materials = '
+                "'cotton', 'wool'`): required unless `at` is set (then one yarn type or none)."),
         Var('law', 'character', '', length=32, lower=True,
             choices=['bonded', 'coulomb', 'adhesion', 'decaying_adhesion', 'general'],
             selects=True,
