@@ -27,6 +27,7 @@ _EXPORTS: dict[str, str] = {
     "set_parameter": "address", "get_parameter": "address", "AddressError": "address",
     "Scene": "scene", "Material": "scene", "Contact": "scene", "Yarn": "scene",
     "Support": "scene", "Load": "scene", "LoadPath": "scene", "Fabric": "scene",
+    "Obstacle": "scene", "Ring": "scene",
     "Geometry": "scene", "SceneError": "scene",
     "run_sweep": "sweep",
     "CalibrationResult": "calibrate", "calibrate": "calibrate", "plot_fit": "calibrate",

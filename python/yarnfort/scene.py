@@ -52,7 +52,7 @@ from numpy.typing import ArrayLike
 from .namelist import make_namelist, read_scene
 
 __all__ = ["Scene", "SceneError", "Material", "Contact", "Yarn", "Support", "Load",
-           "LoadPath", "Fabric", "Geometry"]
+           "LoadPath", "Fabric", "Geometry", "Obstacle", "Ring"]
 
 _NAME = re.compile(r"^[A-Za-z0-9_.\-]+$")
 _FIX = re.compile(r"^(?!.*(.).*\1)[xyzXYZ]{1,3}$")
@@ -109,7 +109,7 @@ def _variables(obj: Any, skip: tuple[str, ...] = ()) -> dict[str, Any]:
         if item.name == "extra" or item.name in skip:
             continue
         value = getattr(obj, item.name)
-        if value is None:
+        if value is None or (isinstance(value, tuple) and not value):
             continue
         if isinstance(value, np.ndarray):
             value = value.ravel().tolist()
@@ -206,34 +206,43 @@ class Material:
 
 @dataclass
 class Contact:
-    """The friction law between two yarn types (``&contact``).
+    """The friction law between two yarn types, or at an obstacle or ring (``&contact``).
 
     Parameters
     ----------
     materials : tuple of str
-        The two material names.
+        The two material names; with ``at``, one material name or none (every type).
     law : str
-        ``'bonded'``, ``'coulomb'``, ``'adhesion'`` or ``'decaying_adhesion'``.
+        ``'bonded'``, ``'coulomb'``, ``'adhesion'``, ``'decaying_adhesion'`` or
+        ``'general'``.
     friction_coefficient, adhesion, decay_start, decay_end : float, optional
         mu, beta (N), w_d and s_d (N), as the law needs.
+    at : str, optional
+        The name of an :class:`Obstacle` or :class:`Ring` whose law this is.
     extra : dict
         Further ``&contact`` variables.
     """
 
-    materials: tuple[str, str]
+    materials: tuple[str, ...]
     law: str
     friction_coefficient: float | None = None
     adhesion: float | None = None
     decay_start: float | None = None
     decay_end: float | None = None
+    at: str | None = None
     extra: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         pair = [self.materials] if isinstance(self.materials, str) else list(self.materials)
-        if len(pair) != 2:
+        pair = [name for name in pair if name not in ("", None)] if self.at else pair
+        if self.at is not None:
+            _name(self.at, "&contact at")
+            if len(pair) > 1:
+                raise SceneError(f"&contact at '{self.at}' materials: expected one name or "
+                                 f"none, got {self.materials!r}")
+        elif len(pair) != 2:
             raise SceneError(f"&contact materials: expected two names, got {self.materials!r}")
-        self.materials = (_name(pair[0], "&contact materials"),
-                          _name(pair[1], "&contact materials"))
+        self.materials = tuple(_name(name, "&contact materials") for name in pair)
         for key in ("friction_coefficient", "adhesion", "decay_start", "decay_end"):
             setattr(self, key, _optional_float(getattr(self, key), f"&contact {key}"))
 
@@ -297,6 +306,53 @@ class Support:
         if self.displacement is not None:
             self.displacement = _reals(self.displacement,
                                        f"&support '{self.name}' displacement", (3,))
+
+
+@dataclass
+class Obstacle:
+    """Fixed obstacles (``&obstacle``): nodes held in place that yarns slide through.
+
+    Parameters
+    ----------
+    name : str
+        Unique name (``Contact(at=name)`` gives its law; its reaction is reported as
+        ``<name>_rx, _ry, _rz``).
+    nodes : array_like of int
+        Node ids; each must be passed through, not ended at, by its yarns.
+    extra : dict
+        Further ``&obstacle`` variables.
+    """
+
+    name: str
+    nodes: ArrayLike
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        _name(self.name, "&obstacle name")
+        self.nodes = _ids(self.nodes, f"&obstacle '{self.name}' nodes")
+
+
+@dataclass
+class Ring:
+    """Free rings (``&ring``): nodes of free position that yarns slide through.
+
+    Parameters
+    ----------
+    name : str
+        Unique name (``Contact(at=name)`` gives its law).
+    nodes : array_like of int
+        Node ids; each must be passed through, not ended at, by its yarns.
+    extra : dict
+        Further ``&ring`` variables.
+    """
+
+    name: str
+    nodes: ArrayLike
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        _name(self.name, "&ring name")
+        self.nodes = _ids(self.nodes, f"&ring '{self.name}' nodes")
 
 
 @dataclass
@@ -402,7 +458,11 @@ _GROUPS: dict[str, tuple[type, bool]] = {
     "material": (Material, True), "contact": (Contact, True), "yarn": (Yarn, True),
     "support": (Support, True), "load": (Load, True), "path": (LoadPath, False),
     "geometry": (Geometry, False), "fabric": (Fabric, False),
+    "obstacle": (Obstacle, True), "ring": (Ring, True),
 }
+#: Repeated group -> the Scene attribute that holds its list.
+_LISTS = {"material": "materials", "contact": "contacts", "yarn": "yarns",
+          "support": "supports", "load": "loads", "obstacle": "obstacles", "ring": "rings"}
 #: Settings groups held as plain keyword dicts.
 _SETTINGS = ("control", "solver", "output")
 
@@ -420,7 +480,7 @@ class Scene:
 
     Attributes
     ----------
-    materials, contacts, yarns, supports, loads : list
+    materials, contacts, yarns, supports, loads, obstacles, rings : list
         The repeated groups, in order.
     nodes : numpy.ndarray or None
         Node positions, shape (n, 3), m (``&nodes``).
@@ -437,6 +497,8 @@ class Scene:
         self.yarns: list[Yarn] = []
         self.supports: list[Support] = []
         self.loads: list[Load] = []
+        self.obstacles: list[Obstacle] = []
+        self.rings: list[Ring] = []
         self._nodes: np.ndarray | None = None
         self.nodes_extra: dict[str, Any] = {}
         self.geometry: Geometry | None = None
@@ -530,6 +592,25 @@ class Scene:
         self._check_materials(contact.materials, "&contact materials")
         self.contacts.append(contact)
         return contact
+
+    def add_obstacle(self, name: str, nodes: ArrayLike, **variables: Any) -> Obstacle:
+        """Add an :class:`Obstacle`: fixed nodes the yarns slide through; its law is a
+        contact ``add_contact((), law, at=name, ...)`` (or with one material)."""
+        return self._add_contact_nodes(Obstacle(name, nodes, variables), self.obstacles)
+
+    def add_ring(self, name: str, nodes: ArrayLike, **variables: Any) -> Ring:
+        """Add a :class:`Ring`: free nodes the yarns slide through; its law is a contact
+        ``add_contact((), law, at=name, ...)``, its force a :meth:`add_load` on its node."""
+        return self._add_contact_nodes(Ring(name, nodes, variables), self.rings)
+
+    def _add_contact_nodes(self, item: Any, items: list) -> Any:
+        names = [o.name for o in self.obstacles] + [r.name for r in self.rings]
+        if item.name in names:
+            raise SceneError(f"&{type(item).__name__.lower()} name: {item.name!r} is given "
+                             "twice (obstacle and ring names are one set)")
+        self._check_nodes(item.nodes, f"&{type(item).__name__.lower()} '{item.name}' nodes")
+        items.append(item)
+        return item
 
     def add_yarn(self, material: str, nodes: ArrayLike, **variables: Any) -> Yarn:
         """Add a :class:`Yarn`.
@@ -645,6 +726,8 @@ class Scene:
             self._check_nodes(support.nodes, f"&support '{support.name}' nodes")
         for load in self.loads:
             self._check_nodes(load.nodes, "&load nodes")
+        for item in [*self.obstacles, *self.rings]:
+            self._check_nodes(item.nodes, f"&{type(item).__name__.lower()} '{item.name}' nodes")
 
     # -- namelist ---------------------------------------------------------------------
     def to_namelist(self) -> f90nml.Namelist:
@@ -665,7 +748,8 @@ class Scene:
         if self.geometry is not None:
             groups["geometry"] = _variables(self.geometry)
         for name, items in (("yarn", self.yarns), ("support", self.supports),
-                            ("load", self.loads)):
+                            ("load", self.loads), ("obstacle", self.obstacles),
+                            ("ring", self.rings)):
             if items:
                 groups[name] = [_variables(item) for item in items]
         groups["path"] = _variables(self.path)
@@ -727,11 +811,11 @@ class Scene:
                 objects = []
                 for group in groups:
                     known, extra = _split(group, names)
+                    if key == "contact" and "at" in known:
+                        known.setdefault("materials", ())
                     objects.append(kind(**_defaults_filled(key, known), extra=extra))
                 if repeated:
-                    getattr(scene, {"material": "materials", "contact": "contacts",
-                                    "yarn": "yarns", "support": "supports",
-                                    "load": "loads"}[key]).extend(objects)
+                    getattr(scene, _LISTS[key]).extend(objects)
                 else:
                     setattr(scene, key, objects[0])
             else:

@@ -222,11 +222,16 @@ def _column(values: list[Any]) -> np.ndarray:
 
 
 def _support_names(scene: f90nml.Namelist) -> list[str]:
-    groups = scene.get("support")
-    if groups is None:
-        return []
-    groups = [groups] if isinstance(groups, f90nml.Namelist) else list(groups)
-    return [str(group["name"]) for group in groups if "name" in group]
+    """Names of the reaction sets: the &support groups, then the &obstacle groups (an
+    obstacle holds its nodes and reports its reaction like a support)."""
+    names: list[str] = []
+    for key in ("support", "obstacle"):
+        groups = scene.get(key)
+        if groups is None:
+            continue
+        groups = [groups] if isinstance(groups, f90nml.Namelist) else list(groups)
+        names += [str(group["name"]) for group in groups if "name" in group]
+    return names
 
 
 def _check_support(scene: f90nml.Namelist, support: str | None) -> str:

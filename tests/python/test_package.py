@@ -409,3 +409,33 @@ def test_states_read_alike_with_and_without_meshio(workdir):
         np.testing.assert_array_equal(state.position, points)
         np.testing.assert_array_equal(state.elements, elements)
         np.testing.assert_array_equal(state.tension, cells["tension"])
+
+
+def test_built_scene_with_an_obstacle_and_a_ring(workdir):
+    """Obstacles, rings and their laws (Contact at) built in Python, written and read
+    back unchanged, and checked by the library; the pin scene runs to the capstan law."""
+    scene = Scene("pin and ring", output={"folder": "out/pin"})
+    scene.add_material("yarn", "linear", stiffness=10.0)
+    scene.nodes = np.array([[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
+    scene.add_yarn("yarn", [1, 2, 3])
+    scene.add_support("ends", [1])
+    scene.add_support("pull", [3], displacement=[0.0, -0.2, 0.0])
+    scene.add_obstacle("pin", [2])
+    scene.add_contact((), "coulomb", at="pin", friction_coefficient=0.3)
+    scene.path = yarnfort.LoadPath(time=[0.0, 1.0], p_disp=[0.0, 1.0])
+    with pytest.raises(yarnfort.SceneError, match="given twice"):
+        scene.add_ring("pin", [2])
+    with pytest.raises(yarnfort.SceneError, match="one name or none"):
+        yarnfort.Contact(("yarn", "yarn"), "coulomb", at="pin")
+    again = Scene.read(scene.write(workdir / "pin.nml"))
+    assert [(o.name, list(o.nodes)) for o in again.obstacles] == [("pin", [2])]
+    assert again.contacts[0].at == "pin" and again.contacts[0].materials == ()
+    run = again.run()
+    state = run.states[-1]
+    t = state.tension
+    a, b = state.position[0] - state.position[1], state.position[2] - state.position[1]
+    alpha = np.pi - np.arctan2(np.linalg.norm(np.cross(a, b)), a @ b)
+    assert t[1] == pytest.approx(t[0] * np.exp(0.3 * alpha), rel=1e-8)
+    ring = Scene.read(TOP / "inputs" / "clothesline.nml")
+    assert [r.name for r in ring.rings] == ["ring"] and ring.contacts[0].at == "ring"
+    ring.check()
