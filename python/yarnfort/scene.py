@@ -594,13 +594,43 @@ class Scene:
         return contact
 
     def add_obstacle(self, name: str, nodes: ArrayLike, **variables: Any) -> Obstacle:
-        """Add an :class:`Obstacle`: fixed nodes the yarns slide through; its law is a
-        contact ``add_contact((), law, at=name, ...)`` (or with one material)."""
+        """Add an :class:`Obstacle`: nodes held in place that the yarns slide through.
+
+        Parameters
+        ----------
+        name : str
+            Unique among obstacles and rings; its law is a contact
+            ``add_contact((), law, at=name, ...)`` (or with one material).
+        nodes : array_like of int
+            Node ids.
+        **variables
+            Any further ``&obstacle`` variable.
+
+        Returns
+        -------
+        Obstacle
+            The obstacle added.
+        """
         return self._add_contact_nodes(Obstacle(name, nodes, variables), self.obstacles)
 
     def add_ring(self, name: str, nodes: ArrayLike, **variables: Any) -> Ring:
-        """Add a :class:`Ring`: free nodes the yarns slide through; its law is a contact
-        ``add_contact((), law, at=name, ...)``, its force a :meth:`add_load` on its node."""
+        """Add a :class:`Ring`: free nodes that the yarns slide through.
+
+        Parameters
+        ----------
+        name : str
+            Unique among obstacles and rings; its law is a contact
+            ``add_contact((), law, at=name, ...)``; its force a :meth:`add_load`.
+        nodes : array_like of int
+            Node ids.
+        **variables
+            Any further ``&ring`` variable.
+
+        Returns
+        -------
+        Ring
+            The ring added.
+        """
         return self._add_contact_nodes(Ring(name, nodes, variables), self.rings)
 
     def _add_contact_nodes(self, item: Any, items: list) -> Any:

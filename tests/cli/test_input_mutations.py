@@ -169,7 +169,8 @@ CONTACT_NODE_ERRORS = [
     ("capstan_pins", [("&path", "&contact at = 'pins', materials = 'yarn', law = 'bonded' /\n"
                        "&contact at = 'pins', materials = 'yarn', law = 'bonded' /\n&path")],
      "&contact #3: at = 'pins', materials = 'yarn' is also &contact #2"),
-    ("capstan_pins", [("name = 'pins'", "name = 'pull'"), ("\n    at = 'pins'", "\n    at = 'pull'")],
+    ("capstan_pins", [("name = 'pins'", "name = 'pull'"),
+                      ("\n    at = 'pins'", "\n    at = 'pull'")],
      "&obstacle: name = 'pull' is also the name of &support #2"),
     ("capstan_pins", [("&path", "&ring name = 'pins', nodes = 1 /\n&path")],
      "&ring: name = 'pins' is used twice (&obstacle #1 and &ring #1"),

@@ -146,7 +146,8 @@ contains
             do i = 1, size(nodes)
                 if (set_of(nodes(i)) /= 0) then
                     call fatal_error(error, label // ': node ' // format_integer(nodes(i)) &
-                        // ' is already a node of ' // contact_node_label(config, set_of(nodes(i))) &
+                        // ' is already a node of ' &
+                        // contact_node_label(config, set_of(nodes(i))) &
                         // ' (a node is one obstacle or one ring)')
                     return
                 end if
