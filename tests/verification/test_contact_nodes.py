@@ -278,3 +278,94 @@ def test_contact_output_at_pins_and_rings(run_yarnfort, tmp_path):
     assert flow[-1] < -0.1 * length_a                   # towards A: the ring slid to B
     assert set(table["mode"][1:]) == {"backward"}
     assert all(s.point_data["contact_state"][1] == 2 for s in states[1:])
+
+
+def test_law_rule_does_not_depend_on_the_input_order(run_yarnfort, tmp_path):
+    """The law at the pins (a law for the yarn's type and one for every type) and the
+    groups in either order: the same curve and contact table to the last digit; and the
+    specific law is the one taken (its T_crit, not the other law's, in contacts.csv)."""
+    k, law = 4, LAWS["adhesion"]
+    net = pin_net(k)
+    first = pin_namelist(net, k, law, specific=True)
+    chunks = first.split("&contact")
+    head, contacts = chunks[0], ["&contact" + c for c in chunks[1:]]
+    obstacle = contacts[-1][contacts[-1].index("&obstacle"):]
+    contacts[-1] = contacts[-1][:contacts[-1].index("&obstacle")]
+    second = obstacle + head + "".join(reversed(contacts))
+    assert second != first and sorted(second.splitlines()) == sorted(first.splitlines())
+    tables = []
+    for name, text in (("first", first), ("second", second)):
+        _, curve, _ = run_scene(run_yarnfort, tmp_path, name, text)
+        table = read_contacts(tmp_path / name / "out")
+        tables.append((curve, table))
+    (c1, t1), (c2, t2) = tables
+    for column in c1.names:
+        if column != "wall_time":
+            np.testing.assert_array_equal(c1[column], c2[column])
+    for column in t1.names:
+        np.testing.assert_array_equal(t1[column], t2[column])
+    np.testing.assert_allclose(t1["critical_tension"],
+                               critical(law, t1["tension_min"], t1["wrap_angle"]), rtol=1e-13)
+
+
+def test_pair_laws_do_not_apply_at_a_ring(run_yarnfort, tmp_path):
+    """Two yarns of two types through one frictionless ring, and a pair &contact between
+    the types with mu = 0.9: at the ring only the ring's law counts, so both yarns slide
+    freely (T_crit = T_min, equal tensions on both sides of each yarn) and the ring's
+    load is held by the four tensions."""
+    nodes = [[-1.0, 0.3, 0.0], [0.0, -0.5, 0.0], [1.0, 0.0, 0.0],
+             [0.0, 0.2, -1.0], [0.0, 0.4, 1.0]]
+    text = defaults_namelist(
+        nodes, [dict(material="line", nodes=[1, 2, 3]), dict(material="cord", nodes=[4, 2, 5])],
+        [dict(name="ends", nodes=[1, 3, 4, 5])], [dict(nodes=[2], force=[0.0, -1.0, 0.0])],
+        [dict(name="line", law="linear", stiffness=10.0),
+         dict(name="cord", law="linear", stiffness=20.0)],
+        dict(time=[0.0, 1.0], p_force=[FIRST_LOAD, 1.0]),
+        [dict(materials=["line", "cord"], law="coulomb", friction_coefficient=0.9),
+         dict(at="hook", law="coulomb", friction_coefficient=0.0)])
+    text += group("ring", name="hook", nodes=[2])
+    _, curve, states = run_scene(run_yarnfort, tmp_path, "hook", text)
+    table = read_contacts(tmp_path / "hook" / "out")
+    assert len(table["step"]) == 2 * len(states)
+    assert set(np.asarray(table["node"], int)) == {2}
+    np.testing.assert_array_equal(table["critical_tension"], table["tension_min"])
+    for i, state in enumerate(states):
+        load = curve["p_force"][i]
+        t = state.tension
+        assert abs(t[0] - t[1]) <= FORCE_RTOL * load and abs(t[2] - t[3]) <= FORCE_RTOL * load
+        x = state.position
+        pull = sum(t[e] * (x[n] - x[1]) / np.linalg.norm(x[n] - x[1])
+                   for e, n in enumerate((0, 2, 3, 4)))
+        assert np.max(np.abs(pull + [0.0, -load, 0.0])) <= FORCE_RTOL * load
+    assert states[-1].tension.min() > 0.1
+
+
+def test_pin_reactions_per_node(run_yarnfort, tmp_path):
+    """&output node_reactions at an obstacle: one row per pin and step, each the force
+    that holds the pin against the yarn's two tensions at it (from the run's own tensions
+    and positions), and the rows adding up to the obstacle's columns in curve.csv."""
+    k = 4
+    net = pin_net(k)
+    text = pin_namelist(net, k, LAWS["coulomb"]).replace(
+        "folder = 'out'", "folder = 'out'\n    node_reactions = .true.")
+    _, curve, states = run_scene(run_yarnfort, tmp_path, "pins", text)
+    from yarnfort.results import read_reactions
+    table = read_reactions(tmp_path / "pins" / "out")
+    rows = [i for i, s in enumerate(table["support"]) if s == "pins"]
+    assert len(rows) == k * len(states)
+    force = np.column_stack([table["rx"], table["ry"], table["rz"]])
+    worst = 0.0
+    for i, state in enumerate(states):
+        mine = [r for r in rows if int(table["step"][r]) == int(curve["step"][i])]
+        assert [int(table["node"][r]) for r in mine] == list(range(2, k + 2))
+        x, t = state.position, state.tension
+        scale = max(float(t.max()), 1e-300)
+        for p, r in enumerate(mine, start=1):
+            u = [(x[p - 1] - x[p]) / np.linalg.norm(x[p - 1] - x[p]),
+                 (x[p + 1] - x[p]) / np.linalg.norm(x[p + 1] - x[p])]
+            held = -(t[p - 1] * u[0] + t[p] * u[1])
+            worst = max(worst, np.max(np.abs(force[r] - held)) / scale)
+        np.testing.assert_allclose(force[mine].sum(axis=0), curve.reaction("pins")[i],
+                                   rtol=0, atol=1e-14 * scale)
+    print(f"pin reactions: {len(rows)} rows, worst {worst:.1e} of the largest tension")
+    assert worst <= FORCE_RTOL
