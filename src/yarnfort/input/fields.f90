@@ -1,21 +1,21 @@
 ! SPDX-License-Identifier: MIT
 !> What the generated readers, checks and echo of yarnfort_input_groups do with one
-!> namelist variable: take a value read into a buffer (length, case, list length against
-!> the "not set" markers), check it (range, choices, the parameters of a law), write it
-!> back, and turn a failed namelist READ into a message naming group, variable and line.
+!> namelist variable: take its values from the assignments of a group (type, entries,
+!> length, case; each error naming group, variable, value and line), check it (range,
+!> choices, the parameters of a law), and write it back.
 module yarnfort_input_fields
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_text, only: to_lower, format_integer, format_real, join_names, closest_name
-    use yarnfort_input_scan, only: namelist_scan_type, explain_read_error
+    use yarnfort_text, only: to_lower, format_integer, format_real, join_names, closest_name, &
+        parse_integer, parse_real
+    use yarnfort_input_scan, only: namelist_scan_type, assignment_type
+    use yarnfort_text, only: string_type
     implicit none
     private
 
-    public :: buffer_length, message_length, max_list, max_coordinates, indent
-    public :: unset_real, unset_integer, other_real, other_integer
-    public :: read_failed, post_read_error, too_many_found, group_label
-    public :: take_text, unset_reals, unset_integers, count_set
+    public :: message_length, max_list, max_coordinates, indent
+    public :: post_read_error, group_label, take_scalar, take_array, list_length
     public :: check_real, check_at_least, check_choice, require_set, require_text, forbid_set
     public :: not_finite, suggestion, quoted_list, check_name
     public :: put, put_reals, put_integers, format_logical
@@ -24,14 +24,6 @@ module yarnfort_input_fields
     integer, parameter :: max_list = 100000
     !> Most values of &nodes xyz (3 per node); larger scenes use &geometry.
     integer, parameter :: max_coordinates = 3 * max_list
-    !> Mark list entries the input did not set. An input value equal to the first
-    !> marker makes the reader read the group again with the second (see
-    !> namelist_scan_type%holds_marker): an entry is unset where both reads left theirs.
-    integer, parameter :: unset_integer = -huge(1), other_integer = huge(1)
-    real(wp), parameter :: unset_real = -huge(1.0_wp), other_real = huge(1.0_wp)
-    !> Length of the character buffers the namelists read into (longer than any config
-    !> field, so that a value too long for its field is detected, not cut).
-    integer, parameter :: buffer_length = 2048
     integer, parameter :: message_length = 512
     !> Indent of the variables in the echo, and values per line of its lists.
     character(len=*), parameter :: indent = '    '
@@ -57,29 +49,6 @@ contains
         if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
     end function group_label
 
-    !> Turn a failed namelist READ into an error naming the group, with the reader's
-    !> message and where possible the variable, the line and a suggestion.
-    subroutine read_failed(error, scan, name, occurrence, stat, message, variables)
-        type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: occurrence, stat
-        character(len=*), intent(in) :: message
-        character(len=*), intent(in) :: variables(:)
-        integer :: g
-
-        if (is_iostat_end(stat)) then
-            g = scan%find_group(name, max(occurrence, 1))
-            call fatal_error(error, group_label(name, occurrence) // ' (line ' &
-                // format_integer(scan%groups(g)%first_line) // ') was not found by the ' &
-                // "Fortran namelist reader: is there a '!' inside a character value " &
-                // 'earlier on that line? (it hides the rest of the line)')
-            return
-        end if
-        call fatal_error(error, group_label(name, occurrence) // ': ' &
-            // explain_read_error(scan, name, max(occurrence, 1), trim(message), variables))
-    end subroutine read_failed
-
     !> An error found after a successful READ, with the group's line.
     subroutine post_read_error(error, scan, name, occurrence, text)
         type(error_type), allocatable, intent(out) :: error
@@ -98,100 +67,225 @@ contains
         end if
     end subroutine post_read_error
 
-    !> The namelist reader found more occurrences than the structural scan.
-    subroutine too_many_found(error, name, n_expected)
+    !> Scalar variable `name` of group `label` (real(wp), integer, logical or character,
+    !> folded to lower case if `lower`, leading blanks dropped if `adjust`) from its
+    !> assignment among `sets`; unchanged where none sets it or its value is null.
+    subroutine take_scalar(sets, label, name, field, error, lower, adjust)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: label, name
+        class(*), intent(inout) :: field
         type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: n_expected
+        logical, intent(in), optional :: lower, adjust
+        type(string_type), allocatable :: words(:)
+        integer :: k
 
-        call fatal_error(error, '&' // name // ': the Fortran namelist reader found more ' &
-            // 'than the ' // format_integer(n_expected) // ' &' // name // ' groups of ' &
-            // "the text; is '&" // name // "' inside a comment after a character value " &
-            // "with '!'?")
-    end subroutine too_many_found
-
-    !> A character value read into `buffer` into its config `field`: it must fit; leading
-    !> blanks dropped if `adjust`, folded to lower case if `lower`.
-    subroutine take_text(error, scan, name, occurrence, variable, buffer, field, lower, adjust)
-        type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name, variable
-        integer, intent(in) :: occurrence
-        character(len=*), intent(inout) :: buffer
-        character(len=*), intent(out) :: field
-        logical, intent(in) :: lower, adjust
-
-        field = ''
-        if (adjust) buffer = adjustl(buffer)
-        if (len_trim(buffer) > len(field)) then
-            call post_read_error(error, scan, name, occurrence, variable // " = '" &
-                // buffer(:min(len_trim(buffer), 40)) // "...' is longer than " &
-                // format_integer(len(field)) // ' characters')
+        do k = 1, size(sets)
+            if (sets(k)%name /= name) cycle
+            if (sets(k)%first /= 0) then
+                call fatal_error(error, label // ': ' // name // '(' &
+                    // format_integer(sets(k)%first) // ') (line ' &
+                    // format_integer(sets(k)%line) // '): ' // name // ' is not an array')
+                return
+            end if
+            call expand(sets(k), label, 1, words, error)
+            if (allocated(error) .or. size(words) == 0) return
+            if (len(words(1)%text) == 0) return
+            call convert(words(1)%text, sets(k)%line, label, name, field, error, lower, adjust)
             return
-        end if
-        if (lower) buffer = to_lower(buffer)
-        field = buffer(:len(field))
-    end subroutine take_text
+        end do
+    end subroutine take_scalar
 
-    !> Which entries of a list read into `values` (prefilled with unset_real) the input
-    !> did not set. If `again` is allocated, `values` holds a second read prefilled with
-    !> other_real and `again` the first: an entry is unset only where both kept their
-    !> marker (so an input value equal to a marker is a value).
-    pure function unset_reals(values, again) result(unset)
-        real(wp), intent(in) :: values(:)
-        real(wp), allocatable, intent(in) :: again(:)
-        logical :: unset(size(values))
-
-        if (allocated(again)) then
-            unset = values == other_real .and. again == unset_real
-        else
-            unset = values == unset_real
-        end if
-    end function unset_reals
-
-    !> As unset_reals for integers (markers unset_integer and other_integer).
-    pure function unset_integers(values, again) result(unset)
-        integer, intent(in) :: values(:)
-        integer, allocatable, intent(in) :: again(:)
-        logical :: unset(size(values))
-
-        if (allocated(again)) then
-            unset = values == other_integer .and. again == unset_integer
-        else
-            unset = values == unset_integer
-        end if
-    end function unset_integers
-
-    !> `n`, the last set entry of a list; an error for a set guard or an unset entry
-    !> before the last set one.
-    subroutine count_set(error, scan, name, occurrence, variable, unset, n)
+    !> Array variable `name` of group `label` from its assignments among `sets`: `name =`
+    !> sets the entries from 1 on, `name(i) =` from i on; the others stay as they are.
+    subroutine take_array(sets, label, name, field, error, lower, adjust)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: label, name
+        class(*), intent(inout) :: field(:)
         type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name, variable
-        integer, intent(in) :: occurrence
-        logical, intent(in) :: unset(:)
+        logical, intent(in), optional :: lower, adjust
+        type(string_type), allocatable :: words(:)
+        integer :: k, j, first
+
+        do k = 1, size(sets)
+            if (sets(k)%name /= name) cycle
+            call first_entry(sets(k), label, size(field), first, error)
+            if (allocated(error)) return
+            call expand(sets(k), label, size(field) - first + 1, words, error)
+            if (allocated(error)) return
+            do j = 1, size(words)
+                if (len(words(j)%text) == 0) cycle
+                call convert(words(j)%text, sets(k)%line, label, name // '(' &
+                    // format_integer(first + j - 1) // ')', field(first + j - 1), error, &
+                    lower, adjust)
+                if (allocated(error)) return
+            end do
+        end do
+    end subroutine take_array
+
+    !> `n`, the last entry of list `name` of group `label` that `sets` give a value (at
+    !> most `most`); an error for an entry without a value before it.
+    subroutine list_length(sets, label, name, most, n, error)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: label, name
+        integer, intent(in) :: most
         integer, intent(out) :: n
-        integer :: i
+        type(error_type), allocatable, intent(out) :: error
+        type(string_type), allocatable :: words(:)
+        logical, allocatable :: given(:)
+        integer :: k, j, first
 
         n = 0
-        do i = size(unset), 1, -1
-            if (.not. unset(i)) then
-                n = i
-                exit
-            end if
+        do k = 1, size(sets)
+            if (sets(k)%name /= name) cycle
+            if (.not. allocated(given)) allocate(given(most), source=.false.)
+            call first_entry(sets(k), label, most, first, error)
+            if (allocated(error)) return
+            call expand(sets(k), label, most - first + 1, words, error)
+            if (allocated(error)) return
+            do j = 1, size(words)
+                given(first + j - 1) = len(words(j)%text) > 0
+            end do
         end do
-        if (n == size(unset)) then
-            call post_read_error(error, scan, name, occurrence, variable // ' has more than ' &
-                // format_integer(size(unset) - 1) // ' values (the most it can hold)')
-            return
-        end if
-        i = findloc(unset(:n), .true., dim=1)
-        if (i > 0) then
-            call post_read_error(error, scan, name, occurrence, variable // '(' &
-                // format_integer(i) // ') has no value, but later entries have (an ' &
-                // 'empty entry between commas?)')
-        end if
-    end subroutine count_set
+        if (.not. allocated(given)) return
+        n = findloc(given, .true., dim=1, back=.true.)
+        j = findloc(given(:n), .false., dim=1)
+        if (j > 0) call fatal_error(error, label // ': ' // name // '(' // format_integer(j) &
+            // ') has no value, but later entries have (an empty entry between commas?)')
+    end subroutine list_length
+
+    !> The entry an assignment starts at: its subscript, which must lie in 1..most, or 1.
+    subroutine first_entry(set, label, most, first, error)
+        type(assignment_type), intent(in) :: set
+        character(len=*), intent(in) :: label
+        integer, intent(in) :: most
+        integer, intent(out) :: first
+        type(error_type), allocatable, intent(out) :: error
+
+        first = max(set%first, 1)
+        if (set%first < 0 .or. set%first > most) call fatal_error(error, label // ': ' &
+            // set%name // '(' // format_integer(set%first) // ') (line ' &
+            // format_integer(set%line) // '): the subscript is outside 1..' &
+            // format_integer(most) // ', the entries of ' // set%name)
+    end subroutine first_entry
+
+    !> The values of an assignment with repeat counts r*v written out (r*: r null values),
+    !> at most `most` of them.
+    subroutine expand(set, label, most, words, error)
+        type(assignment_type), intent(in) :: set
+        character(len=*), intent(in) :: label
+        integer, intent(in) :: most
+        type(string_type), allocatable, intent(out) :: words(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer, allocatable :: repeats(:), skip(:)
+        integer :: j, star, n
+        logical :: ok
+
+        allocate(repeats(size(set%values)), source=1)
+        allocate(skip(size(set%values)), source=0)
+        n = 0
+        do j = 1, size(set%values)
+            associate(word => set%values(j)%text)
+                star = index(word, '*')
+                if (star > 1) then
+                    if (verify(word(:star - 1), '0123456789') == 0) then
+                        skip(j) = star
+                        call parse_integer(word(:star - 1), repeats(j), ok)
+                        if (.not. ok .or. repeats(j) < 1) then
+                            call fatal_error(error, label // ': ' // word // ' (line ' &
+                                // format_integer(set%line) // ') in ' // set%name &
+                                // ': a repeat count is a positive integer')
+                            return
+                        end if
+                    end if
+                end if
+                if (repeats(j) > most - n) then
+                    call fatal_error(error, label // ': ' // set%name // ' has more than ' &
+                        // format_integer(most) // ' values (line ' // format_integer(set%line) &
+                        // '): more values than ' // set%name // ' holds')
+                    return
+                end if
+                n = n + repeats(j)
+            end associate
+        end do
+        allocate(words(n))
+        n = 0
+        do j = 1, size(set%values)
+            words(n + 1:n + repeats(j)) = string_type(set%values(j)%text(skip(j) + 1:))
+            n = n + repeats(j)
+        end do
+    end subroutine expand
+
+    !> The value word `word` (of `variable`, assigned on `line`) into `field`.
+    subroutine convert(word, line, label, variable, field, error, lower, adjust)
+        character(len=*), intent(in) :: word, label, variable
+        integer, intent(in) :: line
+        class(*), intent(inout) :: field
+        type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: lower, adjust
+        character(len=:), allocatable :: text, expected
+        logical :: ok
+
+        text = to_lower(word)
+        select type (field)
+        type is (real(wp))
+            call parse_real(word, field, ok)
+            expected = 'a real number is expected'
+        type is (integer)
+            call parse_integer(word, field, ok)
+            expected = 'an integer is expected'
+        type is (logical)
+            if (text(1:1) == '.') text = text(2:)
+            ok = any(text == [character(len=6) :: 't', 'f', 'true', 'false', 't.', 'f.', &
+                'true.', 'false.'])
+            if (ok) field = text(1:1) == 't'
+            expected = 'a logical is expected: .true. or .false.'
+        type is (character(len=*))
+            ok = len(word) >= 2 .and. scan(word(1:1), "'""") == 1
+            if (ok) ok = word(len(word):) == word(1:1)
+            expected = "a character value is expected, in quotes: 'text'"
+            if (ok) then
+                text = unquoted(word(2:len(word) - 1), word(1:1))
+                if (optional_true(adjust)) text = adjustl(text)
+                if (len_trim(text) > len(field)) then
+                    call fatal_error(error, label // ': ' // variable // " = '" &
+                        // text(:min(len_trim(text), 40)) // "...' is longer than " &
+                        // format_integer(len(field)) // ' characters (line ' &
+                        // format_integer(line) // ')')
+                    return
+                end if
+                if (optional_true(lower)) text = to_lower(text)
+                field = text
+            end if
+        end select
+        if (.not. ok) call fatal_error(error, label // ': ' // word &
+            // ' is not a valid value of ' // variable // ' (line ' // format_integer(line) &
+            // ': ' // expected // ')')
+    end subroutine convert
+
+    !> The text of a character value between its quotes, doubled quotes made single.
+    pure function unquoted(inner, quote) result(text)
+        character(len=*), intent(in) :: inner, quote
+        character(len=:), allocatable :: text
+        integer :: i, n
+
+        allocate(character(len=len(inner)) :: text)
+        n = 0
+        i = 1
+        do while (i <= len(inner))
+            n = n + 1
+            text(n:n) = inner(i:i)
+            if (inner(i:i) == quote) i = i + 1
+            i = i + 1
+        end do
+        text = text(:n)
+    end function unquoted
+
+    pure logical function optional_true(flag)
+        logical, intent(in), optional :: flag
+
+        optional_true = .false.
+        if (present(flag)) optional_true = flag
+    end function optional_true
 
     !> A real that must be finite and, where bounds are given, within them (the texts
     !> of the bounds are those of the description, for the message).

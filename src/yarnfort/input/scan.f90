@@ -1,22 +1,22 @@
 ! SPDX-License-Identifier: MIT
-!> A structural pass over namelist input text before the Fortran namelist reads: finds
-!> every '&group ... /' occurrence with its lines and tokens, and rejects what the
-!> Fortran reader would silently ignore or misread (unknown or misspelt group names,
-!> text outside groups, a group not closed with '/', a variable set twice in one group,
-!> a '&group' inside a character value). It also explains the namelist reader's iomsg
-!> (which variable, which line, what was probably meant).
+!> The tokenizer of namelist input text: finds every '&group ... /' occurrence with its
+!> lines and tokens (names before '=', values, null values between two commas), and
+!> rejects what is not namelist syntax (unknown or misspelt group names, text outside
+!> groups, a group not closed with '/', a variable set twice in one group, a '&group'
+!> inside a character value). `get_assignments` gives a group's assignments, each
+!> variable checked against the group's names. Values are converted by
+!> yarnfort_input_fields.
 module yarnfort_input_scan
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_kinds, only: wp
     use yarnfort_text, only: string_type, read_line, to_lower, format_integer, &
-        closest_name, join_names, byte_order_mark, parse_integer, parse_real, &
-        remove_characters
+        closest_name, join_names, byte_order_mark, parse_integer, remove_characters
     implicit none
     private
 
-    public :: namelist_scan_type, scan_namelist, explain_read_error
+    public :: namelist_scan_type, scan_namelist, assignment_type, get_assignments
 
-    !> A word of a group's text: a variable name (followed by '=') or a value.
+    !> A word of a group's text: a variable name (followed by '=') or a value (empty,
+    !> last < first, for a null value).
     type :: token_type
         integer :: line = 0
         !> Columns of the token on its line.
@@ -36,13 +36,9 @@ module yarnfort_input_scan
     !> The text and its groups, in the order of the text.
     type :: namelist_scan_type
         type(string_type), allocatable :: lines(:)
-        !> Column of the '!' starting a comment on each line, 0 for none.
-        integer, allocatable :: comment_start(:)
         type(group_occurrence_type), allocatable :: groups(:)
         integer :: n_groups = 0
     contains
-        !> Write the text without its comments (same lines) for the namelist reads.
-        procedure :: write_without_comments
         !> Number of occurrences of a group.
         procedure :: count_group
         !> Index in `groups` of the k-th occurrence of a group (0 if there is none).
@@ -51,9 +47,18 @@ module yarnfort_input_scan
         procedure :: token_text
         !> Whether a group sets a variable (any of its entries).
         procedure :: is_set
-        !> Whether a value of a group equals one of the reader's "not set" markers.
-        procedure :: holds_marker
     end type namelist_scan_type
+
+    !> One assignment `name = values` or `name(first) = values` of a group occurrence.
+    type :: assignment_type
+        !> Variable name in lower case, without subscript.
+        character(len=:), allocatable :: name
+        !> The subscript, 0 for none.
+        integer :: first = 0
+        integer :: line = 0
+        !> The value words as written (repeat counts r*v kept; '' for a null value).
+        type(string_type), allocatable :: values(:)
+    end type assignment_type
 
     character(len=1), parameter :: tab = achar(9), carriage_return = achar(13)
     character(len=*), parameter :: name_characters = &
@@ -108,17 +113,17 @@ contains
         type(namelist_scan_type), intent(inout) :: scan
         character(len=*), intent(in) :: known_groups(:)
         type(error_type), allocatable, intent(out) :: error
-        logical :: in_group, in_string
+        logical :: in_group, in_string, after_comma
         character(len=1) :: c, quote
         character(len=:), allocatable :: name
         integer :: iline, i, j, depth
         type(group_occurrence_type), allocatable :: grown(:)
 
         allocate(scan%groups(16))
-        allocate(scan%comment_start(size(scan%lines)), source=0)
         scan%n_groups = 0
         in_group = .false.
         in_string = .false.
+        after_comma = .false.
         quote = ''
         do iline = 1, size(scan%lines)
             associate(text => scan%lines(iline)%text)
@@ -158,7 +163,6 @@ contains
                         case (' ', tab, carriage_return)
                             i = i + 1
                         case ('!')
-                            scan%comment_start(iline) = i
                             exit
                         case ('&', '$')
                             call read_name(text, i + 1, j, name)
@@ -188,11 +192,17 @@ contains
                         cycle
                     end if
                     ! In a group.
+                    if (c /= ',' .and. index(' ;!' // tab // carriage_return, c) == 0) &
+                        after_comma = .false.
                     select case (c)
-                    case (' ', tab, carriage_return, ',', ';')
+                    case (',')
+                        ! Two commas with nothing but blanks between: a null value.
+                        if (after_comma) call add_token(iline, i, i - 1)
+                        after_comma = .true.
+                        i = i + 1
+                    case (' ', tab, carriage_return, ';')
                         i = i + 1
                     case ('!')
-                        scan%comment_start(iline) = i
                         exit
                     case ("'", '"')
                         call add_token(iline, i, i)
@@ -379,7 +389,7 @@ contains
                     return
                 end if
                 associate(last => group%tokens(group%n_tokens))
-                    if (last%is_name .or. index("'""", &
+                    if (last%is_name .or. last%last < last%first .or. index("'""", &
                         scan%lines(last%line)%text(last%first:last%first)) > 0) then
                         call no_name_error()
                         return
@@ -515,34 +525,6 @@ contains
         end if
     end function shorten
 
-    !> gfortran takes a ',' before a '!' comment at the end of a line for an empty value
-    !> (x = 1, 2, ! ...  3 gives x(3) no value and x(4) = 3), and a '!' hides the rest of
-    !> its line from the search for a group: the namelist reads get the text without
-    !> its comments, line for line.
-    subroutine write_without_comments(self, unit, error)
-        class(namelist_scan_type), intent(in) :: self
-        integer, intent(in) :: unit
-        type(error_type), allocatable, intent(out) :: error
-        character(len=512) :: message
-        integer :: iline, stat
-
-        do iline = 1, size(self%lines)
-            associate(text => self%lines(iline)%text, comment => self%comment_start(iline))
-                if (comment > 0) then
-                    write(unit, '(a)', iostat=stat, iomsg=message) text(:comment - 1)
-                else
-                    write(unit, '(a)', iostat=stat, iomsg=message) text
-                end if
-            end associate
-            if (stat /= 0) then
-                call fatal_error(error, 'cannot write the input to a scratch file: ' &
-                    // trim(message))
-                return
-            end if
-        end do
-        rewind(unit)
-    end subroutine write_without_comments
-
     pure function count_group(self, name) result(n)
         class(namelist_scan_type), intent(in) :: self
         character(len=*), intent(in) :: name
@@ -591,36 +573,82 @@ contains
         end associate
     end function is_set
 
-    !> Whether a value of the `occurrence`-th group `name` (with a repeat count r*v, its
-    !> v) reads as `real_marker` or `integer_marker`.
-    logical function holds_marker(self, name, occurrence, real_marker, integer_marker)
-        class(namelist_scan_type), intent(in) :: self
+    !> The assignments of the `occurrence`-th group `name` (1 for a singleton), in text
+    !> order. An error for a value before the first name, a variable not in `variables`
+    !> (with the closest one), a known variable name among the values (a missing '='),
+    !> and a subscript that is not one integer.
+    subroutine get_assignments(scan, name, occurrence, variables, sets, error)
+        type(namelist_scan_type), intent(in) :: scan
         character(len=*), intent(in) :: name
         integer, intent(in) :: occurrence
-        real(wp), intent(in) :: real_marker
-        integer, intent(in) :: integer_marker
-        character(len=:), allocatable :: text
-        real(wp) :: real_value
-        integer :: g, k, integer_value
+        character(len=*), intent(in) :: variables(:)
+        type(assignment_type), allocatable, intent(out) :: sets(:)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text, label, guess
+        integer :: k, n, j, m, g, paren
         logical :: ok
 
-        holds_marker = .false.
-        g = self%find_group(name, occurrence)
-        if (g == 0) return
-        associate(group => self%groups(g))
+        label = '&' // name
+        if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
+        g = scan%find_group(name, max(occurrence, 1))
+        associate(group => scan%groups(g))
+            allocate(sets(count(group%tokens(:group%n_tokens)%is_name)))
+            n = 0
             do k = 1, group%n_tokens
-                if (group%tokens(k)%is_name) cycle
-                text = self%token_text(group%tokens(k))
-                text = text(index(text, '*') + 1:)
-                call parse_integer(text, integer_value, ok)
-                if (ok) holds_marker = integer_value == integer_marker
-                if (holds_marker) return
-                call parse_real(text, real_value, ok)
-                if (ok) holds_marker = real_value == real_marker
-                if (holds_marker) return
+                text = scan%token_text(group%tokens(k))
+                if (group%tokens(k)%is_name) then
+                    n = n + 1
+                    sets(n)%line = group%tokens(k)%line
+                    sets(n)%name = base_name(text)
+                    j = k + 1
+                    do while (j <= group%n_tokens)
+                        if (group%tokens(j)%is_name) exit
+                        j = j + 1
+                    end do
+                    allocate(sets(n)%values(j - k - 1))
+                    m = 0
+                    paren = index(text, '(')
+                    if (paren > 0) then
+                        text = normalized_name(text(paren:))
+                        call parse_integer(text(2:len(text) - 1), sets(n)%first, ok)
+                        if (.not. ok .or. text(len(text):) /= ')') then
+                            call fatal_error(error, label // ': ' // normalized_name( &
+                                scan%token_text(group%tokens(k))) // ' (line ' &
+                                // format_integer(sets(n)%line) // '): a subscript is one ' &
+                                // 'integer, as in ' // sets(n)%name // '(2)')
+                            return
+                        end if
+                    end if
+                    if (.not. any(variables == sets(n)%name)) then
+                        guess = closest_name(sets(n)%name, variables)
+                        if (len(guess) > 0) then
+                            guess = ', did you mean ' // guess // '?'
+                        else
+                            guess = '; &' // name // ' has ' // join_names(variables, '')
+                        end if
+                        call fatal_error(error, label // ': unknown variable ' &
+                            // sets(n)%name // ' (line ' // format_integer(sets(n)%line) &
+                            // ')' // guess)
+                        return
+                    end if
+                else if (n == 0) then
+                    call fatal_error(error, label // ' (line ' &
+                        // format_integer(group%tokens(k)%line) // '): value ' // text &
+                        // ' before any variable name')
+                    return
+                else if (any(variables == to_lower(text))) then
+                    call fatal_error(error, label // ": '=' must follow the variable name " &
+                        // text // ' (line ' // format_integer(group%tokens(k)%line) &
+                        // ': ' // shorten(adjustl(scan%lines(group%tokens(k)%line)%text)) &
+                        // ')')
+                    return
+                else
+                    m = m + 1
+                    sets(n)%values(m)%text = text
+                end if
             end do
         end associate
-    end function holds_marker
+    end subroutine get_assignments
 
     pure function token_text(self, token) result(text)
         class(namelist_scan_type), intent(in) :: self
@@ -629,160 +657,6 @@ contains
 
         text = self%lines(token%line)%text(token%first:token%last)
     end function token_text
-
-    !> The namelist reader's iomsg `message` for the `occurrence`-th group `name` (known
-    !> variables `variables`), explained: with the line, and for "Cannot match namelist
-    !> object name X" whether X is an unknown variable (with a suggestion) or a bad value
-    !> of the variable before it. A bad value leads the text ("'soft' is not a valid
-    !> value of stiffness (line 9: ...)"), with the reader's own words at the end.
-    function explain_read_error(scan, name, occurrence, message, variables) result(hint)
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: occurrence
-        character(len=*), intent(in) :: message
-        character(len=*), intent(in) :: variables(:)
-        character(len=:), allocatable :: hint
-        character(len=*), parameter :: no_match = 'Cannot match namelist object name '
-        character(len=:), allocatable :: object, text, guess, variable
-        integer :: g, k, pass, found, found_subscripted
-
-        g = scan%find_group(name, occurrence)
-        if (g == 0) then
-            hint = message
-            return
-        end if
-        associate(group => scan%groups(g))
-            hint = message // ' (group on line ' // format_integer(group%first_line) // ')'
-            if (index(message, no_match) /= 1) then
-                ! "Bad data for namelist object nodes" and the like: show that assignment
-                ! (for an index or substring message, the first one with a subscript).
-                variable = named_variable(message)
-                if (len(variable) == 0) return
-                found = 0
-                found_subscripted = 0
-                do k = 1, group%n_tokens
-                    if (.not. group%tokens(k)%is_name) cycle
-                    text = scan%token_text(group%tokens(k))
-                    if (base_name(text) /= variable) cycle
-                    if (found == 0) found = k
-                    if (found_subscripted == 0 .and. index(text, '(') > 0) found_subscripted = k
-                end do
-                if (found_subscripted > 0 .and. is_subscript_message()) found = found_subscripted
-                if (found > 0) then
-                    hint = message // ' (line ' // format_integer(group%tokens(found)%line) &
-                        // ': ' // assignment_text(found) // ')'
-                    return
-                end if
-                ! A name the reader took for a variable without '=' after it: show its line.
-                do k = 1, group%n_tokens
-                    if (to_lower(scan%token_text(group%tokens(k))) /= variable) cycle
-                    hint = message // ' (line ' // format_integer(group%tokens(k)%line) &
-                        // ': ' // shorten(adjustl(scan%lines(group%tokens(k)%line)%text)) &
-                        // ')'
-                    return
-                end do
-                return
-            end if
-            object = to_lower(trim(message(len(no_match) + 1:)))
-            ! The reader may run on into the next group ("'stiff'&material", "true.&yarn").
-            if (index(object, '&') > 1) object = object(:index(object, '&') - 1)
-            ! Pass 1: the reader names a whole token (or a string and what followed it);
-            ! pass 2: the end of a token it read in part (the '.5' of '2.5' for an integer).
-            do pass = 1, 2
-                variable = ''
-                do k = 1, group%n_tokens
-                    text = scan%token_text(group%tokens(k))
-                    if (group%tokens(k)%is_name) then
-                        if (pass == 1 .and. (to_lower(text) == object &
-                            .or. base_name(text) == object)) then
-                            guess = closest_name(base_name(text), variables)
-                            hint = message // ' (line ' &
-                                // format_integer(group%tokens(k)%line) // ': unknown variable'
-                            if (len(guess) > 0) then
-                                hint = hint // ', did you mean ' // guess // '?)'
-                            else
-                                hint = hint // '; &' // name // ' has ' &
-                                    // join_names(variables, '') // ')'
-                            end if
-                            return
-                        end if
-                        variable = base_name(text)
-                    else if (len(variable) > 0 .and. matches(to_lower(text), pass)) then
-                        hint = text // ' is not a valid value of ' // variable // ' (line ' &
-                            // format_integer(group%tokens(k)%line) // ': wrong type, text ' &
-                            // 'without quotes, or more values than ' // variable &
-                            // ' holds; the namelist reader says: ' // message // ')'
-                        return
-                    end if
-                end do
-            end do
-        end associate
-
-    contains
-
-        logical function is_subscript_message()
-            is_subscript_message = index(message, 'ndex') > 0 .or. index(message, 'ubstring') > 0 &
-                .or. index(message, 'ualifier') > 0
-        end function is_subscript_message
-
-        !> "name = value value ..." of the name token k of the group, at most 60 characters.
-        function assignment_text(k) result(text)
-            integer, intent(in) :: k
-            character(len=:), allocatable :: text
-            integer, parameter :: max_length = 60
-            integer :: j
-
-            associate(group => scan%groups(g))
-                text = scan%token_text(group%tokens(k)) // ' ='
-                do j = k + 1, group%n_tokens
-                    if (group%tokens(j)%is_name .or. len(text) > max_length) exit
-                    text = text // ' ' // scan%token_text(group%tokens(j))
-                end do
-            end associate
-            if (len(text) > max_length) text = text(:max_length) // '...'
-        end function assignment_text
-
-        logical function matches(token, pass)
-            character(len=*), intent(in) :: token
-            integer, intent(in) :: pass
-
-            if (pass == 1) then
-                matches = token == object .or. (is_string(token) .and. index(object, token) == 1)
-            else
-                matches = len(token) > len(object) .and. len(object) > 0
-                if (matches) matches = token(len(token) - len(object) + 1:) == object
-            end if
-        end function matches
-
-    end function explain_read_error
-
-    !> The variable a namelist reader's message names at its end ("Bad data for namelist
-    !> object nodes", "Index 1 out of range for namelist variable time", "Equal sign must
-    !> follow namelist object name x"), lower case; '' for messages that name none.
-    pure function named_variable(message) result(variable)
-        character(len=*), intent(in) :: message
-        character(len=:), allocatable :: variable
-        character(len=*), parameter :: markers(3) = [character(len=21) :: &
-            'namelist object name', 'namelist object', 'namelist variable']
-        integer :: i, at
-
-        variable = ''
-        do i = 1, size(markers)
-            at = index(message, trim(markers(i)) // ' ', back=.true.)
-            if (at == 0) cycle
-            variable = base_name(adjustl(message(at + len_trim(markers(i)) + 1:)))
-            if (index(variable, ' ') > 0) variable = ''
-            return
-        end do
-    end function named_variable
-
-    !> A quoted character value (the namelist reader may print more after it).
-    pure logical function is_string(text)
-        character(len=*), intent(in) :: text
-
-        is_string = .false.
-        if (len(text) > 0) is_string = text(1:1) == "'" .or. text(1:1) == '"'
-    end function is_string
 
     !> A variable name without subscript, lower case.
     pure function base_name(text) result(name)
