@@ -81,7 +81,7 @@ contains
 
         do k = 1, size(sets)
             if (sets(k)%name /= name) cycle
-            if (sets(k)%first /= 0) then
+            if (sets(k)%subscripted) then
                 call fatal_error(error, label // ': ' // name // '(' &
                     // format_integer(sets(k)%first) // ') (line ' &
                     // format_integer(sets(k)%line) // '): ' // name // ' is not an array')
@@ -161,8 +161,8 @@ contains
         integer, intent(out) :: first
         type(error_type), allocatable, intent(out) :: error
 
-        first = max(set%first, 1)
-        if (set%first < 0 .or. set%first > most) call fatal_error(error, label // ': ' &
+        first = set%first
+        if (first < 1 .or. first > most) call fatal_error(error, label // ': ' &
             // set%name // '(' // format_integer(set%first) // ') (line ' &
             // format_integer(set%line) // '): the subscript is outside 1..' &
             // format_integer(most) // ', the entries of ' // set%name)

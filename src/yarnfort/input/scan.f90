@@ -53,8 +53,9 @@ module yarnfort_input_scan
     type :: assignment_type
         !> Variable name in lower case, without subscript.
         character(len=:), allocatable :: name
-        !> The subscript, 0 for none.
-        integer :: first = 0
+        !> The subscript (1 for none).
+        integer :: first = 1
+        logical :: subscripted = .false.
         integer :: line = 0
         !> The value words as written (repeat counts r*v kept; '' for a null value).
         type(string_type), allocatable :: values(:)
@@ -608,6 +609,7 @@ contains
                     allocate(sets(n)%values(j - k - 1))
                     m = 0
                     paren = index(text, '(')
+                    sets(n)%subscripted = paren > 0
                     if (paren > 0) then
                         text = normalized_name(text(paren:))
                         call parse_integer(text(2:len(text) - 1), sets(n)%first, ok)

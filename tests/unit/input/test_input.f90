@@ -471,7 +471,7 @@ contains
             input_error%message)
     end subroutine test_list_overflow
 
-    !> More values than the buffer holds: the namelist reader fails, the message says why.
+    !> Several values more than the list holds: the message says so.
     subroutine test_list_beyond_buffer(error)
         type(error_type), allocatable, intent(out) :: error
         type(error_type), allocatable :: input_error
@@ -708,8 +708,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         call check_bad_input(error, 'bad_unknown_variable.nml', [character(len=53) :: &
-            '&solver: Cannot match namelist object name line_serch', &
-            'unknown variable', &
+            '&solver: unknown variable line_serch (line 10)', &
             'did you mean line_search?'])
     end subroutine test_bad_unknown_variable
 
