@@ -77,8 +77,9 @@ contains
         type(error_type), allocatable, intent(out) :: error
         logical, intent(in), optional :: lower, adjust
         type(string_type), allocatable :: words(:)
-        integer :: k
+        integer :: k, first
 
+        first = 0
         do k = 1, size(sets)
             if (sets(k)%name /= name) cycle
             if (sets(k)%subscripted) then
@@ -86,13 +87,19 @@ contains
                     // format_integer(sets(k)%first) // ') (line ' &
                     // format_integer(sets(k)%line) // '): ' // name // ' is not an array')
                 return
+            else if (first > 0) then
+                call fatal_error(error, label // ': ' // name // ' is set twice (lines ' &
+                    // format_integer(sets(first)%line) // ' and ' &
+                    // format_integer(sets(k)%line) // ')')
+                return
             end if
-            call expand(sets(k), label, 1, words, error)
-            if (allocated(error) .or. size(words) == 0) return
-            if (len(words(1)%text) == 0) return
-            call convert(words(1)%text, sets(k)%line, label, name, field, error, lower, adjust)
-            return
+            first = k
         end do
+        if (first == 0) return
+        call expand(sets(first), label, 1, words, error)
+        if (allocated(error) .or. size(words) == 0) return
+        if (len(words(1)%text) == 0) return
+        call convert(words(1)%text, sets(first)%line, label, name, field, error, lower, adjust)
     end subroutine take_scalar
 
     !> Array variable `name` of group `label` from its assignments among `sets`: `name =`
@@ -104,20 +111,19 @@ contains
         type(error_type), allocatable, intent(out) :: error
         logical, intent(in), optional :: lower, adjust
         type(string_type), allocatable :: words(:)
-        integer :: k, j, first
+        integer, allocatable :: owner(:)
+        integer :: k, j
 
+        call map_entries(sets, label, name, size(field), owner, error)
         do k = 1, size(sets)
+            if (allocated(error)) return
             if (sets(k)%name /= name) cycle
-            call first_entry(sets(k), label, size(field), first, error)
-            if (allocated(error)) return
-            call expand(sets(k), label, size(field) - first + 1, words, error)
-            if (allocated(error)) return
+            call expand(sets(k), label, size(field), words, error)
             do j = 1, size(words)
-                if (len(words(j)%text) == 0) cycle
+                if (len(words(j)%text) == 0 .or. allocated(error)) cycle
                 call convert(words(j)%text, sets(k)%line, label, name // '(' &
-                    // format_integer(first + j - 1) // ')', field(first + j - 1), error, &
-                    lower, adjust)
-                if (allocated(error)) return
+                    // format_integer(sets(k)%first + j - 1) // ')', &
+                    field(sets(k)%first + j - 1), error, lower, adjust)
             end do
         end do
     end subroutine take_array
@@ -130,43 +136,69 @@ contains
         integer, intent(in) :: most
         integer, intent(out) :: n
         type(error_type), allocatable, intent(out) :: error
-        type(string_type), allocatable :: words(:)
-        logical, allocatable :: given(:)
-        integer :: k, j, first
+        integer, allocatable :: owner(:)
+        integer :: j
 
+        call map_entries(sets, label, name, most, owner, error)
         n = 0
-        do k = 1, size(sets)
-            if (sets(k)%name /= name) cycle
-            if (.not. allocated(given)) allocate(given(most), source=.false.)
-            call first_entry(sets(k), label, most, first, error)
-            if (allocated(error)) return
-            call expand(sets(k), label, most - first + 1, words, error)
-            if (allocated(error)) return
-            do j = 1, size(words)
-                given(first + j - 1) = len(words(j)%text) > 0
-            end do
-        end do
-        if (.not. allocated(given)) return
-        n = findloc(given, .true., dim=1, back=.true.)
-        j = findloc(given(:n), .false., dim=1)
+        if (allocated(error)) return
+        n = findloc(owner > 0, .true., dim=1, back=.true.)
+        j = findloc(owner(:n) > 0, .false., dim=1)
         if (j > 0) call fatal_error(error, label // ': ' // name // '(' // format_integer(j) &
             // ') has no value, but later entries have (an empty entry between commas?)')
     end subroutine list_length
 
-    !> The entry an assignment starts at: its subscript, which must lie in 1..most, or 1.
-    subroutine first_entry(set, label, most, first, error)
-        type(assignment_type), intent(in) :: set
-        character(len=*), intent(in) :: label
+    !> For each entry of array `name` (at most `most`) up to the last one its assignments
+    !> reach, the assignment that sets it (negative for a null value, 0 for none); an
+    !> error for an entry that two assignments set.
+    subroutine map_entries(sets, label, name, most, owner, error)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: label, name
         integer, intent(in) :: most
-        integer, intent(out) :: first
+        integer, allocatable, intent(out) :: owner(:)
         type(error_type), allocatable, intent(out) :: error
+        type(string_type), allocatable :: words(:)
+        integer :: k, j, pass, n, i
 
-        first = set%first
-        if (first < 1 .or. first > most) call fatal_error(error, label // ': ' &
-            // set%name // '(' // format_integer(set%first) // ') (line ' &
-            // format_integer(set%line) // '): the subscript is outside 1..' &
-            // format_integer(most) // ', the entries of ' // set%name)
-    end subroutine first_entry
+        n = 0
+        do pass = 1, 2
+            if (pass == 2) allocate(owner(n), source=0)
+            do k = 1, size(sets)
+                if (sets(k)%name /= name) cycle
+                if (sets(k)%first < 1 .or. sets(k)%first > most) then
+                    call fatal_error(error, label // ': ' // assigned(sets(k)) // ' (line ' &
+                        // format_integer(sets(k)%line) // '): the subscript is outside 1..' &
+                        // format_integer(most) // ', the entries of ' // name)
+                    return
+                end if
+                call expand(sets(k), label, most - sets(k)%first + 1, words, error)
+                if (allocated(error)) return
+                n = max(n, sets(k)%first + size(words) - 1)
+                if (pass == 1) cycle
+                do j = 1, size(words)
+                    i = sets(k)%first + j - 1
+                    if (owner(i) /= 0) then
+                        call fatal_error(error, label // ': ' // assigned(sets(k)) &
+                            // ' (line ' // format_integer(sets(k)%line) // ') sets again ' &
+                            // 'an entry that ' // assigned(sets(abs(owner(i)))) // ' (line ' &
+                            // format_integer(sets(abs(owner(i)))%line) // ') sets; each ' &
+                            // 'entry may be set only once')
+                        return
+                    end if
+                    owner(i) = merge(k, -k, len(words(j)%text) > 0)
+                end do
+            end do
+        end do
+    end subroutine map_entries
+
+    !> 'x' or 'x(i)', as the assignment writes it.
+    pure function assigned(set) result(text)
+        type(assignment_type), intent(in) :: set
+        character(len=:), allocatable :: text
+
+        text = set%name
+        if (set%subscripted) text = text // '(' // format_integer(set%first) // ')'
+    end function assigned
 
     !> The values of an assignment with repeat counts r*v written out (r*: r null values),
     !> at most `most` of them.

@@ -211,7 +211,7 @@ contains
                         in_string = .true.
                         i = i + 1
                     case ('=')
-                        call mark_name(iline)
+                        call mark_name()
                         if (allocated(error)) return
                         i = i + 1
                     case ('/')
@@ -296,72 +296,9 @@ contains
             associate(group => scan%groups(scan%n_groups))
                 group%last_line = last_line
                 group%tokens = group%tokens(:group%n_tokens)
-                call check_entries(group)
             end associate
             in_group = .false.
         end subroutine end_group
-
-        !> No entry of a variable may be set by two assignments of a group (p_force =
-        !> 0, 1, 0 then p_force(2) = 3): each sets the entries from its subscript (1
-        !> without one) on, as many as it has values, or the entries of its section.
-        subroutine check_entries(group)
-            type(group_occurrence_type), intent(in) :: group
-            integer :: j, k
-            integer, allocatable :: first(:), last(:)
-            logical, allocatable :: known(:)
-
-            allocate(first(group%n_tokens), last(group%n_tokens), known(group%n_tokens))
-            known = .false.
-            do k = 1, group%n_tokens
-                if (group%tokens(k)%is_name) call assigned_entries(group, k, first(k), &
-                    last(k), known(k))
-            end do
-            do k = 1, group%n_tokens
-                if (.not. known(k)) cycle
-                do j = 1, k - 1
-                    if (.not. known(j)) cycle
-                    if (base_name(scan%token_text(group%tokens(j))) &
-                        /= base_name(scan%token_text(group%tokens(k)))) cycle
-                    if (first(j) > last(k) .or. first(k) > last(j)) cycle
-                    call fatal_error(error, '&' // group%name // ': ' &
-                        // normalized_name(scan%token_text(group%tokens(k))) // ' (line ' &
-                        // format_integer(group%tokens(k)%line) // ') sets again an entry ' &
-                        // 'that ' // normalized_name(scan%token_text(group%tokens(j))) &
-                        // ' (line ' // format_integer(group%tokens(j)%line) // ') sets; ' &
-                        // 'each entry may be set only once')
-                    return
-                end do
-            end do
-        end subroutine check_entries
-
-        !> Entries first..last that the assignment of name token k sets; `known` is false
-        !> for a subscript of another form (left to the namelist reader).
-        subroutine assigned_entries(group, k, first, last, known)
-            type(group_occurrence_type), intent(in) :: group
-            integer, intent(in) :: k
-            integer, intent(out) :: first, last
-            logical, intent(out) :: known
-            character(len=:), allocatable :: name, text
-            integer :: j, n, repeat_count
-            logical :: ok
-
-            name = normalized_name(scan%token_text(group%tokens(k)))
-            call entry_range(name, first, last, known)
-            known = known .and. first >= 1
-            if (.not. known .or. index(name, ':') > 0) return
-            n = 0
-            do j = k + 1, group%n_tokens
-                if (group%tokens(j)%is_name) exit
-                text = scan%token_text(group%tokens(j))
-                repeat_count = 1
-                if (index(text, '*') > 1) then
-                    call parse_integer(text(:index(text, '*') - 1), repeat_count, ok)
-                    if (.not. ok) repeat_count = 1
-                end if
-                n = n + repeat_count
-            end do
-            last = first + n - 1
-        end subroutine assigned_entries
 
         subroutine add_token(line, first, last)
             integer, intent(in) :: line, first, last
@@ -378,12 +315,8 @@ contains
             end associate
         end subroutine add_token
 
-        !> The token before '=' is a variable name; it must not be set twice in a group.
-        subroutine mark_name(line)
-            integer, intent(in) :: line
-            integer :: k
-            character(len=:), allocatable :: this, other
-
+        !> The token before '=' is a variable name.
+        subroutine mark_name()
             associate(group => scan%groups(scan%n_groups))
                 if (group%n_tokens == 0) then
                     call no_name_error()
@@ -396,19 +329,7 @@ contains
                         return
                     end if
                     last%is_name = .true.
-                    this = normalized_name(scan%token_text(last))
                 end associate
-                do k = 1, group%n_tokens - 1
-                    if (.not. group%tokens(k)%is_name) cycle
-                    other = normalized_name(scan%token_text(group%tokens(k)))
-                    if (other == this) then
-                        call fatal_error(error, '&' // group%name // ': ' &
-                            // scan%token_text(group%tokens(k)) // ' is set twice (lines ' &
-                            // format_integer(group%tokens(k)%line) // ' and ' &
-                            // format_integer(line) // ')')
-                        return
-                    end if
-                end do
             end associate
         end subroutine mark_name
 
@@ -486,32 +407,6 @@ contains
 
         name = to_lower(remove_characters(text, ' ' // tab))
     end function normalized_name
-
-    !> Entries first..last of a name: 'x' (1..), 'x(i)' (i..), 'x(i:j)', 'x(i:)', 'x(:j)';
-    !> `ok` is false for a subscript of another form.
-    pure subroutine entry_range(name, first, last, ok)
-        character(len=*), intent(in) :: name
-        integer, intent(out) :: first, last
-        logical, intent(out) :: ok
-        character(len=:), allocatable :: inner
-        integer :: colon
-
-        first = 1
-        last = huge(1)
-        ok = index(name, '(') == 0
-        if (ok .or. name(len(name):) /= ')') return
-        inner = name(index(name, '(') + 1:len(name) - 1)
-        colon = index(inner, ':')
-        if (colon == 0) then
-            call parse_integer(inner, first, ok)
-            last = first
-            return
-        end if
-        if (index(inner(colon + 1:), ':') > 0) return
-        ok = .true.
-        if (colon > 1) call parse_integer(inner(:colon - 1), first, ok)
-        if (ok .and. colon < len(inner)) call parse_integer(inner(colon + 1:), last, ok)
-    end subroutine entry_range
 
     !> At most 40 characters of a text for a message.
     pure function shorten(text) result(short)
