@@ -16,9 +16,9 @@ module yarnfort_input_fields
 
     public :: message_length, max_list, max_coordinates, indent
     public :: post_read_error, group_label, take_scalar, take_array, list_length
-    public :: check_real, check_at_least, check_choice, require_set, require_text, forbid_set
+    public :: check_real, check_at_least, check_choice, check_law_parameter
     public :: not_finite, suggestion, quoted_list, check_name
-    public :: put, put_reals, put_integers, format_logical
+    public :: put, put_list, format_logical
 
     !> Most node ids in one &yarn, &support or &load group, and most knots in &path.
     integer, parameter :: max_list = 100000
@@ -31,11 +31,6 @@ module yarnfort_input_fields
     !> Characters of material and support names.
     character(len=*), parameter :: name_characters = &
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
-
-    !> A law parameter that another law uses must stay unset.
-    interface forbid_set
-        module procedure forbid_real, forbid_text
-    end interface forbid_set
 
 contains
 
@@ -387,48 +382,21 @@ contains
         end if
     end subroutine check_choice
 
-    !> A parameter of the selected law: set (not its "not set" default).
-    subroutine require_set(error, label, variable, value, unset, law)
+    !> Parameter `variable` of a law: needed by the selected law `law` and then to be set,
+    !> or not used by it and then not to be set; `text` is its value for the message.
+    subroutine check_law_parameter(error, label, variable, is_set, text, law, needed)
         type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, law
-        real(wp), intent(in) :: value, unset
+        character(len=*), intent(in) :: label, variable, text, law
+        logical, intent(in) :: is_set, needed
 
-        if (value == unset) then
+        if (needed .and. .not. is_set) then
             call fatal_error(error, label // ': ' // variable // " is not set (law '" // law &
                 // "' needs it)")
-        end if
-    end subroutine require_set
-
-    subroutine require_text(error, label, variable, value, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, value, law
-
-        if (len_trim(value) == 0) then
-            call fatal_error(error, label // ': ' // variable // " is not set (law '" // law &
-                // "' needs it)")
-        end if
-    end subroutine require_text
-
-    subroutine forbid_real(error, label, variable, value, unset, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, law
-        real(wp), intent(in) :: value, unset
-
-        if (.not. (value == unset)) then
-            call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
+        else if (is_set .and. .not. needed) then
+            call fatal_error(error, label // ': ' // variable // ' = ' // text &
                 // " is not used by law '" // law // "' (remove it)")
         end if
-    end subroutine forbid_real
-
-    subroutine forbid_text(error, label, variable, value, unset, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, value, unset, law
-
-        if (value /= unset) then
-            call fatal_error(error, label // ': ' // variable // " = '" // trim(value) &
-                // "' is not used by law '" // law // "' (remove it)")
-        end if
-    end subroutine forbid_text
+    end subroutine check_law_parameter
 
     subroutine not_finite(error, label, variable, value)
         type(error_type), allocatable, intent(out) :: error
@@ -484,61 +452,31 @@ contains
         write(unit, '(a)', iostat=status) line
     end subroutine put
 
-    !> `name = v1 v2 ...`, integers_per_line values per line; nothing for no values.
-    subroutine put_integers(unit, name, values)
+    !> `name = v1 v2 ...` (integers or reals), integers_per_line or reals_per_line values
+    !> per line; nothing for no values.
+    subroutine put_list(unit, name, values)
         integer, intent(in) :: unit
         character(len=*), intent(in) :: name
-        integer, intent(in) :: values(:)
-
-        call put_values(unit, name, size(values), integers_per_line, integer_text)
-    contains
-        function integer_text(i) result(text)
-            integer, intent(in) :: i
-            character(len=:), allocatable :: text
-
-            text = format_integer(values(i))
-        end function integer_text
-    end subroutine put_integers
-
-    !> `name = v1 v2 ...`, reals_per_line values per line; nothing for no values.
-    subroutine put_reals(unit, name, values)
-        integer, intent(in) :: unit
-        character(len=*), intent(in) :: name
-        real(wp), intent(in) :: values(:)
-
-        call put_values(unit, name, size(values), reals_per_line, real_text)
-    contains
-        function real_text(i) result(text)
-            integer, intent(in) :: i
-            character(len=:), allocatable :: text
-
-            text = format_real(values(i))
-        end function real_text
-    end subroutine put_reals
-
-    !> `name = ` and the texts of values 1..n, `per_line` of them per line.
-    subroutine put_values(unit, name, n, per_line, text_of)
-        integer, intent(in) :: unit, n, per_line
-        character(len=*), intent(in) :: name
-        interface
-            function text_of(i) result(text)
-                integer, intent(in) :: i
-                character(len=:), allocatable :: text
-            end function text_of
-        end interface
+        class(*), intent(in) :: values(:)
         character(len=:), allocatable :: line
-        integer :: i
+        integer :: i, per_line
 
-        if (n == 0) return
         line = indent // name // ' ='
-        do i = 1, n
-            line = line // ' ' // text_of(i)
-            if (mod(i, per_line) == 0 .or. i == n) then
+        do i = 1, size(values)
+            select type (values)
+            type is (integer)
+                line = line // ' ' // format_integer(values(i))
+                per_line = integers_per_line
+            type is (real(wp))
+                line = line // ' ' // format_real(values(i))
+                per_line = reals_per_line
+            end select
+            if (mod(i, per_line) == 0 .or. i == size(values)) then
                 call put(unit, line)
                 line = indent // repeat(' ', len(name) + 2)
             end if
         end do
-    end subroutine put_values
+    end subroutine put_list
 
     pure function format_logical(value) result(text)
         logical, intent(in) :: value

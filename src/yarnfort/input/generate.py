@@ -165,20 +165,18 @@ def law_block(var: Var, law_bound: list[Var]) -> list[tuple[int, str]]:
     body = [(0, f"select case (trim(value%{var.name}))")]
     for law in var.choices or []:
         body.append((0, f"case ('{law}')"))
-        for v in [v for v in law_bound if law in (v.laws or [])]:
+        for v in law_bound:
+            needed = law in (v.laws or [])
             if v.type == "character":
-                body.append((1, f"call require_text(error, label, '{v.name}', value%{v.name}, "
-                                f"'{law}')"))
+                is_set, text = f"len_trim(value%{v.name}) > 0", f"quote_string(value%{v.name})"
             else:
-                body.append((1, f"call require_set(error, label, '{v.name}', value%{v.name}, "
-                                f"{fortran_default(v)}, '{law}')"))
-                for call in range_call(v, "label", f"value%{v.name}", f"'{v.name}'"):
-                    body += [(1, "if (allocated(error)) return"), (1, call)]
+                is_set = f".not. (value%{v.name} == {fortran_default(v)})"
+                text = f"format_real(value%{v.name})"
+            body.append((1, f"call check_law_parameter(error, label, '{v.name}', {is_set}, "
+                            f"{text}, '{law}', {'.true.' if needed else '.false.'})"))
+            for call in range_call(v, "label", f"value%{v.name}", f"'{v.name}'") if needed else []:
+                body += [(1, "if (allocated(error)) return"), (1, call)]
             body.append((1, "if (allocated(error)) return"))
-        for v in [v for v in law_bound if law not in (v.laws or [])]:
-            unset = "''" if v.type == "character" else fortran_default(v)
-            body += [(1, f"call forbid_set(error, label, '{v.name}', value%{v.name}, {unset}, "
-                         f"'{law}')"), (1, "if (allocated(error)) return")]
     return body + [(0, "end select")]
 
 
@@ -300,8 +298,7 @@ def write_routine(group: Group) -> list[str]:
     for var in group.variables:
         field = f"value%{var.name}"
         if var.is_list:
-            kind = "reals" if var.type == "real" else "integers"
-            out += wrap_statement(f"if (allocated({field})) call put_{kind}(unit, "
+            out += wrap_statement(f"if (allocated({field})) call put_list(unit, "
                                   f"'{var.name}', {field})", i2)
             continue
         text = {"character": "quote_string", "real": "format_real",
@@ -365,8 +362,7 @@ def fortran_module() -> str:
            "get_assignments",
            f"{INDENT}use yarnfort_input_fields, only: max_list, max_coordinates, group_label, &",
            f"{INDENT * 3}take_scalar, take_array, list_length, check_real, check_at_least, &",
-           f"{INDENT * 3}check_choice, require_set, require_text, forbid_set, put, put_reals, &",
-           f"{INDENT * 3}put_integers, format_logical, indent",
+           f"{INDENT * 3}check_choice, check_law_parameter, put, put_list, format_logical, indent",
            f"{INDENT}implicit none",
            f"{INDENT}private", ""]
     publics = []

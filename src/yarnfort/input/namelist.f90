@@ -21,7 +21,7 @@ module yarnfort_input_namelist
         post_read_error
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
     use yarnfort_input_geometry, only: read_geometry_file
-    use yarnfort_text, only: read_line, format_integer, folder_of, resolve_path, is_folder
+    use yarnfort_text, only: format_integer, folder_of, resolve_path, is_folder
     use yarnfort_input_validate, only: check_config
     use yarnfort_generate_fabric, only: generate_fabric
     implicit none
@@ -36,8 +36,9 @@ module yarnfort_input_namelist
 
 contains
 
-    !> Read all groups from an open, rewindable formatted sequential unit. Relative file
-    !> names in the input are resolved against `folder` (default: working directory).
+    !> Read all groups from an open formatted sequential unit (from its start, unless it
+    !> is standard input). Relative file names in the input are resolved against `folder`
+    !> (default: working directory).
     subroutine read_config(unit, config, error, folder)
         integer, intent(in) :: unit
         type(config_type), intent(out) :: config
@@ -56,8 +57,17 @@ contains
             end if
             config%input_folder = folder
         end if
-        call scan_namelist(unit, group_names, scan, error)
+        if (unit /= input_unit) rewind(unit)
+        call scan_namelist(unit, merge('standard input, line ', 'input line           ', &
+            unit == input_unit), group_names, scan, error)
+        if (unit /= input_unit) rewind(unit)
         if (allocated(error)) return
+        if (unit == input_unit .and. size(scan%lines) == 0) then
+            ! A folder or a closed standard input reads as an empty one in gfortran.
+            call fatal_error(error, 'standard input is empty: no input was given (is it ' &
+                // 'closed or a folder?); run as: yarnfort < scene.nml')
+            return
+        end if
         do k = 1, size(singleton_names)
             name = trim(singleton_names(k))
             if (scan%count_group(name) > 1) then
@@ -188,58 +198,14 @@ contains
         close(unit)
     end subroutine read_config_from_file
 
-    !> Read the namelist input from standard input (copied to a scratch file first, so
-    !> that groups can be read in any order); relative file names in it are resolved
-    !> against the working directory.
+    !> Read the namelist input from standard input (read whole first, so that groups can
+    !> be read in any order); relative file names in it are resolved against the working
+    !> directory.
     subroutine read_config_from_stdin(config, error)
         type(config_type), intent(out) :: config
         type(error_type), allocatable, intent(out) :: error
-        character(len=:), allocatable :: line
-        character(len=message_length) :: message
-        integer :: scratch, stat, line_number
 
-        call open_scratch(scratch, error)
-        if (allocated(error)) return
-        line_number = 0
-        do
-            call read_line(input_unit, line, stat, message)
-            if (is_iostat_end(stat)) exit
-            if (stat /= 0) then
-                call fatal_error(error, 'standard input, line ' &
-                    // format_integer(line_number + 1) // ': ' // trim(message))
-                close(scratch)
-                return
-            end if
-            line_number = line_number + 1
-            write(scratch, '(a)', iostat=stat, iomsg=message) line
-            if (stat /= 0) then
-                call fatal_error(error, 'cannot copy the input to a scratch file: ' &
-                    // trim(message))
-                close(scratch)
-                return
-            end if
-        end do
-        if (line_number == 0) then
-            ! A folder or a closed standard input reads as an empty one in gfortran.
-            call fatal_error(error, 'standard input is empty: no input was given (is it ' &
-                // 'closed or a folder?); run as: yarnfort < scene.nml')
-            close(scratch)
-            return
-        end if
-        call read_config(scratch, config, error)
-        close(scratch)
+        call read_config(input_unit, config, error)
     end subroutine read_config_from_stdin
-
-    subroutine open_scratch(unit, error)
-        integer, intent(out) :: unit
-        type(error_type), allocatable, intent(out) :: error
-        character(len=message_length) :: message
-        integer :: stat
-
-        open(newunit=unit, status='scratch', action='readwrite', form='formatted', &
-            access='sequential', iostat=stat, iomsg=message)
-        if (stat /= 0) call fatal_error(error, 'cannot open a scratch file for the input: ' &
-            // trim(message))
-    end subroutine open_scratch
 
 end module yarnfort_input_namelist

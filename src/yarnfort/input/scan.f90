@@ -71,10 +71,11 @@ module yarnfort_input_scan
 
 contains
 
-    !> Read the whole text of `unit` (from its start) and find its groups. `known_groups`
-    !> are the valid group names in lower case.
-    subroutine scan_namelist(unit, known_groups, scan, error)
+    !> Read the rest of the text of `unit` and find its groups. `known_groups` are the
+    !> valid group names in lower case; `where` starts a message on a line of the text.
+    subroutine scan_namelist(unit, where, known_groups, scan, error)
         integer, intent(in) :: unit
+        character(len=*), intent(in) :: where
         character(len=*), intent(in) :: known_groups(:)
         type(namelist_scan_type), intent(out) :: scan
         type(error_type), allocatable, intent(out) :: error
@@ -83,14 +84,13 @@ contains
         integer :: stat, n_lines
         type(string_type), allocatable :: grown(:)
 
-        rewind(unit)
         allocate(scan%lines(64))
         n_lines = 0
         do
             call read_line(unit, line, stat, message)
             if (is_iostat_end(stat)) exit
             if (stat /= 0) then
-                call fatal_error(error, 'input line ' // format_integer(n_lines + 1) &
+                call fatal_error(error, trim(where) // ' ' // format_integer(n_lines + 1) &
                     // ': ' // trim(message))
                 return
             end if
@@ -106,7 +106,6 @@ contains
             call move_alloc(line, scan%lines(n_lines)%text)
         end do
         scan%lines = scan%lines(:n_lines)
-        rewind(unit)
         call find_groups(scan, known_groups, error)
     end subroutine scan_namelist
 
@@ -213,6 +212,8 @@ contains
                     case ('=')
                         call mark_name()
                         if (allocated(error)) return
+                        ! A comma right after '=' follows a null value too.
+                        after_comma = .true.
                         i = i + 1
                     case ('/')
                         call end_group(iline)
