@@ -44,7 +44,7 @@ contains
         if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
     end function group_label
 
-    !> An error found after a successful READ, with the group's line.
+    !> An error of a group found after reading it, with the group's line.
     subroutine post_read_error(error, scan, name, occurrence, text)
         type(error_type), allocatable, intent(out) :: error
         type(namelist_scan_type), intent(in) :: scan
@@ -70,7 +70,7 @@ contains
         character(len=*), intent(in) :: label, name
         class(*), intent(inout) :: field
         type(error_type), allocatable, intent(out) :: error
-        logical, intent(in), optional :: lower, adjust
+        logical, intent(in) :: lower, adjust
         type(string_type), allocatable :: words(:)
         integer :: k, first
 
@@ -104,7 +104,7 @@ contains
         character(len=*), intent(in) :: label, name
         class(*), intent(inout) :: field(:)
         type(error_type), allocatable, intent(out) :: error
-        logical, intent(in), optional :: lower, adjust
+        logical, intent(in) :: lower, adjust
         type(string_type), allocatable :: words(:)
         integer, allocatable :: owner(:)
         integer :: k, j
@@ -248,7 +248,7 @@ contains
         integer, intent(in) :: line
         class(*), intent(inout) :: field
         type(error_type), allocatable, intent(out) :: error
-        logical, intent(in), optional :: lower, adjust
+        logical, intent(in) :: lower, adjust
         character(len=:), allocatable :: text, expected
         logical :: ok
 
@@ -272,7 +272,7 @@ contains
             expected = "a character value is expected, in quotes: 'text'"
             if (ok) then
                 text = unquoted(word(2:len(word) - 1), word(1:1))
-                if (optional_true(adjust)) text = adjustl(text)
+                if (adjust) text = adjustl(text)
                 if (len_trim(text) > len(field)) then
                     call fatal_error(error, label // ': ' // variable // " = '" &
                         // text(:min(len_trim(text), 40)) // "...' is longer than " &
@@ -280,7 +280,7 @@ contains
                         // format_integer(line) // ')')
                     return
                 end if
-                if (optional_true(lower)) text = to_lower(text)
+                if (lower) text = to_lower(text)
                 field = text
             end if
         end select
@@ -306,13 +306,6 @@ contains
         end do
         text = text(:n)
     end function unquoted
-
-    pure logical function optional_true(flag)
-        logical, intent(in), optional :: flag
-
-        optional_true = .false.
-        if (present(flag)) optional_true = flag
-    end function optional_true
 
     !> A real that must be finite and, where bounds are given, within them (the texts
     !> of the bounds are those of the description, for the message).

@@ -8,9 +8,10 @@
     generate.py update REFERENCE.md rewrite the tables there
 
 The module holds, per group: its config type (defaults, one doc line per variable), a
-reader of one occurrence (local namelist, lists read against "not set" markers, text
-lengths checked, case folded), the generic checks (range, choices, the parameters of
-the selected law), the echo, and for all groups the names and the --help summary.
+reader of one occurrence (each variable taken from the tokenizer's assignments by the
+typed helpers of fields.f90: entries, lengths, case), the generic checks (range,
+choices, the parameters of the selected law), the echo, and for all groups the names
+and the --help summary.
 """
 from __future__ import annotations
 
@@ -234,10 +235,9 @@ def read_routine(group: Group) -> list[str]:
            f"{i2}call get_assignments(scan, '{name}', occurrence, {name}_variables, sets, error)",
            f"{i2}if (allocated(error)) return"]
     for var in group.variables:
-        args = f"sets, label, '{var.name}', value%{var.name}, error"
-        if var.type == "character":
-            args += f", lower={'.true.' if var.lower else '.false.'}"
-            args += f", adjust={'.true.' if var.adjust else '.false.'}"
+        args = (f"sets, label, '{var.name}', value%{var.name}, error, "
+                f"{'.true.' if var.lower else '.false.'}, "
+                f"{'.true.' if var.adjust and var.type == 'character' else '.false.'}")
         if var.is_list:
             out += wrap_statement(f"call list_length(sets, label, '{var.name}', {var.max}, n, "
                                   "error)", i2)

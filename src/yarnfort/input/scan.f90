@@ -2,9 +2,9 @@
 !> The tokenizer of namelist input text: finds every '&group ... /' occurrence with its
 !> lines and tokens (names before '=', values, null values between two commas), and
 !> rejects what is not namelist syntax (unknown or misspelt group names, text outside
-!> groups, a group not closed with '/', a variable set twice in one group, a '&group'
-!> inside a character value). `get_assignments` gives a group's assignments, each
-!> variable checked against the group's names. Values are converted by
+!> groups, a group not closed with '/', a character value not closed on its line).
+!> `get_assignments` gives a group's assignments, each variable checked against the
+!> group's names. Values are converted (and entries set twice found) by
 !> yarnfort_input_fields.
 module yarnfort_input_scan
     use yarnfort_error, only: error_type, fatal_error
@@ -66,8 +66,6 @@ module yarnfort_input_scan
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_'
     !> Characters that end a bare (unquoted) word inside a group.
     character(len=*), parameter :: word_ends = " ,;=/!&$'""" // tab // carriage_return
-    !> Characters that may follow a group name for the Fortran reader to take it as one.
-    character(len=*), parameter :: name_ends = " ,;/!" // tab // carriage_return
 
 contains
 
@@ -143,17 +141,6 @@ contains
                                 if (group%tokens(group%n_tokens)%line == iline) &
                                     group%tokens(group%n_tokens)%last = i
                             end associate
-                        else if (c == '&' .or. c == '$') then
-                            call read_name(text, i + 1, j, name)
-                            if (any(known_groups == name)) then
-                                if (j > len(text)) then
-                                    call string_group_error()
-                                    return
-                                else if (index(name_ends, text(j:j)) > 0) then
-                                    call string_group_error()
-                                    return
-                                end if
-                            end if
                         end if
                         i = i + 1
                         cycle
@@ -255,8 +242,8 @@ contains
                     end select
                 end do
                 if (in_string) then
-                    ! The Fortran reader would run on into the next lines; no value of
-                    ! the input needs that, a forgotten quote is far more likely.
+                    ! Namelist syntax lets a character value run on into the next lines;
+                    ! no value of the input needs that, a forgotten quote is far likelier.
                     call fatal_error(error, 'line ' // format_integer(iline) &
                         // ': character value not closed with ' // quote &
                         // ' on its line: ' // open_value())
@@ -339,12 +326,6 @@ contains
                 // ": '=' without a variable name before it in &" &
                 // scan%groups(scan%n_groups)%name)
         end subroutine no_name_error
-
-        subroutine string_group_error()
-            call fatal_error(error, 'line ' // format_integer(iline) // ": '&" // name &
-                // "' inside a character value would be read as the start of group &" &
-                // name // "; remove the '&': " // open_value())
-        end subroutine string_group_error
 
         !> The group, the variable and the start of the character value being read:
         !> "&control title = 'see &yarn..." (the variable is the last name before it).
