@@ -253,6 +253,8 @@ contains
         logical :: ok
 
         text = to_lower(word)
+        ok = .false.
+        expected = ''
         select type (field)
         type is (real(wp))
             call parse_real(word, field, ok)
@@ -455,6 +457,7 @@ contains
         integer :: i, per_line
 
         line = indent // name // ' ='
+        per_line = integers_per_line
         do i = 1, size(values)
             select type (values)
             type is (integer)

@@ -10,6 +10,7 @@ module yarnfort_output_filesystem
 
     public :: make_folder, rename_file, remove_file, sync_file, folder_lock_type
     public :: close_checked, flush_checked, truncate_file, ignore_file_size_signal
+    public :: open_append
     public :: lock_file_name
 
     !> The lock file of an output folder (kept; the lock is the kernel's, not the file).
@@ -177,6 +178,23 @@ contains
             call fatal_error(error, "cannot cut '" // path // "' back to its last whole " &
                 // 'line: ' // get_reason())
     end subroutine truncate_file
+
+    !> Open the existing file `path` to append lines to it (`unit` = -1 on failure).
+    subroutine open_append(unit, path, error)
+        integer, intent(out) :: unit
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        character(len=text_length) :: message
+        integer :: status
+
+        message = ''
+        open(newunit=unit, file=path, status='old', position='append', action='write', &
+            iostat=status, iomsg=message)
+        if (status /= 0) then
+            unit = -1
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+        end if
+    end subroutine open_append
 
     !> Close `unit`, connected to the file `path`, and check that every byte written
     !> reached the file. (gfortran's CLOSE and FLUSH report no error when the buffered
