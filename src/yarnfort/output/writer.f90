@@ -66,6 +66,8 @@ module yarnfort_output_writer
         procedure :: on_step
         procedure :: on_cut
         procedure :: on_checkpoint
+        !> Told the step and time a restart resumes after, before the files are opened.
+        procedure :: on_resume
         procedure :: finish
     end type output_writer_type
 
@@ -296,6 +298,13 @@ contains
         real(wp), intent(in) :: time, step
         character(len=*), intent(in) :: reason
     end subroutine on_cut
+
+    !> The default: nothing to say.
+    subroutine on_resume(self, step, time)
+        class(output_writer_type), intent(inout) :: self
+        integer, intent(in) :: step
+        real(wp), intent(in) :: time
+    end subroutine on_resume
 
     !> Write the VTK state of the step just written when due (it needs the snapshot's
     !> passage modes), then the restart file.
