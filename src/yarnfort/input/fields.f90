@@ -227,7 +227,8 @@ contains
                 end if
                 if (repeats(j) > most - n) then
                     call fatal_error(error, label // ': ' // set%name // ' has more than ' &
-                        // format_integer(most) // ' values (line ' // format_integer(set%line) &
+                        // format_integer(most) // trim(merge(' value ', ' values', most == 1)) &
+                        // ' (line ' // format_integer(set%line) &
                         // '): more values than ' // set%name // ' holds')
                     return
                 end if

@@ -111,40 +111,21 @@ contains
         type(namelist_scan_type), intent(inout) :: scan
         character(len=*), intent(in) :: known_groups(:)
         type(error_type), allocatable, intent(out) :: error
-        logical :: in_group, in_string, after_comma
-        character(len=1) :: c, quote
+        logical :: in_group, after_comma
+        character(len=1) :: c
         character(len=:), allocatable :: name
-        integer :: iline, i, j, depth
+        integer :: iline, i, j, k, depth
         type(group_occurrence_type), allocatable :: grown(:)
 
         allocate(scan%groups(16))
         scan%n_groups = 0
         in_group = .false.
-        in_string = .false.
         after_comma = .false.
-        quote = ''
         do iline = 1, size(scan%lines)
             associate(text => scan%lines(iline)%text)
                 i = 1
                 do while (i <= len(text))
                     c = text(i:i)
-                    if (in_string) then
-                        if (c == quote) then
-                            if (i < len(text)) then
-                                if (text(i + 1:i + 1) == quote) then
-                                    i = i + 2
-                                    cycle
-                                end if
-                            end if
-                            in_string = .false.
-                            associate(group => scan%groups(scan%n_groups))
-                                if (group%tokens(group%n_tokens)%line == iline) &
-                                    group%tokens(group%n_tokens)%last = i
-                            end associate
-                        end if
-                        i = i + 1
-                        cycle
-                    end if
                     if (.not. in_group) then
                         select case (c)
                         case (' ', tab, carriage_return)
@@ -192,10 +173,24 @@ contains
                     case ('!')
                         exit
                     case ("'", '"')
-                        call add_token(iline, i, i)
-                        quote = c
-                        in_string = .true.
-                        i = i + 1
+                        ! To the closing quote (a doubled one is a quote of the value).
+                        j = i + 1
+                        do
+                            k = index(text(j:), c)
+                            if (k == 0) then
+                                call add_token(iline, i, len(text))
+                                call fatal_error(error, 'line ' // format_integer(iline) &
+                                    // ': character value not closed with ' // c &
+                                    // ' on its line: ' // open_value())
+                                return
+                            end if
+                            j = j + k
+                            if (j > len(text)) exit
+                            if (text(j:j) /= c) exit
+                            j = j + 1
+                        end do
+                        call add_token(iline, i, j - 1)
+                        i = j
                     case ('=')
                         call mark_name()
                         if (allocated(error)) return
@@ -241,14 +236,6 @@ contains
                         i = j
                     end select
                 end do
-                if (in_string) then
-                    ! Namelist syntax lets a character value run on into the next lines;
-                    ! no value of the input needs that, a forgotten quote is far likelier.
-                    call fatal_error(error, 'line ' // format_integer(iline) &
-                        // ': character value not closed with ' // quote &
-                        // ' on its line: ' // open_value())
-                    return
-                end if
             end associate
         end do
         if (in_group) then
