@@ -166,7 +166,8 @@ contains
                         // format_integer(most) // ', the entries of ' // name)
                     return
                 end if
-                call expand(sets(k), label, most - sets(k)%first + 1, words, error)
+                call expand(sets(k), label, min(most, sets(k)%last) - sets(k)%first + 1, words, &
+                    error)
                 if (allocated(error)) return
                 n = max(n, sets(k)%first + size(words) - 1)
                 if (pass == 1) cycle

@@ -53,8 +53,8 @@ module yarnfort_input_scan
     type :: assignment_type
         !> Variable name in lower case, without subscript.
         character(len=:), allocatable :: name
-        !> The subscript (1 for none).
-        integer :: first = 1
+        !> The subscript or section first:last (1 and no limit for none).
+        integer :: first = 1, last = huge(1)
         logical :: subscripted = .false.
         integer :: line = 0
         !> The value words as written (repeat counts r*v kept; '' for a null value).
@@ -475,13 +475,13 @@ contains
                     paren = index(text, '(')
                     sets(n)%subscripted = paren > 0
                     if (paren > 0) then
-                        text = normalized_name(text(paren:))
-                        call parse_integer(text(2:len(text) - 1), sets(n)%first, ok)
-                        if (.not. ok .or. text(len(text):) /= ')') then
+                        call read_subscript(normalized_name(text(paren:)), sets(n), ok)
+                        if (.not. ok) then
                             call fatal_error(error, label // ': ' // normalized_name( &
                                 scan%token_text(group%tokens(k))) // ' (line ' &
-                                // format_integer(sets(n)%line) // '): a subscript is one ' &
-                                // 'integer, as in ' // sets(n)%name // '(2)')
+                                // format_integer(sets(n)%line) // '): a subscript is an ' &
+                                // 'integer or a section, as in ' // sets(n)%name // '(2) or ' &
+                                // sets(n)%name // '(2:3)')
                             return
                         end if
                     end if
@@ -515,6 +515,26 @@ contains
             end do
         end associate
     end subroutine get_assignments
+
+    !> '(i)', '(i:j)', '(i:)' or '(:j)' into the entries an assignment starts at and may
+    !> reach; `ok` is false for another form.
+    pure subroutine read_subscript(text, set, ok)
+        character(len=*), intent(in) :: text
+        type(assignment_type), intent(inout) :: set
+        logical, intent(out) :: ok
+        integer :: colon
+
+        ok = text(len(text):) == ')'
+        if (.not. ok) return
+        colon = index(text, ':')
+        if (colon == 0) then
+            call parse_integer(text(2:len(text) - 1), set%first, ok)
+            return
+        end if
+        if (colon > 2) call parse_integer(text(2:colon - 1), set%first, ok)
+        if (ok .and. colon < len(text) - 1) call parse_integer(text(colon + 1:len(text) - 1), &
+            set%last, ok)
+    end subroutine read_subscript
 
     pure function token_text(self, token) result(text)
         class(namelist_scan_type), intent(in) :: self
