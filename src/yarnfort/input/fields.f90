@@ -98,22 +98,27 @@ contains
     end subroutine take_scalar
 
     !> Array variable `name` of group `label` from its assignments among `sets`: `name =`
-    !> sets the entries from 1 on, `name(i) =` from i on; the others stay as they are.
-    subroutine take_array(sets, label, name, field, error, lower, adjust)
+    !> sets the entries from 1 on, `name(i) =` from i on; the others stay as they are. A
+    !> list (`most` entries at most, `field` as long as list_length says) may have null
+    !> values beyond its last value.
+    subroutine take_array(sets, label, name, field, error, lower, adjust, most)
         type(assignment_type), intent(in) :: sets(:)
         character(len=*), intent(in) :: label, name
         class(*), intent(inout) :: field(:)
         type(error_type), allocatable, intent(out) :: error
         logical, intent(in) :: lower, adjust
+        integer, intent(in), optional :: most
         type(string_type), allocatable :: words(:)
         integer, allocatable :: owner(:)
-        integer :: k, j
+        integer :: k, j, limit
 
-        call map_entries(sets, label, name, size(field), owner, error)
+        limit = size(field)
+        if (present(most)) limit = most
+        call map_entries(sets, label, name, limit, owner, error)
         do k = 1, size(sets)
             if (allocated(error)) return
             if (sets(k)%name /= name) cycle
-            call expand(sets(k), label, size(field), words, error)
+            call expand(sets(k), label, limit, words, error)
             do j = 1, size(words)
                 if (len(words(j)%text) == 0 .or. allocated(error)) cycle
                 call convert(words(j)%text, sets(k)%line, label, name // '(' &

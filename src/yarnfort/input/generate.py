@@ -243,6 +243,8 @@ def read_routine(group: Group) -> list[str]:
                                   "error)", i2)
             out += [f"{i2}if (allocated(error)) return", f"{i2}allocate(value%{var.name}(n))"]
         kind = "array" if var.is_list or var.size else "scalar"
+        if var.is_list:
+            args += f", most={var.max}"
         out += wrap_statement(f"call take_{kind}({args})", i2)
         out.append(f"{i2}if (allocated(error)) return")
     out = out[:-1] + [f"{INDENT}end subroutine read_{name}", ""]
