@@ -204,17 +204,13 @@ contains
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
         character(len=256) :: message
-        integer(8) :: expected
         integer :: status
 
-        inquire(unit=unit, size=expected)
+        call flush_checked(unit, path, error)
         message = ''
         close(unit, iostat=status, iomsg=message)
-        if (status /= 0) then
+        if (status /= 0 .and. .not. allocated(error)) &
             call fatal_error(error, "cannot write '" // path // "': " // trim(message))
-            return
-        end if
-        call check_size(path, expected, error)
     end subroutine close_checked
 
     !> Flush `unit`, connected to the file `path`, and check that every byte written so
