@@ -24,7 +24,7 @@ module yarnfort_output_manifest
     character(len=*), parameter :: manifest_file_name = '.yarnfort-manifest'
 
     !> The fixed names a run may write (and their temporaries).
-    character(len=*), parameter :: fixed_names(*) = [character(len=16) :: 'curve.csv', &
+    character(len=*), parameter :: fixed_names(*) = [character(len=17) :: 'curve.csv', &
         'curve.csv.tmp', 'input.nml', 'input.nml.tmp', 'restart.dat', 'restart.dat.tmp', &
         'states.pvd', 'states.pvd.tmp', 'reactions.csv', 'reactions.csv.tmp', &
         'contacts.csv', 'contacts.csv.tmp']
