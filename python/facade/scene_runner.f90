@@ -16,8 +16,7 @@ module yarnfort_facade_scene_runner
     use yarnfort_input_namelist, only: read_config, check_config
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_output_writer, only: output_writer_type
-    use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash
-    use yarnfort_driver, only: run_scene
+    use yarnfort_driver, only: solve_with_outputs
     implicit none
     private
 
@@ -89,8 +88,8 @@ contains
         type(config_type) :: config
         type(scene_type), target :: scene
         type(facade_writer_type) :: writer
-        type(restart_type) :: restart
-        type(error_type), allocatable :: finish_error
+        character(len=:), allocatable :: stage
+        integer :: status
         logical :: stopped
 
         n_steps = 0
@@ -111,54 +110,12 @@ contains
         writer%notify => notify
         writer%time_start = scene%path%time(1)
         writer%time_end = scene%path%time(size(scene%path%time))
-        writer%input_hash = get_input_hash(config, scene)
-        if (config%control%restart) then
-            ! Check the restart file before touching anything in the folder.
-            call read_restart(trim(config%output%folder), restart, error)
-            if (.not. allocated(error)) call check_restart(restart, scene, &
-                writer%input_hash, trim(config%output%folder), error)
-            if (allocated(error)) then
-                call set_stage(error, 'restart', status_input)
-                return
-            end if
-            call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time)
-        else
-            call writer%open(scene, error)
-        end if
-        if (allocated(error)) then
-            call set_stage(error, 'output', status_input)
-            return
-        end if
-        ! The effective input, written as the program writes it (checked, atomic).
-        call writer%write_input(config, error)
-        if (allocated(error)) then
-            call writer%finish(scene, finish_error)     ! releases the folder's lock
-            call set_stage(error, 'output', status_input)
-            return
-        end if
-
-        if (config%control%restart) then
-            call run_scene(scene, writer, error, restart=restart, &
-                max_steps=config%control%max_steps, stopped=stopped)
-        else
-            call run_scene(scene, writer, error, max_steps=config%control%max_steps, &
-                stopped=stopped)
-        end if
-        if (stopped) outcome = outcome_max_steps
-        if (allocated(error)) then
-            if (error%stat == status_stop_request) then
-                deallocate(error)
-                outcome = outcome_stopped
-            end if
-        end if
-        call writer%finish(scene, finish_error)
+        call solve_with_outputs(config, scene, writer, error, stage, status, stopped, &
+            unwind_stat=status_stop_request)
         n_steps = writer%n_steps
-        if (allocated(error)) then
-            call set_stage(error, 'solve', status_solve)
-        else if (allocated(finish_error)) then
-            call move_alloc(finish_error, error)
-            call set_stage(error, 'output', status_solve)
-        end if
+        if (stopped) outcome = outcome_max_steps
+        if (writer%stop_requested .and. .not. allocated(error)) outcome = outcome_stopped
+        if (allocated(error)) call set_stage(error, stage, status)
     end subroutine run_scene_from_file
 
     !> Read the namelist file `path` with relative names taken from the working

@@ -11,18 +11,16 @@ program yarnfort_main
     use yarnfort_input_groups, only: input_help_lines => help_lines
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_scene_builder, only: new_scene
-    use yarnfort_driver, only: run_scene, get_linear_solver_name
+    use yarnfort_driver, only: solve_with_outputs, get_linear_solver_name
     use yarnfort_app_progress, only: progress_writer_type
-    use yarnfort_solver_restart, only: restart_type
-    use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash
     use yarnfort_output_filesystem, only: ignore_file_size_signal
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
     type(progress_writer_type) :: writer
     type(error_type), allocatable :: error
-    type(error_type), allocatable :: finish_error
-    type(restart_type) :: restart
+    character(len=:), allocatable :: stage
+    integer :: status
     logical :: stopped
 
     call handle_arguments()
@@ -48,36 +46,8 @@ program yarnfort_main
 
     writer%progress = config%output%progress
     writer%residual_history = config%output%residual_history
-    writer%input_hash = get_input_hash(config, scene)
-    if (config%control%restart) then
-        ! Lock the folder (no other run may write it meanwhile), then check the restart
-        ! file before touching anything in it.
-        call writer%lock(config%output%folder, error, create=.false.)
-        if (allocated(error)) call fail('output', error, 2)
-        call read_restart(trim(config%output%folder), restart, error)
-        if (.not. allocated(error)) call check_restart(restart, scene, writer%input_hash, &
-            trim(config%output%folder), error)
-        if (allocated(error)) call fail('restart', error, 2)
-        write(error_unit, '(a, i0, a, g0.6)') 'yarnfort: restarting after step ', restart%step, &
-            ' at t = ', restart%time
-        call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time)
-    else
-        call writer%open(scene, error)
-    end if
-    if (allocated(error)) call fail('output', error, 2)
-    call writer%write_input(config, error)
-    if (allocated(error)) call fail('output', error, 2)
-
-    if (config%control%restart) then
-        call run_scene(scene, writer, error, restart=restart, &
-            max_steps=config%control%max_steps, stopped=stopped)
-    else
-        call run_scene(scene, writer, error, max_steps=config%control%max_steps, stopped=stopped)
-    end if
-    call writer%finish(scene, finish_error)
-    if (allocated(error) .and. writer%failed) call fail('output', error, 1)
-    if (allocated(error)) call fail('solve', error, 1)
-    if (allocated(finish_error)) call fail('output', finish_error, 1)
+    call solve_with_outputs(config, scene, writer, error, stage, status, stopped)
+    if (allocated(error)) call fail(stage, error, status)
     if (stopped) then
         write(error_unit, '(a, i0, a)') 'yarnfort: stopped after max_steps = ', &
             config%control%max_steps, ' load steps; results so far in ' &

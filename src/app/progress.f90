@@ -18,6 +18,7 @@ module yarnfort_app_progress
     contains
         procedure :: on_step
         procedure :: on_cut
+        procedure :: on_resume
     end type progress_writer_type
 
 contains
@@ -52,5 +53,14 @@ contains
         write(error_unit, '("  cut: step of ", es9.2, " from t = ", f9.5, " failed: ", a)') &
             step, time, reason
     end subroutine on_cut
+
+    subroutine on_resume(self, step, time)
+        class(progress_writer_type), intent(inout) :: self
+        integer, intent(in) :: step
+        real(wp), intent(in) :: time
+
+        write(error_unit, '(a, i0, a, g0.6)') 'yarnfort: restarting after step ', step, &
+            ' at t = ', time
+    end subroutine on_resume
 
 end module yarnfort_app_progress

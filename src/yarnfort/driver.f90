@@ -1,8 +1,12 @@
 ! SPDX-License-Identifier: MIT
-!> Run a scene: choose the linear solver, set up Newton (KINSOL) and follow the load path.
+!> Run a scene: choose the linear solver, set up Newton (KINSOL) and follow the load path;
+!> with its outputs, as the program and the Python facade run it.
 module yarnfort_driver
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, prefix_error
+    use yarnfort_input_config, only: config_type
+    use yarnfort_output_writer, only: output_writer_type
+    use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
@@ -13,7 +17,7 @@ module yarnfort_driver
     implicit none
     private
 
-    public :: run_scene, get_linear_solver_name
+    public :: run_scene, get_linear_solver_name, solve_with_outputs
 
 contains
 
@@ -67,5 +71,71 @@ contains
         if (allocated(error)) return
         call run_continuation(scene, stepper, observer, error, restart, max_steps, stopped)
     end subroutine run_scene
+
+    !> Solve the built `scene` of `config` with its outputs: open the &output folder with
+    !> `writer` (with &control restart: lock it, read and check its restart.dat before
+    !> touching anything else, tell `writer` (on_resume) and resume after that step),
+    !> write the effective input, follow the load path (`stopped`: &control max_steps
+    !> reached) and close the files. On failure `stage` says where ('restart', 'output'
+    !> or 'solve') and `status` is 2 when nothing of the run was written, 1 after it (the
+    !> converged steps are kept). A run error of stat `unwind_stat` is a stop the writer
+    !> asked for, not a failure.
+    subroutine solve_with_outputs(config, scene, writer, error, stage, status, stopped, &
+            unwind_stat)
+        type(config_type), intent(in) :: config
+        type(scene_type), target, intent(in) :: scene
+        class(output_writer_type), intent(inout) :: writer
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable, intent(out) :: stage
+        integer, intent(out) :: status
+        logical, intent(out) :: stopped
+        integer, intent(in), optional :: unwind_stat
+        type(restart_type) :: restart
+        type(error_type), allocatable :: finish_error
+
+        stopped = .false.
+        status = 2
+        writer%input_hash = get_input_hash(config, scene)
+        if (config%control%restart) then
+            stage = 'output'
+            call writer%lock(config%output%folder, error, create=.false.)
+            if (allocated(error)) return
+            stage = 'restart'
+            call read_restart(trim(config%output%folder), restart, error)
+            if (.not. allocated(error)) call check_restart(restart, scene, writer%input_hash, &
+                trim(config%output%folder), error)
+            if (allocated(error)) return
+            call writer%on_resume(restart%step, restart%time)
+            stage = 'output'
+            call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time)
+        else
+            stage = 'output'
+            call writer%open(scene, error)
+        end if
+        if (allocated(error)) return
+        call writer%write_input(config, error)
+        if (allocated(error)) then
+            call writer%finish(scene, finish_error)     ! releases the folder's lock
+            return
+        end if
+
+        if (config%control%restart) then
+            call run_scene(scene, writer, error, restart=restart, &
+                max_steps=config%control%max_steps, stopped=stopped)
+        else
+            call run_scene(scene, writer, error, max_steps=config%control%max_steps, &
+                stopped=stopped)
+        end if
+        if (allocated(error) .and. present(unwind_stat)) then
+            if (error%stat == unwind_stat) deallocate(error)
+        end if
+        call writer%finish(scene, finish_error)
+        status = 1
+        if (allocated(error)) then
+            if (.not. writer%failed) stage = 'solve'
+        else if (allocated(finish_error)) then
+            call move_alloc(finish_error, error)
+        end if
+    end subroutine solve_with_outputs
 
 end module yarnfort_driver

@@ -117,7 +117,7 @@ KNOWN = [
     ("vnet", "! A V-shaped", "\ufeff! A V-shaped", "input checked"),
     ("vnet", "&control", "\ufeff&control", "line 7: text outside a group"),
     ("vnet", "nodes = 1, 2, 3", "nodes = 1, 2, 3, nodes(2) = 2",
-     "&yarn: nodes(2) (line"),
+     "&yarn #1: nodes(2) (line"),
     ("vnet", "nodes = 1, 2, 3", f"nodes = 1, 2, 3, {MARKER_INTEGER}",
      f"&yarn #1: nodes(4) = {MARKER_INTEGER} is not a node"),
 ]

@@ -1,37 +1,29 @@
 ! SPDX-License-Identifier: MIT
 !> What the generated readers, checks and echo of yarnfort_input_groups do with one
-!> namelist variable: take a value read into a buffer (length, case, list length against
-!> the "not set" markers), check it (range, choices, the parameters of a law), write it
-!> back, and turn a failed namelist READ into a message naming group, variable and line.
+!> namelist variable: take its values from the assignments of a group (type, entries,
+!> length, case; each error naming group, variable, value and line), check it (range,
+!> choices, the parameters of a law), and write it back.
 module yarnfort_input_fields
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_text, only: to_lower, format_integer, format_real, join_names, closest_name
-    use yarnfort_input_scan, only: namelist_scan_type, explain_read_error
+    use yarnfort_text, only: to_lower, format_integer, format_real, join_names, closest_name, &
+        parse_integer, parse_real
+    use yarnfort_input_scan, only: namelist_scan_type, assignment_type
+    use yarnfort_text, only: string_type
     implicit none
     private
 
-    public :: buffer_length, message_length, max_list, max_coordinates, indent
-    public :: unset_real, unset_integer, other_real, other_integer
-    public :: read_failed, post_read_error, too_many_found, group_label
-    public :: take_text, unset_reals, unset_integers, count_set
-    public :: check_real, check_at_least, check_choice, require_set, require_text, forbid_set
+    public :: message_length, max_list, max_coordinates, indent
+    public :: post_read_error, group_label, take_scalar, take_array, list_length
+    public :: check_real, check_at_least, check_choice, check_law_parameter
     public :: not_finite, suggestion, quoted_list, check_name
-    public :: put, put_reals, put_integers, format_logical
+    public :: put, put_list, format_logical
 
     !> Most node ids in one &yarn, &support or &load group, and most knots in &path.
     integer, parameter :: max_list = 100000
     !> Most values of &nodes xyz (3 per node); larger scenes use &geometry.
     integer, parameter :: max_coordinates = 3 * max_list
-    !> Mark list entries the input did not set. An input value equal to the first
-    !> marker makes the reader read the group again with the second (see
-    !> namelist_scan_type%holds_marker): an entry is unset where both reads left theirs.
-    integer, parameter :: unset_integer = -huge(1), other_integer = huge(1)
-    real(wp), parameter :: unset_real = -huge(1.0_wp), other_real = huge(1.0_wp)
-    !> Length of the character buffers the namelists read into (longer than any config
-    !> field, so that a value too long for its field is detected, not cut).
-    integer, parameter :: buffer_length = 2048
     integer, parameter :: message_length = 512
     !> Indent of the variables in the echo, and values per line of its lists.
     character(len=*), parameter :: indent = '    '
@@ -39,11 +31,6 @@ module yarnfort_input_fields
     !> Characters of material and support names.
     character(len=*), parameter :: name_characters = &
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
-
-    !> A law parameter that another law uses must stay unset.
-    interface forbid_set
-        module procedure forbid_real, forbid_text
-    end interface forbid_set
 
 contains
 
@@ -57,30 +44,7 @@ contains
         if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
     end function group_label
 
-    !> Turn a failed namelist READ into an error naming the group, with the reader's
-    !> message and where possible the variable, the line and a suggestion.
-    subroutine read_failed(error, scan, name, occurrence, stat, message, variables)
-        type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: occurrence, stat
-        character(len=*), intent(in) :: message
-        character(len=*), intent(in) :: variables(:)
-        integer :: g
-
-        if (is_iostat_end(stat)) then
-            g = scan%find_group(name, max(occurrence, 1))
-            call fatal_error(error, group_label(name, occurrence) // ' (line ' &
-                // format_integer(scan%groups(g)%first_line) // ') was not found by the ' &
-                // "Fortran namelist reader: is there a '!' inside a character value " &
-                // 'earlier on that line? (it hides the rest of the line)')
-            return
-        end if
-        call fatal_error(error, group_label(name, occurrence) // ': ' &
-            // explain_read_error(scan, name, max(occurrence, 1), trim(message), variables))
-    end subroutine read_failed
-
-    !> An error found after a successful READ, with the group's line.
+    !> An error of a group found after reading it, with the group's line.
     subroutine post_read_error(error, scan, name, occurrence, text)
         type(error_type), allocatable, intent(out) :: error
         type(namelist_scan_type), intent(in) :: scan
@@ -98,100 +62,259 @@ contains
         end if
     end subroutine post_read_error
 
-    !> The namelist reader found more occurrences than the structural scan.
-    subroutine too_many_found(error, name, n_expected)
+    !> Scalar variable `name` of group `label` (real(wp), integer, logical or character,
+    !> folded to lower case if `lower`, leading blanks dropped if `adjust`) from its
+    !> assignment among `sets`; unchanged where none sets it or its value is null.
+    subroutine take_scalar(sets, label, name, field, error, lower, adjust)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: label, name
+        class(*), intent(inout) :: field
         type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: n_expected
-
-        call fatal_error(error, '&' // name // ': the Fortran namelist reader found more ' &
-            // 'than the ' // format_integer(n_expected) // ' &' // name // ' groups of ' &
-            // "the text; is '&" // name // "' inside a comment after a character value " &
-            // "with '!'?")
-    end subroutine too_many_found
-
-    !> A character value read into `buffer` into its config `field`: it must fit; leading
-    !> blanks dropped if `adjust`, folded to lower case if `lower`.
-    subroutine take_text(error, scan, name, occurrence, variable, buffer, field, lower, adjust)
-        type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name, variable
-        integer, intent(in) :: occurrence
-        character(len=*), intent(inout) :: buffer
-        character(len=*), intent(out) :: field
         logical, intent(in) :: lower, adjust
+        type(string_type), allocatable :: words(:)
+        integer :: k, first
 
-        field = ''
-        if (adjust) buffer = adjustl(buffer)
-        if (len_trim(buffer) > len(field)) then
-            call post_read_error(error, scan, name, occurrence, variable // " = '" &
-                // buffer(:min(len_trim(buffer), 40)) // "...' is longer than " &
-                // format_integer(len(field)) // ' characters')
-            return
-        end if
-        if (lower) buffer = to_lower(buffer)
-        field = buffer(:len(field))
-    end subroutine take_text
+        first = 0
+        do k = 1, size(sets)
+            if (sets(k)%name /= name) cycle
+            if (sets(k)%subscripted) then
+                call fatal_error(error, label // ': ' // name // '(' &
+                    // format_integer(sets(k)%first) // ') (line ' &
+                    // format_integer(sets(k)%line) // '): ' // name // ' is not an array')
+                return
+            else if (first > 0) then
+                call fatal_error(error, label // ': ' // name // ' is set twice (lines ' &
+                    // format_integer(sets(first)%line) // ' and ' &
+                    // format_integer(sets(k)%line) // ')')
+                return
+            end if
+            first = k
+        end do
+        if (first == 0) return
+        call expand(sets(first), label, 1, words, error)
+        if (allocated(error) .or. size(words) == 0) return
+        if (len(words(1)%text) == 0) return
+        call convert(words(1)%text, sets(first)%line, label, name, field, error, lower, adjust)
+    end subroutine take_scalar
 
-    !> Which entries of a list read into `values` (prefilled with unset_real) the input
-    !> did not set. If `again` is allocated, `values` holds a second read prefilled with
-    !> other_real and `again` the first: an entry is unset only where both kept their
-    !> marker (so an input value equal to a marker is a value).
-    pure function unset_reals(values, again) result(unset)
-        real(wp), intent(in) :: values(:)
-        real(wp), allocatable, intent(in) :: again(:)
-        logical :: unset(size(values))
-
-        if (allocated(again)) then
-            unset = values == other_real .and. again == unset_real
-        else
-            unset = values == unset_real
-        end if
-    end function unset_reals
-
-    !> As unset_reals for integers (markers unset_integer and other_integer).
-    pure function unset_integers(values, again) result(unset)
-        integer, intent(in) :: values(:)
-        integer, allocatable, intent(in) :: again(:)
-        logical :: unset(size(values))
-
-        if (allocated(again)) then
-            unset = values == other_integer .and. again == unset_integer
-        else
-            unset = values == unset_integer
-        end if
-    end function unset_integers
-
-    !> `n`, the last set entry of a list; an error for a set guard or an unset entry
-    !> before the last set one.
-    subroutine count_set(error, scan, name, occurrence, variable, unset, n)
+    !> Array variable `name` of group `label` from its assignments among `sets`: `name =`
+    !> sets the entries from 1 on, `name(i) =` from i on; the others stay as they are. A
+    !> list (`most` entries at most, `field` as long as list_length says) may have null
+    !> values beyond its last value.
+    subroutine take_array(sets, label, name, field, error, lower, adjust, most)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: label, name
+        class(*), intent(inout) :: field(:)
         type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name, variable
-        integer, intent(in) :: occurrence
-        logical, intent(in) :: unset(:)
+        logical, intent(in) :: lower, adjust
+        integer, intent(in), optional :: most
+        type(string_type), allocatable :: words(:)
+        integer, allocatable :: owner(:)
+        integer :: k, j, limit
+
+        limit = size(field)
+        if (present(most)) limit = most
+        call map_entries(sets, label, name, limit, owner, error)
+        do k = 1, size(sets)
+            if (allocated(error)) return
+            if (sets(k)%name /= name) cycle
+            call expand(sets(k), label, limit, words, error)
+            do j = 1, size(words)
+                if (len(words(j)%text) == 0 .or. allocated(error)) cycle
+                call convert(words(j)%text, sets(k)%line, label, name // '(' &
+                    // format_integer(sets(k)%first + j - 1) // ')', &
+                    field(sets(k)%first + j - 1), error, lower, adjust)
+            end do
+        end do
+    end subroutine take_array
+
+    !> `n`, the last entry of list `name` of group `label` that `sets` give a value (at
+    !> most `most`); an error for an entry without a value before it.
+    subroutine list_length(sets, label, name, most, n, error)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: label, name
+        integer, intent(in) :: most
         integer, intent(out) :: n
-        integer :: i
+        type(error_type), allocatable, intent(out) :: error
+        integer, allocatable :: owner(:)
+        integer :: j
+
+        call map_entries(sets, label, name, most, owner, error)
+        n = 0
+        if (allocated(error)) return
+        n = findloc(owner > 0, .true., dim=1, back=.true.)
+        j = findloc(owner(:n) > 0, .false., dim=1)
+        if (j > 0) call fatal_error(error, label // ': ' // name // '(' // format_integer(j) &
+            // ') has no value, but later entries have (an empty entry between commas?)')
+    end subroutine list_length
+
+    !> For each entry of array `name` (at most `most`) up to the last one its assignments
+    !> reach, the assignment that sets it (negative for a null value, 0 for none); an
+    !> error for an entry that two assignments set.
+    subroutine map_entries(sets, label, name, most, owner, error)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: label, name
+        integer, intent(in) :: most
+        integer, allocatable, intent(out) :: owner(:)
+        type(error_type), allocatable, intent(out) :: error
+        type(string_type), allocatable :: words(:)
+        integer :: k, j, pass, n, i
 
         n = 0
-        do i = size(unset), 1, -1
-            if (.not. unset(i)) then
-                n = i
-                exit
-            end if
+        do pass = 1, 2
+            if (pass == 2) allocate(owner(n), source=0)
+            do k = 1, size(sets)
+                if (sets(k)%name /= name) cycle
+                if (sets(k)%first < 1 .or. sets(k)%first > most) then
+                    call fatal_error(error, label // ': ' // assigned(sets(k)) // ' (line ' &
+                        // format_integer(sets(k)%line) // '): the subscript is outside 1..' &
+                        // format_integer(most) // ', the entries of ' // name)
+                    return
+                end if
+                call expand(sets(k), label, min(most, sets(k)%last) - sets(k)%first + 1, words, &
+                    error)
+                if (allocated(error)) return
+                n = max(n, sets(k)%first + size(words) - 1)
+                if (pass == 1) cycle
+                do j = 1, size(words)
+                    i = sets(k)%first + j - 1
+                    if (owner(i) /= 0) then
+                        call fatal_error(error, label // ': ' // assigned(sets(k)) &
+                            // ' (line ' // format_integer(sets(k)%line) // ') sets again ' &
+                            // 'an entry that ' // assigned(sets(abs(owner(i)))) // ' (line ' &
+                            // format_integer(sets(abs(owner(i)))%line) // ') sets; each ' &
+                            // 'entry may be set only once')
+                        return
+                    end if
+                    owner(i) = merge(k, -k, len(words(j)%text) > 0)
+                end do
+            end do
         end do
-        if (n == size(unset)) then
-            call post_read_error(error, scan, name, occurrence, variable // ' has more than ' &
-                // format_integer(size(unset) - 1) // ' values (the most it can hold)')
-            return
-        end if
-        i = findloc(unset(:n), .true., dim=1)
-        if (i > 0) then
-            call post_read_error(error, scan, name, occurrence, variable // '(' &
-                // format_integer(i) // ') has no value, but later entries have (an ' &
-                // 'empty entry between commas?)')
-        end if
-    end subroutine count_set
+    end subroutine map_entries
+
+    !> 'x' or 'x(i)', as the assignment writes it.
+    pure function assigned(set) result(text)
+        type(assignment_type), intent(in) :: set
+        character(len=:), allocatable :: text
+
+        text = set%name
+        if (set%subscripted) text = text // '(' // format_integer(set%first) // ')'
+    end function assigned
+
+    !> The values of an assignment with repeat counts r*v written out (r*: r null values),
+    !> at most `most` of them.
+    subroutine expand(set, label, most, words, error)
+        type(assignment_type), intent(in) :: set
+        character(len=*), intent(in) :: label
+        integer, intent(in) :: most
+        type(string_type), allocatable, intent(out) :: words(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer, allocatable :: repeats(:), skip(:)
+        integer :: j, star, n
+        logical :: ok
+
+        allocate(repeats(size(set%values)), source=1)
+        allocate(skip(size(set%values)), source=0)
+        n = 0
+        do j = 1, size(set%values)
+            associate(word => set%values(j)%text)
+                star = index(word, '*')
+                if (star > 1) then
+                    if (verify(word(:star - 1), '0123456789') == 0) then
+                        skip(j) = star
+                        call parse_integer(word(:star - 1), repeats(j), ok)
+                        if (.not. ok .or. repeats(j) < 1) then
+                            call fatal_error(error, label // ': ' // word // ' (line ' &
+                                // format_integer(set%line) // ') in ' // set%name &
+                                // ': a repeat count is a positive integer')
+                            return
+                        end if
+                    end if
+                end if
+                if (repeats(j) > most - n) then
+                    call fatal_error(error, label // ': ' // set%name // ' has more than ' &
+                        // format_integer(most) // trim(merge(' value ', ' values', most == 1)) &
+                        // ' (line ' // format_integer(set%line) &
+                        // '): more values than ' // set%name // ' holds')
+                    return
+                end if
+                n = n + repeats(j)
+            end associate
+        end do
+        allocate(words(n))
+        n = 0
+        do j = 1, size(set%values)
+            words(n + 1:n + repeats(j)) = string_type(set%values(j)%text(skip(j) + 1:))
+            n = n + repeats(j)
+        end do
+    end subroutine expand
+
+    !> The value word `word` (of `variable`, assigned on `line`) into `field`.
+    subroutine convert(word, line, label, variable, field, error, lower, adjust)
+        character(len=*), intent(in) :: word, label, variable
+        integer, intent(in) :: line
+        class(*), intent(inout) :: field
+        type(error_type), allocatable, intent(out) :: error
+        logical, intent(in) :: lower, adjust
+        character(len=:), allocatable :: text, expected
+        logical :: ok
+
+        text = to_lower(word)
+        ok = .false.
+        expected = ''
+        select type (field)
+        type is (real(wp))
+            call parse_real(word, field, ok)
+            expected = 'a real number is expected'
+        type is (integer)
+            call parse_integer(word, field, ok)
+            expected = 'an integer is expected'
+        type is (logical)
+            if (text(1:1) == '.') text = text(2:)
+            ok = any(text == [character(len=6) :: 't', 'f', 'true', 'false', 't.', 'f.', &
+                'true.', 'false.'])
+            if (ok) field = text(1:1) == 't'
+            expected = 'a logical is expected: .true. or .false.'
+        type is (character(len=*))
+            ok = len(word) >= 2 .and. scan(word(1:1), "'""") == 1
+            if (ok) ok = word(len(word):) == word(1:1)
+            expected = "a character value is expected, in quotes: 'text'"
+            if (ok) then
+                text = unquoted(word(2:len(word) - 1), word(1:1))
+                if (adjust) text = adjustl(text)
+                if (len_trim(text) > len(field)) then
+                    call fatal_error(error, label // ': ' // variable // " = '" &
+                        // text(:min(len_trim(text), 40)) // "...' is longer than " &
+                        // format_integer(len(field)) // ' characters (line ' &
+                        // format_integer(line) // ')')
+                    return
+                end if
+                if (lower) text = to_lower(text)
+                field = text
+            end if
+        end select
+        if (.not. ok) call fatal_error(error, label // ': ' // word &
+            // ' is not a valid value of ' // variable // ' (line ' // format_integer(line) &
+            // ': ' // expected // ')')
+    end subroutine convert
+
+    !> The text of a character value between its quotes, doubled quotes made single.
+    pure function unquoted(inner, quote) result(text)
+        character(len=*), intent(in) :: inner, quote
+        character(len=:), allocatable :: text
+        integer :: i, n
+
+        allocate(character(len=len(inner)) :: text)
+        n = 0
+        i = 1
+        do while (i <= len(inner))
+            n = n + 1
+            text(n:n) = inner(i:i)
+            if (inner(i:i) == quote) i = i + 1
+            i = i + 1
+        end do
+        text = text(:n)
+    end function unquoted
 
     !> A real that must be finite and, where bounds are given, within them (the texts
     !> of the bounds are those of the description, for the message).
@@ -261,48 +384,21 @@ contains
         end if
     end subroutine check_choice
 
-    !> A parameter of the selected law: set (not its "not set" default).
-    subroutine require_set(error, label, variable, value, unset, law)
+    !> Parameter `variable` of a law: needed by the selected law `law` and then to be set,
+    !> or not used by it and then not to be set; `text` is its value for the message.
+    subroutine check_law_parameter(error, label, variable, is_set, text, law, needed)
         type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, law
-        real(wp), intent(in) :: value, unset
+        character(len=*), intent(in) :: label, variable, text, law
+        logical, intent(in) :: is_set, needed
 
-        if (value == unset) then
+        if (needed .and. .not. is_set) then
             call fatal_error(error, label // ': ' // variable // " is not set (law '" // law &
                 // "' needs it)")
-        end if
-    end subroutine require_set
-
-    subroutine require_text(error, label, variable, value, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, value, law
-
-        if (len_trim(value) == 0) then
-            call fatal_error(error, label // ': ' // variable // " is not set (law '" // law &
-                // "' needs it)")
-        end if
-    end subroutine require_text
-
-    subroutine forbid_real(error, label, variable, value, unset, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, law
-        real(wp), intent(in) :: value, unset
-
-        if (.not. (value == unset)) then
-            call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
+        else if (is_set .and. .not. needed) then
+            call fatal_error(error, label // ': ' // variable // ' = ' // text &
                 // " is not used by law '" // law // "' (remove it)")
         end if
-    end subroutine forbid_real
-
-    subroutine forbid_text(error, label, variable, value, unset, law)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable, value, unset, law
-
-        if (value /= unset) then
-            call fatal_error(error, label // ': ' // variable // " = '" // trim(value) &
-                // "' is not used by law '" // law // "' (remove it)")
-        end if
-    end subroutine forbid_text
+    end subroutine check_law_parameter
 
     subroutine not_finite(error, label, variable, value)
         type(error_type), allocatable, intent(out) :: error
@@ -358,61 +454,32 @@ contains
         write(unit, '(a)', iostat=status) line
     end subroutine put
 
-    !> `name = v1 v2 ...`, integers_per_line values per line; nothing for no values.
-    subroutine put_integers(unit, name, values)
+    !> `name = v1 v2 ...` (integers or reals), integers_per_line or reals_per_line values
+    !> per line; nothing for no values.
+    subroutine put_list(unit, name, values)
         integer, intent(in) :: unit
         character(len=*), intent(in) :: name
-        integer, intent(in) :: values(:)
-
-        call put_values(unit, name, size(values), integers_per_line, integer_text)
-    contains
-        function integer_text(i) result(text)
-            integer, intent(in) :: i
-            character(len=:), allocatable :: text
-
-            text = format_integer(values(i))
-        end function integer_text
-    end subroutine put_integers
-
-    !> `name = v1 v2 ...`, reals_per_line values per line; nothing for no values.
-    subroutine put_reals(unit, name, values)
-        integer, intent(in) :: unit
-        character(len=*), intent(in) :: name
-        real(wp), intent(in) :: values(:)
-
-        call put_values(unit, name, size(values), reals_per_line, real_text)
-    contains
-        function real_text(i) result(text)
-            integer, intent(in) :: i
-            character(len=:), allocatable :: text
-
-            text = format_real(values(i))
-        end function real_text
-    end subroutine put_reals
-
-    !> `name = ` and the texts of values 1..n, `per_line` of them per line.
-    subroutine put_values(unit, name, n, per_line, text_of)
-        integer, intent(in) :: unit, n, per_line
-        character(len=*), intent(in) :: name
-        interface
-            function text_of(i) result(text)
-                integer, intent(in) :: i
-                character(len=:), allocatable :: text
-            end function text_of
-        end interface
+        class(*), intent(in) :: values(:)
         character(len=:), allocatable :: line
-        integer :: i
+        integer :: i, per_line
 
-        if (n == 0) return
         line = indent // name // ' ='
-        do i = 1, n
-            line = line // ' ' // text_of(i)
-            if (mod(i, per_line) == 0 .or. i == n) then
+        per_line = integers_per_line
+        do i = 1, size(values)
+            select type (values)
+            type is (integer)
+                line = line // ' ' // format_integer(values(i))
+                per_line = integers_per_line
+            type is (real(wp))
+                line = line // ' ' // format_real(values(i))
+                per_line = reals_per_line
+            end select
+            if (mod(i, per_line) == 0 .or. i == size(values)) then
                 call put(unit, line)
                 line = indent // repeat(' ', len(name) + 2)
             end if
         end do
-    end subroutine put_values
+    end subroutine put_list
 
     pure function format_logical(value) result(text)
         logical, intent(in) :: value

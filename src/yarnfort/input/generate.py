@@ -8,9 +8,10 @@
     generate.py update REFERENCE.md rewrite the tables there
 
 The module holds, per group: its config type (defaults, one doc line per variable), a
-reader of one occurrence (local namelist, lists read against "not set" markers, text
-lengths checked, case folded), the generic checks (range, choices, the parameters of
-the selected law), the echo, and for all groups the names and the --help summary.
+reader of one occurrence (each variable taken from the tokenizer's assignments by the
+typed helpers of fields.f90: entries, lengths, case), the generic checks (range,
+choices, the parameters of the selected law), the echo, and for all groups the names
+and the --help summary.
 """
 from __future__ import annotations
 
@@ -165,20 +166,18 @@ def law_block(var: Var, law_bound: list[Var]) -> list[tuple[int, str]]:
     body = [(0, f"select case (trim(value%{var.name}))")]
     for law in var.choices or []:
         body.append((0, f"case ('{law}')"))
-        for v in [v for v in law_bound if law in (v.laws or [])]:
+        for v in law_bound:
+            needed = law in (v.laws or [])
             if v.type == "character":
-                body.append((1, f"call require_text(error, label, '{v.name}', value%{v.name}, "
-                                f"'{law}')"))
+                is_set, text = f"len_trim(value%{v.name}) > 0", f"quote_string(value%{v.name})"
             else:
-                body.append((1, f"call require_set(error, label, '{v.name}', value%{v.name}, "
-                                f"{fortran_default(v)}, '{law}')"))
-                for call in range_call(v, "label", f"value%{v.name}", f"'{v.name}'"):
-                    body += [(1, "if (allocated(error)) return"), (1, call)]
+                is_set = f".not. (value%{v.name} == {fortran_default(v)})"
+                text = f"format_real(value%{v.name})"
+            body.append((1, f"call check_law_parameter(error, label, '{v.name}', {is_set}, "
+                            f"{text}, '{law}', {'.true.' if needed else '.false.'})"))
+            for call in range_call(v, "label", f"value%{v.name}", f"'{v.name}'") if needed else []:
+                body += [(1, "if (allocated(error)) return"), (1, call)]
             body.append((1, "if (allocated(error)) return"))
-        for v in [v for v in law_bound if law not in (v.laws or [])]:
-            unset = "''" if v.type == "character" else fortran_default(v)
-            body += [(1, f"call forbid_set(error, label, '{v.name}', value%{v.name}, {unset}, "
-                         f"'{law}')"), (1, "if (allocated(error)) return")]
     return body + [(0, "end select")]
 
 
@@ -220,141 +219,57 @@ def check_routine(group: Group) -> list[str]:
 
 
 def read_routine(group: Group) -> list[str]:
-    lists = [v for v in group.variables if v.is_list]
-    i2 = INDENT * 2
-    out = [f"{INDENT}!> Read the next &{group.name} group of the comment-free text `unit` "
-           "(at its",
-           f"{INDENT}!> `occurrence`, 0 for a singleton) into `value`; `found` is false at "
-           "the end.",
-           f"{INDENT}subroutine read_{group.name}(unit, scan, occurrence, value, found, error)",
-           f"{i2}integer, intent(in) :: unit, occurrence",
-           f"{i2}type(namelist_scan_type), intent(in) :: scan",
-           f"{i2}type({group.type_name}), intent(out) :: value",
-           f"{i2}logical, intent(out) :: found",
-           f"{i2}type(error_type), allocatable, intent(out) :: error"]
-    for var in group.variables:
-        out.append(i2 + declaration(var, buffer=True))
-    for var in lists:
-        out.append(i2 + declaration(var).replace(f":: {var.name}(:)", f":: {var.name}_again(:)"))
-    out += wrap_statement(f"namelist /{group.name}/ "
-                          + ", ".join(v.name for v in group.variables), i2)
-    needs_k = bool(lists) or any(v.type == "character" and v.size for v in group.variables)
-    out += [f"{i2}character(len=message_length) :: message",
-            f"{i2}integer :: stat" + (", k" if needs_k else "") + (", n" if lists else ""), ""]
-    for var in lists:
-        out.append(f"{i2}allocate({var.name}({var.max} + 1))")
-    out += [f"{i2}call reset(.false.)",
-            f"{i2}message = ''",
-            f"{i2}read(unit, nml={group.name}, iostat=stat, iomsg=message)",
-            f"{i2}found = .not. is_iostat_end(stat)",
-            f"{i2}if (.not. found) return",
-            f"{i2}if (stat /= 0) then",
-            f"{i2}{INDENT}call read_failed(error, scan, '{group.name}', occurrence, stat, "
-            f"message, &",
-            f"{i2}{INDENT * 2}{group.name}_variables)",
-            f"{i2}{INDENT}return",
-            f"{i2}end if"]
-    if lists:
-        out += [f"{i2}! A value equal to a 'not set' marker: read again with the other markers",
-                f"{i2}! (an entry is unset only where both reads left their marker).",
-                f"{i2}if (scan%holds_marker('{group.name}', max(occurrence, 1), unset_real, &",
-                f"{i2}{INDENT * 2}unset_integer)) then"]
-        for var in lists:
-            out.append(f"{i2}{INDENT}{var.name}_again = {var.name}")
-        out += [f"{i2}{INDENT}rewind(unit)",
-                f"{i2}{INDENT}do k = 1, max(occurrence, 1)",
-                f"{i2}{INDENT * 2}call reset(.true.)",
-                f"{i2}{INDENT * 2}read(unit, nml={group.name}, iostat=stat)",
-                f"{i2}{INDENT}end do",
-                f"{i2}end if"]
-    for var in group.variables:
-        if var.type == "character":
-            args = (f"{'.true.' if var.lower else '.false.'}, "
-                    f"{'.true.' if var.adjust else '.false.'}")
-            if var.size:
-                out.append(f"{i2}do k = 1, {var.size}")
-                out += wrap_statement(f"call take_text(error, scan, '{group.name}', occurrence, "
-                                      f"'{var.name}(' // format_integer(k) // ')', "
-                                      f"{var.name}(k), value%{var.name}(k), {args})", i2 + INDENT)
-                out += [f"{i2}{INDENT}if (allocated(error)) return", f"{i2}end do"]
-            else:
-                out += wrap_statement(f"call take_text(error, scan, '{group.name}', occurrence,"
-                                      f" '{var.name}', {var.name}, value%{var.name}, {args})", i2)
-                out.append(f"{i2}if (allocated(error)) return")
-        elif var.is_list:
-            kind = "reals" if var.type == "real" else "integers"
-            out += wrap_statement(f"call count_set(error, scan, '{group.name}', occurrence, "
-                                  f"'{var.name}', unset_{kind}({var.name}, {var.name}_again), "
-                                  "n)", i2)
-            out.append(f"{i2}if (allocated(error)) return")
-            out.append(f"{i2}if (allocated({var.name}_again)) {var.name} = {var.name}_again")
-            out.append(f"{i2}value%{var.name} = {var.name}(:n)")
-        else:
-            out.append(f"{i2}value%{var.name} = {var.name}")
-    out += ["", f"{INDENT}contains", "",
-            f"{i2}!> Defaults from the type; lists filled with the first or the `second` "
-            "markers.",
-            f"{i2}subroutine reset(second)",
-            f"{i2}{INDENT}logical, intent(in) :: second"]
-    if len(lists) < len(group.variables):
-        out.append(f"{i2}{INDENT}type({group.type_name}) :: defaults")
-    out.append("")
-    for var in group.variables:
-        if var.is_list:
-            kind = "real" if var.type == "real" else "integer"
-            out.append(f"{i2}{INDENT}{var.name} = merge(other_{kind}, unset_{kind}, second)")
-        else:
-            out.append(f"{i2}{INDENT}{var.name} = defaults%{var.name}")
-    if not lists:
-        out.append(f"{i2}{INDENT}if (second) return")
-    out += [f"{i2}end subroutine reset"]
-    out += [f"{INDENT}end subroutine read_{group.name}", ""]
-    return out
-
-
-def read_all_routine(group: Group) -> list[str]:
-    """read_<group>_groups: every occurrence, checked against the structural scan."""
+    """read_<group>: one occurrence from its assignments; read_<group>_groups: all."""
     i2, i3 = INDENT * 2, INDENT * 3
     name = group.name
+    out = [f"{INDENT}!> The `occurrence`-th &{name} group (0 for a singleton) into `value`.",
+           f"{INDENT}subroutine read_{name}(scan, occurrence, value, error)",
+           f"{i2}type(namelist_scan_type), intent(in) :: scan",
+           f"{i2}integer, intent(in) :: occurrence",
+           f"{i2}type({group.type_name}), intent(inout) :: value",
+           f"{i2}type(error_type), allocatable, intent(out) :: error",
+           f"{i2}type(assignment_type), allocatable :: sets(:)",
+           f"{i2}character(len=:), allocatable :: label",
+           f"{i2}integer :: n", "",
+           f"{i2}label = group_label('{name}', occurrence)",
+           f"{i2}call get_assignments(scan, '{name}', occurrence, {name}_variables, sets, error)",
+           f"{i2}if (allocated(error)) return"]
+    for var in group.variables:
+        args = (f"sets, label, '{var.name}', value%{var.name}, error, "
+                f"{'.true.' if var.lower else '.false.'}, "
+                f"{'.true.' if var.adjust and var.type == 'character' else '.false.'}")
+        if var.is_list:
+            out += wrap_statement(f"call list_length(sets, label, '{var.name}', {var.max}, n, "
+                                  "error)", i2)
+            out += [f"{i2}if (allocated(error)) return", f"{i2}allocate(value%{var.name}(n))"]
+        kind = "array" if var.is_list or var.size else "scalar"
+        if var.is_list:
+            args += f", most={var.max}"
+        out += wrap_statement(f"call take_{kind}({args})", i2)
+        out.append(f"{i2}if (allocated(error)) return")
+    out = out[:-1] + [f"{INDENT}end subroutine read_{name}", ""]
     if group.kind == "singleton":
-        return [f"{INDENT}!> The &{name} group into `value` if there is one (`value` is "
-                "unchanged otherwise).",
-                f"{INDENT}subroutine read_{name}_groups(unit, scan, value, error)",
-                f"{i2}integer, intent(in) :: unit",
-                f"{i2}type(namelist_scan_type), intent(in) :: scan",
-                f"{i2}type({group.type_name}), intent(inout) :: value",
-                f"{i2}type(error_type), allocatable, intent(out) :: error",
-                f"{i2}logical :: found", "",
-                f"{i2}if (scan%count_group('{name}') == 0) return",
-                f"{i2}rewind(unit)",
-                f"{i2}call read_{name}(unit, scan, 0, value, found, error)",
-                f"{i2}if (.not. allocated(error) .and. .not. found) &",
-                f"{i3}call read_failed(error, scan, '{name}', 0, iostat_end, '', {name}_variables)",
-                f"{INDENT}end subroutine read_{name}_groups", ""]
-    return [f"{INDENT}!> Every &{name} group, in the order of the text.",
-            f"{INDENT}subroutine read_{name}_groups(unit, scan, values, error)",
-            f"{i2}integer, intent(in) :: unit",
-            f"{i2}type(namelist_scan_type), intent(in) :: scan",
-            f"{i2}type({group.type_name}), allocatable, intent(out) :: values(:)",
-            f"{i2}type(error_type), allocatable, intent(out) :: error",
-            f"{i2}type({group.type_name}) :: extra",
-            f"{i2}type(error_type), allocatable :: ignored",
-            f"{i2}logical :: found",
-            f"{i2}integer :: k", "",
-            f"{i2}allocate(values(scan%count_group('{name}')))",
-            f"{i2}rewind(unit)",
-            f"{i2}do k = 1, size(values)",
-            f"{i3}call read_{name}(unit, scan, k, values(k), found, error)",
-            f"{i3}if (allocated(error)) return",
-            f"{i3}if (.not. found) then",
-            f"{i3}{INDENT}call read_failed(error, scan, '{name}', k, iostat_end, '', "
-            f"{name}_variables)",
-            f"{i3}{INDENT}return",
-            f"{i3}end if",
-            f"{i2}end do",
-            f"{i2}call read_{name}(unit, scan, size(values) + 1, extra, found, ignored)",
-            f"{i2}if (found) call too_many_found(error, '{name}', size(values))",
-            f"{INDENT}end subroutine read_{name}_groups", ""]
+        return out + [f"{INDENT}!> The &{name} group into `value` if there is one (`value` is "
+                      "unchanged otherwise).",
+                      f"{INDENT}subroutine read_{name}_groups(scan, value, error)",
+                      f"{i2}type(namelist_scan_type), intent(in) :: scan",
+                      f"{i2}type({group.type_name}), intent(inout) :: value",
+                      f"{i2}type(error_type), allocatable, intent(out) :: error", "",
+                      f"{i2}if (scan%count_group('{name}') > 0) call read_{name}(scan, 0, "
+                      "value, error)",
+                      f"{INDENT}end subroutine read_{name}_groups", ""]
+    return out + [f"{INDENT}!> Every &{name} group, in the order of the text.",
+                  f"{INDENT}subroutine read_{name}_groups(scan, values, error)",
+                  f"{i2}type(namelist_scan_type), intent(in) :: scan",
+                  f"{i2}type({group.type_name}), allocatable, intent(out) :: values(:)",
+                  f"{i2}type(error_type), allocatable, intent(out) :: error",
+                  f"{i2}integer :: k", "",
+                  f"{i2}allocate(values(scan%count_group('{name}')))",
+                  f"{i2}do k = 1, size(values)",
+                  f"{i3}call read_{name}(scan, k, values(k), error)",
+                  f"{i3}if (allocated(error)) return",
+                  f"{i2}end do",
+                  f"{INDENT}end subroutine read_{name}_groups", ""]
 
 
 def preset_routine(group: Group) -> list[str]:
@@ -385,8 +300,7 @@ def write_routine(group: Group) -> list[str]:
     for var in group.variables:
         field = f"value%{var.name}"
         if var.is_list:
-            kind = "reals" if var.type == "real" else "integers"
-            out += wrap_statement(f"if (allocated({field})) call put_{kind}(unit, "
+            out += wrap_statement(f"if (allocated({field})) call put_list(unit, "
                                   f"'{var.name}', {field})", i2)
             continue
         text = {"character": "quote_string", "real": "format_real",
@@ -443,17 +357,14 @@ def fortran_module() -> str:
            "--help",
            "!> summary. The helpers they call are in yarnfort_input_fields.",
            "module yarnfort_input_groups",
-           f"{INDENT}use, intrinsic :: iso_fortran_env, only: iostat_end",
            f"{INDENT}use yarnfort_kinds, only: wp",
            f"{INDENT}use yarnfort_error, only: error_type",
            f"{INDENT}use yarnfort_text, only: format_integer, format_real, quote_string",
-           f"{INDENT}use yarnfort_input_scan, only: namelist_scan_type",
-           f"{INDENT}use yarnfort_input_fields, only: buffer_length, message_length, max_list, &",
-           f"{INDENT * 3}max_coordinates, unset_real, unset_integer, other_real, other_integer, &",
-           f"{INDENT * 3}read_failed, too_many_found, take_text, unset_reals, unset_integers, count_set, &",
-           f"{INDENT * 3}check_real, check_at_least, check_choice, require_set, &",
-           f"{INDENT * 3}require_text, forbid_set, put, put_reals, put_integers, format_logical, &",
-           f"{INDENT * 3}indent",
+           f"{INDENT}use yarnfort_input_scan, only: namelist_scan_type, assignment_type, "
+           "get_assignments",
+           f"{INDENT}use yarnfort_input_fields, only: max_list, max_coordinates, group_label, &",
+           f"{INDENT * 3}take_scalar, take_array, list_length, check_real, check_at_least, &",
+           f"{INDENT * 3}check_choice, check_law_parameter, put, put_list, format_logical, indent",
            f"{INDENT}implicit none",
            f"{INDENT}private", ""]
     publics = []
@@ -492,7 +403,6 @@ def fortran_module() -> str:
         out += type_definition(group)
     out += ["contains", ""]
     for group in GROUPS:
-        out += read_all_routine(group)
         out += read_routine(group)
         out += preset_routine(group)
         out += write_routine(group)

@@ -2,9 +2,8 @@
 !> Reading the namelist input into a `config_type`. Groups may come in any order; each
 !> is read by the reader generated from its description (yarnfort_input_groups, from
 !> variables.py). Singletons may appear at most once, repeatable groups once per item.
-!> A structural scan of the text first rejects unknown group names, text outside
-!> groups, unclosed groups and entries set twice (see yarnfort_input_scan); the namelist
-!> reads then run on a scratch copy of the text without its comments.
+!> The tokenizer (yarnfort_input_scan) rejects unknown group names, text outside groups,
+!> unclosed groups and entries set twice; the readers convert and store the values.
 !>
 !> Reading checks form only (names, types, list lengths); `check_config` (re-exported
 !> here from yarnfort_input_validate) checks meaning.
@@ -22,7 +21,7 @@ module yarnfort_input_namelist
         post_read_error
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
     use yarnfort_input_geometry, only: read_geometry_file
-    use yarnfort_text, only: read_line, format_integer, folder_of, resolve_path, is_folder
+    use yarnfort_text, only: format_integer, folder_of, resolve_path, is_folder
     use yarnfort_input_validate, only: check_config
     use yarnfort_generate_fabric, only: generate_fabric
     implicit none
@@ -37,8 +36,9 @@ module yarnfort_input_namelist
 
 contains
 
-    !> Read all groups from an open, rewindable formatted sequential unit. Relative file
-    !> names in the input are resolved against `folder` (default: working directory).
+    !> Read all groups from an open formatted sequential unit (from its start, unless it
+    !> is standard input). Relative file names in the input are resolved against `folder`
+    !> (default: working directory).
     subroutine read_config(unit, config, error, folder)
         integer, intent(in) :: unit
         type(config_type), intent(out) :: config
@@ -46,7 +46,7 @@ contains
         character(len=*), intent(in), optional :: folder
         type(namelist_scan_type) :: scan
         character(len=:), allocatable :: name
-        integer :: k, text
+        integer :: k
 
         if (present(folder)) then
             if (len_trim(folder) > len(config%input_folder)) then
@@ -57,8 +57,17 @@ contains
             end if
             config%input_folder = folder
         end if
-        call scan_namelist(unit, group_names, scan, error)
+        if (unit /= input_unit) rewind(unit)
+        call scan_namelist(unit, merge('standard input, line ', 'input line           ', &
+            unit == input_unit), group_names, scan, error)
+        if (unit /= input_unit) rewind(unit)
         if (allocated(error)) return
+        if (unit == input_unit .and. size(scan%lines) == 0) then
+            ! A folder or a closed standard input reads as an empty one in gfortran.
+            call fatal_error(error, 'standard input is empty: no input was given (is it ' &
+                // 'closed or a folder?); run as: yarnfort < scene.nml')
+            return
+        end if
         do k = 1, size(singleton_names)
             name = trim(singleton_names(k))
             if (scan%count_group(name) > 1) then
@@ -71,12 +80,7 @@ contains
             end if
         end do
 
-        call open_scratch(text, error)
-        if (allocated(error)) return
-        call scan%write_without_comments(text, error)
-        if (.not. allocated(error)) call read_groups(text, scan, config, error)
-        close(text)
-        rewind(unit)
+        call read_groups(scan, config, error)
         if (allocated(error)) return
 
         if (len_trim(config%geometry%file) > 0) then
@@ -109,10 +113,9 @@ contains
         if (.not. allocated(config%links)) allocate(config%links(0))
     end subroutine read_config
 
-    !> Each group from the comment-free text, in a fixed order; then what is not one
-    !> variable's business: the solver preset, the node triplets, the default load factors.
-    subroutine read_groups(unit, scan, config, error)
-        integer, intent(in) :: unit
+    !> Each group, in a fixed order; then what is not one variable's business: the
+    !> solver preset, the node triplets, the default load factors.
+    subroutine read_groups(scan, config, error)
         type(namelist_scan_type), intent(in) :: scan
         type(config_type), intent(inout) :: config
         type(error_type), allocatable, intent(out) :: error
@@ -121,18 +124,18 @@ contains
         logical :: known
         integer :: n
 
-        call read_control_groups(unit, scan, config%control, error)
+        call read_control_groups(scan, config%control, error)
         if (allocated(error)) return
-        call read_solver_groups(unit, scan, config%solver, error)
+        call read_solver_groups(scan, config%solver, error)
         if (allocated(error)) return
         ! An unknown preset gives the plain defaults here; check_config rejects its name.
         call get_solver_preset(trim(config%solver%preset), preset, known)
         call apply_solver_preset(scan, preset, config%solver)
-        call read_material_groups(unit, scan, config%materials, error)
+        call read_material_groups(scan, config%materials, error)
         if (allocated(error)) return
-        call read_contact_groups(unit, scan, config%contacts, error)
+        call read_contact_groups(scan, config%contacts, error)
         if (allocated(error)) return
-        call read_fabric_groups(unit, scan, config%fabric, error)
+        call read_fabric_groups(scan, config%fabric, error)
         if (allocated(error)) return
         if (scan%count_group('fabric') > 0 .and. len_trim(config%fabric%kind) == 0) then
             call post_read_error(error, scan, 'fabric', 0, &
@@ -142,7 +145,7 @@ contains
         if (.not. allocated(config%fabric%gap_factor)) allocate(config%fabric%gap_factor(0))
         if (.not. allocated(config%fabric%gap_factor_p_disp)) &
             allocate(config%fabric%gap_factor_p_disp(0))
-        call read_nodes_groups(unit, scan, nodes, error)
+        call read_nodes_groups(scan, nodes, error)
         if (allocated(error)) return
         if (allocated(nodes%xyz)) then
             n = size(nodes%xyz)
@@ -153,15 +156,15 @@ contains
             end if
             config%node_positions = reshape(nodes%xyz, [3, n / 3])
         end if
-        call read_geometry_groups(unit, scan, config%geometry, error)
+        call read_geometry_groups(scan, config%geometry, error)
         if (allocated(error)) return
-        call read_yarn_groups(unit, scan, config%yarns, error)
+        call read_yarn_groups(scan, config%yarns, error)
         if (allocated(error)) return
-        call read_support_groups(unit, scan, config%supports, error)
+        call read_support_groups(scan, config%supports, error)
         if (allocated(error)) return
-        call read_load_groups(unit, scan, config%loads, error)
+        call read_load_groups(scan, config%loads, error)
         if (allocated(error)) return
-        call read_path_groups(unit, scan, config%path, error)
+        call read_path_groups(scan, config%path, error)
         if (allocated(error)) return
         ! An omitted p_force or p_disp is all zeros.
         if (allocated(config%path%time)) then
@@ -169,11 +172,11 @@ contains
             if (size(config%path%p_force) == 0) config%path%p_force = spread(0.0_wp, 1, n)
             if (size(config%path%p_disp) == 0) config%path%p_disp = spread(0.0_wp, 1, n)
         end if
-        call read_output_groups(unit, scan, config%output, error)
+        call read_output_groups(scan, config%output, error)
         if (allocated(error)) return
-        call read_obstacle_groups(unit, scan, config%obstacles, error)
+        call read_obstacle_groups(scan, config%obstacles, error)
         if (allocated(error)) return
-        call read_ring_groups(unit, scan, config%rings, error)
+        call read_ring_groups(scan, config%rings, error)
     end subroutine read_groups
 
     !> Read the namelist input from the file `path`; relative file names in it are
@@ -199,58 +202,14 @@ contains
         close(unit)
     end subroutine read_config_from_file
 
-    !> Read the namelist input from standard input (copied to a scratch file first, so
-    !> that groups can be read in any order); relative file names in it are resolved
-    !> against the working directory.
+    !> Read the namelist input from standard input (read whole first, so that groups can
+    !> be read in any order); relative file names in it are resolved against the working
+    !> directory.
     subroutine read_config_from_stdin(config, error)
         type(config_type), intent(out) :: config
         type(error_type), allocatable, intent(out) :: error
-        character(len=:), allocatable :: line
-        character(len=message_length) :: message
-        integer :: scratch, stat, line_number
 
-        call open_scratch(scratch, error)
-        if (allocated(error)) return
-        line_number = 0
-        do
-            call read_line(input_unit, line, stat, message)
-            if (is_iostat_end(stat)) exit
-            if (stat /= 0) then
-                call fatal_error(error, 'standard input, line ' &
-                    // format_integer(line_number + 1) // ': ' // trim(message))
-                close(scratch)
-                return
-            end if
-            line_number = line_number + 1
-            write(scratch, '(a)', iostat=stat, iomsg=message) line
-            if (stat /= 0) then
-                call fatal_error(error, 'cannot copy the input to a scratch file: ' &
-                    // trim(message))
-                close(scratch)
-                return
-            end if
-        end do
-        if (line_number == 0) then
-            ! A folder or a closed standard input reads as an empty one in gfortran.
-            call fatal_error(error, 'standard input is empty: no input was given (is it ' &
-                // 'closed or a folder?); run as: yarnfort < scene.nml')
-            close(scratch)
-            return
-        end if
-        call read_config(scratch, config, error)
-        close(scratch)
+        call read_config(input_unit, config, error)
     end subroutine read_config_from_stdin
-
-    subroutine open_scratch(unit, error)
-        integer, intent(out) :: unit
-        type(error_type), allocatable, intent(out) :: error
-        character(len=message_length) :: message
-        integer :: stat
-
-        open(newunit=unit, status='scratch', action='readwrite', form='formatted', &
-            access='sequential', iostat=stat, iomsg=message)
-        if (stat /= 0) call fatal_error(error, 'cannot open a scratch file for the input: ' &
-            // trim(message))
-    end subroutine open_scratch
 
 end module yarnfort_input_namelist

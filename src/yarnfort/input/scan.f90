@@ -1,22 +1,22 @@
 ! SPDX-License-Identifier: MIT
-!> A structural pass over namelist input text before the Fortran namelist reads: finds
-!> every '&group ... /' occurrence with its lines and tokens, and rejects what the
-!> Fortran reader would silently ignore or misread (unknown or misspelt group names,
-!> text outside groups, a group not closed with '/', a variable set twice in one group,
-!> a '&group' inside a character value). It also explains the namelist reader's iomsg
-!> (which variable, which line, what was probably meant).
+!> The tokenizer of namelist input text: finds every '&group ... /' occurrence with its
+!> lines and tokens (names before '=', values, null values between two commas), and
+!> rejects what is not namelist syntax (unknown or misspelt group names, text outside
+!> groups, a group not closed with '/', a character value not closed on its line).
+!> `get_assignments` gives a group's assignments, each variable checked against the
+!> group's names. Values are converted (and entries set twice found) by
+!> yarnfort_input_fields.
 module yarnfort_input_scan
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_kinds, only: wp
     use yarnfort_text, only: string_type, read_line, to_lower, format_integer, &
-        closest_name, join_names, byte_order_mark, parse_integer, parse_real, &
-        remove_characters
+        closest_name, join_names, byte_order_mark, parse_integer, remove_characters
     implicit none
     private
 
-    public :: namelist_scan_type, scan_namelist, explain_read_error
+    public :: namelist_scan_type, scan_namelist, assignment_type, get_assignments
 
-    !> A word of a group's text: a variable name (followed by '=') or a value.
+    !> A word of a group's text: a variable name (followed by '=') or a value (empty,
+    !> last < first, for a null value).
     type :: token_type
         integer :: line = 0
         !> Columns of the token on its line.
@@ -36,13 +36,9 @@ module yarnfort_input_scan
     !> The text and its groups, in the order of the text.
     type :: namelist_scan_type
         type(string_type), allocatable :: lines(:)
-        !> Column of the '!' starting a comment on each line, 0 for none.
-        integer, allocatable :: comment_start(:)
         type(group_occurrence_type), allocatable :: groups(:)
         integer :: n_groups = 0
     contains
-        !> Write the text without its comments (same lines) for the namelist reads.
-        procedure :: write_without_comments
         !> Number of occurrences of a group.
         procedure :: count_group
         !> Index in `groups` of the k-th occurrence of a group (0 if there is none).
@@ -51,24 +47,33 @@ module yarnfort_input_scan
         procedure :: token_text
         !> Whether a group sets a variable (any of its entries).
         procedure :: is_set
-        !> Whether a value of a group equals one of the reader's "not set" markers.
-        procedure :: holds_marker
     end type namelist_scan_type
+
+    !> One assignment `name = values` or `name(first) = values` of a group occurrence.
+    type :: assignment_type
+        !> Variable name in lower case, without subscript.
+        character(len=:), allocatable :: name
+        !> The subscript or section first:last (1 and no limit for none).
+        integer :: first = 1, last = huge(1)
+        logical :: subscripted = .false.
+        integer :: line = 0
+        !> The value words as written (repeat counts r*v kept; '' for a null value).
+        type(string_type), allocatable :: values(:)
+    end type assignment_type
 
     character(len=1), parameter :: tab = achar(9), carriage_return = achar(13)
     character(len=*), parameter :: name_characters = &
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_'
     !> Characters that end a bare (unquoted) word inside a group.
     character(len=*), parameter :: word_ends = " ,;=/!&$'""" // tab // carriage_return
-    !> Characters that may follow a group name for the Fortran reader to take it as one.
-    character(len=*), parameter :: name_ends = " ,;/!" // tab // carriage_return
 
 contains
 
-    !> Read the whole text of `unit` (from its start) and find its groups. `known_groups`
-    !> are the valid group names in lower case.
-    subroutine scan_namelist(unit, known_groups, scan, error)
+    !> Read the rest of the text of `unit` and find its groups. `known_groups` are the
+    !> valid group names in lower case; `where` starts a message on a line of the text.
+    subroutine scan_namelist(unit, where, known_groups, scan, error)
         integer, intent(in) :: unit
+        character(len=*), intent(in) :: where
         character(len=*), intent(in) :: known_groups(:)
         type(namelist_scan_type), intent(out) :: scan
         type(error_type), allocatable, intent(out) :: error
@@ -77,14 +82,13 @@ contains
         integer :: stat, n_lines
         type(string_type), allocatable :: grown(:)
 
-        rewind(unit)
         allocate(scan%lines(64))
         n_lines = 0
         do
             call read_line(unit, line, stat, message)
             if (is_iostat_end(stat)) exit
             if (stat /= 0) then
-                call fatal_error(error, 'input line ' // format_integer(n_lines + 1) &
+                call fatal_error(error, trim(where) // ' ' // format_integer(n_lines + 1) &
                     // ': ' // trim(message))
                 return
             end if
@@ -100,7 +104,6 @@ contains
             call move_alloc(line, scan%lines(n_lines)%text)
         end do
         scan%lines = scan%lines(:n_lines)
-        rewind(unit)
         call find_groups(scan, known_groups, error)
     end subroutine scan_namelist
 
@@ -108,57 +111,26 @@ contains
         type(namelist_scan_type), intent(inout) :: scan
         character(len=*), intent(in) :: known_groups(:)
         type(error_type), allocatable, intent(out) :: error
-        logical :: in_group, in_string
-        character(len=1) :: c, quote
+        logical :: in_group, after_comma
+        character(len=1) :: c
         character(len=:), allocatable :: name
-        integer :: iline, i, j, depth
+        integer :: iline, i, j, k, depth
         type(group_occurrence_type), allocatable :: grown(:)
 
         allocate(scan%groups(16))
-        allocate(scan%comment_start(size(scan%lines)), source=0)
         scan%n_groups = 0
         in_group = .false.
-        in_string = .false.
-        quote = ''
+        after_comma = .false.
         do iline = 1, size(scan%lines)
             associate(text => scan%lines(iline)%text)
                 i = 1
                 do while (i <= len(text))
                     c = text(i:i)
-                    if (in_string) then
-                        if (c == quote) then
-                            if (i < len(text)) then
-                                if (text(i + 1:i + 1) == quote) then
-                                    i = i + 2
-                                    cycle
-                                end if
-                            end if
-                            in_string = .false.
-                            associate(group => scan%groups(scan%n_groups))
-                                if (group%tokens(group%n_tokens)%line == iline) &
-                                    group%tokens(group%n_tokens)%last = i
-                            end associate
-                        else if (c == '&' .or. c == '$') then
-                            call read_name(text, i + 1, j, name)
-                            if (any(known_groups == name)) then
-                                if (j > len(text)) then
-                                    call string_group_error()
-                                    return
-                                else if (index(name_ends, text(j:j)) > 0) then
-                                    call string_group_error()
-                                    return
-                                end if
-                            end if
-                        end if
-                        i = i + 1
-                        cycle
-                    end if
                     if (.not. in_group) then
                         select case (c)
                         case (' ', tab, carriage_return)
                             i = i + 1
                         case ('!')
-                            scan%comment_start(iline) = i
                             exit
                         case ('&', '$')
                             call read_name(text, i + 1, j, name)
@@ -188,20 +160,42 @@ contains
                         cycle
                     end if
                     ! In a group.
+                    if (c /= ',' .and. index(' ;!' // tab // carriage_return, c) == 0) &
+                        after_comma = .false.
                     select case (c)
-                    case (' ', tab, carriage_return, ',', ';')
+                    case (',')
+                        ! Two commas with nothing but blanks between: a null value.
+                        if (after_comma) call add_token(iline, i, i - 1)
+                        after_comma = .true.
+                        i = i + 1
+                    case (' ', tab, carriage_return, ';')
                         i = i + 1
                     case ('!')
-                        scan%comment_start(iline) = i
                         exit
                     case ("'", '"')
-                        call add_token(iline, i, i)
-                        quote = c
-                        in_string = .true.
-                        i = i + 1
+                        ! To the closing quote (a doubled one is a quote of the value).
+                        j = i + 1
+                        do
+                            k = index(text(j:), c)
+                            if (k == 0) then
+                                call add_token(iline, i, len(text))
+                                call fatal_error(error, 'line ' // format_integer(iline) &
+                                    // ': character value not closed with ' // c &
+                                    // ' on its line: ' // open_value())
+                                return
+                            end if
+                            j = j + k
+                            if (j > len(text)) exit
+                            if (text(j:j) /= c) exit
+                            j = j + 1
+                        end do
+                        call add_token(iline, i, j - 1)
+                        i = j
                     case ('=')
-                        call mark_name(iline)
+                        call mark_name()
                         if (allocated(error)) return
+                        ! A comma right after '=' follows a null value too.
+                        after_comma = .true.
                         i = i + 1
                     case ('/')
                         call end_group(iline)
@@ -242,14 +236,6 @@ contains
                         i = j
                     end select
                 end do
-                if (in_string) then
-                    ! The Fortran reader would run on into the next lines; no value of
-                    ! the input needs that, a forgotten quote is far more likely.
-                    call fatal_error(error, 'line ' // format_integer(iline) &
-                        // ': character value not closed with ' // quote &
-                        // ' on its line: ' // open_value())
-                    return
-                end if
             end associate
         end do
         if (in_group) then
@@ -285,72 +271,9 @@ contains
             associate(group => scan%groups(scan%n_groups))
                 group%last_line = last_line
                 group%tokens = group%tokens(:group%n_tokens)
-                call check_entries(group)
             end associate
             in_group = .false.
         end subroutine end_group
-
-        !> No entry of a variable may be set by two assignments of a group (p_force =
-        !> 0, 1, 0 then p_force(2) = 3): each sets the entries from its subscript (1
-        !> without one) on, as many as it has values, or the entries of its section.
-        subroutine check_entries(group)
-            type(group_occurrence_type), intent(in) :: group
-            integer :: j, k
-            integer, allocatable :: first(:), last(:)
-            logical, allocatable :: known(:)
-
-            allocate(first(group%n_tokens), last(group%n_tokens), known(group%n_tokens))
-            known = .false.
-            do k = 1, group%n_tokens
-                if (group%tokens(k)%is_name) call assigned_entries(group, k, first(k), &
-                    last(k), known(k))
-            end do
-            do k = 1, group%n_tokens
-                if (.not. known(k)) cycle
-                do j = 1, k - 1
-                    if (.not. known(j)) cycle
-                    if (base_name(scan%token_text(group%tokens(j))) &
-                        /= base_name(scan%token_text(group%tokens(k)))) cycle
-                    if (first(j) > last(k) .or. first(k) > last(j)) cycle
-                    call fatal_error(error, '&' // group%name // ': ' &
-                        // normalized_name(scan%token_text(group%tokens(k))) // ' (line ' &
-                        // format_integer(group%tokens(k)%line) // ') sets again an entry ' &
-                        // 'that ' // normalized_name(scan%token_text(group%tokens(j))) &
-                        // ' (line ' // format_integer(group%tokens(j)%line) // ') sets; ' &
-                        // 'each entry may be set only once')
-                    return
-                end do
-            end do
-        end subroutine check_entries
-
-        !> Entries first..last that the assignment of name token k sets; `known` is false
-        !> for a subscript of another form (left to the namelist reader).
-        subroutine assigned_entries(group, k, first, last, known)
-            type(group_occurrence_type), intent(in) :: group
-            integer, intent(in) :: k
-            integer, intent(out) :: first, last
-            logical, intent(out) :: known
-            character(len=:), allocatable :: name, text
-            integer :: j, n, repeat_count
-            logical :: ok
-
-            name = normalized_name(scan%token_text(group%tokens(k)))
-            call entry_range(name, first, last, known)
-            known = known .and. first >= 1
-            if (.not. known .or. index(name, ':') > 0) return
-            n = 0
-            do j = k + 1, group%n_tokens
-                if (group%tokens(j)%is_name) exit
-                text = scan%token_text(group%tokens(j))
-                repeat_count = 1
-                if (index(text, '*') > 1) then
-                    call parse_integer(text(:index(text, '*') - 1), repeat_count, ok)
-                    if (.not. ok) repeat_count = 1
-                end if
-                n = n + repeat_count
-            end do
-            last = first + n - 1
-        end subroutine assigned_entries
 
         subroutine add_token(line, first, last)
             integer, intent(in) :: line, first, last
@@ -367,37 +290,21 @@ contains
             end associate
         end subroutine add_token
 
-        !> The token before '=' is a variable name; it must not be set twice in a group.
-        subroutine mark_name(line)
-            integer, intent(in) :: line
-            integer :: k
-            character(len=:), allocatable :: this, other
-
+        !> The token before '=' is a variable name.
+        subroutine mark_name()
             associate(group => scan%groups(scan%n_groups))
                 if (group%n_tokens == 0) then
                     call no_name_error()
                     return
                 end if
                 associate(last => group%tokens(group%n_tokens))
-                    if (last%is_name .or. index("'""", &
+                    if (last%is_name .or. last%last < last%first .or. index("'""", &
                         scan%lines(last%line)%text(last%first:last%first)) > 0) then
                         call no_name_error()
                         return
                     end if
                     last%is_name = .true.
-                    this = normalized_name(scan%token_text(last))
                 end associate
-                do k = 1, group%n_tokens - 1
-                    if (.not. group%tokens(k)%is_name) cycle
-                    other = normalized_name(scan%token_text(group%tokens(k)))
-                    if (other == this) then
-                        call fatal_error(error, '&' // group%name // ': ' &
-                            // scan%token_text(group%tokens(k)) // ' is set twice (lines ' &
-                            // format_integer(group%tokens(k)%line) // ' and ' &
-                            // format_integer(line) // ')')
-                        return
-                    end if
-                end do
             end associate
         end subroutine mark_name
 
@@ -406,12 +313,6 @@ contains
                 // ": '=' without a variable name before it in &" &
                 // scan%groups(scan%n_groups)%name)
         end subroutine no_name_error
-
-        subroutine string_group_error()
-            call fatal_error(error, 'line ' // format_integer(iline) // ": '&" // name &
-                // "' inside a character value would be read as the start of group &" &
-                // name // "; remove the '&': " // open_value())
-        end subroutine string_group_error
 
         !> The group, the variable and the start of the character value being read:
         !> "&control title = 'see &yarn..." (the variable is the last name before it).
@@ -476,32 +377,6 @@ contains
         name = to_lower(remove_characters(text, ' ' // tab))
     end function normalized_name
 
-    !> Entries first..last of a name: 'x' (1..), 'x(i)' (i..), 'x(i:j)', 'x(i:)', 'x(:j)';
-    !> `ok` is false for a subscript of another form.
-    pure subroutine entry_range(name, first, last, ok)
-        character(len=*), intent(in) :: name
-        integer, intent(out) :: first, last
-        logical, intent(out) :: ok
-        character(len=:), allocatable :: inner
-        integer :: colon
-
-        first = 1
-        last = huge(1)
-        ok = index(name, '(') == 0
-        if (ok .or. name(len(name):) /= ')') return
-        inner = name(index(name, '(') + 1:len(name) - 1)
-        colon = index(inner, ':')
-        if (colon == 0) then
-            call parse_integer(inner, first, ok)
-            last = first
-            return
-        end if
-        if (index(inner(colon + 1:), ':') > 0) return
-        ok = .true.
-        if (colon > 1) call parse_integer(inner(:colon - 1), first, ok)
-        if (ok .and. colon < len(inner)) call parse_integer(inner(colon + 1:), last, ok)
-    end subroutine entry_range
-
     !> At most 40 characters of a text for a message.
     pure function shorten(text) result(short)
         character(len=*), intent(in) :: text
@@ -514,34 +389,6 @@ contains
             short = trim(text)
         end if
     end function shorten
-
-    !> gfortran takes a ',' before a '!' comment at the end of a line for an empty value
-    !> (x = 1, 2, ! ...  3 gives x(3) no value and x(4) = 3), and a '!' hides the rest of
-    !> its line from the search for a group: the namelist reads get the text without
-    !> its comments, line for line.
-    subroutine write_without_comments(self, unit, error)
-        class(namelist_scan_type), intent(in) :: self
-        integer, intent(in) :: unit
-        type(error_type), allocatable, intent(out) :: error
-        character(len=512) :: message
-        integer :: iline, stat
-
-        do iline = 1, size(self%lines)
-            associate(text => self%lines(iline)%text, comment => self%comment_start(iline))
-                if (comment > 0) then
-                    write(unit, '(a)', iostat=stat, iomsg=message) text(:comment - 1)
-                else
-                    write(unit, '(a)', iostat=stat, iomsg=message) text
-                end if
-            end associate
-            if (stat /= 0) then
-                call fatal_error(error, 'cannot write the input to a scratch file: ' &
-                    // trim(message))
-                return
-            end if
-        end do
-        rewind(unit)
-    end subroutine write_without_comments
 
     pure function count_group(self, name) result(n)
         class(namelist_scan_type), intent(in) :: self
@@ -591,36 +438,103 @@ contains
         end associate
     end function is_set
 
-    !> Whether a value of the `occurrence`-th group `name` (with a repeat count r*v, its
-    !> v) reads as `real_marker` or `integer_marker`.
-    logical function holds_marker(self, name, occurrence, real_marker, integer_marker)
-        class(namelist_scan_type), intent(in) :: self
+    !> The assignments of the `occurrence`-th group `name` (1 for a singleton), in text
+    !> order. An error for a value before the first name, a variable not in `variables`
+    !> (with the closest one), a known variable name among the values (a missing '='),
+    !> and a subscript that is not one integer.
+    subroutine get_assignments(scan, name, occurrence, variables, sets, error)
+        type(namelist_scan_type), intent(in) :: scan
         character(len=*), intent(in) :: name
         integer, intent(in) :: occurrence
-        real(wp), intent(in) :: real_marker
-        integer, intent(in) :: integer_marker
-        character(len=:), allocatable :: text
-        real(wp) :: real_value
-        integer :: g, k, integer_value
+        character(len=*), intent(in) :: variables(:)
+        type(assignment_type), allocatable, intent(out) :: sets(:)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text, label, guess
+        integer :: k, n, j, m, g, paren
         logical :: ok
 
-        holds_marker = .false.
-        g = self%find_group(name, occurrence)
-        if (g == 0) return
-        associate(group => self%groups(g))
+        label = '&' // name
+        if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
+        g = scan%find_group(name, max(occurrence, 1))
+        associate(group => scan%groups(g))
+            allocate(sets(count(group%tokens(:group%n_tokens)%is_name)))
+            n = 0
             do k = 1, group%n_tokens
-                if (group%tokens(k)%is_name) cycle
-                text = self%token_text(group%tokens(k))
-                text = text(index(text, '*') + 1:)
-                call parse_integer(text, integer_value, ok)
-                if (ok) holds_marker = integer_value == integer_marker
-                if (holds_marker) return
-                call parse_real(text, real_value, ok)
-                if (ok) holds_marker = real_value == real_marker
-                if (holds_marker) return
+                text = scan%token_text(group%tokens(k))
+                if (group%tokens(k)%is_name) then
+                    n = n + 1
+                    sets(n)%line = group%tokens(k)%line
+                    sets(n)%name = base_name(text)
+                    j = k + 1
+                    do while (j <= group%n_tokens)
+                        if (group%tokens(j)%is_name) exit
+                        j = j + 1
+                    end do
+                    allocate(sets(n)%values(j - k - 1))
+                    m = 0
+                    paren = index(text, '(')
+                    sets(n)%subscripted = paren > 0
+                    if (paren > 0) then
+                        call read_subscript(normalized_name(text(paren:)), sets(n), ok)
+                        if (.not. ok) then
+                            call fatal_error(error, label // ': ' // normalized_name( &
+                                scan%token_text(group%tokens(k))) // ' (line ' &
+                                // format_integer(sets(n)%line) // '): a subscript is an ' &
+                                // 'integer or a section, as in ' // sets(n)%name // '(2) or ' &
+                                // sets(n)%name // '(2:3)')
+                            return
+                        end if
+                    end if
+                    if (.not. any(variables == sets(n)%name)) then
+                        guess = closest_name(sets(n)%name, variables)
+                        if (len(guess) > 0) then
+                            guess = ', did you mean ' // guess // '?'
+                        else
+                            guess = '; &' // name // ' has ' // join_names(variables, '')
+                        end if
+                        call fatal_error(error, label // ': unknown variable ' &
+                            // sets(n)%name // ' (line ' // format_integer(sets(n)%line) &
+                            // ')' // guess)
+                        return
+                    end if
+                else if (n == 0) then
+                    call fatal_error(error, label // ' (line ' &
+                        // format_integer(group%tokens(k)%line) // '): value ' // text &
+                        // ' before any variable name')
+                    return
+                else if (any(variables == to_lower(text))) then
+                    call fatal_error(error, label // ": '=' must follow the variable name " &
+                        // text // ' (line ' // format_integer(group%tokens(k)%line) &
+                        // ': ' // shorten(adjustl(scan%lines(group%tokens(k)%line)%text)) &
+                        // ')')
+                    return
+                else
+                    m = m + 1
+                    sets(n)%values(m)%text = text
+                end if
             end do
         end associate
-    end function holds_marker
+    end subroutine get_assignments
+
+    !> '(i)', '(i:j)', '(i:)' or '(:j)' into the entries an assignment starts at and may
+    !> reach; `ok` is false for another form.
+    pure subroutine read_subscript(text, set, ok)
+        character(len=*), intent(in) :: text
+        type(assignment_type), intent(inout) :: set
+        logical, intent(out) :: ok
+        integer :: colon
+
+        ok = text(len(text):) == ')'
+        if (.not. ok) return
+        colon = index(text, ':')
+        if (colon == 0) then
+            call parse_integer(text(2:len(text) - 1), set%first, ok)
+            return
+        end if
+        if (colon > 2) call parse_integer(text(2:colon - 1), set%first, ok)
+        if (ok .and. colon < len(text) - 1) call parse_integer(text(colon + 1:len(text) - 1), &
+            set%last, ok)
+    end subroutine read_subscript
 
     pure function token_text(self, token) result(text)
         class(namelist_scan_type), intent(in) :: self
@@ -629,160 +543,6 @@ contains
 
         text = self%lines(token%line)%text(token%first:token%last)
     end function token_text
-
-    !> The namelist reader's iomsg `message` for the `occurrence`-th group `name` (known
-    !> variables `variables`), explained: with the line, and for "Cannot match namelist
-    !> object name X" whether X is an unknown variable (with a suggestion) or a bad value
-    !> of the variable before it. A bad value leads the text ("'soft' is not a valid
-    !> value of stiffness (line 9: ...)"), with the reader's own words at the end.
-    function explain_read_error(scan, name, occurrence, message, variables) result(hint)
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: occurrence
-        character(len=*), intent(in) :: message
-        character(len=*), intent(in) :: variables(:)
-        character(len=:), allocatable :: hint
-        character(len=*), parameter :: no_match = 'Cannot match namelist object name '
-        character(len=:), allocatable :: object, text, guess, variable
-        integer :: g, k, pass, found, found_subscripted
-
-        g = scan%find_group(name, occurrence)
-        if (g == 0) then
-            hint = message
-            return
-        end if
-        associate(group => scan%groups(g))
-            hint = message // ' (group on line ' // format_integer(group%first_line) // ')'
-            if (index(message, no_match) /= 1) then
-                ! "Bad data for namelist object nodes" and the like: show that assignment
-                ! (for an index or substring message, the first one with a subscript).
-                variable = named_variable(message)
-                if (len(variable) == 0) return
-                found = 0
-                found_subscripted = 0
-                do k = 1, group%n_tokens
-                    if (.not. group%tokens(k)%is_name) cycle
-                    text = scan%token_text(group%tokens(k))
-                    if (base_name(text) /= variable) cycle
-                    if (found == 0) found = k
-                    if (found_subscripted == 0 .and. index(text, '(') > 0) found_subscripted = k
-                end do
-                if (found_subscripted > 0 .and. is_subscript_message()) found = found_subscripted
-                if (found > 0) then
-                    hint = message // ' (line ' // format_integer(group%tokens(found)%line) &
-                        // ': ' // assignment_text(found) // ')'
-                    return
-                end if
-                ! A name the reader took for a variable without '=' after it: show its line.
-                do k = 1, group%n_tokens
-                    if (to_lower(scan%token_text(group%tokens(k))) /= variable) cycle
-                    hint = message // ' (line ' // format_integer(group%tokens(k)%line) &
-                        // ': ' // shorten(adjustl(scan%lines(group%tokens(k)%line)%text)) &
-                        // ')'
-                    return
-                end do
-                return
-            end if
-            object = to_lower(trim(message(len(no_match) + 1:)))
-            ! The reader may run on into the next group ("'stiff'&material", "true.&yarn").
-            if (index(object, '&') > 1) object = object(:index(object, '&') - 1)
-            ! Pass 1: the reader names a whole token (or a string and what followed it);
-            ! pass 2: the end of a token it read in part (the '.5' of '2.5' for an integer).
-            do pass = 1, 2
-                variable = ''
-                do k = 1, group%n_tokens
-                    text = scan%token_text(group%tokens(k))
-                    if (group%tokens(k)%is_name) then
-                        if (pass == 1 .and. (to_lower(text) == object &
-                            .or. base_name(text) == object)) then
-                            guess = closest_name(base_name(text), variables)
-                            hint = message // ' (line ' &
-                                // format_integer(group%tokens(k)%line) // ': unknown variable'
-                            if (len(guess) > 0) then
-                                hint = hint // ', did you mean ' // guess // '?)'
-                            else
-                                hint = hint // '; &' // name // ' has ' &
-                                    // join_names(variables, '') // ')'
-                            end if
-                            return
-                        end if
-                        variable = base_name(text)
-                    else if (len(variable) > 0 .and. matches(to_lower(text), pass)) then
-                        hint = text // ' is not a valid value of ' // variable // ' (line ' &
-                            // format_integer(group%tokens(k)%line) // ': wrong type, text ' &
-                            // 'without quotes, or more values than ' // variable &
-                            // ' holds; the namelist reader says: ' // message // ')'
-                        return
-                    end if
-                end do
-            end do
-        end associate
-
-    contains
-
-        logical function is_subscript_message()
-            is_subscript_message = index(message, 'ndex') > 0 .or. index(message, 'ubstring') > 0 &
-                .or. index(message, 'ualifier') > 0
-        end function is_subscript_message
-
-        !> "name = value value ..." of the name token k of the group, at most 60 characters.
-        function assignment_text(k) result(text)
-            integer, intent(in) :: k
-            character(len=:), allocatable :: text
-            integer, parameter :: max_length = 60
-            integer :: j
-
-            associate(group => scan%groups(g))
-                text = scan%token_text(group%tokens(k)) // ' ='
-                do j = k + 1, group%n_tokens
-                    if (group%tokens(j)%is_name .or. len(text) > max_length) exit
-                    text = text // ' ' // scan%token_text(group%tokens(j))
-                end do
-            end associate
-            if (len(text) > max_length) text = text(:max_length) // '...'
-        end function assignment_text
-
-        logical function matches(token, pass)
-            character(len=*), intent(in) :: token
-            integer, intent(in) :: pass
-
-            if (pass == 1) then
-                matches = token == object .or. (is_string(token) .and. index(object, token) == 1)
-            else
-                matches = len(token) > len(object) .and. len(object) > 0
-                if (matches) matches = token(len(token) - len(object) + 1:) == object
-            end if
-        end function matches
-
-    end function explain_read_error
-
-    !> The variable a namelist reader's message names at its end ("Bad data for namelist
-    !> object nodes", "Index 1 out of range for namelist variable time", "Equal sign must
-    !> follow namelist object name x"), lower case; '' for messages that name none.
-    pure function named_variable(message) result(variable)
-        character(len=*), intent(in) :: message
-        character(len=:), allocatable :: variable
-        character(len=*), parameter :: markers(3) = [character(len=21) :: &
-            'namelist object name', 'namelist object', 'namelist variable']
-        integer :: i, at
-
-        variable = ''
-        do i = 1, size(markers)
-            at = index(message, trim(markers(i)) // ' ', back=.true.)
-            if (at == 0) cycle
-            variable = base_name(adjustl(message(at + len_trim(markers(i)) + 1:)))
-            if (index(variable, ' ') > 0) variable = ''
-            return
-        end do
-    end function named_variable
-
-    !> A quoted character value (the namelist reader may print more after it).
-    pure logical function is_string(text)
-        character(len=*), intent(in) :: text
-
-        is_string = .false.
-        if (len(text) > 0) is_string = text(1:1) == "'" .or. text(1:1) == '"'
-    end function is_string
 
     !> A variable name without subscript, lower case.
     pure function base_name(text) result(name)

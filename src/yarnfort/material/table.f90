@@ -73,7 +73,7 @@ contains
         real(wp), intent(in), optional :: end_slope_ratio
         character(len=*), parameter :: context = 'table'
         type(csv_row_type) :: row, previous
-        integer :: i, bad
+        integer :: i
 
         if (size(strain) /= size(force)) then
             call fatal_error(error, context // ': ' // format_integer(size(strain)) &
@@ -89,17 +89,8 @@ contains
             if (allocated(error)) return
             previous = row
         end do
-        if (size(strain) < min_rows) then
-            call fatal_error(error, context // ': ' // too_few_rows(size(strain)))
-            return
-        end if
-        call set_ratio(self, end_slope_ratio, context, error)
-        if (allocated(error)) return
-        call setup_table(self, strain, force, bad)
-        if (bad > 0) then
-            call fatal_error(error, context // ', row ' // format_integer(bad + 1) // ': ' &
-                // slope_range_message(strain, force, bad))
-        end if
+        call finish_table(self, strain, force, context, 'row', [(i, i = 1, size(strain))], &
+            end_slope_ratio, error)
     end subroutine new_table_law
 
     !> Read a table law from a CSV file of rows "strain,force" (spaces allowed). Lines
@@ -115,25 +106,40 @@ contains
         character(len=:), allocatable :: context
         real(wp), allocatable :: strain(:), force(:)
         integer, allocatable :: lines(:)
-        integer :: nrow, bad
 
         context = "table '" // path // "'"
         call read_csv_pairs(path, context, [character(len=6) :: 'strain', 'force'], &
             check_row, strain, force, lines, error)
         if (allocated(error)) return
-        nrow = size(strain)
-        if (nrow < min_rows) then
-            call fatal_error(error, context // ': ' // too_few_rows(nrow))
+        call finish_table(self, strain, force, context, 'line', lines, end_slope_ratio, error)
+    end subroutine read_table_law
+
+    !> The part of new_table_law and read_table_law after the rows are read and in order:
+    !> enough rows, the end slope ratio, the interpolant. `places(i)` is the row or line
+    !> number (`place` says which) of knot i, for the message.
+    subroutine finish_table(self, strain, force, context, place, places, end_slope_ratio, &
+            error)
+        type(table_law_type), intent(inout) :: self
+        real(wp), intent(in) :: strain(:), force(:)
+        character(len=*), intent(in) :: context, place
+        integer, intent(in) :: places(:)
+        real(wp), intent(in), optional :: end_slope_ratio
+        type(error_type), allocatable, intent(out) :: error
+        integer :: bad
+
+        if (size(strain) < min_rows) then
+            call fatal_error(error, context // ': ' // too_few_rows(size(strain)))
             return
         end if
         call set_ratio(self, end_slope_ratio, context, error)
         if (allocated(error)) return
         call setup_table(self, strain, force, bad)
         if (bad > 0) then
-            call fatal_error(error, context // ', line ' // format_integer(lines(bad + 1)) // ': ' &
-                // slope_range_message(strain, force, bad))
+            call fatal_error(error, context // ', ' // place // ' ' &
+                // format_integer(places(bad + 1)) // ': ' // slope_range_message(strain, &
+                force, bad))
         end if
-    end subroutine read_table_law
+    end subroutine finish_table
 
     !> Tension and df/dlambda: the Hermite cubic of the interval holding the strain, the
     !> linear extension beyond the last row, zero when slack.

@@ -9,7 +9,7 @@ module yarnfort_output_curve
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_text, only: read_line
-    use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, &
+    use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, open_append, &
         flush_checked, truncate_file
     implicit none
     private
@@ -212,13 +212,7 @@ contains
         call rename_file(temporary, path, error)
         if (allocated(error)) return
         self%path = path
-        message = ''
-        open(newunit=self%unit, file=path, status='old', position='append', action='write', &
-            iostat=status, iomsg=message)
-        if (status /= 0) then
-            self%unit = -1
-            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
-        end if
+        call open_append(self%unit, path, error)
     contains
         pure integer function count_commas(text)
             character(len=*), intent(in) :: text

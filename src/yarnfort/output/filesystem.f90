@@ -10,6 +10,7 @@ module yarnfort_output_filesystem
 
     public :: make_folder, rename_file, remove_file, sync_file, folder_lock_type
     public :: close_checked, flush_checked, truncate_file, ignore_file_size_signal
+    public :: open_append
     public :: lock_file_name
 
     !> The lock file of an output folder (kept; the lock is the kernel's, not the file).
@@ -178,6 +179,23 @@ contains
                 // 'line: ' // get_reason())
     end subroutine truncate_file
 
+    !> Open the existing file `path` to append lines to it (`unit` = -1 on failure).
+    subroutine open_append(unit, path, error)
+        integer, intent(out) :: unit
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        character(len=text_length) :: message
+        integer :: status
+
+        message = ''
+        open(newunit=unit, file=path, status='old', position='append', action='write', &
+            iostat=status, iomsg=message)
+        if (status /= 0) then
+            unit = -1
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+        end if
+    end subroutine open_append
+
     !> Close `unit`, connected to the file `path`, and check that every byte written
     !> reached the file. (gfortran's CLOSE and FLUSH report no error when the buffered
     !> data cannot be written, e.g. on a full disk: the file's size tells.)
@@ -186,17 +204,13 @@ contains
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
         character(len=256) :: message
-        integer(8) :: expected
         integer :: status
 
-        inquire(unit=unit, size=expected)
+        call flush_checked(unit, path, error)
         message = ''
         close(unit, iostat=status, iomsg=message)
-        if (status /= 0) then
+        if (status /= 0 .and. .not. allocated(error)) &
             call fatal_error(error, "cannot write '" // path // "': " // trim(message))
-            return
-        end if
-        call check_size(path, expected, error)
     end subroutine close_checked
 
     !> Flush `unit`, connected to the file `path`, and check that every byte written so

@@ -14,7 +14,7 @@
 module yarnfort_output_manifest
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, &
+    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, open_append, &
         close_checked, flush_checked
     implicit none
     private
@@ -24,7 +24,7 @@ module yarnfort_output_manifest
     character(len=*), parameter :: manifest_file_name = '.yarnfort-manifest'
 
     !> The fixed names a run may write (and their temporaries).
-    character(len=*), parameter :: fixed_names(*) = [character(len=16) :: 'curve.csv', &
+    character(len=*), parameter :: fixed_names(*) = [character(len=17) :: 'curve.csv', &
         'curve.csv.tmp', 'input.nml', 'input.nml.tmp', 'restart.dat', 'restart.dat.tmp', &
         'states.pvd', 'states.pvd.tmp', 'reactions.csv', 'reactions.csv.tmp', &
         'contacts.csv', 'contacts.csv.tmp']
@@ -143,12 +143,7 @@ contains
             call remove_file(temporary, ignored)
             return
         end if
-        open(newunit=self%unit, file=path, status='old', position='append', action='write', &
-            iostat=status, iomsg=message)
-        if (status /= 0) then
-            self%unit = -1
-            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
-        end if
+        call open_append(self%unit, path, error)
     end subroutine save
 
     subroutine add_state(self, name, step, time, error)

@@ -66,6 +66,8 @@ module yarnfort_output_writer
         procedure :: on_step
         procedure :: on_cut
         procedure :: on_checkpoint
+        !> Told the step and time a restart resumes after, before the files are opened.
+        procedure :: on_resume
         procedure :: finish
     end type output_writer_type
 
@@ -277,12 +279,8 @@ contains
             if (has_constrained_nodes(scene)) &
                 call self%reactions%put_line(get_reaction_rows(scene, state), error)
         end if
-        if (allocated(error)) then
-            self%failed = .true.
-            return
-        end if
-        self%state_due = .false.
-        self%last_written = .true.
+        call note_written(self, error)
+        if (allocated(error)) return
         if (self%contact_state .and. self%vtk_every <= 0) self%last = state
         if (self%vtk_every > 0) then
             self%last = state
@@ -296,6 +294,13 @@ contains
         real(wp), intent(in) :: time, step
         character(len=*), intent(in) :: reason
     end subroutine on_cut
+
+    !> The default: nothing to say.
+    subroutine on_resume(self, step, time)
+        class(output_writer_type), intent(inout) :: self
+        integer, intent(in) :: step
+        real(wp), intent(in) :: time
+    end subroutine on_resume
 
     !> Write the VTK state of the step just written when due (it needs the snapshot's
     !> passage modes), then the restart file.
@@ -343,13 +348,19 @@ contains
             if (.not. allocated(self%last_mode)) self%last_mode = [integer :: ]
             call self%vtk%write_state(scene, self%last, self%last_mode, error)
         end if
-        if (allocated(error)) then
-            self%failed = .true.
-            return
-        end if
+        call note_written(self, error)
+    end subroutine write_last_state
+
+    !> After a write of the last state's files: failed if `error`, else nothing is due.
+    subroutine note_written(self, error)
+        class(output_writer_type), intent(inout) :: self
+        type(error_type), allocatable, intent(in) :: error
+
+        self%failed = self%failed .or. allocated(error)
+        if (allocated(error)) return
         self%state_due = .false.
         self%last_written = .true.
-    end subroutine write_last_state
+    end subroutine note_written
 
     !> Write the last converged state if it was skipped and states.pvd complete, close
     !> the files and release the folder's lock.
