@@ -107,11 +107,11 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer, allocatable :: roots(:), textiles(:), yarn_elements(:), nodes(:), found(:)
         integer, allocatable :: repeats(:)
-        real(wp), allocatable :: master(:, :), up(:, :), lattice(:, :)
+        real(wp), allocatable :: master(:, :), up(:, :), lattice(:, :), tangent(:, :)
         real(wp) :: vector(3), first_lattice(3, 2)
         character(len=:), allocatable :: value, kind
         character(len=120) :: buffer
-        logical :: present, periodic
+        logical :: present, periodic, forced
         integer :: y, k
 
         cell = 0.0_wp
@@ -154,7 +154,7 @@ contains
                 call fatal_error(error, trim(buffer) // ' fewer than two master nodes')
                 return
             end if
-            allocate(master(3, size(nodes)), up(3, size(nodes)))
+            allocate(master(3, size(nodes)), up(3, size(nodes)), tangent(3, size(nodes)))
             do k = 1, size(nodes)
                 call read_vector(document, nodes(k), 'Position', master(:, k), .true., error)
                 if (allocated(error)) goto 200
@@ -162,11 +162,16 @@ contains
                 call read_vector(document, nodes(k), 'Up', vector, .false., error)
                 if (allocated(error)) goto 200
                 if (norm2(vector) > 0.0_wp) up(:, k) = vector / norm2(vector)
+                call read_vector(document, nodes(k), 'Tangent', tangent(:, k), .false., error)
+                if (allocated(error)) goto 200
             end do
             found = document%children(yarn_elements(y), 'Interpolation')
             kind = 'CInterpolationCubic'
             periodic = .true.
+            forced = .false.
             if (size(found) > 0) then
+                call document%attribute(found(1), 'ForceMasterNodeTangent', value, present)
+                if (present) forced = value /= '0'
                 call document%attribute(found(1), 'type', value, present)
                 if (present) kind = value
                 call document%attribute(found(1), 'Periodic', value, present)
@@ -201,8 +206,9 @@ contains
             call read_section(document, yarn_elements(y), yarns(y)%width, yarns(y)%height, &
                 error)
             if (allocated(error)) goto 200
-            call sample_centre_line(master, up, kind == 'CInterpolationLinear', samples, &
-                yarns(y))
+            if (.not. forced) tangent = 0.0_wp
+            call sample_centre_line(master, up, tangent, kind == 'CInterpolationLinear', &
+                samples, yarns(y))
             vector = yarns(y)%period / [cell, 1.0_wp]
             if (norm2(yarns(y)%period) < lattice_tolerance * minval(cell) .or. &
                     any(abs(vector(1:2) - nint(vector(1:2))) > lattice_tolerance) .or. &
@@ -212,7 +218,7 @@ contains
                     // 'periodic yarn)')
                 return
             end if
-            deallocate(master, up, lattice)
+            deallocate(master, up, lattice, tangent)
         end do
         return
 200     error%message = trim(buffer) // ' ' // error%message
@@ -340,13 +346,16 @@ contains
     end subroutine read_section
 
     !> Points along the centre line through master nodes p(:, 1:n), p(n) = p(1) + period.
-    subroutine sample_centre_line(p, up, linear, samples, yarn)
-        real(wp), intent(in) :: p(:, :), up(:, :)
+    !> A node's tangent has the direction of `given` where that is not zero (TexGen's
+    !> ForceMasterNodeTangent), else of (p(i+1) - p(i-1)), and the length |p(i+1) - p(i-1)|/2.
+    subroutine sample_centre_line(p, up, given, linear, samples, yarn)
+        real(wp), intent(in) :: p(:, :), up(:, :), given(:, :)
         logical, intent(in) :: linear
         integer, intent(in) :: samples
         type(texgen_yarn_type), intent(inout) :: yarn
         integer :: n, i, k, m
         real(wp) :: t, h00, h10, h01, h11, m0(3), m1(3), before(3), after(3)
+        real(wp), allocatable :: node_tangent(:, :)
 
         n = size(p, 2)
         yarn%period = p(:, n) - p(:, 1)
@@ -356,19 +365,22 @@ contains
         yarn%samples = samples
         yarn%linear = linear
         allocate(yarn%tangent(3, n - 1, 2), source=0.0_wp)
+        allocate(node_tangent(3, n))
         do i = 1, n - 1
             if (i > 1) then
                 before = p(:, i - 1)
             else
                 before = p(:, n - 1) - yarn%period
             end if
-            if (i < n - 1) then
-                after = p(:, i + 2)
-            else
-                after = p(:, 2) + yarn%period
-            end if
-            m0 = 0.5_wp * (p(:, i + 1) - before)
-            m1 = 0.5_wp * (after - p(:, i))
+            after = p(:, i + 1)
+            node_tangent(:, i) = 0.5_wp * (after - before)
+            if (norm2(given(:, i)) > 0.0_wp) node_tangent(:, i) = given(:, i) &
+                / norm2(given(:, i)) * norm2(node_tangent(:, i))
+        end do
+        node_tangent(:, n) = node_tangent(:, 1)
+        do i = 1, n - 1
+            m0 = node_tangent(:, i)
+            m1 = node_tangent(:, i + 1)
             if (linear) then
                 m0 = p(:, i + 1) - p(:, i)
                 m1 = m0
@@ -719,7 +731,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer :: y, k, n, c, side, first, last, leader, follower, anchor
         real(wp) :: total, cut, strain(3), gap(3), period(3), position(3)
-        real(wp), allocatable :: s(:), gaps(:)
+        real(wp), allocatable :: s(:), gaps(:), chain(:, :)
         integer, allocatable :: who(:), order(:), list(:)
         logical, allocatable :: wrapped(:, :)
         character(len=300) :: buffer
@@ -749,22 +761,30 @@ contains
                 k = maxloc(gaps, dim=1)
                 cut = modulo(s(k) + 0.5_wp * gaps(k), total)
             end if
-            first = net%add_node(scale * point_at(yarns(y), cut))
-            allocate(list(0))
-            list = [first]
             ! From the cut onwards; points before it lie one period on.
+            allocate(list(0), chain(3, n))
             do k = 1, n
                 side = who(1 + modulo(k - 1 + count(s < cut), n))
                 c = (side - 1) / 2 + 1
                 side = side - 2 * (c - 1)
-                position = contacts(c)%point(:, side)
+                chain(:, k) = contacts(c)%point(:, side)
                 wrapped(side, c) = contacts(c)%s(side) < cut
-                if (wrapped(side, c)) position = position + yarns(y)%period
-                contacts(c)%node(side) = net%add_node(scale * position)
+                if (wrapped(side, c)) chain(:, k) = chain(:, k) + yarns(y)%period
+                contacts(c)%node(side) = net%add_node(scale * chain(:, k))
                 list = [list, contacts(c)%node(side)]
             end do
-            last = net%add_node(scale * (point_at(yarns(y), cut) + yarns(y)%period))
-            list = [list, last]
+            ! The ends: half way between the last contact (one period back) and the first,
+            ! on the straight string between them (not on the curve: a string under
+            ! tension is straight between contacts, and an end off that line would be a
+            ! kink no passage accounts for).
+            if (n > 0) then
+                position = 0.5_wp * (chain(:, n) - yarns(y)%period + chain(:, 1))
+            else
+                position = point_at(yarns(y), cut)
+            end if
+            first = net%add_node(scale * position)
+            last = net%add_node(scale * (position + yarns(y)%period))
+            list = [first, list, last]
             call net%add_yarn(trim(material_of(y)), list, fabric%elements_per_segment)
             ! The end is the start's image one yarn period on (or the other way round, so
             ! that the follower lies on the +x side and carries the force across the cell).
@@ -776,7 +796,7 @@ contains
                 call net%add_link(first, last, strain, .false.)
                 if (anchor == 0) anchor = last
             end if
-            deallocate(s, who, list)
+            deallocate(s, who, list, chain)
         end do
         do c = 1, size(contacts)
             associate(p => contacts(c))
