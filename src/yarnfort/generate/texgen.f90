@@ -85,7 +85,7 @@ contains
         n_yarns = 0
         n_contacts = 0
         call read_xml_file(path, document, error)
-        if (allocated(error)) return
+        if (allocated(error)) goto 100
         call read_model(document, fabric%texgen_samples, yarns, cell, scale, error)
         if (allocated(error)) goto 100
         n_yarns = size(yarns)

@@ -37,7 +37,7 @@ module yarnfort_generate_xml_subset
 
 contains
 
-    !> Read and parse file `path`.
+    !> Read and parse file `path` (errors do not repeat its name).
     subroutine read_xml_file(path, document, error)
         character(len=*), intent(in) :: path
         type(xml_document_type), intent(out) :: document
@@ -49,7 +49,7 @@ contains
         open(newunit=unit, file=path, access='stream', form='unformatted', status='old', &
             action='read', iostat=stat, iomsg=message)
         if (stat /= 0) then
-            call fatal_error(error, "cannot open '" // trim(path) // "': " // trim(message))
+            call fatal_error(error, 'cannot open it: ' // trim(message))
             return
         end if
         inquire(unit=unit, size=size_bytes)
@@ -58,11 +58,10 @@ contains
         if (size_bytes > 0) read(unit, iostat=stat, iomsg=message) text
         close(unit)
         if (stat /= 0) then
-            call fatal_error(error, "cannot read '" // trim(path) // "': " // trim(message))
+            call fatal_error(error, 'cannot read it: ' // trim(message))
             return
         end if
         call parse_xml(text, document, error)
-        if (allocated(error)) error%message = "'" // trim(path) // "': " // error%message
     end subroutine read_xml_file
 
     !> Parse XML text into `document`; an error names the line and what was wrong.
@@ -135,7 +134,8 @@ contains
             end if
         end do
         if (current /= 0) then
-            call fail(n, "element <" // document%elements(current)%name // "> is not closed")
+            call fatal_error(error, 'the file ends inside element <' &
+                // document%elements(current)%name // '> (not closed)')
             return
         end if
         if (document%n_elements == 0) call fail(1, 'no elements (not an XML file?)')
