@@ -93,7 +93,7 @@ def main() -> None:
     planar, stderr_p, *_ = run("inputs/knit.nml", {
         **cycle, "fabric.cells": [1, 1], "fabric.spacing": [1.2e-3, 1.0e-3],
         "fabric.inlay_material": None, "fabric.gap": None, "fabric.inlay_offset": None,
-        "fabric.inlay_every": None, "contact[1]": None}, "knit_planar")
+        "fabric.inlay_every": None}, "knit_planar")
     for name, curve, stderr in (("TexGen", texgen, stderr_t), ("planar", planar, stderr_p)):
         strain, force = curve["strain"], curve["force_per_width"]
         peak = int(np.argmax(strain))

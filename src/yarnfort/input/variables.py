@@ -285,7 +285,7 @@ GROUPS = [
                 'periodic yarns with repeats along x and y (the cell), master nodes, '
                 'interpolation, section width and height, GeometryScale. See *TexGen import* '
                 'below.'),
-        Var('texgen_materials', 'character', '', length='name_length', shape=16,
+        Var('texgen_materials', 'character', '', length='name_length', shape=64,
             checked_by='fabric', default_doc='required (texgen)',
             doc="TexGen: the `&material` of TexGen's yarn 0, 1, 2, ... (by index); yarns "
                 'beyond the last name given take that one, so one name serves all yarns.'),
