@@ -789,6 +789,16 @@ contains
             ! The end is the start's image one yarn period on (or the other way round, so
             ! that the follower lies on the +x side and carries the force across the cell).
             period = scale * yarns(y)%period
+            ! The force across the cell is the sum of the x reactions of the images one
+            ! x period on: a yarn that spans several x periods would count once.
+            if (abs(abs(period(1)) - scale * cell(1)) > lattice_tolerance * scale * cell(1) &
+                    .and. abs(period(1)) > lattice_tolerance * scale * cell(1)) then
+                write(buffer, '("yarn ", i0, " spans ", g0, " cells along x in one period; ", &
+                    & "only yarns of one x period (or none) are supported")') y - 1, &
+                    period(1) / (scale * cell(1))
+                call fatal_error(error, trim(buffer))
+                return
+            end if
             if (positive(period)) then
                 call net%add_link(last, first, strain, .false.)
                 if (anchor == 0) anchor = first
