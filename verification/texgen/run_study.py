@@ -2,7 +2,8 @@
 """TexGen import: import and run times of the examples, contact counts of pytexgen
 models, and TexGen's weft knit against the built-in planar knit of the same spacing.
 
-    .venv/bin/python verification/texgen/run_study.py
+    .venv/bin/python verification/texgen/run_study.py          # all (pytexgen: minutes)
+    .venv/bin/python verification/texgen/run_study.py plots    # knit_states.png only
 
 Runs build/yarnfort (from the repository top, one run at a time) into out/texgen_study/,
 prints the tables of README.md, writes results.txt and knit_curves.png. The models are
@@ -121,5 +122,56 @@ def main() -> None:
     (Path(__file__).with_name("results.txt")).write_text("\n".join(lines) + "\n")
 
 
+def plot_states() -> None:
+    """knit_states.png: the TexGen knit at strain 0, 0.5 and 1 (loading), 3 x 3 cells,
+    seen from the front (x-y), elements coloured by tension."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+    from yarnfort import read_states
+
+    folder = OUT / "knit_states"
+    text = patched_scene("inputs/texgen_knit.nml", {
+        "path.time": [0.0, 1.0], "path.p_disp": [0.0, 1.0], "solver.max_step": 0.05,
+        "solver.initial_step": 0.05, "output.vtk_every": 1}, folder)
+    proc = subprocess.run([str(EXE)], input=text, capture_output=True, text=True, cwd=TOP)
+    if proc.returncode != 0:
+        raise SystemExit(proc.stderr)
+    curve, states = read_curve(folder), read_states(folder)
+    period = np.array([1.2e-3, 1.0e-3])  # inputs/texgen_knit.tg3's repeats (m)
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4.2))
+    top = max(state.tension.max() for state in states)
+    for ax, target in zip(axes, (0.0, 0.5, 1.0)):
+        k = int(np.argmin(np.abs(curve["strain"] - target)))
+        state = states[k]
+        cell = period * [1.0 + curve["strain"][k], 1.0]
+        segments, colours = [], []
+        for i in range(3):
+            for j in range(3):
+                shift = np.array([i * cell[0], j * cell[1]])
+                for (a, b), tension in zip(state.elements, state.tension):
+                    segments.append([state.position[a, :2] + shift,
+                                     state.position[b, :2] + shift])
+                    colours.append(tension)
+        lines = LineCollection(np.array(segments) * 1e3, array=np.array(colours),
+                               cmap="viridis", linewidths=2)
+        lines.set_clim(0.0, top)
+        ax.add_collection(lines)
+        ax.autoscale()
+        ax.set_aspect("equal")
+        ax.set_title(f"strain {curve['strain'][k]:.2f}")
+        ax.set_xlabel("x (mm)")
+    axes[0].set_ylabel("y (mm)")
+    fig.colorbar(lines, ax=axes, label="tension (N)", shrink=0.8)
+    fig.suptitle("TexGen weft knit, 3 x 3 periodic cells (computed; illustrative yarn table)")
+    fig.savefig(Path(__file__).with_name("knit_states.png"), dpi=110)
+
+
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:] == ["plots"]:
+        OUT.mkdir(parents=True, exist_ok=True)
+        plot_states()
+    else:
+        main()
+        plot_states()
