@@ -37,6 +37,9 @@ program yarnfort_main
     write(error_unit, '(a, i0, a, i0, a, i0, a, a)') 'yarnfort: ', scene%network%n_nodes(), &
         ' nodes, ', scene%network%n_elements(), ' elements, ', scene%dofs%n_unknowns, &
         ' unknowns; linear solver ', get_linear_solver_name(scene)
+    if (config%fabric%kind == 'texgen') write(error_unit, '(a, i0, a, i0, a)') &
+        'yarnfort: TexGen model: ', config%texgen_yarns, ' yarns, ', config%texgen_contacts, &
+        ' contacts (one gap-holder each)'
     if (scene%passages%size() > 0) write(error_unit, '(a, i0, a, a, a)') 'yarnfort: ', &
         scene%passages%size(), ' sliding passages, ', trim(scene%solver%scheme), ' scheme'
     if (config%control%check_only) then

@@ -11,8 +11,9 @@ import pytest
 TOP = Path(__file__).resolve().parents[2]
 DATA = TOP / "tests" / "data" / "input"
 BAD_INPUTS = sorted(DATA.glob("bad_*.nml"))
-#: Files a catalogued input may name (geometry files, tables), copied next to it.
-COMPANIONS = sorted([*DATA.glob("*.geo"), *DATA.glob("*.csv")])
+#: Files a catalogued input may name (geometry files, tables, TexGen models), copied
+#: next to it.
+COMPANIONS = sorted([*DATA.glob("*.geo"), *DATA.glob("*.csv"), *DATA.glob("*.tg3")])
 VNET = (TOP / "inputs" / "vnet.nml").read_text()
 #: First line of every catalogued bad input: the words its error message must contain.
 EXPECT = re.compile(r"! expect: (?P<words>.*\S)")

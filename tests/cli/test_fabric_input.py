@@ -24,7 +24,7 @@ BASE = """
 
 CASES = {
     "unknown_kind": ("kind = 'plain'", "kind = 'satin'",
-                     "&fabric: kind = 'satin' is unknown (use knit, plain or twill)"),
+                     "&fabric: kind = 'satin' is unknown (use knit, plain, twill or texgen)"),
     "odd_periodic_plain": ("cells = 2, 2", "cells = 3, 2",
                            "cells = 3, 2 must be multiples of 2 for a periodic plain cell"),
     "twill_repeat": ("kind = 'plain'", "kind = 'twill'",

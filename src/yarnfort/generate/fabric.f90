@@ -9,6 +9,8 @@ module yarnfort_generate_fabric
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_knit, only: generate_knit
     use yarnfort_generate_woven, only: generate_woven
+    use yarnfort_generate_texgen, only: generate_texgen
+    use yarnfort_text, only: resolve_path
     implicit none
     private
 
@@ -31,6 +33,14 @@ contains
         select case (trim(config%fabric%kind))
         case ('knit')
             call generate_knit(config%fabric, net, width, pulled)
+        case ('texgen')
+            call generate_texgen(config%fabric, resolve_path(trim(config%fabric%texgen_file), &
+                trim(config%input_folder)), net, width, pulled, config%texgen_yarns, &
+                config%texgen_contacts, error)
+            if (allocated(error)) then
+                error%message = '&fabric: ' // error%message
+                return
+            end if
         case default
             call generate_woven(config%fabric, net, width, pulled)
         end select
@@ -48,10 +58,10 @@ contains
 
         associate(fabric => config%fabric)
             select case (trim(fabric%kind))
-            case ('knit', 'plain', 'twill')
+            case ('knit', 'plain', 'twill', 'texgen')
             case default
                 call fatal_error(error, label // "kind = '" // trim(fabric%kind) &
-                    // "' is unknown (use knit, plain or twill)")
+                    // "' is unknown (use knit, plain, twill or texgen)")
                 return
             end select
             select case (trim(fabric%boundary))
@@ -68,6 +78,21 @@ contains
                     // "' is unknown (use free or rollers)")
                 return
             end select
+            if (fabric%kind == 'texgen') then
+                call require_range(error, 'strain', fabric%strain, -0.9_wp, 100.0_wp)
+                if (allocated(error)) return
+                call require_range(error, 'lateral_strain', fabric%lateral_strain, -0.9_wp, &
+                    100.0_wp)
+                if (allocated(error)) return
+                if (fabric%elements_per_segment < 1 .or. fabric%elements_per_segment > 1000) then
+                    write(buffer, '(a, "elements_per_segment = ", i0, " must lie in [1, ", &
+                        & "1000]")') label, fabric%elements_per_segment
+                    call fatal_error(error, trim(buffer))
+                    return
+                end if
+                call check_texgen(error)
+                return
+            end if
             if (any(fabric%cells < 1) .or. &
                     real(fabric%cells(1), wp) * fabric%cells(2) > max_generated_cells) then
                 write(buffer, '(a, "cells = ", i0, ", ", i0, " must be at least 1 and at most ", &
@@ -101,6 +126,10 @@ contains
                 return
             end if
 
+            call forbid_name(error, 'texgen_file', fabric%texgen_file)
+            if (allocated(error)) return
+            call forbid_name(error, 'texgen_materials', fabric%texgen_materials(1))
+            if (allocated(error)) return
             if (fabric%kind == 'knit') then
                 call require_material(error, 'knit_material', fabric%knit_material, .true.)
                 if (allocated(error)) return
@@ -172,6 +201,97 @@ contains
             call fatal_error(error, label // variable // " = '" // trim(name) &
                 // "' is not the name of any &material")
         end subroutine require_material
+
+        !> The TexGen route: a file, materials by yarn index, the search settings; the
+        !> pattern variables of the built-in generators do not apply.
+        subroutine check_texgen(error)
+            type(error_type), allocatable, intent(out) :: error
+            integer :: given, m
+            associate(fabric => config%fabric)
+                if (len_trim(fabric%texgen_file) == 0) then
+                    call fatal_error(error, label // "texgen_file is required for kind = 'texgen'")
+                    return
+                end if
+                if (fabric%boundary /= 'periodic') then
+                    call fatal_error(error, label // "boundary = '" // trim(fabric%boundary) &
+                        // "': a TexGen model is imported as its periodic cell only (use " &
+                        // "boundary = 'periodic')")
+                    return
+                end if
+                given = 0
+                do m = 1, size(fabric%texgen_materials)
+                    if (len_trim(fabric%texgen_materials(m)) == 0) cycle
+                    if (m > given + 1) then
+                        write(buffer, '(a, "texgen_materials(", i0, ") is given but ", &
+                            & "texgen_materials(", i0, ") is not: give them in yarn order")') &
+                            label, m, given + 1
+                        call fatal_error(error, trim(buffer))
+                        return
+                    end if
+                    given = m
+                    write(buffer, '("texgen_materials(", i0, ")")') m
+                    call require_material(error, trim(buffer), fabric%texgen_materials(m), &
+                        .true.)
+                    if (allocated(error)) return
+                end do
+                if (given == 0) then
+                    call fatal_error(error, label // "texgen_materials is required for kind " &
+                        // "= 'texgen' (the &material of each TexGen yarn, by index)")
+                    return
+                end if
+                call require_range(error, 'texgen_contact_tolerance', &
+                    fabric%texgen_contact_tolerance, 0.0_wp, 1.0_wp)
+                if (allocated(error)) return
+                if (fabric%texgen_samples < 2 .or. fabric%texgen_samples > 1000) then
+                    write(buffer, '(a, "texgen_samples = ", i0, " must lie in [2, 1000]")') &
+                        label, fabric%texgen_samples
+                    call fatal_error(error, trim(buffer))
+                    return
+                end if
+                call forbid_name(error, 'knit_material', fabric%knit_material)
+                if (allocated(error)) return
+                call forbid_name(error, 'inlay_material', fabric%inlay_material)
+                if (allocated(error)) return
+                call forbid_name(error, 'warp_material', fabric%warp_material)
+                if (allocated(error)) return
+                call forbid_name(error, 'weft_material', fabric%weft_material)
+                if (allocated(error)) return
+                if (fabric%gap /= -1.0_wp) then
+                    call fatal_error(error, label // "gap does not apply to kind = 'texgen' " &
+                        // '(the holders take the distances of the model; gap_factor scales ' &
+                        // 'them)')
+                    return
+                end if
+                call check_gap_factor_positive(error)
+            end associate
+        end subroutine check_texgen
+
+        subroutine check_gap_factor_positive(error)
+            type(error_type), allocatable, intent(out) :: error
+            associate(p => config%fabric%gap_factor_p_disp, f => config%fabric%gap_factor)
+                if (size(p) /= size(f)) then
+                    write(buffer, '(a, "gap_factor_p_disp has ", i0, " values but gap_factor ", &
+                        & "has ", i0)') label, size(p), size(f)
+                    call fatal_error(error, trim(buffer))
+                    return
+                end if
+                do k = 2, size(p)
+                    if (.not. (p(k) > p(k - 1))) then
+                        write(buffer, '(a, "gap_factor_p_disp must increase strictly: value ", &
+                            & i0, " (", g0, ") follows ", g0)') label, k, p(k), p(k - 1)
+                        call fatal_error(error, trim(buffer))
+                        return
+                    end if
+                end do
+                if (any(.not. (f > 0.0_wp .and. f < huge(1.0_wp)))) then
+                    call fatal_error(error, label // 'gap_factor values must be positive and ' &
+                        // 'finite')
+                    return
+                end if
+                if (any(p /= p) .or. any(abs(p) > huge(1.0_wp))) &
+                    call fatal_error(error, label // 'gap_factor_p_disp must be finite')
+            end associate
+        end subroutine check_gap_factor_positive
 
         subroutine forbid_name(error, variable, name)
             type(error_type), allocatable, intent(out) :: error

@@ -74,12 +74,14 @@ contains
     end subroutine add_support
 
     !> Node `follower` follows `leader`: a periodic image (strain: macroscopic strain at
-    !> p_disp = 1) or a gap-holder partner (gap = .true.).
-    subroutine add_link(self, follower, leader, strain, gap)
+    !> p_disp = 1) or a gap-holder partner (gap = .true.); a gap-holder between a node
+    !> and a periodic image of its partner also takes the lattice vector `period`.
+    subroutine add_link(self, follower, leader, strain, gap, period)
         class(net_builder_type), intent(inout) :: self
         integer, intent(in) :: follower, leader
         real(wp), intent(in) :: strain(3)
         logical, intent(in) :: gap
+        real(wp), intent(in), optional :: period(3)
         type(link_config_type), allocatable :: grown(:)
 
         if (.not. allocated(self%links)) allocate(self%links(64))
@@ -93,6 +95,8 @@ contains
         self%links(self%n_links)%leader = leader
         self%links(self%n_links)%strain = strain
         self%links(self%n_links)%gap = gap
+        self%links(self%n_links)%period = 0.0_wp
+        if (present(period)) self%links(self%n_links)%period = period
     end subroutine add_link
 
     subroutine hand_over(self, config)

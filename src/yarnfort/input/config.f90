@@ -31,6 +31,10 @@ module yarnfort_input_config
         !> offset by the gap factor instead.
         real(wp) :: strain(3) = 0.0_wp
         logical :: gap = .false.
+        !> Gap link only: the part of the offset that is a lattice vector (a gap-holder
+        !> to a periodic image, TexGen import); it follows the macroscopic strain
+        !> (p_disp * strain * period), the rest is the gap.
+        real(wp) :: period(3) = 0.0_wp
     end type link_config_type
 
     !> The whole input.
@@ -57,6 +61,9 @@ module yarnfort_input_config
         !> support whose x reaction is the fabric's force (0: not a fabric).
         real(wp) :: fabric_width = 0.0_wp
         integer :: fabric_support = 0
+        !> TexGen import (&fabric kind = 'texgen'): yarns and contacts found.
+        integer :: texgen_yarns = 0
+        integer :: texgen_contacts = 0
         type(path_config_type) :: path
         type(output_config_type) :: output
         !> Not a namelist variable: the folder of the input file, against which relative

@@ -202,10 +202,12 @@ GROUPS = [
     Group('fabric', 'singleton',
           'A generated fabric (knitted with inlay, or woven) instead of &nodes, &yarn and '
           '&support groups.', [
-        Var('kind', 'character', '', length=16, lower=True, choices=['knit', 'plain', 'twill'],
+        Var('kind', 'character', '', length=16, lower=True,
+            choices=['knit', 'plain', 'twill', 'texgen'],
             checked_by='fabric', default_doc='required',
-            doc="`'knit'` (weft-knitted single jersey, optional inlay), `'plain'` (plain weave) "
-                "or `'twill'` (2/2 twill)."),
+            doc="`'knit'` (weft-knitted single jersey, optional inlay), `'plain'` (plain weave), "
+                "`'twill'` (2/2 twill) or `'texgen'` (a periodic cell from a TexGen model file, "
+                '`texgen_file`).'),
         Var('cells', 'integer', [4, 4], shape=2, range='>= 1', checked_by='fabric',
             doc='Repeats along x and y: wales x courses (knit); weft yarns (crossings along x) x '
                 'warp yarns (woven). A periodic plain weave needs even counts, a periodic twill '
@@ -281,6 +283,25 @@ GROUPS = [
             doc='The gap factor as a piecewise-linear function of the displacement factor p_disp '
                 "(constant beyond the end knots): the holders' length is gap * factor (paper "
                 'Fig. 13b). `gap_factor_p_disp` increasing; factors positive.'),
+        Var('texgen_file', 'character', '', length='path_length', adjust=False,
+            checked_by='fabric', default_doc='required (texgen)',
+            doc="TexGen: the model file (`.tg3`, TexGen's XML), relative to the input file's "
+                'folder (the working directory for stdin). Read without TexGen: one textile, '
+                'periodic yarns with repeats along x and y (the cell), master nodes, '
+                'interpolation, section width and height, GeometryScale. See *TexGen import* '
+                'below.'),
+        Var('texgen_materials', 'character', '', length='name_length', shape=64,
+            checked_by='fabric', default_doc='required (texgen)',
+            doc="TexGen: the `&material` of TexGen's yarn 0, 1, 2, ... (by index); yarns "
+                'beyond the last name given take that one, so one name serves all yarns.'),
+        Var('texgen_contact_tolerance', 'real', 0.05, unit='1', range='[0, 1]',
+            checked_by='fabric',
+            doc='TexGen: two yarns are in contact where their centre lines come within (1 + '
+                'this) times the sum of their half thicknesses (TexGen yarns that touch are '
+                'exactly that far apart, up to its interpolation).'),
+        Var('texgen_samples', 'integer', 16, range='[2, 1000]', checked_by='fabric',
+            doc='TexGen: points per master-node span of the sampled centre lines on which '
+                'contacts are searched.'),
     ]),
     Group('nodes', 'singleton',
           'Node coordinates (node ids 1..n in list order).', [

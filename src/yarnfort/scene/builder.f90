@@ -374,7 +374,8 @@ contains
                     step = scene%network%position(:, r) - scene%network%position(:, leader(r))
                     offset = offset + step
                     if (link%gap) then
-                        gap = gap + step
+                        gap = gap + step - link%period
+                        macro = macro + link%strain * link%period
                     else
                         macro = macro + link%strain * step
                     end if
