@@ -303,6 +303,18 @@ GROUPS = [
                 'out of the whole segment: each of its elements takes its share of the change, '
                 'in proportion to its initial length. The new nodes are material points that a '
                 'yarn does not slide through.'),
+        Var('length0', 'real', None, shape='list', unit='m', range='> 0',
+            default_doc='none (from the geometry)',
+            doc='Reference length L0 of every element of the yarn, in order along it (one '
+                'value per element: (number of nodes - 1) * elements_per_segment), so that a '
+                'measured or computed pretensioned state is given exactly. Each > 0. Not with '
+                '`stretch`, nor on a yarn whose material has a `prestress`.'),
+        Var('stretch', 'real', None, shape='list', unit='1', range='> 0',
+            default_doc='none (1)',
+            doc='Initial stretch lambda of every element of the yarn instead: L0 = l / lambda, '
+                'l the element\'s length in the initial geometry (the operation `prestress` '
+                'does with one lambda per material). One value per element, each > 0. Not with '
+                '`length0`, nor with a `prestress` of the material.'),
     ]),
     Group('support', 'repeatable',
           'A named set of nodes whose listed components are prescribed.', [

@@ -51,6 +51,7 @@ contains
         if (allocated(error)) return
         call apply_prestress(scene, config, error)
         if (allocated(error)) return
+        call apply_element_lengths(scene, config)
         call build_constraints(scene, config, error)
         if (allocated(error)) return
         call build_links(scene, config, error)
@@ -276,6 +277,29 @@ contains
             end do
         end do
     end subroutine apply_prestress
+
+    !> Per-element reference lengths of the yarns that give them (checked: one value per
+    !> element, > 0): `length0` as given, or `stretch` lambda as L0 = l / lambda (the
+    !> operation of apply_prestress, so that lambda_p per element gives its lengths).
+    subroutine apply_element_lengths(scene, config)
+        type(scene_type), intent(inout) :: scene
+        type(config_type), intent(in) :: config
+        integer :: y, first, last
+
+        do y = 1, size(config%yarns)
+            first = scene%network%yarn_first_element(y)
+            last = scene%network%yarn_first_element(y + 1) - 1
+            associate(yarn => config%yarns(y))
+                if (allocated(yarn%length0)) then
+                    if (size(yarn%length0) > 0) scene%network%length0(first:last) = yarn%length0
+                end if
+                if (allocated(yarn%stretch)) then
+                    if (size(yarn%stretch) > 0) scene%network%length0(first:last) = &
+                        scene%network%length0(first:last) / yarn%stretch
+                end if
+            end associate
+        end do
+    end subroutine apply_element_lengths
 
     !> Links (periodic images, eq. 53, and gap-holders): a follower node's coordinates
     !> share the unknowns of its leader (followed to the end of a chain), offset by their
