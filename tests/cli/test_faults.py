@@ -285,10 +285,12 @@ def test_killed_run_leaves_no_stale_lock(tmp_path):
 
 # ------------------------------------------------------------------ step numbers
 
-#: Byte offsets of the fields of restart.dat (format version 2, see output/restart.f90).
+#: Byte offsets of the fields of restart.dat (format version 3, see output/restart.f90;
+#: the factors of the scenes' two default channels p_force and p_disp follow have_old).
 OFFSET = {"n_nodes": 36, "n_elements": 40, "n_unknowns": 44, "n_passages": 48, "step": 52,
           "knot": 56, "time": 60, "next_step": 68, "previous_load": 76, "stepper": 84,
-          "p_force": 100, "p_disp": 108, "load_old": 116, "have_old": 124, "u": 128}
+          "n_channels": 100, "load_old": 104, "have_old": 112, "p_force": 116, "p_disp": 124,
+          "u": 132}
 #: The file ends with a checksum (16 hex digits) of every byte before it.
 CHECKSUM_LENGTH = 16
 
@@ -452,7 +454,10 @@ def corrupt(path: Path, field: str, how: str) -> None:
     ("next_step", "nan", "next step NaN is not in"),
     ("next_step", "huge", "is not in [min_step"),
     ("p_disp", "shifted", "are not those of the path at its time"),
-    ("previous_load", "huge", "is not p_force + p_disp"),
+    ("previous_load", "huge", "is not the sum of its load factors"),
+    ("n_channels", "huge", "a size or flag field holds an impossible value"),
+    ("n_channels", "zero", "a size or flag field holds an impossible value"),
+    ("n_channels", "plus_one", "bytes do not fit the sizes it records"),
     ("stepper", "", "its stepper 'elastic' is not 'friction'"),
     ("n_unknowns", "plus_one", "bytes do not fit the sizes it records"),
     ("n_unknowns", "huge", "bytes do not fit the sizes it records"),

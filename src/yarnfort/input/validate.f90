@@ -18,6 +18,7 @@ module yarnfort_input_validate
     use yarnfort_input_network_checks, only: check_nodes, check_yarns, &
         check_duplicate_segments, check_supports, check_loads, coincidence_tolerance
     use yarnfort_input_contact_checks, only: check_contacts
+    use yarnfort_input_channel_checks, only: check_channels
     use yarnfort_text, only: format_integer, format_real
     implicit none
     private
@@ -66,6 +67,8 @@ contains
             return
         end if
         call check_path(config%path, error)
+        if (allocated(error)) return
+        call check_channels(config, error)
         if (allocated(error)) return
         call check_prescribed_reach(config, error)
         if (allocated(error)) return

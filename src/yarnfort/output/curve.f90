@@ -9,12 +9,14 @@ module yarnfort_output_curve
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_text, only: read_line
+    use yarnfort_input_channel_checks, only: load_column_prefix
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, &
         flush_checked, truncate_file
     implicit none
     private
 
-    public :: curve_writer_type, curve_file_name
+    public :: curve_writer_type, curve_file_name, get_support_displacement
+    public :: get_load_displacement
 
     character(len=*), parameter :: curve_file_name = 'curve.csv'
 
@@ -35,10 +37,15 @@ module yarnfort_output_curve
 
 contains
 
-    !> Create folder/curve.csv and write its header. Columns: step, time, p_force,
-    !> p_disp, then rx, ry, rz (N, force applied by the support on the net) for each
-    !> support set, then direction (1 loading, -1 unloading, 0 neither: sign of the
-    !> change of p_force + p_disp), passages slipping and sliding passages in all,
+    !> Create folder/curve.csv and write its header. Columns: step, time, the factor of
+    !> each load channel (p_force, p_disp without &path channels), then rx, ry, rz (N,
+    !> force applied by the support on the net) for each support set, then ux, uy, uz (m,
+    !> the mean displacement of the set's prescribed coordinates, per component; 0 for a
+    !> component it does not prescribe) for each support set, then load_<k>_ux, _uy, _uz
+    !> (m, the mean displacement of the nodes of &load #k) for each &load, then for a
+    !> fabric strain and force_per_width, then direction (1 loading, -1 unloading, 0
+    !> neither: sign of the change of the sum of the channels' factors), passages
+    !> slipping and sliding passages in all,
     !> Newton iterations of the step (all solves), final scaled residual, step cuts and
     !> wall time (s) of the step.
     subroutine open_curve(self, folder, scene, error)
@@ -237,11 +244,24 @@ contains
         character(len=:), allocatable :: name
         integer :: s
 
-        header = 'step,time,p_force,p_disp'
+        header = 'step,time'
+        do s = 1, size(scene%path%channel)
+            header = header // ',' // trim(scene%path%channel(s))
+        end do
         do s = 1, size(scene%supports)
             name = trim(scene%supports(s)%name)
             header = header // ',' // name // '_rx,' // name // '_ry,' // name // '_rz'
         end do
+        do s = 1, size(scene%supports)
+            name = trim(scene%supports(s)%name)
+            header = header // ',' // name // '_ux,' // name // '_uy,' // name // '_uz'
+        end do
+        if (allocated(scene%loads)) then
+            do s = 1, size(scene%loads)
+                name = load_column_prefix(s)
+                header = header // ',' // name // '_ux,' // name // '_uy,' // name // '_uz'
+            end do
+        end if
         if (scene%fabric_set > 0) header = header // ',strain,force_per_width'
         header = header // ',direction,slipping,passages,newton_iterations,residual,step_cuts,wall_time'
     end function get_header
@@ -254,19 +274,36 @@ contains
         character(len=32) :: field
         character(len=:), allocatable :: row
         integer :: s, k
+        real(wp) :: displacement(3)
 
         write(field, '(i0)') state%step
         row = trim(field)
         call append(state%time)
-        call append(state%p_force)
-        call append(state%p_disp)
+        do s = 1, size(state%factors)
+            call append(state%factors(s))
+        end do
         do s = 1, size(state%reaction, 2)
             do k = 1, 3
                 call append(state%reaction(k, s))
             end do
         end do
+        do s = 1, size(scene%supports)
+            displacement = get_support_displacement(scene, state, s)
+            do k = 1, 3
+                call append(displacement(k))
+            end do
+        end do
+        if (allocated(scene%loads)) then
+            do s = 1, size(scene%loads)
+                displacement = get_load_displacement(scene, state, s)
+                do k = 1, 3
+                    call append(displacement(k))
+                end do
+            end do
+        end if
         if (scene%fabric_set > 0) then
-            call append(state%p_disp * scene%fabric_strain)
+            ! A fabric has the two default channels: p_disp is channel 2.
+            call append(state%factors(2) * scene%fabric_strain)
             call append(state%reaction(1, scene%fabric_set) / scene%fabric_width)
         end if
         write(field, '(i0, ",", i0, ",", i0, ",", i0)') state%direction, state%n_slipping, &
@@ -288,6 +325,47 @@ contains
             row = row // ',' // trim(adjustl(field))
         end subroutine append
     end subroutine write_step
+
+    !> Mean displacement (m, from the initial position) of the coordinates support set s
+    !> prescribes, per component (0 for a component it prescribes nowhere).
+    pure function get_support_displacement(scene, state, s) result(displacement)
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: s
+        real(wp) :: displacement(3)
+        integer :: i, c, k, node, n(3)
+
+        displacement = 0.0_wp
+        n = 0
+        do i = 1, size(scene%supports(s)%coordinates)
+            c = scene%supports(s)%coordinates(i)
+            node = (c - 1) / 3 + 1
+            k = c - 3 * (node - 1)
+            displacement(k) = displacement(k) + (state%position(k, node) &
+                - scene%network%position(k, node))
+            n(k) = n(k) + 1
+        end do
+        where (n > 0) displacement = displacement / n
+    end function get_support_displacement
+
+    !> Mean displacement (m) of the nodes of &load #l.
+    pure function get_load_displacement(scene, state, l) result(displacement)
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: l
+        real(wp) :: displacement(3)
+        integer :: i, node
+
+        displacement = 0.0_wp
+        associate(nodes => scene%loads(l)%nodes)
+            do i = 1, size(nodes)
+                node = nodes(i)
+                displacement = displacement + (state%position(:, node) &
+                    - scene%network%position(:, node))
+            end do
+            if (size(nodes) > 0) displacement = displacement / size(nodes)
+        end associate
+    end function get_load_displacement
 
     !> Close the file; `error` says if the last data could not be written.
     subroutine close_curve(self, error)

@@ -5,7 +5,8 @@
 !> Each state holds the nodes (points: current positions) and, as cells, the yarn
 !> elements followed by the links (gap-holders and periodic images, so that a fabric
 !> shows connected). Arrays:
-!> - field data: time, step, p_force, p_disp; for a fabric also strain and
+!> - field data: time, step, the factor of each load channel (p_force, p_disp without
+!>   &path channels); for a fabric also strain and
 !>   force_per_width (as in curve.csv);
 !> - point data: displacement (from the initial position), position, and for scenes
 !>   with sliding passages contact_state (0 no passage, 1 all stick, 2 a passage slips);
@@ -139,10 +140,14 @@ contains
         vtu%appended = ''
         call add_reals(vtu, 'time', [state%time], 1, field=.true.)
         call add_int32(vtu, 'step', [int(state%step, int32)], field=.true.)
-        call add_reals(vtu, 'p_force', [state%p_force], 1, field=.true.)
-        call add_reals(vtu, 'p_disp', [state%p_disp], 1, field=.true.)
+        do l = 1, size(state%factors)
+            call add_reals(vtu, trim(scene%path%channel(l)), [state%factors(l)], 1, &
+                field=.true.)
+        end do
         if (scene%fabric_set > 0) then
-            call add_reals(vtu, 'strain', [state%p_disp * scene%fabric_strain], 1, field=.true.)
+            ! A fabric has the two default channels: p_disp is channel 2.
+            call add_reals(vtu, 'strain', [state%factors(2) * scene%fabric_strain], 1, &
+                field=.true.)
             call add_reals(vtu, 'force_per_width', &
                 [state%reaction(1, scene%fabric_set) / scene%fabric_width], 1, field=.true.)
         end if

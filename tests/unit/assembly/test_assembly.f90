@@ -158,7 +158,7 @@ contains
         scene%network%yarn_first_element = [1, 9]
         scene%network%length0 = 0.9_wp * [1.0_wp, 1.0_wp, 1.0_wp, 1.1_wp, 1.0_wp, 1.1_wp, &
             1.0_wp, 1.4_wp]
-        allocate(scene%dofs%unknown(18), scene%dofs%base(18), scene%dofs%delta(18))
+        allocate(scene%dofs%unknown(18), scene%dofs%base(18), scene%dofs%delta(18, 2))
         scene%dofs%base = 0.0_wp
         scene%dofs%delta = 0.0_wp
         count = 0
@@ -166,15 +166,15 @@ contains
             if (any(prescribed == c)) then
                 scene%dofs%unknown(c) = 0
                 scene%dofs%base(c) = scene%network%position(mod(c - 1, 3) + 1, (c - 1) / 3 + 1)
-                scene%dofs%delta(c) = 0.05_wp * c
+                scene%dofs%delta(c, 2) = 0.05_wp * c
             else
                 count = count + 1
                 scene%dofs%unknown(c) = count
             end if
         end do
         scene%dofs%n_unknowns = count
-        allocate(scene%external_force(18), source=0.0_wp)
-        scene%external_force(8) = -0.3_wp
+        allocate(scene%external_force(18, 2), source=0.0_wp)
+        scene%external_force(8, 1) = -0.3_wp
         scene%solver%slack_stiffness = 1.0e-6_wp
     end subroutine make_scene
 
@@ -216,6 +216,7 @@ contains
         type(pattern_type) :: pattern
         real(wp), allocatable :: u(:), up(:), rp(:), rm(:), values(:), dense(:, :), x(:, :)
         real(wp), parameter :: p_disp = 0.7_wp, p_force = 0.4_wp
+        real(wp), parameter :: factors(2) = [p_force, p_disp]
         integer :: n, j, p
 
         call make_scene(scene, error)
@@ -225,7 +226,7 @@ contains
         allocate(u(n), rp(n), rm(n), values(pattern%nnz), dense(n, n), x(3, 6))
         call scene%dofs%restrict(scene%network%position, u)
         u = u + 0.03_wp * [(sin(real(3 * j, wp)), j = 1, n)]
-        call scene%dofs%expand(u, p_disp, x)
+        call scene%dofs%expand(u, factors, x)
         call assemble_jacobian(scene, pattern, x, scene%network%length0, values, error)
         if (allocated(error)) return
         dense = 0.0_wp
@@ -237,12 +238,12 @@ contains
         do j = 1, n
             up = u
             up(j) = u(j) + fd_step
-            call scene%dofs%expand(up, p_disp, x)
-            call assemble_residual(scene, x, scene%network%length0, p_force, rp, error)
+            call scene%dofs%expand(up, factors, x)
+            call assemble_residual(scene, x, scene%network%length0, factors, rp, error)
             if (allocated(error)) return
             up(j) = u(j) - fd_step
-            call scene%dofs%expand(up, p_disp, x)
-            call assemble_residual(scene, x, scene%network%length0, p_force, rm, error)
+            call scene%dofs%expand(up, factors, x)
+            call assemble_residual(scene, x, scene%network%length0, factors, rm, error)
             if (allocated(error)) return
             call check_close(error, dense(:, j), (rp - rm) / (2 * fd_step), fd_tolerance, &
                 'Jacobian column', abs_tol=fd_tolerance * maxval(abs(dense)))
