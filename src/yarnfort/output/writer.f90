@@ -51,6 +51,7 @@ module yarnfort_output_writer
         !> (written by finish).
         type(step_state_type) :: last
         integer, allocatable :: last_mode(:)
+        real(wp), allocatable :: last_flow(:)
         logical :: state_due = .false.
         logical :: last_written = .true.
         !> Fingerprint of the input, stamped on the restart files (get_input_hash).
@@ -310,6 +311,11 @@ contains
         else
             self%last_mode = [integer :: ]
         end if
+        if (allocated(snapshot%flow)) then
+            self%last_flow = snapshot%flow
+        else
+            self%last_flow = [real(wp) :: ]
+        end if
         if (self%contact_state) then
             if (.not. allocated(snapshot%flow) .or. .not. allocated(snapshot%mode)) then
                 call fatal_error(error, "cannot write '" // self%contacts%path // "': the " &
@@ -341,7 +347,8 @@ contains
             self%last%time, error)
         if (.not. allocated(error)) then
             if (.not. allocated(self%last_mode)) self%last_mode = [integer :: ]
-            call self%vtk%write_state(scene, self%last, self%last_mode, error)
+            if (.not. allocated(self%last_flow)) self%last_flow = [real(wp) :: ]
+            call self%vtk%write_state(scene, self%last, self%last_mode, self%last_flow, error)
         end if
         if (allocated(error)) then
             self%failed = .true.
