@@ -89,6 +89,32 @@ class Curve:
                            + (", ".join(known) or "none"))
         return np.column_stack([self.columns[f"{support}_r{k}"] for k in "xyz"])
 
+    def displacement(self, name: str) -> np.ndarray:
+        """Displacement of a named support set (its applied displacement) or of a load
+        (``'load_<k>'``, the mean displacement of the nodes of ``&load`` number k).
+
+        Parameters
+        ----------
+        name : str
+            The ``&support`` name, or ``'load_1'``, ``'load_2'``, ...
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n_steps, 3), m.
+
+        Raises
+        ------
+        KeyError
+            If the curve has no such set (the message lists those it has).
+        """
+        missing = [f"{name}_u{k}" for k in "xyz" if f"{name}_u{k}" not in self.columns]
+        if missing:
+            known = [column[:-3] for column in self.columns if column.endswith("_ux")]
+            raise KeyError(f"curve has no displacement of {name!r}; sets: "
+                           + (", ".join(known) or "none"))
+        return np.column_stack([self.columns[f"{name}_u{k}"] for k in "xyz"])
+
     def to_array(self) -> np.ndarray:
         """The curve as a numpy structured array (one field per column)."""
         dtype = [(name, values.dtype) for name, values in self.columns.items()]

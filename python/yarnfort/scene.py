@@ -250,6 +250,11 @@ class Yarn:
         Node ids (from 1), at least two.
     elements_per_segment : int, optional
         Elements between two listed nodes.
+    length0 : array_like, optional
+        Reference length of every element (m), in order along the yarn: (len(nodes) - 1)
+        * elements_per_segment values.
+    stretch : array_like, optional
+        Initial stretch of every element instead (L0 = length / stretch).
     extra : dict
         Further ``&yarn`` variables.
     """
@@ -258,10 +263,27 @@ class Yarn:
     nodes: ArrayLike
     elements_per_segment: int | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    length0: ArrayLike | None = None
+    stretch: ArrayLike | None = None
 
     def __post_init__(self) -> None:
         _name(self.material, "&yarn material")
         self.nodes = _ids(self.nodes, f"&yarn ({self.material}) nodes", minimum=2)
+        if self.length0 is not None and self.stretch is not None:
+            raise SceneError(f"&yarn ({self.material}): length0 and stretch are both given")
+        for key in ("length0", "stretch"):
+            value = getattr(self, key)
+            if value is None:
+                continue
+            array = np.atleast_1d(_reals(value, f"&yarn ({self.material}) {key}"))
+            per_segment = 1 if self.elements_per_segment is None else int(self.elements_per_segment)
+            expected = (len(self.nodes) - 1) * per_segment
+            if array.ndim != 1 or array.size != expected:
+                raise SceneError(f"&yarn ({self.material}) {key}: {array.size} values for "
+                                 f"{expected} elements")
+            if not np.all(array > 0.0):
+                raise SceneError(f"&yarn ({self.material}) {key}: every value must be > 0")
+            setattr(self, key, array)
 
 
 @dataclass
@@ -277,9 +299,11 @@ class Support:
     fix : str
         Prescribed components, e.g. ``'xyz'`` or ``'y'``.
     displacement : array_like of 3 floats, optional
-        Displacement at p_disp = 1 (m).
+        Displacement at factor 1 of its load channel (m).
     extra : dict
         Further ``&support`` variables.
+    channel : str, optional
+        The load channel that scales the displacement (default ``'p_disp'``).
     """
 
     name: str
@@ -287,6 +311,7 @@ class Support:
     fix: str | None = None
     displacement: ArrayLike | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    channel: str | None = None
 
     def __post_init__(self) -> None:
         _name(self.name, "&support name")
@@ -297,6 +322,8 @@ class Support:
         if self.displacement is not None:
             self.displacement = _reals(self.displacement,
                                        f"&support '{self.name}' displacement", (3,))
+        if self.channel is not None:
+            _name(self.channel, f"&support '{self.name}' channel")
 
 
 @dataclass
@@ -308,38 +335,50 @@ class Load:
     nodes : array_like of int
         Node ids.
     force : array_like of 3 floats
-        Force on each node at p_force = 1 (N).
+        Force on each node at factor 1 of its load channel (N).
     extra : dict
         Further ``&load`` variables.
+    channel : str, optional
+        The load channel that scales the force (default ``'p_force'``).
     """
 
     nodes: ArrayLike
     force: ArrayLike
     extra: dict[str, Any] = field(default_factory=dict)
+    channel: str | None = None
 
     def __post_init__(self) -> None:
         self.nodes = _ids(self.nodes, "&load nodes")
         self.force = _reals(self.force, "&load force", (3,))
+        if self.channel is not None:
+            _name(self.channel, "&load channel")
 
 
 @dataclass
 class LoadPath:
-    """The load path (``&path``): knots of the force and displacement factors.
+    """The load path (``&path``): knots of the load channels' factors.
 
     Parameters
     ----------
     time : array_like
         Pseudo-times of the knots (at least two).
     p_force, p_disp : array_like, optional
-        Factors at the knots (default zeros).
+        Factors at the knots of the two default channels (default zeros).
     extra : dict
         Further ``&path`` variables.
+    channels : sequence of str, optional
+        Names of independent load channels instead (``&path channels``, at most 8).
+    factors : array_like, optional
+        With ``channels``: shape (n_knots, n_channels), one row per knot (written row by
+        row, as ``&path factors`` reads them).
     """
 
     time: ArrayLike
     p_force: ArrayLike | None = None
     p_disp: ArrayLike | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    channels: list[str] | None = None
+    factors: ArrayLike | None = None
 
     def __post_init__(self) -> None:
         self.time = np.atleast_1d(_reals(self.time, "&path time"))
@@ -353,6 +392,24 @@ class LoadPath:
                     raise SceneError(f"&path {key}: {array.size} values for"
                                      f" {self.time.size} knots")
                 setattr(self, key, array)
+        if self.channels is not None:
+            names = [self.channels] if isinstance(self.channels, str) else list(self.channels)
+            self.channels = [_name(name, "&path channels") for name in names]
+            if len(set(self.channels)) != len(self.channels):
+                raise SceneError(f"&path channels: a name is given twice: {self.channels}")
+            if self.p_force is not None or self.p_disp is not None:
+                raise SceneError("&path: p_force or p_disp together with channels (give "
+                                 "every factor in factors)")
+            if self.factors is None:
+                raise SceneError("&path channels: factors (n_knots x n_channels) missing")
+            array = np.asarray(_reals(self.factors, "&path factors"), dtype=float)
+            shape = (self.time.size, len(self.channels))
+            if array.size != shape[0] * shape[1]:
+                raise SceneError(f"&path factors: {array.size} values for {shape[0]} knots "
+                                 f"x {shape[1]} channels")
+            self.factors = array.reshape(shape)
+        elif self.factors is not None:
+            raise SceneError("&path factors: given without channels")
 
 
 @dataclass
@@ -541,14 +598,17 @@ class Scene:
         nodes : array_like of int
             Node ids along the yarn (from 1).
         **variables
-            ``elements_per_segment`` and any further ``&yarn`` variable.
+            ``elements_per_segment``, ``length0`` or ``stretch`` and any further ``&yarn``
+            variable.
 
         Returns
         -------
         Yarn
             The yarn added.
         """
-        yarn = Yarn(material, nodes, variables.pop("elements_per_segment", None), variables)
+        yarn = Yarn(material, nodes, variables.pop("elements_per_segment", None),
+                    length0=variables.pop("length0", None),
+                    stretch=variables.pop("stretch", None), extra=variables)
         self._check_materials([material], "&yarn material")
         self._check_nodes(yarn.nodes, f"&yarn ({material}) nodes")
         self.yarns.append(yarn)
@@ -567,9 +627,9 @@ class Scene:
         fix : str, optional
             Prescribed components (default ``'xyz'``).
         displacement : array_like of 3 floats, optional
-            Displacement at p_disp = 1 (m).
+            Displacement at factor 1 of its channel (m).
         **variables
-            Any further ``&support`` variable.
+            ``channel`` and any further ``&support`` variable.
 
         Returns
         -------
@@ -578,7 +638,8 @@ class Scene:
         """
         if any(s.name == name for s in self.supports):
             raise SceneError(f"&support name: {name!r} is given twice")
-        support = Support(name, nodes, fix, displacement, variables)
+        support = Support(name, nodes, fix, displacement,
+                          channel=variables.pop("channel", None), extra=variables)
         self._check_nodes(support.nodes, f"&support '{name}' nodes")
         self.supports.append(support)
         return support
@@ -591,16 +652,16 @@ class Scene:
         nodes : array_like of int
             Node ids.
         force : array_like of 3 floats
-            Force on each node at p_force = 1 (N).
+            Force on each node at factor 1 of its channel (N).
         **variables
-            Any further ``&load`` variable.
+            ``channel`` and any further ``&load`` variable.
 
         Returns
         -------
         Load
             The load added.
         """
-        load = Load(nodes, force, variables)
+        load = Load(nodes, force, channel=variables.pop("channel", None), extra=variables)
         self._check_nodes(load.nodes, "&load nodes")
         self.loads.append(load)
         return load

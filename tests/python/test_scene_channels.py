@@ -1,0 +1,75 @@
+# SPDX-License-Identifier: MIT
+"""The Python scene helpers for issue 11's input: per-element `length0` / `stretch` on a
+yarn, load channels on loads, supports and the path. A scene built in Python writes the
+namelist the program reads (checked by the library), reads back equal, and runs to the
+curve columns the channels name; bad values raise SceneError naming the variable."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import yarnfort
+from yarnfort import SceneError
+
+
+def ring_scene(folder) -> yarnfort.Scene:
+    """A yarn A-R-B through a free ring R with a stub R-S (Coulomb), S pulled down on
+    channel 'down' and then sideways on channel 'side'."""
+    scene = yarnfort.Scene("channels from python")
+    scene.nodes = [[-1.0, 0.4, 0.0], [-0.9, -0.2, 0.0], [1.0, 0.0, 0.0], [-0.9, -0.5, 0.0]]
+    scene.add_material("yarn", "linear", stiffness=10.0)
+    scene.add_material("stub", "linear", stiffness=10.0)
+    scene.add_contact(("yarn", "stub"), "coulomb", friction_coefficient=0.3)
+    scene.add_yarn("yarn", [1, 2, 3], elements_per_segment=2,
+                   stretch=[1.0, 1.0, 1.0, 1.0])
+    scene.add_yarn("stub", [2, 4])
+    scene.add_support("a", [1])
+    scene.add_support("b", [3])
+    scene.add_load([4], [0.0, -1.0, 0.0], channel="down")
+    scene.add_load([4], [0.3, 0.0, 0.0], channel="side")
+    scene.path = yarnfort.LoadPath(time=[0.0, 1.0, 2.0], channels=["down", "side"],
+                                   factors=[[0.05, 0.0], [1.0, 0.0], [1.0, 1.0]])
+    scene.output.update(folder=str(folder), progress=False)
+    return scene
+
+
+def test_channels_and_element_lengths_round_trip_and_run(tmp_path):
+    scene = ring_scene(tmp_path / "out")
+    path = scene.write(tmp_path / "ring.nml")
+    text = path.read_text()
+    assert "channels = 'down', 'side'" in text and "channel = 'side'" in text
+    again = yarnfort.Scene.read(path)
+    np.testing.assert_array_equal(again.path.factors, scene.path.factors)
+    assert again.path.channels == ["down", "side"]
+    assert [load.channel for load in again.loads] == ["down", "side"]
+    np.testing.assert_array_equal(again.yarns[0].stretch, [1.0] * 4)
+    scene.check()
+    result = scene.run()
+    curve = result.curve
+    assert curve.names[:4] == ["step", "time", "down", "side"]
+    np.testing.assert_allclose(curve["side"][-1], 1.0)
+    # The load's displacement is that of the stub's end; support displacements are 0.
+    assert curve.displacement("load_1").shape == (len(curve), 3)
+    np.testing.assert_array_equal(curve.displacement("load_1"), curve.displacement("load_2"))
+    assert np.all(curve.displacement("a") == 0.0)
+    with pytest.raises(KeyError, match="sets: a, b, load_1, load_2"):
+        curve.displacement("c")
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda: yarnfort.LoadPath(time=[0, 1], channels=["a"], factors=[0, 1, 2]),
+     "&path factors: 3 values for 2 knots x 1 channels"),
+    (lambda: yarnfort.LoadPath(time=[0, 1], channels=["a", "a"], factors=[0] * 4),
+     "a name is given twice"),
+    (lambda: yarnfort.LoadPath(time=[0, 1], factors=[0, 1]), "given without channels"),
+    (lambda: yarnfort.LoadPath(time=[0, 1], channels=["a"], factors=[0, 1],
+                               p_force=[0, 1]), "p_force or p_disp together with channels"),
+    (lambda: yarnfort.Yarn("y", [1, 2, 3], 2, length0=[1.0, 1.0]),
+     "length0: 2 values for 4 elements"),
+    (lambda: yarnfort.Yarn("y", [1, 2], length0=[0.0]), "every value must be > 0"),
+    (lambda: yarnfort.Yarn("y", [1, 2], length0=[1.0], stretch=[1.0]),
+     "length0 and stretch are both given"),
+])
+def test_bad_values_raise(make, message):
+    with pytest.raises(SceneError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        make()
