@@ -64,6 +64,19 @@ class Curve:
         """Column names, in file order."""
         return list(self.columns)
 
+    @property
+    def channels(self) -> list[str]:
+        """The load channels' columns of ``curve.csv`` (``['p_force', 'p_disp']``
+        without ``&path channels``): those after ``time``, before the first support,
+        load or fabric column."""
+        out = []
+        for name in self.names[2:]:
+            if name.endswith(("_rx", "_ry", "_rz", "_ux", "_uy", "_uz")) or name in (
+                    "strain", "force_per_width", "direction"):
+                break
+            out.append(name)
+        return out
+
     def reaction(self, support: str) -> np.ndarray:
         """Reaction force of a named support set on the net.
 

@@ -73,3 +73,20 @@ def test_channels_and_element_lengths_round_trip_and_run(tmp_path):
 def test_bad_values_raise(make, message):
     with pytest.raises(SceneError, match=message.replace("(", r"\(").replace(")", r"\)")):
         make()
+
+
+def test_curve_channels_and_plot_command(tmp_path):
+    """Curve.channels lists the channels' columns, and `python -m yarnfort plot` draws
+    a run on channels (its abscissa: the first channel that moves)."""
+    import subprocess
+    import sys
+
+    scene = ring_scene(tmp_path / "out")
+    scene.run()
+    curve = yarnfort.read_curve(tmp_path / "out")
+    assert curve.channels == ["down", "side"]
+    done = subprocess.run([sys.executable, "-m", "yarnfort", "plot", str(tmp_path / "out"),
+                           "--out", str(tmp_path / "ring.png")], capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "ring.png").stat().st_size > 0
