@@ -213,11 +213,14 @@ class Contact:
     materials : tuple of str
         The two material names.
     law : str
-        ``'bonded'``, ``'coulomb'``, ``'adhesion'`` or ``'decaying_adhesion'``.
+        ``'bonded'``, ``'coulomb'``, ``'adhesion'``, ``'decaying_adhesion'`` or
+        ``'general'``.
     friction_coefficient, adhesion, decay_start, decay_end : float, optional
         mu, beta (N), w_d and s_d (N), as the law needs.
     extra : dict
         Further ``&contact`` variables.
+    rate_table : str or path, optional
+        ``'general'``: CSV file of (T in N, g in N/rad), the rate of T' = g(T).
     """
 
     materials: tuple[str, str]
@@ -227,6 +230,7 @@ class Contact:
     decay_start: float | None = None
     decay_end: float | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    rate_table: str | os.PathLike | None = None
 
     def __post_init__(self) -> None:
         pair = [self.materials] if isinstance(self.materials, str) else list(self.materials)
@@ -570,10 +574,11 @@ class Scene:
         materials : tuple of str
             The two material names (added before).
         law : str
-            ``'bonded'``, ``'coulomb'``, ``'adhesion'`` or ``'decaying_adhesion'``.
+            ``'bonded'``, ``'coulomb'``, ``'adhesion'``, ``'decaying_adhesion'`` or
+            ``'general'``.
         **parameters
-            ``friction_coefficient``, ``adhesion``, ``decay_start``, ``decay_end`` and
-            any further ``&contact`` variable.
+            ``friction_coefficient``, ``adhesion``, ``decay_start``, ``decay_end``,
+            ``rate_table`` and any further ``&contact`` variable.
 
         Returns
         -------

@@ -90,3 +90,29 @@ def test_curve_channels_and_plot_command(tmp_path):
                           timeout=300)
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "ring.png").stat().st_size > 0
+
+
+def test_general_law_from_python(tmp_path):
+    """`critical_tension('general', rate_table=...)`: g = mu T (rows (0, 0), (1, mu),
+    continued with the last slope) is the Coulomb law, T_min exp(mu alpha), to
+    rounding; and a Scene with a 'general' contact writes rate_table and is accepted by
+    the library's checks."""
+    mu = 0.3
+    table = tmp_path / "rates.csv"
+    table.write_text(f"T,g\n0.0,0.0\n1.0,{mu!r}\n")
+    t_min = np.array([0.01, 0.5, 2.0, 7.0])
+    alpha = np.array([0.1, 1.0, 2.5, 4.0])
+    critical, d_dt, d_da = yarnfort.critical_tension("general", t_min, alpha,
+                                                     rate_table=str(table))
+    exact = t_min * np.exp(mu * alpha)
+    np.testing.assert_allclose(critical, exact, rtol=1e-14)
+    np.testing.assert_allclose(d_dt, np.exp(mu * alpha), rtol=1e-13)
+    np.testing.assert_allclose(d_da, mu * exact, rtol=1e-13)
+    with pytest.raises(yarnfort.YarnfortError, match="rates_missing.csv"):
+        yarnfort.critical_tension("general", 1.0, 1.0, rate_table=str(tmp_path / "rates_missing.csv"))
+    scene = ring_scene(tmp_path / "out")
+    scene.contacts.clear()
+    contact = scene.add_contact(("yarn", "stub"), "general", rate_table=str(table))
+    assert contact.rate_table == str(table) and not contact.extra
+    assert f"rate_table = '{table}'" in scene.write(tmp_path / "general.nml").read_text()
+    scene.check()
