@@ -121,7 +121,8 @@ contains
                 call set_stage(error, 'restart', status_input)
                 return
             end if
-            call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time)
+            call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time, &
+                resume_previous_time=restart%time_old)
         else
             call writer%open(scene, error)
         end if

@@ -60,7 +60,8 @@ program yarnfort_main
         if (allocated(error)) call fail('restart', error, 2)
         write(error_unit, '(a, i0, a, g0.6)') 'yarnfort: restarting after step ', restart%step, &
             ' at t = ', restart%time
-        call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time)
+        call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time, &
+            resume_previous_time=restart%time_old)
     else
         call writer%open(scene, error)
     end if

@@ -108,28 +108,31 @@ contains
     !> append from there. The kept rows go to a temporary file renamed over the old one,
     !> so an interruption leaves the old file. Fails if the file is missing, has other
     !> columns than `scene` writes, or has no row for `step`.
-    !> The row of `step` must have the pseudo-time `time` (that of the restart file).
-    subroutine resume_curve(self, folder, scene, step, error, time)
+    !> The row of `step` must have the pseudo-time `time` (that of the restart file), and
+    !> the row of step - 1 (when step > 0 and the file has it) `previous_time`.
+    subroutine resume_curve(self, folder, scene, step, error, time, previous_time)
         class(curve_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: folder
         type(scene_type), intent(in) :: scene
         integer, intent(in) :: step
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: time
+        real(wp), intent(in), optional :: time, previous_time
 
-        call self%resume_table(folder, curve_file_name, get_header(scene), step, error, time)
+        call self%resume_table(folder, curve_file_name, get_header(scene), step, error, time, &
+            previous_time=previous_time)
     end subroutine resume_curve
 
     !> Continue folder/name (header `header`) after `step` as resume_curve does: rows are
     !> lines whose first field is their step; a step may have several rows (long format).
     !> With `row_required` false (default true), a step without rows is accepted (a
     !> file that has none for any step, e.g. of a scene with nothing to report).
-    subroutine resume_table(self, folder, name, header, step, error, time, row_required)
+    subroutine resume_table(self, folder, name, header, step, error, time, row_required, &
+            previous_time)
         class(curve_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: folder, name, header
         integer, intent(in) :: step
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: time
+        real(wp), intent(in), optional :: time, previous_time
         logical, intent(in), optional :: row_required
         type(error_type), allocatable :: ignored
         character(len=:), allocatable :: path, temporary, line
@@ -137,7 +140,7 @@ contains
         character(len=256) :: message
         integer :: old, new, status, row_step, comma, last_kept, write_status
         character(len=256) :: read_message
-        real(wp) :: row_time
+        real(wp) :: row_time, row_time_previous
 
         path = folder // '/' // name
         temporary = path // '.tmp'
@@ -164,6 +167,7 @@ contains
         write(new, '(a)', iostat=write_status, iomsg=message) header
         last_kept = -1
         row_time = -huge(row_time)
+        row_time_previous = -huge(row_time)
         do
             call read_line(old, line, status, read_message)
             if (status /= 0) exit
@@ -180,6 +184,9 @@ contains
                 ! The time field is the second one (list-directed: up to the comma).
                 read(line(comma + 1:), *, iostat=status) row_time
                 if (status /= 0) row_time = -huge(row_time)
+            else if (row_step == step - 1) then
+                read(line(comma + 1:), *, iostat=status) row_time_previous
+                if (status /= 0) row_time_previous = -huge(row_time)
             end if
         end do
         close(old)
@@ -213,6 +220,21 @@ contains
                     // format_real_text(time) // ' is not that of step ' // trim(text) &
                     // " in '" // path // "' (" // format_real_text(row_time) &
                     // '): the two files are not of the same run')
+                return
+            end if
+        end if
+        ! (A folder whose rows were renumbered may lack the row before: then unchecked.)
+        if (present(previous_time) .and. step > 0 .and. row_time_previous > -huge(row_time)) &
+                then
+            if (.not. abs(row_time_previous - previous_time) &
+                    <= 2 * spacing(max(abs(previous_time), tiny(previous_time)))) then
+                call remove_file(temporary, ignored)
+                write(text, '(i0)') step - 1
+                call fatal_error(error, "&control restart: the restart file's previous " &
+                    // 'time ' // format_real_text(previous_time) // ' is not that of step ' &
+                    // trim(text) // " in '" // path // "' (" &
+                    // format_real_text(row_time_previous) // '): the two files are not ' &
+                    // 'of the same run')
                 return
             end if
         end if

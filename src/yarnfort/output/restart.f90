@@ -9,7 +9,7 @@
 !>     input fingerprint (16 characters),
 !>     n_nodes, n_elements, n_unknowns, n_passages, step, knot (integers),
 !>     time, next_step, previous_load (reals), stepper (16 characters),
-!>     n_channels (integer), load_old (real), have_old (integer 0 or 1),
+!>     n_channels (integer), load_old, time_old (reals), have_old (integer 0 or 1),
 !>     factors(n_channels) (the load channels' factors), u(n_unknowns), u_old(n_unknowns), length0(n_elements),
 !>     flow(n_passages), flow_old(n_passages) (reals), mode(n_passages) (integers),
 !>     'end-of-restart' (16 characters), then the checksum of every byte before it
@@ -84,7 +84,7 @@ contains
             write(unit, iostat=status, iomsg=message) magic, format_version, stamp, &
                 s%n_nodes, s%n_elements, &
                 s%n_unknowns, s%n_passages, s%step, s%knot, s%time, s%next_step, &
-                s%previous_load, stepper, size(s%factors), s%load_old, &
+                s%previous_load, stepper, size(s%factors), s%load_old, s%time_old, &
                 merge(1, 0, s%have_old)
             if (status == 0) write(unit, iostat=status, iomsg=message) s%factors
             if (status == 0) call put_reals(s%u, s%n_unknowns)
@@ -195,7 +195,7 @@ contains
         associate(s => snapshot)
             read(unit, iostat=status) s%input_hash, s%n_nodes, s%n_elements, s%n_unknowns, &
                 s%n_passages, s%step, s%knot, s%time, s%next_step, s%previous_load, &
-                s%stepper, n_channels, s%load_old, have_old
+                s%stepper, n_channels, s%load_old, s%time_old, have_old
             if (status /= 0) then
                 close(unit)
                 call fatal_error(error, "&control restart: '" // path &
@@ -374,6 +374,26 @@ contains
                     all(ieee_is_finite(snapshot%flow_old)))) then
                 call damaged('its previous state holds a value that is not a finite number')
                 return
+            end if
+            ! After step 0 the previous state is the step before: its time lies on the
+            ! path before this one (and is its curve row's, checked with curve.csv), and
+            ! its load is the path's there.
+            if (snapshot%step > 0) then
+                if (.not. (snapshot%time_old >= scene%path%time(1) .and. &
+                        snapshot%time_old < snapshot%time)) then
+                    call damaged('the time ' // format_real(snapshot%time_old) // ' of its ' &
+                        // 'previous step is not on the load path before its time ' &
+                        // format_real(snapshot%time))
+                    return
+                end if
+                call scene%path%get_factors(snapshot%time_old, factors)
+                if (.not. abs(snapshot%load_old - sum(factors)) <= factor_tolerance &
+                        * size(factors) * scale) then
+                    call damaged('the load ' // format_real(snapshot%load_old) // ' of its ' &
+                        // 'previous step is not the sum of the load factors at its time ' &
+                        // format_real(snapshot%time_old))
+                    return
+                end if
             end if
         end if
     contains

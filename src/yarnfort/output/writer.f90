@@ -97,13 +97,14 @@ contains
     !> Lock the output folder, delete the files an earlier run listed in its manifest,
     !> and start the curve file; with `resume_step` (a restart), continue the folder's
     !> curve file and VTK states after that step instead (`resume_time`: the restart's
-    !> time, which the curve row of that step must have).
-    subroutine open_writer(self, scene, error, resume_step, resume_time)
+    !> time, which the curve row of that step must have; `resume_previous_time`: that of
+    !> the step before, for the row before).
+    subroutine open_writer(self, scene, error, resume_step, resume_time, resume_previous_time)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
         integer, intent(in), optional :: resume_step
-        real(wp), intent(in), optional :: resume_time
+        real(wp), intent(in), optional :: resume_time, resume_previous_time
         logical :: found
 
         self%vtk_every = scene%output%vtk_every
@@ -115,7 +116,8 @@ contains
             self%vtk%folder = self%folder
             call self%manifest%load(self%folder, found)
             if (present(resume_step)) then
-                call resume_files(self, scene, resume_step, error, resume_time)
+                call resume_files(self, scene, resume_step, error, resume_time, &
+                    resume_previous_time)
             else
                 call start_files(self, scene, error)
                 if (.not. allocated(error)) call start_contacts(self, error)
@@ -169,16 +171,16 @@ contains
     !> A restart after `step`: keep curve rows and the listed states up to that step,
     !> delete the listed states after it (and any that is incomplete), and rewrite the
     !> manifest and states.pvd with what is kept.
-    subroutine resume_files(self, scene, step, error, time)
+    subroutine resume_files(self, scene, step, error, time, previous_time)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         integer, intent(in) :: step
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: time
+        real(wp), intent(in), optional :: time, previous_time
         logical, allocatable :: keep(:)
         integer :: i
 
-        call self%curve%resume(self%folder, scene, step, error, time)
+        call self%curve%resume(self%folder, scene, step, error, time, previous_time)
         if (allocated(error)) return
         if (self%node_reactions) then
             call self%reactions%resume_table(self%folder, reactions_file_name, &

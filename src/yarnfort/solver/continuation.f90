@@ -210,6 +210,8 @@ contains
             call stepper%save_state(snapshot)
             snapshot%step = step
             snapshot%time = time
+            ! t is still the time of the step before (checkpoint comes before t moves on).
+            snapshot%time_old = t
             snapshot%next_step = dt
             snapshot%knot = knot
             snapshot%previous_load = previous_load

@@ -37,6 +37,9 @@ module yarnfort_solver_restart
         integer, allocatable :: mode(:)
         logical :: have_old = .false.
         real(wp) :: load_old = 0.0_wp
+        !> Pseudo-time of the converged step before `step` (that of its curve row; the
+        !> step's own time for step 0), so that load_old can be checked against the path.
+        real(wp) :: time_old = 0.0_wp
         real(wp), allocatable :: u_old(:), flow_old(:)
     end type restart_type
 
