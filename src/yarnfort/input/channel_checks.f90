@@ -214,55 +214,74 @@ contains
 
     end subroutine check_channels
 
-    !> No two columns of curve.csv with one name: channels, supports (_rx, _ry, _rz, _ux,
-    !> _uy, _uz) and loads (load_<k>_ux, ...) make them, with the fixed columns.
+    !> No two columns of curve.csv with one name. Support names are unique and the fixed
+    !> columns end in no support suffix, so a clash needs a channel named like a fixed,
+    !> support or load column (e.g. 'a_rx' with a support 'a'), or a support named like a
+    !> load's columns ('load_2' with two loads): linear in the number of columns.
     subroutine check_curve_columns(config, names, error)
         type(config_type), intent(in) :: config
         character(len=*), intent(in) :: names(:)
         type(error_type), allocatable, intent(out) :: error
-        character(len=name_length + 16), allocatable :: columns(:)
-        character(len=80), allocatable :: origins(:)
         character(len=3), parameter :: suffixes(6) = ['_rx', '_ry', '_rz', '_ux', '_uy', '_uz']
-        integer :: k, j, i
+        integer :: k, j, n_loads, length
+        character(len=:), allocatable :: name, stem
 
-        allocate(columns(0), origins(0))
-        do k = 1, size(fixed_curve_columns)
-            call add(fixed_curve_columns(k), 'a column of every curve.csv')
-        end do
+        n_loads = 0
+        if (allocated(config%loads)) n_loads = size(config%loads)
         do k = 1, size(names)
-            call add(names(k), 'the factor of channel ' // trim(names(k)))
+            name = trim(names(k))
+            length = len(name)
+            if (length <= 3) cycle
+            if (.not. any(suffixes == name(length - 2:))) cycle
+            stem = name(:length - 3)
+            if (allocated(config%supports)) then
+                do j = 1, size(config%supports)
+                    if (trim(config%supports(j)%name) == stem) then
+                        call fatal_error(error, "curve.csv would have two columns '" // name &
+                            // "' (the factor of channel " // name // " and &support '" &
+                            // stem // "'): rename one")
+                        return
+                    end if
+                end do
+            end if
+            j = load_number(stem)
+            if (j > 0 .and. any(suffixes(4:) == name(length - 2:))) then
+                call fatal_error(error, "curve.csv would have two columns '" // name &
+                    // "' (the factor of channel " // name // ' and &load #' &
+                    // format_integer(j) // '): rename the channel')
+                return
+            end if
         end do
         if (allocated(config%supports)) then
             do k = 1, size(config%supports)
-                do j = 1, size(suffixes)
-                    call add(trim(config%supports(k)%name) // suffixes(j), &
-                        "&support '" // trim(config%supports(k)%name) // "'")
-                end do
-            end do
-        end if
-        if (allocated(config%loads)) then
-            do k = 1, size(config%loads)
-                do j = 4, size(suffixes)
-                    call add(load_column_prefix(k) // suffixes(j), '&load #' // format_integer(k))
-                end do
-            end do
-        end if
-        do i = 2, size(columns)
-            do j = 1, i - 1
-                if (columns(i) == columns(j)) then
+                j = load_number(trim(config%supports(k)%name))
+                if (j > 0) then
                     call fatal_error(error, "curve.csv would have two columns '" &
-                        // trim(columns(i)) // "' (" // trim(origins(j)) // ' and ' &
-                        // trim(origins(i)) // '): rename one')
+                        // trim(config%supports(k)%name) // "_ux' (&support '" &
+                        // trim(config%supports(k)%name) // "' and &load #" &
+                        // format_integer(j) // '): rename the support')
                     return
                 end if
             end do
-        end do
+        end if
     contains
-        subroutine add(column, origin)
-            character(len=*), intent(in) :: column, origin
-            columns = [columns, [character(len=len(columns)) :: column]]
-            origins = [origins, [character(len=len(origins)) :: origin]]
-        end subroutine add
+        !> k if `text` is load_column_prefix(k) of an existing &load, else 0.
+        integer function load_number(text)
+            character(len=*), intent(in) :: text
+            integer :: status
+
+            load_number = 0
+            if (len(text) < 6) return
+            if (text(:5) /= 'load_') return
+            if (verify(text(6:), '0123456789') /= 0) return
+            read(text(6:), *, iostat=status) load_number
+            if (status /= 0) load_number = 0
+            if (load_number < 1 .or. load_number > n_loads) then
+                load_number = 0
+            else if (load_column_prefix(load_number) /= text) then
+                load_number = 0          ! 'load_01' is no column name
+            end if
+        end function load_number
     end subroutine check_curve_columns
 
 end module yarnfort_input_channel_checks
