@@ -109,7 +109,8 @@ def test_general_law_from_python(tmp_path):
     np.testing.assert_allclose(d_dt, np.exp(mu * alpha), rtol=1e-13)
     np.testing.assert_allclose(d_da, mu * exact, rtol=1e-13)
     with pytest.raises(yarnfort.YarnfortError, match="rates_missing.csv"):
-        yarnfort.critical_tension("general", 1.0, 1.0, rate_table=str(tmp_path / "rates_missing.csv"))
+        yarnfort.critical_tension("general", 1.0, 1.0,
+                                  rate_table=str(tmp_path / "rates_missing.csv"))
     scene = ring_scene(tmp_path / "out")
     scene.contacts.clear()
     contact = scene.add_contact(("yarn", "stub"), "general", rate_table=str(table))

@@ -10,7 +10,8 @@
 !>     n_nodes, n_elements, n_unknowns, n_passages, step, knot (integers),
 !>     time, next_step, previous_load (reals), stepper (16 characters),
 !>     n_channels (integer), load_old, time_old (reals), have_old (integer 0 or 1),
-!>     factors(n_channels) (the load channels' factors), u(n_unknowns), u_old(n_unknowns), length0(n_elements),
+!>     factors(n_channels) (the load channels' factors), u(n_unknowns), u_old(n_unknowns),
+!>     length0(n_elements),
 !>     flow(n_passages), flow_old(n_passages) (reals), mode(n_passages) (integers),
 !>     'end-of-restart' (16 characters), then the checksum of every byte before it
 !>     (16 hex digits), so a file damaged after it was written is refused.
