@@ -326,6 +326,8 @@ class Support:
         if self.displacement is not None:
             self.displacement = _reals(self.displacement,
                                        f"&support '{self.name}' displacement", (3,))
+        if self.channel == "":
+            self.channel = None          # the default channel, as an echoed input has it
         if self.channel is not None:
             _name(self.channel, f"&support '{self.name}' channel")
 
@@ -354,6 +356,8 @@ class Load:
     def __post_init__(self) -> None:
         self.nodes = _ids(self.nodes, "&load nodes")
         self.force = _reals(self.force, "&load force", (3,))
+        if self.channel == "":
+            self.channel = None
         if self.channel is not None:
             _name(self.channel, "&load channel")
 
@@ -398,12 +402,18 @@ class LoadPath:
                 setattr(self, key, array)
         if self.channels is not None:
             names = [self.channels] if isinstance(self.channels, str) else list(self.channels)
-            self.channels = [_name(name, "&path channels") for name in names]
+            # Empty entries are unset (an echoed input lists all 8 entries).
+            names = [name for name in names if name not in (None, "")]
+            self.channels = [_name(name, "&path channels") for name in names] or None
+        if self.channels is not None:
             if len(set(self.channels)) != len(self.channels):
                 raise SceneError(f"&path channels: a name is given twice: {self.channels}")
-            if self.p_force is not None or self.p_disp is not None:
+            # Zeros are the default (an echoed input writes them), as the library reads it.
+            if any(value is not None and np.any(value != 0.0)
+                   for value in (self.p_force, self.p_disp)):
                 raise SceneError("&path: p_force or p_disp together with channels (give "
                                  "every factor in factors)")
+            self.p_force = self.p_disp = None
             if self.factors is None:
                 raise SceneError("&path channels: factors (n_knots x n_channels) missing")
             array = np.asarray(_reals(self.factors, "&path factors"), dtype=float)

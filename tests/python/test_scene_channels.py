@@ -117,3 +117,28 @@ def test_general_law_from_python(tmp_path):
     assert contact.rate_table == str(table) and not contact.extra
     assert f"rate_table = '{table}'" in scene.write(tmp_path / "general.nml").read_text()
     scene.check()
+
+
+def test_echoed_inputs_read_back_as_scenes(tmp_path):
+    """input.nml lists every entry (empty channel names, zero p_force and p_disp): a
+    Scene reads it back, with and without channels, and writes the same run again."""
+    scene = ring_scene(tmp_path / "out")
+    scene.run()
+    again = yarnfort.Scene.read(tmp_path / "out" / "input.nml")
+    assert again.path.channels == ["down", "side"] and again.path.p_force is None
+    np.testing.assert_array_equal(again.path.factors, scene.path.factors)
+    assert [load.channel for load in again.loads] == ["down", "side"]
+    assert [support.channel for support in again.supports] == [None, None]
+    plain = yarnfort.Scene("no channels")
+    plain.nodes = [[0.0, 0.0, 0.0], [1.0, -0.2, 0.0], [2.0, 0.0, 0.0]]
+    plain.add_material("yarn", "linear", stiffness=10.0)
+    plain.add_yarn("yarn", [1, 2, 3])
+    plain.add_support("ends", [1, 3])
+    plain.add_load([2], [0.0, -0.1, 0.0])
+    plain.path = yarnfort.LoadPath(time=[0.0, 1.0], p_force=[0.0, 1.0])
+    plain.output.update(folder=str(tmp_path / "plain"), progress=False)
+    plain.run()
+    echoed = yarnfort.Scene.read(tmp_path / "plain" / "input.nml")
+    assert echoed.path.channels is None
+    np.testing.assert_array_equal(echoed.path.p_force, [0.0, 1.0])
+    assert echoed.loads[0].channel is None
