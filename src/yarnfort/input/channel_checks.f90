@@ -80,6 +80,13 @@ contains
         index = 0
     end function find_channel
 
+    !> Number of values of &path factors (0 when unallocated).
+    pure integer function n_factors(path)
+        type(path_config_type), intent(in) :: path
+        n_factors = 0
+        if (allocated(path%factors)) n_factors = size(path%factors)
+    end function n_factors
+
     !> Number of given channel names (entries before the first empty one).
     pure integer function count_given(path) result(n)
         type(path_config_type), intent(in) :: path
@@ -118,8 +125,9 @@ contains
                     return
                 end if
             end do
+            ! A config built in code (tests, benchmarks) may leave factors unallocated.
             if (.not. given) then
-                if (size(path%factors) > 0) then
+                if (n_factors(path) > 0) then
                     call fatal_error(error, '&path: factors is given but channels is not ' &
                         // '(factors are the columns of the channels that channels names; ' &
                         // 'without channels give p_force and p_disp)')
@@ -138,9 +146,9 @@ contains
                         // "'p_force' / 'p_disp' as channel names if you want them)")
                     return
                 end if
-                if (size(path%factors) /= n * n_knots) then
+                if (n_factors(path) /= n * n_knots) then
                     call fatal_error(error, '&path: factors has ' &
-                        // format_integer(size(path%factors)) // ' values but the ' &
+                        // format_integer(n_factors(path)) // ' values but the ' &
                         // format_integer(n) // ' channels (' // quoted_list(path%channels(:n)) &
                         // ') at ' // format_integer(n_knots) // ' knots need ' &
                         // format_integer(n * n_knots) // ' (one row per knot, one value per ' &
