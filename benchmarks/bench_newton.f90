@@ -63,8 +63,7 @@ program bench_newton
     call new_linear_solver(linear, trim(solver_name), error)
     if (allocated(error)) call fail('bench_newton', error)
     call new_elastic_problem(problem, scene)
-    problem%p_force = 1.0_wp
-    problem%p_disp = 1.0_wp
+    problem%factors = [1.0_wp, 1.0_wp]
     call new_newton_solver(newton, problem, linear, scene%solver, error)
     if (allocated(error)) call fail('bench_newton', error)
     allocate(u(scene%dofs%n_unknowns))

@@ -63,13 +63,13 @@ contains
 
     !> Critical tension T_crit(T_min, alpha) of a friction law and its derivatives with
     !> respect to T_min and alpha at each pair (tension_min(i), angle(i)). `law`:
-    !> 'coulomb' (mu), 'adhesion' (mu, beta) or 'decaying_adhesion' (mu, beta, w_d, s_d).
-    !> Unused parameters are ignored.
-    subroutine friction_critical_tension(law, mu, beta, w_d, s_d, tension_min, angle, n, &
-            critical, dcrit_dtension, dcrit_dangle, status, message)
+    !> 'coulomb' (mu), 'adhesion' (mu, beta), 'decaying_adhesion' (mu, beta, w_d, s_d) or
+    !> 'general' (`rate_table`: CSV of T, g). Unused parameters are ignored.
+    subroutine friction_critical_tension(law, mu, beta, w_d, s_d, rate_table, tension_min, &
+            angle, n, critical, dcrit_dtension, dcrit_dangle, status, message)
         !> Length of `message`.
         integer, parameter :: text_length = 1024
-        character(len=*), intent(in) :: law
+        character(len=*), intent(in) :: law, rate_table
         real(c_double), intent(in) :: mu, beta, w_d, s_d
         integer(c_int), intent(in) :: n
         real(c_double), intent(in) :: tension_min(n), angle(n)
@@ -80,8 +80,8 @@ contains
         real(wp), allocatable :: critical_wp(:), dtension_wp(:), dangle_wp(:)
 
         call get_critical_tensions(law, real(mu, wp), real(beta, wp), real(w_d, wp), &
-            real(s_d, wp), real(tension_min, wp), real(angle, wp), critical_wp, dtension_wp, &
-            dangle_wp, error)
+            real(s_d, wp), rate_table, real(tension_min, wp), real(angle, wp), critical_wp, &
+            dtension_wp, dangle_wp, error)
         critical = real(critical_wp, c_double)
         dcrit_dtension = real(dtension_wp, c_double)
         dcrit_dangle = real(dangle_wp, c_double)

@@ -14,6 +14,8 @@ module yarnfort_facade_laws
     use yarnfort_friction_adhesion, only: adhesion_law_type, new_adhesion_law
     use yarnfort_friction_decaying_adhesion, only: decaying_adhesion_law_type, &
         new_decaying_adhesion_law
+    use yarnfort_friction_general, only: rate_table_law_type => table_law_type, &
+        read_rate_table
     implicit none
     private
 
@@ -46,11 +48,12 @@ contains
     end subroutine get_force_law_values
 
     !> Critical tension of the friction law `law` ('coulomb': mu; 'adhesion': mu, beta;
-    !> 'decaying_adhesion': mu, beta, w_d, s_d) and its derivatives with respect to T_min
-    !> and alpha, at each pair (tension_min(i), angle(i)).
-    subroutine get_critical_tensions(law, mu, beta, w_d, s_d, tension_min, angle, critical, &
-            dcritical_dtension, dcritical_dangle, error)
-        character(len=*), intent(in) :: law
+    !> 'decaying_adhesion': mu, beta, w_d, s_d; 'general': the CSV `rate_table` of T, g)
+    !> and its derivatives with respect to T_min and alpha, at each pair (tension_min(i),
+    !> angle(i)).
+    subroutine get_critical_tensions(law, mu, beta, w_d, s_d, rate_table, tension_min, angle, &
+            critical, dcritical_dtension, dcritical_dangle, error)
+        character(len=*), intent(in) :: law, rate_table
         real(wp), intent(in) :: mu, beta, w_d, s_d
         real(wp), intent(in) :: tension_min(:), angle(:)
         real(wp), allocatable, intent(out) :: critical(:), dcritical_dtension(:), &
@@ -65,7 +68,7 @@ contains
             call fatal_error(error, 'friction law: tension_min and angle differ in size')
             return
         end if
-        call new_friction_law(friction_law, law, mu, beta, w_d, s_d, error)
+        call new_friction_law(friction_law, law, mu, beta, w_d, s_d, rate_table, error)
         if (allocated(error)) return
         do i = 1, n
             call friction_law%get_critical_tension(tension_min(i), angle(i), critical(i), &
@@ -110,9 +113,9 @@ contains
     end subroutine new_force_law
 
     !> Build the friction law named `law` with the library's constructors.
-    subroutine new_friction_law(friction_law, law, mu, beta, w_d, s_d, error)
+    subroutine new_friction_law(friction_law, law, mu, beta, w_d, s_d, rate_table, error)
         class(friction_law_type), allocatable, intent(out) :: friction_law
-        character(len=*), intent(in) :: law
+        character(len=*), intent(in) :: law, rate_table
         real(wp), intent(in) :: mu, beta, w_d, s_d
         type(error_type), allocatable, intent(out) :: error
 
@@ -138,9 +141,16 @@ contains
                 call new_decaying_adhesion_law(decaying, mu, beta, w_d, s_d, error)
                 call move_alloc(decaying, friction_law)
             end block
+        case ('general')
+            block
+                type(rate_table_law_type), allocatable :: general
+                allocate(general)
+                call read_rate_table(general, trim(rate_table), error)
+                call move_alloc(general, friction_law)
+            end block
         case default
             call fatal_error(error, "friction law '" // trim(law) &
-                // "' is unknown (use coulomb, adhesion or decaying_adhesion)")
+                // "' is unknown (use coulomb, adhesion, decaying_adhesion or general)")
         end select
     end subroutine new_friction_law
 

@@ -151,10 +151,18 @@ contains
         self%stop_requested = self%notify(int(state%step, c_int), &
             real(state%time, c_double), real(self%time_start, c_double), &
             real(self%time_end, c_double), &
-            real(state%p_force, c_double), real(state%p_disp, c_double), &
+            real(channel_factor(1), c_double), real(channel_factor(2), c_double), &
             int(state%newton_iterations, c_int), real(state%newton%residual_norm, c_double), &
             int(state%n_slipping, c_int), int(state%n_passages, c_int), &
             real(state%wall_time, c_double)) /= 0_c_int
+    contains
+        !> The factor of load channel c (p_force, p_disp without &path channels); 0 if the
+        !> path has fewer channels.
+        real(wp) function channel_factor(c)
+            integer, intent(in) :: c
+            channel_factor = 0.0_wp
+            if (c <= size(state%factors)) channel_factor = state%factors(c)
+        end function channel_factor
     end subroutine on_step
 
     !> Write the restart file of the step just written; then, if the call-back asked

@@ -19,7 +19,7 @@ from ._version import __version__
 _EXPORTS: dict[str, str] = {
     "Curve": "results", "State": "results", "ResultError": "results",
     "read_curve": "results", "read_state": "results", "read_states": "results",
-    "read_run": "results",
+    "read_run": "results", "read_reactions": "results", "read_contacts": "results",
     "YarnfortError": "_native", "critical_tension": "_native", "force_law": "_native",
     "run_scene": "runner", "RunResult": "runner", "RunInterrupted": "runner",
     "Step": "runner",

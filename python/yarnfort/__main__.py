@@ -143,7 +143,10 @@ def plot_folder(folder: Path, support: str | None = None, out: Path | None = Non
     else:
         name = choose_support(curve, folder, support)
         component = _dominant_component(curve, name)
-        x = "p_disp" if np.ptp(curve["p_disp"]) > 0 else "p_force"
+        # The abscissa: p_disp if it moves, else the first load channel that does.
+        channels = curve.channels
+        moving = [c for c in channels if np.ptp(curve[c]) > 0]
+        x = "p_disp" if "p_disp" in moving else (moving or channels or ["time"])[0]
         plot_hysteresis(curve, name, component=component, x=x, ax=left)
         left.set_title(f"reaction of '{name}'")
     if states:

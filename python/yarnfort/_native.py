@@ -12,6 +12,7 @@ import functools
 import importlib
 import os
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -32,6 +33,7 @@ FRICTION_LAW_PARAMETERS: dict[str, tuple[str, ...]] = {
     "coulomb": ("friction_coefficient",),
     "adhesion": ("friction_coefficient", "adhesion"),
     "decaying_adhesion": ("friction_coefficient", "adhesion", "decay_start", "decay_end"),
+    "general": ("rate_table",),
 }
 
 
@@ -153,7 +155,7 @@ def force_law(law: str, stretch: ArrayLike, **params: float | str | os.PathLike
     return _shaped((force, dforce, energy), lam.shape)
 
 
-def critical_tension(law: str, tension_min: ArrayLike, angle: ArrayLike, **params: float
+def critical_tension(law: str, tension_min: ArrayLike, angle: ArrayLike, **params: Any
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Critical tension T_crit(T_min, alpha) of a friction law of the library.
 
@@ -161,8 +163,9 @@ def critical_tension(law: str, tension_min: ArrayLike, angle: ArrayLike, **param
     ----------
     law : str
         ``'coulomb'`` (``friction_coefficient`` mu), ``'adhesion'`` (mu and ``adhesion``
-        beta in N/rad) or ``'decaying_adhesion'`` (mu, beta, ``decay_start`` w_d and
-        ``decay_end`` s_d in N).
+        beta in N/rad), ``'decaying_adhesion'`` (mu, beta, ``decay_start`` w_d and
+        ``decay_end`` s_d in N) or ``'general'`` (``rate_table``: a CSV file of T in N and
+        g in N/rad, as ``&contact rate_table``; relative to the working directory).
     tension_min, angle : array_like
         Low-side tension T_min (N) and bending angle alpha (rad), broadcast together.
     **params
@@ -178,11 +181,14 @@ def critical_tension(law: str, tension_min: ArrayLike, angle: ArrayLike, **param
     YarnfortError
         If the library rejects the law or a parameter.
     """
-    values = list(map(float, _parameters("friction", law, FRICTION_LAW_PARAMETERS, params)))
-    mu, beta, w_d, s_d = (values + [np.nan] * 4)[:4]
+    values = _parameters("friction", law, FRICTION_LAW_PARAMETERS, params)
+    rate_table = ""
+    if law == "general":
+        rate_table = os.fspath(values.pop())
+    mu, beta, w_d, s_d = (list(map(float, values)) + [np.nan] * 4)[:4]
     tension, alpha = np.broadcast_arrays(np.asarray(tension_min, dtype=float),
                                          np.asarray(angle, dtype=float))
     critical, d_dtension, d_dangle, status, message = _facade().friction_critical_tension(
-        law, mu, beta, w_d, s_d, _flat(tension), _flat(alpha))
+        law, mu, beta, w_d, s_d, rate_table, _flat(tension), _flat(alpha))
     check_status(status, message)
     return _shaped((critical, d_dtension, d_dangle), tension.shape)

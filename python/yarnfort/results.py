@@ -64,6 +64,19 @@ class Curve:
         """Column names, in file order."""
         return list(self.columns)
 
+    @property
+    def channels(self) -> list[str]:
+        """The load channels' columns of ``curve.csv`` (``['p_force', 'p_disp']``
+        without ``&path channels``): those after ``time``, before the first support,
+        load or fabric column."""
+        out = []
+        for name in self.names[2:]:
+            if name.endswith(("_rx", "_ry", "_rz", "_ux", "_uy", "_uz")) or name in (
+                    "strain", "force_per_width", "direction"):
+                break
+            out.append(name)
+        return out
+
     def reaction(self, support: str) -> np.ndarray:
         """Reaction force of a named support set on the net.
 
@@ -88,6 +101,32 @@ class Curve:
             raise KeyError(f"curve has no support {support!r}; supports: "
                            + (", ".join(known) or "none"))
         return np.column_stack([self.columns[f"{support}_r{k}"] for k in "xyz"])
+
+    def displacement(self, name: str) -> np.ndarray:
+        """Displacement of a named support set (its applied displacement) or of a load
+        (``'load_<k>'``, the mean displacement of the nodes of ``&load`` number k).
+
+        Parameters
+        ----------
+        name : str
+            The ``&support`` name, or ``'load_1'``, ``'load_2'``, ...
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n_steps, 3), m.
+
+        Raises
+        ------
+        KeyError
+            If the curve has no such set (the message lists those it has).
+        """
+        missing = [f"{name}_u{k}" for k in "xyz" if f"{name}_u{k}" not in self.columns]
+        if missing:
+            known = [column[:-3] for column in self.columns if column.endswith("_ux")]
+            raise KeyError(f"curve has no displacement of {name!r}; sets: "
+                           + (", ".join(known) or "none"))
+        return np.column_stack([self.columns[f"{name}_u{k}"] for k in "xyz"])
 
     def to_array(self) -> np.ndarray:
         """The curve as a numpy structured array (one field per column)."""

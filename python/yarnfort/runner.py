@@ -49,7 +49,8 @@ class Step:
     time, time_start, time_end : float
         Pseudo-time of the step, and of the load path's first and last knots.
     p_force, p_disp : float
-        Load factors at the step.
+        Load factors at the step: of the channels ``p_force`` and ``p_disp``, or with
+        ``&path channels`` of the first two channels (0 for a channel the path lacks).
     iterations : int
         Newton iterations of the step.
     residual : float

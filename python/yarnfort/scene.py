@@ -221,6 +221,8 @@ class Contact:
         The name of an :class:`Obstacle` or :class:`Ring` whose law this is.
     extra : dict
         Further ``&contact`` variables.
+    rate_table : str or path, optional
+        ``'general'``: CSV file of (T in N, g in N/rad), the rate of T' = g(T).
     """
 
     materials: tuple[str, ...]
@@ -231,8 +233,11 @@ class Contact:
     decay_end: float | None = None
     at: str | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    rate_table: str | os.PathLike | None = None
 
     def __post_init__(self) -> None:
+        if self.at == "":
+            self.at = None               # a pair law, as an echoed input has it
         pair = [self.materials] if isinstance(self.materials, str) else list(self.materials)
         pair = [name for name in pair if name not in ("", None)] if self.at else pair
         if self.at is not None:
@@ -259,6 +264,11 @@ class Yarn:
         Node ids (from 1), at least two.
     elements_per_segment : int, optional
         Elements between two listed nodes.
+    length0 : array_like, optional
+        Reference length of every element (m), in order along the yarn: (len(nodes) - 1)
+        * elements_per_segment values.
+    stretch : array_like, optional
+        Initial stretch of every element instead (L0 = length / stretch).
     extra : dict
         Further ``&yarn`` variables.
     """
@@ -267,10 +277,27 @@ class Yarn:
     nodes: ArrayLike
     elements_per_segment: int | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    length0: ArrayLike | None = None
+    stretch: ArrayLike | None = None
 
     def __post_init__(self) -> None:
         _name(self.material, "&yarn material")
         self.nodes = _ids(self.nodes, f"&yarn ({self.material}) nodes", minimum=2)
+        if self.length0 is not None and self.stretch is not None:
+            raise SceneError(f"&yarn ({self.material}): length0 and stretch are both given")
+        for key in ("length0", "stretch"):
+            value = getattr(self, key)
+            if value is None:
+                continue
+            array = np.atleast_1d(_reals(value, f"&yarn ({self.material}) {key}"))
+            per_segment = 1 if self.elements_per_segment is None else int(self.elements_per_segment)
+            expected = (len(self.nodes) - 1) * per_segment
+            if array.ndim != 1 or array.size != expected:
+                raise SceneError(f"&yarn ({self.material}) {key}: {array.size} values for "
+                                 f"{expected} elements")
+            if not np.all(array > 0.0):
+                raise SceneError(f"&yarn ({self.material}) {key}: every value must be > 0")
+            setattr(self, key, array)
 
 
 @dataclass
@@ -286,9 +313,11 @@ class Support:
     fix : str
         Prescribed components, e.g. ``'xyz'`` or ``'y'``.
     displacement : array_like of 3 floats, optional
-        Displacement at p_disp = 1 (m).
+        Displacement at factor 1 of its load channel (m).
     extra : dict
         Further ``&support`` variables.
+    channel : str, optional
+        The load channel that scales the displacement (default ``'p_disp'``).
     """
 
     name: str
@@ -296,6 +325,7 @@ class Support:
     fix: str | None = None
     displacement: ArrayLike | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    channel: str | None = None
 
     def __post_init__(self) -> None:
         _name(self.name, "&support name")
@@ -306,6 +336,10 @@ class Support:
         if self.displacement is not None:
             self.displacement = _reals(self.displacement,
                                        f"&support '{self.name}' displacement", (3,))
+        if self.channel == "":
+            self.channel = None          # the default channel, as an echoed input has it
+        if self.channel is not None:
+            _name(self.channel, f"&support '{self.name}' channel")
 
 
 @dataclass
@@ -364,38 +398,52 @@ class Load:
     nodes : array_like of int
         Node ids.
     force : array_like of 3 floats
-        Force on each node at p_force = 1 (N).
+        Force on each node at factor 1 of its load channel (N).
     extra : dict
         Further ``&load`` variables.
+    channel : str, optional
+        The load channel that scales the force (default ``'p_force'``).
     """
 
     nodes: ArrayLike
     force: ArrayLike
     extra: dict[str, Any] = field(default_factory=dict)
+    channel: str | None = None
 
     def __post_init__(self) -> None:
         self.nodes = _ids(self.nodes, "&load nodes")
         self.force = _reals(self.force, "&load force", (3,))
+        if self.channel == "":
+            self.channel = None
+        if self.channel is not None:
+            _name(self.channel, "&load channel")
 
 
 @dataclass
 class LoadPath:
-    """The load path (``&path``): knots of the force and displacement factors.
+    """The load path (``&path``): knots of the load channels' factors.
 
     Parameters
     ----------
     time : array_like
         Pseudo-times of the knots (at least two).
     p_force, p_disp : array_like, optional
-        Factors at the knots (default zeros).
+        Factors at the knots of the two default channels (default zeros).
     extra : dict
         Further ``&path`` variables.
+    channels : sequence of str, optional
+        Names of independent load channels instead (``&path channels``, at most 8).
+    factors : array_like, optional
+        With ``channels``: shape (n_knots, n_channels), one row per knot (written row by
+        row, as ``&path factors`` reads them).
     """
 
     time: ArrayLike
     p_force: ArrayLike | None = None
     p_disp: ArrayLike | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    channels: list[str] | None = None
+    factors: ArrayLike | None = None
 
     def __post_init__(self) -> None:
         self.time = np.atleast_1d(_reals(self.time, "&path time"))
@@ -409,6 +457,30 @@ class LoadPath:
                     raise SceneError(f"&path {key}: {array.size} values for"
                                      f" {self.time.size} knots")
                 setattr(self, key, array)
+        if self.channels is not None:
+            names = [self.channels] if isinstance(self.channels, str) else list(self.channels)
+            # Empty entries are unset (an echoed input lists all 8 entries).
+            names = [name for name in names if name not in (None, "")]
+            self.channels = [_name(name, "&path channels") for name in names] or None
+        if self.channels is not None:
+            if len(set(self.channels)) != len(self.channels):
+                raise SceneError(f"&path channels: a name is given twice: {self.channels}")
+            # Zeros are the default (an echoed input writes them), as the library reads it.
+            if any(value is not None and np.any(value != 0.0)
+                   for value in (self.p_force, self.p_disp)):
+                raise SceneError("&path: p_force or p_disp together with channels (give "
+                                 "every factor in factors)")
+            self.p_force = self.p_disp = None
+            if self.factors is None:
+                raise SceneError("&path channels: factors (n_knots x n_channels) missing")
+            array = np.asarray(_reals(self.factors, "&path factors"), dtype=float)
+            shape = (self.time.size, len(self.channels))
+            if array.size != shape[0] * shape[1]:
+                raise SceneError(f"&path factors: {array.size} values for {shape[0]} knots "
+                                 f"x {shape[1]} channels")
+            self.factors = array.reshape(shape)
+        elif self.factors is not None:
+            raise SceneError("&path factors: given without channels")
 
 
 @dataclass
@@ -575,10 +647,11 @@ class Scene:
         materials : tuple of str
             The two material names (added before).
         law : str
-            ``'bonded'``, ``'coulomb'``, ``'adhesion'`` or ``'decaying_adhesion'``.
+            ``'bonded'``, ``'coulomb'``, ``'adhesion'``, ``'decaying_adhesion'`` or
+            ``'general'``.
         **parameters
-            ``friction_coefficient``, ``adhesion``, ``decay_start``, ``decay_end`` and
-            any further ``&contact`` variable.
+            ``friction_coefficient``, ``adhesion``, ``decay_start``, ``decay_end``,
+            ``rate_table`` and any further ``&contact`` variable.
 
         Returns
         -------
@@ -652,14 +725,17 @@ class Scene:
         nodes : array_like of int
             Node ids along the yarn (from 1).
         **variables
-            ``elements_per_segment`` and any further ``&yarn`` variable.
+            ``elements_per_segment``, ``length0`` or ``stretch`` and any further ``&yarn``
+            variable.
 
         Returns
         -------
         Yarn
             The yarn added.
         """
-        yarn = Yarn(material, nodes, variables.pop("elements_per_segment", None), variables)
+        yarn = Yarn(material, nodes, variables.pop("elements_per_segment", None),
+                    length0=variables.pop("length0", None),
+                    stretch=variables.pop("stretch", None), extra=variables)
         self._check_materials([material], "&yarn material")
         self._check_nodes(yarn.nodes, f"&yarn ({material}) nodes")
         self.yarns.append(yarn)
@@ -678,9 +754,9 @@ class Scene:
         fix : str, optional
             Prescribed components (default ``'xyz'``).
         displacement : array_like of 3 floats, optional
-            Displacement at p_disp = 1 (m).
+            Displacement at factor 1 of its channel (m).
         **variables
-            Any further ``&support`` variable.
+            ``channel`` and any further ``&support`` variable.
 
         Returns
         -------
@@ -689,7 +765,8 @@ class Scene:
         """
         if any(s.name == name for s in self.supports):
             raise SceneError(f"&support name: {name!r} is given twice")
-        support = Support(name, nodes, fix, displacement, variables)
+        support = Support(name, nodes, fix, displacement,
+                          channel=variables.pop("channel", None), extra=variables)
         self._check_nodes(support.nodes, f"&support '{name}' nodes")
         self.supports.append(support)
         return support
@@ -702,16 +779,16 @@ class Scene:
         nodes : array_like of int
             Node ids.
         force : array_like of 3 floats
-            Force on each node at p_force = 1 (N).
+            Force on each node at factor 1 of its channel (N).
         **variables
-            Any further ``&load`` variable.
+            ``channel`` and any further ``&load`` variable.
 
         Returns
         -------
         Load
             The load added.
         """
-        load = Load(nodes, force, variables)
+        load = Load(nodes, force, channel=variables.pop("channel", None), extra=variables)
         self._check_nodes(load.nodes, "&load nodes")
         self.loads.append(load)
         return load

@@ -93,12 +93,16 @@ contains
             "Newton's method (SUNDIALS KINSOL) and sparse direct linear solvers.", &
             '', &
             'A generated knitted or woven fabric (&fabric) replaces &nodes ... &load.', &
+            'Load channels: each &load and &support names a channel (&path channels, one', &
+            'column of &path factors per channel); default: p_force and p_disp.', &
+            'Per-element reference lengths: &yarn length0 or stretch (one per element).', &
             'Examples: inputs/*.nml.', &
             ''
         write(output_unit, '(a)') (trim(input_help_lines(i)), i = 1, size(input_help_lines))
         write(output_unit, '(a)') &
             '', &
-            'Writes to the &output folder: curve.csv (one row per converged step),', &
+            'Writes to the &output folder: curve.csv (one row per converged step: channel', &
+            'factors, reactions and displacements of the supports, load displacements),', &
             'state_NNNNN.vtu (5 or more digits; binary, or &output vtk_format = ''ascii'')', &
             '+ states.pvd (ParaView) and input.nml (the effective input); it lists them in', &
             '.yarnfort-manifest and deletes only files listed there, and holds the lock', &

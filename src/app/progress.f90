@@ -29,12 +29,18 @@ contains
         type(step_state_type), intent(in) :: state
         type(error_type), allocatable, intent(out) :: error
 
+        integer :: c
+
         call self%output_writer_type%on_step(scene, state, error)
         if (allocated(error) .or. .not. self%progress) return
-        write(error_unit, '("step ", i5, "  t = ", f9.5, "  p_force = ", f8.4, "  p_disp = ", &
-            & f8.4, "  newton ", i3, "  residual ", es9.2, "  ", f8.3, " s")', advance='no') &
-            state%step, state%time, state%p_force, state%p_disp, state%newton_iterations, &
-            state%newton%residual_norm, state%wall_time
+        write(error_unit, '("step ", i5, "  t = ", f9.5)', advance='no') state%step, state%time
+        ! The factor of every load channel (p_force and p_disp without &path channels).
+        do c = 1, size(state%factors)
+            write(error_unit, '("  ", a, " = ", f8.4)', advance='no') &
+                trim(scene%path%channel(c)), state%factors(c)
+        end do
+        write(error_unit, '("  newton ", i3, "  residual ", es9.2, "  ", f8.3, " s")', &
+            advance='no') state%newton_iterations, state%newton%residual_norm, state%wall_time
         if (state%n_passages > 0) then
             write(error_unit, '("  slipping ", i0, "/", i0)') state%n_slipping, state%n_passages
         else

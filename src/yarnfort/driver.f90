@@ -107,7 +107,8 @@ contains
             if (allocated(error)) return
             call writer%on_resume(restart%step, restart%time)
             stage = 'output'
-            call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time)
+            call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time, &
+                resume_previous_time=restart%time_old)
         else
             stage = 'output'
             call writer%open(scene, error)

@@ -285,10 +285,12 @@ def test_killed_run_leaves_no_stale_lock(tmp_path):
 
 # ------------------------------------------------------------------ step numbers
 
-#: Byte offsets of the fields of restart.dat (format version 2, see output/restart.f90).
+#: Byte offsets of the fields of restart.dat (format version 3, see output/restart.f90;
+#: the factors of the scenes' two default channels p_force and p_disp follow have_old).
 OFFSET = {"n_nodes": 36, "n_elements": 40, "n_unknowns": 44, "n_passages": 48, "step": 52,
           "knot": 56, "time": 60, "next_step": 68, "previous_load": 76, "stepper": 84,
-          "p_force": 100, "p_disp": 108, "load_old": 116, "have_old": 124, "u": 128}
+          "n_channels": 100, "load_old": 104, "time_old": 112, "have_old": 120, "p_force": 124,
+          "p_disp": 132, "u": 140}
 #: The file ends with a checksum (16 hex digits) of every byte before it.
 CHECKSUM_LENGTH = 16
 
@@ -423,7 +425,8 @@ def test_restart_with_a_changed_geometry_file_is_refused(tmp_path):
 
 
 def corrupt(path: Path, field: str, how: str) -> None:
-    if field in ("time", "next_step", "p_force", "p_disp", "previous_load"):
+    if field in ("time", "next_step", "p_force", "p_disp", "previous_load", "load_old",
+                 "time_old"):
         value = unpack(path, field, "<d")
         new = {"nan": float("nan"), "negative": -abs(value) - 1.0, "zero": 0.0, "tiny": 1e-300,
                "huge": 1e300, "shifted": value + 0.0123}[how]
@@ -452,7 +455,14 @@ def corrupt(path: Path, field: str, how: str) -> None:
     ("next_step", "nan", "next step NaN is not in"),
     ("next_step", "huge", "is not in [min_step"),
     ("p_disp", "shifted", "are not those of the path at its time"),
-    ("previous_load", "huge", "is not p_force + p_disp"),
+    ("previous_load", "huge", "is not the sum of its load factors"),
+    ("n_channels", "huge", "a size or flag field holds an impossible value"),
+    ("n_channels", "zero", "a size or flag field holds an impossible value"),
+    ("n_channels", "plus_one", "bytes do not fit the sizes it records"),
+    ("load_old", "huge", "the load 1.0e300 of its previous step is not the sum of the load"),
+    ("load_old", "shifted", "of its previous step is not the sum of the load factors"),
+    ("time_old", "negative", "of its previous step is not on the load path before its time"),
+    ("time_old", "shifted", "of its previous step is not the sum of the load factors at"),
     ("stepper", "", "its stepper 'elastic' is not 'friction'"),
     ("n_unknowns", "plus_one", "bytes do not fit the sizes it records"),
     ("n_unknowns", "huge", "bytes do not fit the sizes it records"),
@@ -489,6 +499,23 @@ def test_time_and_factors_changed_together_are_refused(tmp_path):
     assert proc.returncode == 2, proc.stderr
     assert ("the restart file's time 2.9999999999999999E-001 is not that of step 5 in "
             "'out/curve.csv' (2.5000000000000000E-001): the two files are not of the same "
+            "run") in proc.stderr
+
+
+def test_previous_time_and_load_changed_together_are_refused(tmp_path):
+    """The previous step's time and load moved consistently along the path (the
+    predictor would use them) still do not fit the curve row of the step before."""
+    assert run(with_output(CAPSTAN, "out", control="max_steps = 5"), tmp_path).returncode == 0
+    path = tmp_path / "out" / "restart.dat"
+    # Step 4 at t = 0.2 (p_disp = 0.2); move it to t = 0.15 with the path's load there.
+    assert unpack(path, "time_old", "<d") == pytest.approx(0.2)
+    assert unpack(path, "load_old", "<d") == pytest.approx(0.2)
+    patch(path, "time_old", "<d", 0.15)
+    patch(path, "load_old", "<d", 0.15)
+    proc = run(with_output(CAPSTAN, "out", control="restart = .true."), tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert ("the restart file's previous time 1.4999999999999999E-001 is not that of step 4 "
+            "in 'out/curve.csv' (2.0000000000000001E-001): the two files are not of the same "
             "run") in proc.stderr
 
 

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 """Mutation fuzzing of the input: the example scenes with random damage must never crash.
 
-The example inputs ``inputs/vnet.nml``, ``inputs/capstan.nml`` and ``inputs/knit.nml`` (its
+The example inputs ``inputs/vnet.nml``, ``inputs/capstan.nml``, ``inputs/ring_sideways.nml``
+(load channels) and ``inputs/knit.nml`` (its
 table laws made linear) are mutated at random
 with a fixed seed: characters and lines deleted, inserted, duplicated or swapped, the text
 truncated, numbers replaced by extreme values (0, -1, 1e300, nan, huge integers, ...),
@@ -61,7 +62,8 @@ from test_faults import CHECKSUM_LENGTH, checksum
 from yarnfort.results import read_curve, read_state
 
 TOP = Path(__file__).resolve().parents[2]
-SEEDS = {name: (TOP / "inputs" / f"{name}.nml").read_text() for name in ("vnet", "capstan")}
+SEEDS = {name: (TOP / "inputs" / f"{name}.nml").read_text()
+         for name in ("vnet", "capstan", "ring_sideways")}
 
 
 def _without_tables(text: str) -> str:
@@ -541,14 +543,17 @@ def test_fuzz_full_run(executable, tmp_path, batch):
 
 #: Restart cases per batch, and batches.
 RESTART_BATCHES, RESTART_CASES_PER_BATCH = 2, 40
-#: Byte offsets and types of the header fields of restart.dat (format version 1, see
+#: Byte offsets and types of the header fields of restart.dat (format version 3, see
 #: src/yarnfort/output/restart.f90): after the 16-byte magic, the version and the
 #: 16-byte fingerprint come n_nodes, n_elements, n_unknowns, n_passages, step, knot
-#: (int32), time, next_step, previous_load (float64), the stepper (16 bytes), p_force,
-#: p_disp, load_old (float64) and have_old (int32); the arrays follow.
+#: (int32), time, next_step, previous_load (float64), the stepper (16 bytes),
+#: n_channels (int32), load_old, time_old (float64), have_old (int32), then the factors of the
+#: channels (float64; the seeds' first two channels: p_force and p_disp, or down and
+#: side); the arrays follow.
 RESTART_FIELDS = ([(36 + 4 * k, "<i") for k in range(6)]
                   + [(60 + 8 * k, "<d") for k in range(3)]
-                  + [(100 + 8 * k, "<d") for k in range(3)] + [(124, "<i")])
+                  + [(100, "<i"), (104, "<d"), (112, "<d"), (120, "<i"), (124, "<d"),
+                     (132, "<d")])
 INT_DAMAGE = (0, -1, 1, 2, 7, 1000, 2**31 - 1, -2**31, 123456)
 REAL_DAMAGE = (0.0, -1.0, 1e-300, 1e300, -1e300, float("nan"), float("inf"), 0.5, 2.0,
                1e8, -0.0)
@@ -590,7 +595,7 @@ def damage_restart(rng: random.Random, path: Path) -> str:
 def curve_columns(folder: Path) -> dict[str, np.ndarray]:
     curve = read_curve(folder)
     return {name: np.asarray(curve[name]) for name in curve.columns
-            if name in ("step", "p_force", "p_disp") or "_r" in name}
+            if name in ("step", "p_force", "p_disp", "down", "side") or "_r" in name}
 
 
 def run_restart_batch(executable: Path, batch: int, count: int, tmp_path: Path) -> None:

@@ -5,7 +5,7 @@ module yarnfort_assembly_assemble
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_scene, only: scene_type, get_applied_force
     use yarnfort_assembly_truss, only: get_truss_response
     use yarnfort_assembly_pattern, only: pattern_type
     implicit none
@@ -63,22 +63,23 @@ contains
         end subroutine overflow
     end subroutine assemble_internal_force
 
-    !> Residual on the unknowns: P^T (internal - p_force * external); `spring` as for
-    !> assemble_internal_force.
-    subroutine assemble_residual(scene, x, length0, p_force, residual, error, spring)
+    !> Residual on the unknowns: P^T (internal - applied force at the channels' factors);
+    !> `spring` as for assemble_internal_force.
+    subroutine assemble_residual(scene, x, length0, factors, residual, error, spring)
         type(scene_type), intent(in) :: scene
-        real(wp), intent(in) :: x(:, :), length0(:), p_force
+        real(wp), intent(in) :: x(:, :), length0(:), factors(:)
         real(wp), intent(out) :: residual(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(in), optional :: spring
-        real(wp), allocatable :: internal(:), tension(:), stretch(:)
+        real(wp), allocatable :: internal(:), tension(:), stretch(:), applied(:)
 
-        allocate(internal(size(scene%external_force)))
+        allocate(internal(size(scene%external_force, 1)), applied(size(scene%external_force, 1)))
         allocate(tension(scene%network%n_elements()), stretch(scene%network%n_elements()))
         call assemble_internal_force(scene, x, length0, internal, tension, stretch, error, &
             spring)
         if (allocated(error)) return
-        call scene%dofs%gather(internal - p_force * scene%external_force, residual)
+        call get_applied_force(scene, factors, applied)
+        call scene%dofs%gather(internal - applied, residual)
     end subroutine assemble_residual
 
     !> Jacobian values P^T K P in the slots of `pattern` (values are overwritten);

@@ -6,7 +6,7 @@
 !> not with a material stiffness or a choice of units.
 module yarnfort_assembly_scales
     use yarnfort_kinds, only: wp
-    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_scene, only: scene_type, get_node_force_scale
     use yarnfort_assembly_truss, only: get_truss_tension
     use yarnfort_material_law, only: force_law_type
     implicit none
@@ -24,16 +24,16 @@ module yarnfort_assembly_scales
 
 contains
 
-    !> For nodes at x (3, n_nodes), reference lengths length0 and load factor p_force:
+    !> For nodes at x (3, n_nodes), reference lengths length0 and channel factors:
     !> level(n) = max(largest |tension| of the elements at n, |applied force at n|),
     !> floored at node_level_floor * the largest such force of the scene (max_force);
     !> noise(n) = the rounding error of the residual at n (sum over its elements of
     !> rounding_factor * eps * (|T| + lambda dT/dlambda)). `spring` as in
     !> get_truss_tension. With no force anywhere (max_force = 0) every level is 0.
-    pure subroutine get_node_force_levels(scene, x, length0, p_force, spring, level, noise, &
+    pure subroutine get_node_force_levels(scene, x, length0, factors, spring, level, noise, &
             max_force)
         type(scene_type), intent(in) :: scene
-        real(wp), intent(in) :: x(:, :), length0(:), p_force, spring
+        real(wp), intent(in) :: x(:, :), length0(:), factors(:), spring
         real(wp), intent(out) :: level(:), noise(:), max_force
         integer :: e, n, k
         real(wp) :: tension, rounding
@@ -51,7 +51,7 @@ contains
             end associate
         end do
         do n = 1, size(level)
-            level(n) = max(level(n), abs(p_force) * norm2(scene%external_force(3 * n - 2:3 * n)))
+            level(n) = max(level(n), get_node_force_scale(scene, factors, n))
         end do
         max_force = maxval([0.0_wp, level])
         level = max(level, node_level_floor * max_force)

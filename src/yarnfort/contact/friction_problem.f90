@@ -33,7 +33,7 @@
 module yarnfort_contact_friction_problem
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_scene, only: scene_type, get_applied_force, get_node_force_scale
     use yarnfort_assembly_truss, only: get_truss_tension
     use yarnfort_assembly_pattern, only: build_clique_pattern
     use yarnfort_assembly_assemble, only: assemble_internal_force, add_element_tangents
@@ -62,7 +62,8 @@ module yarnfort_contact_friction_problem
         !> Flows are the only unknowns; positions come from `u_frozen`.
         logical :: positions_frozen = .false.
         integer :: n_x = 0, n_p = 0
-        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
+        !> Factors of the load channels.
+        real(wp), allocatable :: factors(:)
         !> Active set: mode of each passage, and the flow a stick passage keeps.
         integer, allocatable :: mode(:)
         real(wp), allocatable :: flow_target(:)
@@ -120,6 +121,7 @@ contains
         self%length_scale = scene%length_scale
         self%stick_scale = 1.0_wp / scene%length_scale
         n_elements = scene%network%n_elements()
+        allocate(self%factors(scene%path%n_channels()), source=0.0_wp)
         allocate(self%mode(self%n_p), source=mode_stick)
         allocate(self%locked(self%n_p), source=0)
         allocate(self%flow_target(self%n_p), source=0.0_wp)
@@ -206,10 +208,10 @@ contains
 
         associate(scene => self%scene)
             if (self%positions_frozen) then
-                call scene%dofs%expand(self%u_frozen, self%p_disp, self%x)
+                call scene%dofs%expand(self%u_frozen, self%factors, self%x)
                 call scene%passages%get_length0(scene%network%length0, u, self%length0)
             else
-                call scene%dofs%expand(u(1:self%n_x), self%p_disp, self%x)
+                call scene%dofs%expand(u(1:self%n_x), self%factors, self%x)
                 call scene%passages%get_length0(scene%network%length0, u(self%n_x + 1:), &
                     self%length0)
             end if
@@ -318,8 +320,7 @@ contains
         integer :: n
         level = maxval([0.0_wp, abs(self%tension)])
         do n = 1, self%scene%network%n_nodes()
-            level = max(level, abs(self%p_force) &
-                * norm2(self%scene%external_force(3 * n - 2:3 * n)))
+            level = max(level, get_node_force_scale(self%scene, self%factors, n))
         end do
     end function get_force_level
 
@@ -340,7 +341,7 @@ contains
         call self%update_state(u, error)
         if (allocated(error)) return
         allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
-        call get_node_force_levels(self%scene, self%x, self%length0, self%p_force, self%spring, &
+        call get_node_force_levels(self%scene, self%x, self%length0, self%factors, self%spring, &
             node_level, node_noise, max_force)
         row = 0
         if (.not. self%positions_frozen) then
@@ -393,7 +394,9 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer :: p, row
         real(wp) :: t_before, t_after, angle, critical, dcrit_dt, dcrit_da, flow
+        real(wp), allocatable :: applied(:)
 
+        allocate(applied(size(self%internal)))
         call self%update_state(u, error)
         if (allocated(error)) return
         row = 0
@@ -401,8 +404,8 @@ contains
         if (self%semismooth) call self%choose_modes(u(row + 1:))
         row = 0
         if (.not. self%positions_frozen) then
-            call self%scene%dofs%gather(self%internal - self%p_force * self%scene%external_force, &
-                residual(1:self%n_x))
+            call get_applied_force(self%scene, self%factors, applied)
+            call self%scene%dofs%gather(self%internal - applied, residual(1:self%n_x))
             row = self%n_x
         end if
         do p = 1, self%n_p

@@ -53,11 +53,11 @@ module yarnfort_contact_friction_stepper
         !> Accepted state: position unknowns, flows, active set, load factors.
         real(wp), allocatable :: u(:), flow(:)
         integer, allocatable :: mode(:)
-        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
+        real(wp), allocatable :: factors(:)
         !> Trial state of the last successful try_step.
         real(wp), allocatable :: u_trial(:), flow_trial(:)
         integer, allocatable :: mode_trial(:)
-        real(wp) :: p_force_trial = 0.0_wp, p_disp_trial = 0.0_wp
+        real(wp), allocatable :: factors_trial(:)
         !> The accepted state before the current one, for a secant predictor.
         real(wp), allocatable :: u_old(:), flow_old(:)
         real(wp) :: load_old = 0.0_wp
@@ -122,20 +122,21 @@ contains
         call scene%dofs%restrict(scene%network%position, self%u)
         allocate(self%flow(n_p), source=0.0_wp)
         allocate(self%mode(n_p), source=mode_stick)
+        allocate(self%factors(scene%path%n_channels()), source=0.0_wp)
+        self%factors_trial = self%factors
         self%u_trial = self%u
         self%flow_trial = self%flow
         self%mode_trial = self%mode
     end subroutine new_friction_stepper
 
-    subroutine try_step(self, p_force, p_disp, stats, iterations, error)
+    subroutine try_step(self, factors, stats, iterations, error)
         class(friction_stepper_type), intent(inout) :: self
-        real(wp), intent(in) :: p_force, p_disp
+        real(wp), intent(in) :: factors(:)
         type(newton_stats_type), intent(out) :: stats
         integer, intent(out) :: iterations
         type(error_type), allocatable, intent(out) :: error
 
-        self%p_force_trial = p_force
-        self%p_disp_trial = p_disp
+        self%factors_trial = factors
         self%u_trial = self%u
         self%flow_trial = self%flow
         self%mode_trial = self%mode
@@ -159,8 +160,7 @@ contains
 
         associate(problem => self%full, scene => self%scene)
             n_x = scene%dofs%n_unknowns
-            problem%p_force = self%p_force_trial
-            problem%p_disp = self%p_disp_trial
+            problem%factors = self%factors_trial
             problem%flow_target = self%flow
             unknowns = [self%u, self%flow]
             call predict(self, unknowns)
@@ -237,10 +237,8 @@ contains
         logical :: relax
 
         associate(scene => self%scene, elastic => self%elastic, sliding => self%sliding)
-            elastic%p_force = self%p_force_trial
-            elastic%p_disp = self%p_disp_trial
-            sliding%p_force = self%p_force_trial
-            sliding%p_disp = self%p_disp_trial
+            elastic%factors = self%factors_trial
+            sliding%factors = self%factors_trial
             sliding%flow_target = self%flow
             sliding%locked = 0
             allocate(flips(size(self%flow)), source=0)
@@ -463,7 +461,8 @@ contains
 
     !> Secant predictor for the monolithic unknowns: extrapolate positions and the flows
     !> of slipping passages along the last accepted increment, scaled by the ratio of
-    !> load increments, while the loading keeps its direction.
+    !> load increments (of the sum of the channels' factors), while the loading keeps its
+    !> direction.
     subroutine predict(self, unknowns)
         type(friction_stepper_type), intent(in) :: self
         real(wp), intent(inout) :: unknowns(:)
@@ -471,8 +470,8 @@ contains
         integer :: n_x
 
         if (.not. self%have_old) return
-        load = self%p_force_trial + self%p_disp_trial
-        load_now = self%p_force + self%p_disp
+        load = sum(self%factors_trial)
+        load_now = sum(self%factors)
         if (load_now == self%load_old) return
         ratio = (load - load_now) / (load_now - self%load_old)
         if (.not. (ratio > 0.0_wp .and. ratio <= 2.0_wp)) return
@@ -486,13 +485,12 @@ contains
         class(friction_stepper_type), intent(inout) :: self
         self%u_old = self%u
         self%flow_old = self%flow
-        self%load_old = self%p_force + self%p_disp
+        self%load_old = sum(self%factors)
         self%have_old = .true.
         self%u = self%u_trial
         self%flow = self%flow_trial
         self%mode = self%mode_trial
-        self%p_force = self%p_force_trial
-        self%p_disp = self%p_disp_trial
+        self%factors = self%factors_trial
     end subroutine accept
 
     subroutine get_state(self, state, error)
@@ -503,7 +501,7 @@ contains
 
         allocate(length0(self%scene%network%n_elements()))
         call self%scene%passages%get_length0(self%scene%network%length0, self%flow, length0)
-        call fill_step_state(self%scene, self%u, length0, self%p_force, self%p_disp, state, error)
+        call fill_step_state(self%scene, self%u, length0, self%factors, state, error)
         state%n_passages = size(self%mode)
         state%n_slipping = count(self%mode /= mode_stick)
     end subroutine get_state
@@ -516,8 +514,7 @@ contains
         type(restart_type), intent(inout) :: snapshot
 
         snapshot%stepper = stepper_friction
-        snapshot%p_force = self%p_force
-        snapshot%p_disp = self%p_disp
+        snapshot%factors = self%factors
         snapshot%u = self%u
         snapshot%flow = self%flow
         snapshot%mode = self%mode
@@ -562,8 +559,12 @@ contains
                 // 'element reference lengths')
             return
         end if
-        self%p_force = snapshot%p_force
-        self%p_disp = snapshot%p_disp
+        if (size(snapshot%factors) /= size(self%factors)) then
+            call fatal_error(error, 'the restart file does not match the scene: other ' &
+                // 'load channels')
+            return
+        end if
+        self%factors = snapshot%factors
         self%u = snapshot%u
         self%flow = snapshot%flow
         self%mode = snapshot%mode
@@ -571,8 +572,7 @@ contains
         self%load_old = snapshot%load_old
         self%u_old = snapshot%u_old
         self%flow_old = snapshot%flow_old
-        self%p_force_trial = self%p_force
-        self%p_disp_trial = self%p_disp
+        self%factors_trial = self%factors
         self%u_trial = self%u
         self%flow_trial = self%flow
         self%mode_trial = self%mode

@@ -4,6 +4,8 @@
 !>     # comment (to the end of the line)
 !>     node <id> <x> <y> <z>
 !>     yarn <material> <elements_per_segment> <id> <id> ... [&]
+!>     length0 <L0 of element 1> <L0 of element 2> ... [&]   (optional, after its yarn)
+!>     stretch <stretch of element 1> ... [&]                 (or this instead)
 !>
 !> Words are separated by blanks; keywords are case-insensitive. Node ids are 1..n, each
 !> defined exactly once, in any order. A yarn line ending in '&' continues on the next
@@ -32,7 +34,7 @@ contains
         type(string_type), allocatable :: words(:)
         integer :: position, line_number, first_line, n_nodes, n_yarns, id, k, i
         integer, allocatable :: node_ids(:), node_lines(:), yarn_lines(:), defined_on(:)
-        real(wp), allocatable :: node_xyz(:, :)
+        real(wp), allocatable :: node_xyz(:, :), values(:)
         type(yarn_config_type), allocatable :: grown(:)
         real(wp) :: xyz(3)
         logical :: ok
@@ -161,9 +163,47 @@ contains
                         return
                     end if
                 end do
+            case ('length0', 'stretch')
+                ! Per-element reference lengths or stretches of the yarn line before it.
+                if (n_yarns == 0) then
+                    call fail(first_line, "a '" // to_lower(words(1)%text) // "' line " &
+                        // 'belongs to the yarn line before it, and there is none')
+                    return
+                end if
+                if (allocated(yarns(n_yarns)%length0) .or. allocated(yarns(n_yarns)%stretch)) &
+                        then
+                    call fail(first_line, 'the yarn of line ' &
+                        // format_integer(yarn_lines(n_yarns)) // " already has a 'length0' " &
+                        // "or 'stretch' line (give one of them, once)")
+                    return
+                end if
+                if (size(words) < 2) then
+                    call fail(first_line, "a '" // to_lower(words(1)%text) // "' line " &
+                        // 'lists one value per element of the yarn before it')
+                    return
+                end if
+                allocate(values(size(words) - 1), stat=stat, errmsg=message)
+                if (stat /= 0) then
+                    call out_of_memory()
+                    return
+                end if
+                do k = 2, size(words)
+                    call parse_real(words(k)%text, values(k - 1), ok)
+                    if (.not. ok) then
+                        call fail(first_line, to_lower(words(1)%text) // " value '" &
+                            // words(k)%text // "' is not a number")
+                        return
+                    end if
+                end do
+                if (to_lower(words(1)%text) == 'length0') then
+                    call move_alloc(values, yarns(n_yarns)%length0)
+                else
+                    call move_alloc(values, yarns(n_yarns)%stretch)
+                end if
             case default
                 call fail(first_line, "unknown keyword '" // words(1)%text &
-                    // "' (a line is 'node ...' or 'yarn ...'; comments start with #)")
+                    // "' (a line is 'node ...', 'yarn ...', 'length0 ...' or 'stretch ...'; " &
+                    // 'comments start with #)')
                 return
             end select
         end do read_lines

@@ -6,7 +6,9 @@ module yarnfort_input_magnitudes
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: config_type
+    use yarnfort_input_config, only: config_type, name_length
+    use yarnfort_input_channel_checks, only: get_channel_names, get_channel_factors, &
+        find_channel, default_displacement_channel
     use yarnfort_text, only: format_real, format_integer
     implicit none
     private
@@ -66,24 +68,33 @@ contains
         end do
     end subroutine check_scene_size
 
-    !> The prescribed positions: initial ones plus p_disp times the displacements.
+    !> The prescribed positions: initial ones plus the factors of their channels times the
+    !> displacements (after check_channels: every channel is defined).
     subroutine check_prescribed_reach(config, error)
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
+        character(len=name_length), allocatable :: names(:)
+        real(wp), allocatable :: factors(:, :)
         real(wp) :: reach, factor
-        integer :: s, k
+        integer :: s, k, c
 
         reach = maxval(abs(config%node_positions))
-        factor = maxval(abs(config%path%p_disp))
+        names = get_channel_names(config%path)
+        factors = get_channel_factors(config%path)
         if (allocated(config%supports)) then
             do s = 1, size(config%supports)
+                c = find_channel(names, config%supports(s)%channel, &
+                    default_displacement_channel, len_trim(config%path%channels(1)) > 0)
+                factor = 0.0_wp
+                if (c > 0) factor = maxval(abs(factors(:, c)))
                 do k = 1, 3
                     associate(d => config%supports(s)%displacement(k))
                         if (.not. (abs(d) * factor + reach <= max_coordinate)) then
                             call fatal_error(error, "&support '" &
                                 // trim(config%supports(s)%name) // "': displacement(" &
                                 // format_integer(k) // ') = ' // format_real(d) &
-                                // ' times p_disp up to ' // format_real(factor) &
+                                // ' times ' // trim(names(max(c, 1))) // ' up to ' &
+                                // format_real(factor) &
                                 // ' moves nodes beyond ' // format_real(max_coordinate) &
                                 // ' m, where squared lengths overflow')
                             return

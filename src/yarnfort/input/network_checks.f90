@@ -8,7 +8,7 @@ module yarnfort_input_network_checks
     use, intrinsic :: iso_fortran_env, only: int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: config_type, name_length
+    use yarnfort_input_config, only: config_type, name_length, yarn_config_type
     use yarnfort_input_groups, only: check_yarn_variables, check_support_variables, &
         check_load_variables
     use yarnfort_input_fields, only: quoted_list, check_name
@@ -120,7 +120,12 @@ contains
                         // quoted_list(material_names) // ')' // guess)
                     return
                 end if
-                call check_yarn_variables(yarn, label, error)
+                if (allocated(yarn%length0) .and. allocated(yarn%stretch)) then
+                    call check_yarn_variables(yarn, label, error)
+                else
+                    ! Yarns of a geometry file or a generator may leave the lists unset.
+                    call check_yarn_variables(with_lists(yarn), label, error)
+                end if
                 if (allocated(error)) return
                 if (size(yarn%nodes) < 2) then
                     call fatal_error(error, label // ': nodes has ' &
@@ -128,6 +133,8 @@ contains
                         // ' node id(s); a yarn needs at least 2')
                     return
                 end if
+                call check_element_lengths(config, y, label, error)
+                if (allocated(error)) return
                 n_elements = n_elements + (size(yarn%nodes) - 1) &
                     * int(yarn%elements_per_segment, int64)
                 n_new_nodes = n_new_nodes + (size(yarn%nodes) - 1) &
@@ -177,6 +184,73 @@ contains
             end if
         end do
     end subroutine check_yarns
+
+    !> A copy of `yarn` with its unset per-element lists empty.
+    function with_lists(yarn) result(copy)
+        type(yarn_config_type), intent(in) :: yarn
+        type(yarn_config_type) :: copy
+
+        copy = yarn
+        if (.not. allocated(copy%length0)) allocate(copy%length0(0))
+        if (.not. allocated(copy%stretch)) allocate(copy%stretch(0))
+    end function with_lists
+
+    !> Per-element reference lengths of yarn y (`length0` or `stretch`): one value per
+    !> element, not both, and not on a yarn whose material has a prestress (which would
+    !> set the same lengths another way). Their ranges (> 0) are checked with the group.
+    subroutine check_element_lengths(config, y, label, error)
+        type(config_type), intent(in) :: config
+        integer, intent(in) :: y
+        character(len=*), intent(in) :: label
+        type(error_type), allocatable, intent(out) :: error
+        integer(int64) :: n_elements
+        integer :: m
+        character(len=:), allocatable :: name
+
+        associate(yarn => config%yarns(y))
+            if (is_given(yarn%length0) .and. is_given(yarn%stretch)) then
+                call fatal_error(error, label // ': length0 and stretch are both given ' &
+                    // '(each sets the reference lengths of the elements: give one)')
+                return
+            end if
+            if (is_given(yarn%length0)) then
+                name = 'length0'
+                n_elements = size(yarn%length0)
+            else if (is_given(yarn%stretch)) then
+                name = 'stretch'
+                n_elements = size(yarn%stretch)
+            else
+                return
+            end if
+            if (n_elements /= (size(yarn%nodes) - 1) * int(yarn%elements_per_segment, int64)) &
+                    then
+                call fatal_error(error, label // ': ' // name // ' has ' &
+                    // format_integer(int(n_elements)) // ' values but the yarn has ' &
+                    // format_integer(int((size(yarn%nodes) - 1) &
+                    * int(yarn%elements_per_segment, int64))) // ' elements (' &
+                    // format_integer(size(yarn%nodes) - 1) // ' segments of ' &
+                    // format_integer(yarn%elements_per_segment) &
+                    // '): give one value per element, in order along the yarn')
+                return
+            end if
+            do m = 1, size(config%materials)
+                if (trim(config%materials(m)%name) /= trim(yarn%material)) cycle
+                if (config%materials(m)%prestress > 0.0_wp) then
+                    call fatal_error(error, label // ': ' // name // " is given, but its " &
+                        // "material '" // trim(yarn%material) // "' has prestress = " &
+                        // format_real(config%materials(m)%prestress) // ' (both set the ' &
+                        // 'reference lengths: give one)')
+                    return
+                end if
+            end do
+        end associate
+    contains
+        pure logical function is_given(values)
+            real(wp), allocatable, intent(in) :: values(:)
+            is_given = allocated(values)
+            if (is_given) is_given = size(values) > 0
+        end function is_given
+    end subroutine check_element_lengths
 
     !> No two segments, of one yarn or of two, join the same two nodes: their elements
     !> would lie on top of each other (a yarn doubling back, or a yarn listed twice).

@@ -19,6 +19,7 @@ module yarnfort_input_validate
         check_duplicate_segments, check_supports, check_loads, coincidence_tolerance
     use yarnfort_input_contact_checks, only: check_contacts
     use yarnfort_input_contact_node_checks, only: check_contact_nodes, check_contact_node_laws
+    use yarnfort_input_channel_checks, only: check_channels
     use yarnfort_text, only: format_integer, format_real
     implicit none
     private
@@ -72,6 +73,8 @@ contains
             return
         end if
         call check_path(config%path, error)
+        if (allocated(error)) return
+        call check_channels(config, error)
         if (allocated(error)) return
         call check_prescribed_reach(config, error)
         if (allocated(error)) return

@@ -329,6 +329,18 @@ GROUPS = [
                 'out of the whole segment: each of its elements takes its share of the change, '
                 'in proportion to its initial length. The new nodes are material points that a '
                 'yarn does not slide through.'),
+        Var('length0', 'real', None, shape='list', unit='m', range='> 0',
+            default_doc='none (from the geometry)',
+            doc='Reference length L0 of every element of the yarn, in order along it (one '
+                'value per element: (number of nodes - 1) * elements_per_segment), so that a '
+                'measured or computed pretensioned state is given exactly. Each > 0. Not with '
+                '`stretch`, nor on a yarn whose material has a `prestress`.'),
+        Var('stretch', 'real', None, shape='list', unit='1', range='> 0',
+            default_doc='none (1)',
+            doc='Initial stretch lambda of every element of the yarn instead: L0 = l / lambda, '
+                'l the element\'s length in the initial geometry (the operation `prestress` '
+                'does with one lambda per material). One value per element, each > 0. Not with '
+                '`length0`, nor with a `prestress` of the material.'),
     ]),
     Group('support', 'repeatable',
           'A named set of nodes whose listed components are prescribed.', [
@@ -344,6 +356,12 @@ GROUPS = [
             doc='Displacement D at load factor p_disp = 1, per component. Prescribed position = '
                 'initial position + p_disp(t) * D. A nonzero component outside `fix` is an '
                 'error.'),
+        Var('channel', 'character', '', length='name_length',
+            default_doc="`''` (`'p_disp'`)",
+            doc='The load channel whose factor scales `displacement`: a name of `&path '
+                "channels`, or `'p_force'` / `'p_disp'` without them ('' is `'p_disp'`). With "
+                '`&path channels`, a support with a nonzero displacement must name one. See '
+                '*Load channels* below.'),
     ]),
     Group('load', 'repeatable',
           'A force P (N) at load factor p_force = 1 on each listed node.', [
@@ -353,6 +371,12 @@ GROUPS = [
             doc='Force P on each listed node at load factor p_force = 1. Applied force = '
                 'p_force(t) * P. A nonzero component on a coordinate that a support prescribes '
                 'is an error.'),
+        Var('channel', 'character', '', length='name_length',
+            default_doc="`''` (`'p_force'`)",
+            doc='The load channel whose factor scales `force`: a name of `&path channels`, or '
+                "`'p_force'` / `'p_disp'` without them ('' is `'p_force'`). With `&path "
+                'channels`, a load with a nonzero force must name one. See *Load channels* '
+                'below.'),
     ]),
     Group('path', 'singleton',
           'The load path as knots over pseudo-time, linear in between.', [
@@ -362,6 +386,18 @@ GROUPS = [
             doc='Force factor at each knot (scales every `&load` force).'),
         Var('p_disp', 'real', None, shape='list', unit='1', range='finite', default_doc='zeros',
             doc='Displacement factor at each knot (scales every `&support` displacement).'),
+        Var('channels', 'character', '', length='name_length', shape=8,
+            default_doc="none (`'p_force'`, `'p_disp'`)", type_doc='character(64) x 8',
+            doc='Names of independent load channels (at most 8), each one word of letters, '
+                'digits, `_`, `-`, `.`, unique, and none of the other columns of `curve.csv`. '
+                'Each `&load` and `&support` names the channel that scales it. Given, the '
+                'factors come from `factors` and `p_force`, `p_disp` may not be set. Not with '
+                '`&fabric`.'),
+        Var('factors', 'real', None, shape='list', unit='1', range='finite',
+            default_doc='none',
+            doc='With `channels`: the factor of every channel at every knot, one row per knot '
+                '(the values of the channels in the order of `channels`), so n_knots * '
+                'n_channels values.'),
     ]),
     Group('output', 'singleton',
           'Where and what to write.', [

@@ -1,9 +1,11 @@
 ! SPDX-License-Identifier: MIT
 !> Map between the solver's unknowns u and the nodal coordinates x of the network.
 !> Constrained coordinates are eliminated, not penalised: every coordinate is
-!>     x(i) = u(unknown(i)) + base(i) + p_disp * delta(i) + (g(p_disp) - 1) * gap(i),
+!>     x(i) = u(unknown(i)) + base(i) + sum_c p_c * delta(i, c) + (g(p_g) - 1) * gap(i),
 !> with unknown(i) = 0 for a prescribed coordinate (then base is its initial value and
-!> delta its prescribed displacement at p_disp = 1). A free coordinate has base = delta = 0.
+!> delta(i, c) its prescribed displacement at factor p_c = 1 of load channel c; today's
+!> p_disp is one channel). A free coordinate has base = delta = 0. p_g is the factor of
+!> channel gap_channel (p_disp).
 !> Several coordinates may share one unknown: a periodic image (eq. 53; base is the
 !> offset, delta the macroscopic stretch) or the far side of a gap-holder (gap is the
 !> holder's offset, scaled by the gap factor g, a piecewise-linear function of p_disp).
@@ -19,14 +21,17 @@ module yarnfort_network_dof_map
         !> Unknown of each coordinate 3*(node-1)+k, or 0 if prescribed.
         integer, allocatable :: unknown(:)
         real(wp), allocatable :: base(:)
-        real(wp), allocatable :: delta(:)
-        !> Gap-holder offsets (zero where there is none) and the gap factor's knots.
+        !> Prescribed displacement per coordinate and load channel (n_coordinates, n_channels).
+        real(wp), allocatable :: delta(:, :)
+        !> Gap-holder offsets (zero where there is none), the gap factor's knots and the
+        !> channel whose factor they follow.
         real(wp), allocatable :: gap(:)
+        integer :: gap_channel = 2
         real(wp), allocatable :: gap_p_disp(:), gap_factor(:)
     contains
         !> The gap factor g(p_disp) (1 without knots; constant beyond the end knots).
         procedure :: get_gap_factor
-        !> Coordinates x (3, n_nodes) from unknowns u at displacement factor p_disp.
+        !> Coordinates x (3, n_nodes) from unknowns u at the channels' factors.
         procedure :: expand
         !> Unknowns u from coordinates x (the inverse on free coordinates).
         procedure :: restrict
@@ -36,18 +41,25 @@ module yarnfort_network_dof_map
 
 contains
 
-    pure subroutine expand(self, u, p_disp, x)
+    pure subroutine expand(self, u, factors, x)
         class(dof_map_type), intent(in) :: self
-        real(wp), intent(in) :: u(:), p_disp
+        real(wp), intent(in) :: u(:), factors(:)
         real(wp), intent(out) :: x(:, :)
-        integer :: i, node, k
+        integer :: i, node, k, c
         real(wp) :: gap_change
 
-        gap_change = self%get_gap_factor(p_disp) - 1.0_wp
+        gap_change = 0.0_wp
+        if (allocated(self%gap)) then
+            if (self%gap_channel >= 1 .and. self%gap_channel <= size(factors)) &
+                gap_change = self%get_gap_factor(factors(self%gap_channel)) - 1.0_wp
+        end if
         do i = 1, size(self%unknown)
             node = (i - 1) / 3 + 1
             k = i - 3 * (node - 1)
-            x(k, node) = self%base(i) + p_disp * self%delta(i)
+            x(k, node) = self%base(i)
+            do c = 1, size(self%delta, 2)
+                x(k, node) = x(k, node) + factors(c) * self%delta(i, c)
+            end do
             if (allocated(self%gap)) x(k, node) = x(k, node) + gap_change * self%gap(i)
             if (self%unknown(i) > 0) x(k, node) = x(k, node) + u(self%unknown(i))
         end do

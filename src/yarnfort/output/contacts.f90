@@ -13,6 +13,24 @@ module yarnfort_output_contacts
     private
 
     public :: contacts_file_name, contacts_header, get_contact_rows
+    public :: passage_state_type, get_passage_states, mode_names
+    public :: mode_none, mode_code_stick, mode_code_forward, mode_code_backward, mode_code_locked
+
+    !> Codes of a passage's mode (the VTK point data `mode`; 0: no passage at the node).
+    integer, parameter :: mode_none = 0, mode_code_stick = 1, mode_code_forward = 2, &
+        mode_code_backward = 3, mode_code_locked = 4
+    !> The mode words of contacts.csv, by code 1..4.
+    character(len=8), parameter :: mode_names(4) = [character(len=8) :: 'stick', 'forward', &
+        'backward', 'locked']
+
+    !> The state of every sliding passage at a converged step (contacts.csv, VTK).
+    type :: passage_state_type
+        !> Flow (m), smaller and larger tension (N, clipped at 0), T_crit(T_min, alpha)
+        !> (N) and wrap angle alpha (rad), per passage.
+        real(wp), allocatable :: flow(:), tension_min(:), tension_max(:), critical(:), angle(:)
+        !> Mode code per passage (mode_code_*).
+        integer, allocatable :: mode(:)
+    end type passage_state_type
 
     character(len=*), parameter :: contacts_file_name = 'contacts.csv'
 
@@ -32,32 +50,26 @@ module yarnfort_output_contacts
 
 contains
 
-    !> The rows of one step, joined by newlines (no newline after the last). `mode` and
-    !> `flow` are the snapshot's. Mode: 'forward' / 'backward' while the yarn slides
-    !> towards the element after / before the node; 'locked' for a stick passage whose
-    !> element on its low-tension side is at its minimum length (`&solver
-    !> min_length_ratio`): it would slide but has no material left to give; 'stick'
-    !> otherwise.
-    function get_contact_rows(scene, state, mode, flow) result(rows)
+    !> The state of every passage at `state`; `mode` and `flow` are the snapshot's. Mode:
+    !> 'forward' / 'backward' while the yarn slides towards the element after / before
+    !> the node; 'locked' for a stick passage whose element on its low-tension side is at
+    !> its minimum length (`&solver min_length_ratio`): it would slide but has no material
+    !> left to give; 'stick' otherwise.
+    subroutine get_passage_states(scene, state, mode, flow, passages_state)
         type(scene_type), intent(in) :: scene
         type(step_state_type), intent(in) :: state
         integer, intent(in) :: mode(:)
         real(wp), intent(in) :: flow(:)
-        character(len=:), allocatable :: rows
-        character(len=:), allocatable :: step_text, mode_text, buffer
-        character(len=32) :: field
+        type(passage_state_type), intent(out) :: passages_state
         real(wp) :: t_before, t_after, angle, critical, d1, d2, dangle(3, 3)
-        integer :: p, before, after, used
+        integer :: p, before, after, n
 
-        ! Filled in place (appending to a growing string would copy it for every field):
-        ! a row has 4 integers and 5 reals of at most 32 characters and a mode word.
-        allocate(character(len=max(scene%passages%size(), 1) * (10 * (len(field) + 1) + 1)) :: &
-            buffer)
-        used = 0
-        write(field, '(i0)') state%step
-        step_text = trim(field)
+        n = scene%passages%size()
+        allocate(passages_state%flow(n), passages_state%tension_min(n), &
+            passages_state%tension_max(n), passages_state%critical(n), &
+            passages_state%angle(n), passages_state%mode(n))
         associate(passages => scene%passages, net => scene%network)
-            do p = 1, passages%size()
+            do p = 1, n
                 before = passages%element_before(p)
                 after = passages%element_after(p)
                 t_before = max(state%tension(before), 0.0_wp)
@@ -71,24 +83,63 @@ contains
                         d1, d2)
                 end associate
                 if (mode(p) == mode_forward) then
-                    mode_text = 'forward'
+                    passages_state%mode(p) = mode_code_forward
                 else if (mode(p) == mode_backward) then
-                    mode_text = 'backward'
+                    passages_state%mode(p) = mode_code_backward
                 else if ((t_after >= t_before .and. at_minimum(before)) &
                         .or. (t_before >= t_after .and. at_minimum(after))) then
-                    mode_text = 'locked'
+                    passages_state%mode(p) = mode_code_locked
                 else
-                    mode_text = 'stick'
+                    passages_state%mode(p) = mode_code_stick
                 end if
+                passages_state%flow(p) = flow(p)
+                passages_state%tension_min(p) = min(t_before, t_after)
+                passages_state%tension_max(p) = max(t_before, t_after)
+                passages_state%critical(p) = critical
+                passages_state%angle(p) = angle
+            end do
+        end associate
+    contains
+        !> Whether element e's reference length is at its minimum.
+        logical function at_minimum(e)
+            integer, intent(in) :: e
+            at_minimum = state%length0(e) <= (scene%solver%min_length_ratio &
+                + length_round_off) * scene%network%length0(e)
+        end function at_minimum
+    end subroutine get_passage_states
+
+    !> The rows of one step, joined by newlines (no newline after the last); modes as
+    !> get_passage_states gives them.
+    function get_contact_rows(scene, state, mode, flow) result(rows)
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: mode(:)
+        real(wp), intent(in) :: flow(:)
+        character(len=:), allocatable :: rows
+        character(len=:), allocatable :: step_text, buffer
+        character(len=32) :: field
+        type(passage_state_type) :: passages_state
+        integer :: p, used
+
+        call get_passage_states(scene, state, mode, flow, passages_state)
+        ! Filled in place (appending to a growing string would copy it for every field):
+        ! a row has 4 integers and 5 reals of at most 32 characters and a mode word.
+        allocate(character(len=max(scene%passages%size(), 1) * (10 * (len(field) + 1) + 1)) :: &
+            buffer)
+        used = 0
+        write(field, '(i0)') state%step
+        step_text = trim(field)
+        associate(passages => scene%passages, ps => passages_state)
+            do p = 1, passages%size()
                 if (used > 0) call put(achar(10))
                 write(field, '(i0, ",", i0, ",", i0)') p, passages%node(p), passages%yarn(p)
                 call put(step_text // ',' // trim(field))
-                call append(flow(p))
-                call put(',' // mode_text)
-                call append(min(t_before, t_after))
-                call append(max(t_before, t_after))
-                call append(critical)
-                call append(angle)
+                call append(ps%flow(p))
+                call put(',' // trim(mode_names(ps%mode(p))))
+                call append(ps%tension_min(p))
+                call append(ps%tension_max(p))
+                call append(ps%critical(p))
+                call append(ps%angle(p))
             end do
         end associate
         rows = buffer(:used)
@@ -104,13 +155,6 @@ contains
             buffer(used + 1:used + len(text)) = text
             used = used + len(text)
         end subroutine put
-
-        !> Whether element e's reference length is at its minimum.
-        logical function at_minimum(e)
-            integer, intent(in) :: e
-            at_minimum = state%length0(e) <= (scene%solver%min_length_ratio &
-                + length_round_off) * scene%network%length0(e)
-        end function at_minimum
     end function get_contact_rows
 
 end module yarnfort_output_contacts

@@ -9,12 +9,14 @@ module yarnfort_output_curve
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_text, only: read_line
+    use yarnfort_input_channel_checks, only: load_column_prefix
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, open_append, &
         flush_checked, truncate_file
     implicit none
     private
 
-    public :: curve_writer_type, curve_file_name
+    public :: curve_writer_type, curve_file_name, get_support_displacement
+    public :: get_load_displacement
 
     character(len=*), parameter :: curve_file_name = 'curve.csv'
 
@@ -35,10 +37,15 @@ module yarnfort_output_curve
 
 contains
 
-    !> Create folder/curve.csv and write its header. Columns: step, time, p_force,
-    !> p_disp, then rx, ry, rz (N, force applied by the support on the net) for each
-    !> support set, then direction (1 loading, -1 unloading, 0 neither: sign of the
-    !> change of p_force + p_disp), passages slipping and sliding passages in all,
+    !> Create folder/curve.csv and write its header. Columns: step, time, the factor of
+    !> each load channel (p_force, p_disp without &path channels), then rx, ry, rz (N,
+    !> force applied by the support on the net) for each support set, then ux, uy, uz (m,
+    !> the mean displacement of the set's prescribed coordinates, per component; 0 for a
+    !> component it does not prescribe) for each support set, then load_<k>_ux, _uy, _uz
+    !> (m, the mean displacement of the nodes of &load #k) for each &load, then for a
+    !> fabric strain and force_per_width, then direction (1 loading, -1 unloading, 0
+    !> neither: sign of the change of the sum of the channels' factors), passages
+    !> slipping and sliding passages in all,
     !> Newton iterations of the step (all solves), final scaled residual, step cuts and
     !> wall time (s) of the step.
     subroutine open_curve(self, folder, scene, error)
@@ -101,28 +108,31 @@ contains
     !> append from there. The kept rows go to a temporary file renamed over the old one,
     !> so an interruption leaves the old file. Fails if the file is missing, has other
     !> columns than `scene` writes, or has no row for `step`.
-    !> The row of `step` must have the pseudo-time `time` (that of the restart file).
-    subroutine resume_curve(self, folder, scene, step, error, time)
+    !> The row of `step` must have the pseudo-time `time` (that of the restart file), and
+    !> the row of step - 1 (when step > 0 and the file has it) `previous_time`.
+    subroutine resume_curve(self, folder, scene, step, error, time, previous_time)
         class(curve_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: folder
         type(scene_type), intent(in) :: scene
         integer, intent(in) :: step
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: time
+        real(wp), intent(in), optional :: time, previous_time
 
-        call self%resume_table(folder, curve_file_name, get_header(scene), step, error, time)
+        call self%resume_table(folder, curve_file_name, get_header(scene), step, error, time, &
+            previous_time=previous_time)
     end subroutine resume_curve
 
     !> Continue folder/name (header `header`) after `step` as resume_curve does: rows are
     !> lines whose first field is their step; a step may have several rows (long format).
     !> With `row_required` false (default true), a step without rows is accepted (a
     !> file that has none for any step, e.g. of a scene with nothing to report).
-    subroutine resume_table(self, folder, name, header, step, error, time, row_required)
+    subroutine resume_table(self, folder, name, header, step, error, time, row_required, &
+            previous_time)
         class(curve_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: folder, name, header
         integer, intent(in) :: step
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: time
+        real(wp), intent(in), optional :: time, previous_time
         logical, intent(in), optional :: row_required
         type(error_type), allocatable :: ignored
         character(len=:), allocatable :: path, temporary, line
@@ -130,7 +140,7 @@ contains
         character(len=256) :: message
         integer :: old, new, status, row_step, comma, last_kept, write_status
         character(len=256) :: read_message
-        real(wp) :: row_time
+        real(wp) :: row_time, row_time_previous
 
         path = folder // '/' // name
         temporary = path // '.tmp'
@@ -157,6 +167,7 @@ contains
         write(new, '(a)', iostat=write_status, iomsg=message) header
         last_kept = -1
         row_time = -huge(row_time)
+        row_time_previous = -huge(row_time)
         do
             call read_line(old, line, status, read_message)
             if (status /= 0) exit
@@ -173,6 +184,9 @@ contains
                 ! The time field is the second one (list-directed: up to the comma).
                 read(line(comma + 1:), *, iostat=status) row_time
                 if (status /= 0) row_time = -huge(row_time)
+            else if (row_step == step - 1) then
+                read(line(comma + 1:), *, iostat=status) row_time_previous
+                if (status /= 0) row_time_previous = -huge(row_time)
             end if
         end do
         close(old)
@@ -209,6 +223,21 @@ contains
                 return
             end if
         end if
+        ! (A folder whose rows were renumbered may lack the row before: then unchecked.)
+        if (present(previous_time) .and. step > 0 .and. row_time_previous > -huge(row_time)) &
+                then
+            if (.not. abs(row_time_previous - previous_time) &
+                    <= 2 * spacing(max(abs(previous_time), tiny(previous_time)))) then
+                call remove_file(temporary, ignored)
+                write(text, '(i0)') step - 1
+                call fatal_error(error, "&control restart: the restart file's previous " &
+                    // 'time ' // format_real_text(previous_time) // ' is not that of step ' &
+                    // trim(text) // " in '" // path // "' (" &
+                    // format_real_text(row_time_previous) // '): the two files are not ' &
+                    // 'of the same run')
+                return
+            end if
+        end if
         call rename_file(temporary, path, error)
         if (allocated(error)) return
         self%path = path
@@ -231,11 +260,24 @@ contains
         character(len=:), allocatable :: name
         integer :: s
 
-        header = 'step,time,p_force,p_disp'
+        header = 'step,time'
+        do s = 1, size(scene%path%channel)
+            header = header // ',' // trim(scene%path%channel(s))
+        end do
         do s = 1, size(scene%supports)
             name = trim(scene%supports(s)%name)
             header = header // ',' // name // '_rx,' // name // '_ry,' // name // '_rz'
         end do
+        do s = 1, size(scene%supports)
+            name = trim(scene%supports(s)%name)
+            header = header // ',' // name // '_ux,' // name // '_uy,' // name // '_uz'
+        end do
+        if (allocated(scene%loads)) then
+            do s = 1, size(scene%loads)
+                name = load_column_prefix(s)
+                header = header // ',' // name // '_ux,' // name // '_uy,' // name // '_uz'
+            end do
+        end if
         if (scene%fabric_set > 0) header = header // ',strain,force_per_width'
         header = header // ',direction,slipping,passages,newton_iterations,residual,step_cuts,wall_time'
     end function get_header
@@ -248,19 +290,36 @@ contains
         character(len=32) :: field
         character(len=:), allocatable :: row
         integer :: s, k
+        real(wp) :: displacement(3)
 
         write(field, '(i0)') state%step
         row = trim(field)
         call append(state%time)
-        call append(state%p_force)
-        call append(state%p_disp)
+        do s = 1, size(state%factors)
+            call append(state%factors(s))
+        end do
         do s = 1, size(state%reaction, 2)
             do k = 1, 3
                 call append(state%reaction(k, s))
             end do
         end do
+        do s = 1, size(scene%supports)
+            displacement = get_support_displacement(scene, state, s)
+            do k = 1, 3
+                call append(displacement(k))
+            end do
+        end do
+        if (allocated(scene%loads)) then
+            do s = 1, size(scene%loads)
+                displacement = get_load_displacement(scene, state, s)
+                do k = 1, 3
+                    call append(displacement(k))
+                end do
+            end do
+        end if
         if (scene%fabric_set > 0) then
-            call append(state%p_disp * scene%fabric_strain)
+            ! A fabric has the two default channels: p_disp is channel 2.
+            call append(state%factors(2) * scene%fabric_strain)
             call append(state%reaction(1, scene%fabric_set) / scene%fabric_width)
         end if
         write(field, '(i0, ",", i0, ",", i0, ",", i0)') state%direction, state%n_slipping, &
@@ -282,6 +341,47 @@ contains
             row = row // ',' // trim(adjustl(field))
         end subroutine append
     end subroutine write_step
+
+    !> Mean displacement (m, from the initial position) of the coordinates support set s
+    !> prescribes, per component (0 for a component it prescribes nowhere).
+    pure function get_support_displacement(scene, state, s) result(displacement)
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: s
+        real(wp) :: displacement(3)
+        integer :: i, c, k, node, n(3)
+
+        displacement = 0.0_wp
+        n = 0
+        do i = 1, size(scene%supports(s)%coordinates)
+            c = scene%supports(s)%coordinates(i)
+            node = (c - 1) / 3 + 1
+            k = c - 3 * (node - 1)
+            displacement(k) = displacement(k) + (state%position(k, node) &
+                - scene%network%position(k, node))
+            n(k) = n(k) + 1
+        end do
+        where (n > 0) displacement = displacement / n
+    end function get_support_displacement
+
+    !> Mean displacement (m) of the nodes of &load #l.
+    pure function get_load_displacement(scene, state, l) result(displacement)
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: l
+        real(wp) :: displacement(3)
+        integer :: i, node
+
+        displacement = 0.0_wp
+        associate(nodes => scene%loads(l)%nodes)
+            do i = 1, size(nodes)
+                node = nodes(i)
+                displacement = displacement + (state%position(:, node) &
+                    - scene%network%position(:, node))
+            end do
+            if (size(nodes) > 0) displacement = displacement / size(nodes)
+        end associate
+    end function get_load_displacement
 
     !> Close the file; `error` says if the last data could not be written.
     subroutine close_curve(self, error)

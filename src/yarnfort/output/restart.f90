@@ -4,13 +4,14 @@
 !> restart.dat.tmp and renamed over restart.dat, so a run killed at any moment leaves
 !> either the previous complete file or the new one.
 !>
-!> Binary (unformatted stream, native byte order, full precision), version 2:
+!> Binary (unformatted stream, native byte order, full precision), version 3:
 !>     'yarnfort-restart' (16 characters), version (integer),
 !>     input fingerprint (16 characters),
 !>     n_nodes, n_elements, n_unknowns, n_passages, step, knot (integers),
 !>     time, next_step, previous_load (reals), stepper (16 characters),
-!>     p_force, p_disp, load_old (reals), have_old (integer 0 or 1),
-!>     u(n_unknowns), u_old(n_unknowns), length0(n_elements),
+!>     n_channels (integer), load_old, time_old (reals), have_old (integer 0 or 1),
+!>     factors(n_channels) (the load channels' factors), u(n_unknowns), u_old(n_unknowns),
+!>     length0(n_elements),
 !>     flow(n_passages), flow_old(n_passages) (reals), mode(n_passages) (integers),
 !>     'end-of-restart' (16 characters), then the checksum of every byte before it
 !>     (16 hex digits), so a file damaged after it was written is refused.
@@ -23,7 +24,7 @@ module yarnfort_output_restart
     use yarnfort_input_config, only: config_type, control_config_type, output_config_type
     use yarnfort_input_echo, only: write_config
     use yarnfort_scene_scene, only: scene_type
-    use yarnfort_text, only: resolve_path, format_integer, format_real
+    use yarnfort_text, only: resolve_path, format_integer, format_real, join_names
     use yarnfort_solver_restart, only: restart_type, stepper_elastic, stepper_friction
     use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, close_checked
     implicit none
@@ -35,7 +36,9 @@ module yarnfort_output_restart
     character(len=*), parameter :: restart_file_name = 'restart.dat'
     character(len=16), parameter :: magic = 'yarnfort-restart'
     character(len=16), parameter :: end_marker = 'end-of-restart'
-    integer, parameter :: format_version = 2
+    integer, parameter :: format_version = 3
+    !> Most load channels a restart file may hold (&path channels has at most 8).
+    integer, parameter :: max_restart_channels = 64
 
     !> Two 32-bit multiplicative hashes of the FNV-1a kind (FNV's offset basis and prime,
     !> and a second basis and prime) make the 64-bit fingerprint. Values stay below
@@ -82,8 +85,9 @@ contains
             write(unit, iostat=status, iomsg=message) magic, format_version, stamp, &
                 s%n_nodes, s%n_elements, &
                 s%n_unknowns, s%n_passages, s%step, s%knot, s%time, s%next_step, &
-                s%previous_load, stepper, s%p_force, s%p_disp, s%load_old, &
+                s%previous_load, stepper, size(s%factors), s%load_old, s%time_old, &
                 merge(1, 0, s%have_old)
+            if (status == 0) write(unit, iostat=status, iomsg=message) s%factors
             if (status == 0) call put_reals(s%u, s%n_unknowns)
             if (status == 0) call put_reals(s%u_old, s%n_unknowns)
             if (status == 0) call put_reals(s%length0, s%n_elements)
@@ -153,7 +157,7 @@ contains
         character(len=32) :: text
         integer(int64) :: state(2)
         character(len=256) :: message
-        integer :: unit, status, version, have_old
+        integer :: unit, status, version, have_old, n_channels
         integer(int64) :: file_size, position, expected
         logical :: exists
 
@@ -192,7 +196,7 @@ contains
         associate(s => snapshot)
             read(unit, iostat=status) s%input_hash, s%n_nodes, s%n_elements, s%n_unknowns, &
                 s%n_passages, s%step, s%knot, s%time, s%next_step, s%previous_load, &
-                s%stepper, s%p_force, s%p_disp, s%load_old, have_old
+                s%stepper, n_channels, s%load_old, s%time_old, have_old
             if (status /= 0) then
                 close(unit)
                 call fatal_error(error, "&control restart: '" // path &
@@ -200,7 +204,8 @@ contains
                 return
             end if
             if (min(s%n_nodes, s%n_elements, s%n_unknowns, s%n_passages) < 0 .or. &
-                    (have_old /= 0 .and. have_old /= 1)) then
+                    (have_old /= 0 .and. have_old /= 1) .or. n_channels < 1 .or. &
+                    n_channels > max_restart_channels) then
                 close(unit)
                 call fatal_error(error, "&control restart: '" // path // "' is damaged: " &
                     // 'a size or flag field holds an impossible value')
@@ -208,7 +213,7 @@ contains
             end if
             ! What follows must be exactly the arrays of these sizes and the end marker.
             inquire(unit=unit, size=file_size, pos=position)
-            expected = 8_int64 * (2_int64 * s%n_unknowns + s%n_elements &
+            expected = 8_int64 * (n_channels + 2_int64 * s%n_unknowns + s%n_elements &
                 + 2_int64 * s%n_passages) + 4_int64 * s%n_passages + len(end_marker) &
                 + len(checksum)
             if (file_size - (position - 1) /= expected) then
@@ -220,7 +225,8 @@ contains
                 return
             end if
             s%have_old = have_old /= 0
-            allocate(s%u(s%n_unknowns), s%u_old(s%n_unknowns), s%length0(s%n_elements), &
+            allocate(s%factors(n_channels), s%u(s%n_unknowns), s%u_old(s%n_unknowns), &
+                s%length0(s%n_elements), &
                 s%flow(s%n_passages), s%flow_old(s%n_passages), s%mode(s%n_passages), &
                 stat=status, errmsg=message)
             if (status /= 0) then
@@ -229,8 +235,8 @@ contains
                     // path // "': " // trim(message))
                 return
             end if
-            read(unit, iostat=status) s%u, s%u_old, s%length0, s%flow, s%flow_old, s%mode, &
-                marker, checksum
+            read(unit, iostat=status) s%factors, s%u, s%u_old, s%length0, s%flow, &
+                s%flow_old, s%mode, marker, checksum
             if (status == 0 .and. marker /= end_marker) status = -1
         end associate
         close(unit)
@@ -262,7 +268,8 @@ contains
         type(error_type), allocatable, intent(out) :: error
         character(len=200) :: file_sizes, scene_sizes
         character(len=:), allocatable :: path, expected_stepper
-        real(wp) :: t_start, t_end, span, p_force, p_disp, scale
+        real(wp) :: t_start, t_end, span, scale
+        real(wp), allocatable :: factors(:)
         integer :: n_knots
 
         path = folder // '/' // restart_file_name
@@ -329,21 +336,24 @@ contains
         end if
         ! The run computed these factors from the same time by the same code: they agree
         ! to round-off of the path's own factors.
-        call scene%path%get_factors(snapshot%time, p_force, p_disp)
-        scale = max(maxval(abs(scene%path%p_force)), maxval(abs(scene%path%p_disp)), &
-            tiny(1.0_wp))
-        if (.not. (abs(snapshot%p_force - p_force) <= factor_tolerance * scale .and. &
-                abs(snapshot%p_disp - p_disp) <= factor_tolerance * scale)) then
-            call damaged('its load factors p_force = ' // format_real(snapshot%p_force) &
-                // ', p_disp = ' // format_real(snapshot%p_disp) // ' are not those ' &
-                // 'of the path at its time (' // format_real(p_force) // ', ' &
-                // format_real(p_disp) // ')')
+        if (size(snapshot%factors) /= scene%path%n_channels()) then
+            call damaged('it has ' // format_integer(size(snapshot%factors)) // ' load ' &
+                // 'channels, the scene ' // format_integer(scene%path%n_channels()))
             return
         end if
-        if (.not. abs(snapshot%previous_load - (p_force + p_disp)) <= factor_tolerance &
-                * 2 * scale) then
+        allocate(factors(scene%path%n_channels()))
+        call scene%path%get_factors(snapshot%time, factors)
+        scale = max(maxval(abs(scene%path%factor)), tiny(1.0_wp))
+        if (.not. all(abs(snapshot%factors - factors) <= factor_tolerance * scale)) then
+            call damaged('its load factors ' // join_reals(snapshot%factors) // ' are not ' &
+                // 'those of the path at its time (' // join_reals(factors) // ') for the ' &
+                // 'channels ' // join_names(scene%path%channel, ''))
+            return
+        end if
+        if (.not. abs(snapshot%previous_load - sum(factors)) <= factor_tolerance &
+                * size(factors) * scale) then
             call damaged('its previous load ' // format_real(snapshot%previous_load) &
-                // ' is not p_force + p_disp')
+                // ' is not the sum of its load factors')
             return
         end if
         if (.not. (all(ieee_is_finite(snapshot%u)) .and. all(ieee_is_finite(snapshot%flow)))) &
@@ -366,8 +376,39 @@ contains
                 call damaged('its previous state holds a value that is not a finite number')
                 return
             end if
+            ! After step 0 the previous state is the step before: its time lies on the
+            ! path before this one (and is its curve row's, checked with curve.csv), and
+            ! its load is the path's there.
+            if (snapshot%step > 0) then
+                if (.not. (snapshot%time_old >= scene%path%time(1) .and. &
+                        snapshot%time_old < snapshot%time)) then
+                    call damaged('the time ' // format_real(snapshot%time_old) // ' of its ' &
+                        // 'previous step is not on the load path before its time ' &
+                        // format_real(snapshot%time))
+                    return
+                end if
+                call scene%path%get_factors(snapshot%time_old, factors)
+                if (.not. abs(snapshot%load_old - sum(factors)) <= factor_tolerance &
+                        * size(factors) * scale) then
+                    call damaged('the load ' // format_real(snapshot%load_old) // ' of its ' &
+                        // 'previous step is not the sum of the load factors at its time ' &
+                        // format_real(snapshot%time_old))
+                    return
+                end if
+            end if
         end if
     contains
+        function join_reals(values) result(text)
+            real(wp), intent(in) :: values(:)
+            character(len=:), allocatable :: text
+            integer :: i
+            text = ''
+            do i = 1, size(values)
+                if (i > 1) text = text // ', '
+                text = text // format_real(values(i))
+            end do
+        end function join_reals
+
         subroutine damaged(reason)
             character(len=*), intent(in) :: reason
             call fatal_error(error, "&control restart: '" // path // "' is damaged or not " &
@@ -444,8 +485,9 @@ contains
         call add_bytes(transfer(scene%network%length0, [0_int8]))
         call add_bytes(transfer(scene%external_force, [0_int8]))
         call add_bytes(transfer(scene%path%time, [0_int8]))
-        call add_bytes(transfer(scene%path%p_force, [0_int8]))
-        call add_bytes(transfer(scene%path%p_disp, [0_int8]))
+        call add_bytes(transfer(scene%path%factor, [0_int8]))
+        call add_bytes(transfer(scene%path%channel, [0_int8]))
+        call add_bytes(transfer(scene%dofs%delta, [0_int8]))
         write(hash, '(z8.8, z8.8)') state(1), state(2)
     contains
         subroutine add_bytes(bytes)

@@ -5,10 +5,15 @@
 !> Each state holds the nodes (points: current positions) and, as cells, the yarn
 !> elements followed by the links (gap-holders and periodic images, so that a fabric
 !> shows connected). Arrays:
-!> - field data: time, step, p_force, p_disp; for a fabric also strain and
+!> - field data: time, step, the factor of each load channel (p_force, p_disp without
+!>   &path channels); for a fabric also strain and
 !>   force_per_width (as in curve.csv);
 !> - point data: displacement (from the initial position), position, and for scenes
-!>   with sliding passages contact_state (0 no passage, 1 all stick, 2 a passage slips);
+!>   with sliding passages contact_state (0 no passage, 1 all stick, 2 a passage slips),
+!>   passages (the number of sliding passages at the node), and the state of one of them
+!>   (see write_state): passage (its number, 0 none), mode (0 none, 1 stick, 2 forward,
+!>   3 backward, 4 locked), flow, tension_min, tension_max, critical_tension and
+!>   wrap_angle (as in contacts.csv; 0 at nodes without a passage);
 !> - cell data: kind (0 yarn element, 1 gap-holder, 2 periodic link), yarn and material
 !>   (1-based, in input order; 0 for links), tension (N; 0 for links), stretch
 !>   (current over reference length) and L0 (reference length).
@@ -21,6 +26,7 @@ module yarnfort_output_vtk
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked
+    use yarnfort_output_contacts, only: passage_state_type, get_passage_states
     implicit none
     private
 
@@ -74,14 +80,19 @@ contains
         name = trim(buffer)
     end function get_state_name
 
-    !> Write the state file of `state` (`mode`: stick/slip mode of each passage, may be
-    !> empty), then states.pvd when due (collection_lag). A failed write removes the
-    !> incomplete state file and says why.
-    subroutine write_state(self, scene, state, mode, error)
+    !> Write the state file of `state` (`mode`, `flow`: stick/slip mode and flow of each
+    !> passage, may be empty), then states.pvd when due (collection_lag). A failed write
+    !> removes the incomplete state file and says why. A node with several passages shows
+    !> the one that matters most for stick/slip: a slipping one (forward or backward)
+    !> before a locked one before a stick one, and among those the one with the largest
+    !> tension_max (the first in passage order on a tie); `passages` tells how many there
+    !> are and contact_state whether any slips.
+    subroutine write_state(self, scene, state, mode, flow, error)
         class(vtk_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(step_state_type), intent(in) :: state
         integer, intent(in) :: mode(:)
+        real(wp), intent(in) :: flow(:)
         type(error_type), allocatable, intent(out) :: error
         type(vtu_builder_type) :: vtu
         character(len=:), allocatable :: name, path
@@ -139,10 +150,14 @@ contains
         vtu%appended = ''
         call add_reals(vtu, 'time', [state%time], 1, field=.true.)
         call add_int32(vtu, 'step', [int(state%step, int32)], field=.true.)
-        call add_reals(vtu, 'p_force', [state%p_force], 1, field=.true.)
-        call add_reals(vtu, 'p_disp', [state%p_disp], 1, field=.true.)
+        do l = 1, size(state%factors)
+            call add_reals(vtu, trim(scene%path%channel(l)), [state%factors(l)], 1, &
+                field=.true.)
+        end do
         if (scene%fabric_set > 0) then
-            call add_reals(vtu, 'strain', [state%p_disp * scene%fabric_strain], 1, field=.true.)
+            ! A fabric has the two default channels: p_disp is channel 2.
+            call add_reals(vtu, 'strain', [state%factors(2) * scene%fabric_strain], 1, &
+                field=.true.)
             call add_reals(vtu, 'force_per_width', &
                 [state%reaction(1, scene%fabric_set) / scene%fabric_width], 1, field=.true.)
         end if
@@ -163,6 +178,8 @@ contains
                 end if
             end do
             call add_int32(vtu, 'contact_state', contact)
+            if (size(mode) == scene%passages%size() .and. size(flow) == size(mode)) &
+                call add_passage_data(vtu, scene, state, mode, flow, n_nodes)
         end if
         call add_text(vtu, '</PointData>')
         call add_text(vtu, '<CellData Scalars="tension">')
@@ -296,6 +313,48 @@ contains
                 // encode_base64(bytes)
         end if
     end subroutine add_array
+
+    !> Point data of the passages: count, the shown passage (rule in write_state), its
+    !> mode code and values.
+    subroutine add_passage_data(vtu, scene, state, mode, flow, n_nodes)
+        type(vtu_builder_type), intent(inout) :: vtu
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: mode(:), n_nodes
+        real(wp), intent(in) :: flow(:)
+        !> Rank of each mode code for the choice of the shown passage (higher wins).
+        integer, parameter :: rank(0:4) = [0, 1, 3, 3, 2]
+        type(passage_state_type) :: ps
+        integer(int32), allocatable :: count(:), shown(:), code(:)
+        real(wp), allocatable :: values(:, :)
+        integer :: p, node, q
+
+        call get_passage_states(scene, state, mode, flow, ps)
+        allocate(count(n_nodes), shown(n_nodes), code(n_nodes), source=0_int32)
+        allocate(values(n_nodes, 5), source=0.0_wp)
+        do p = 1, scene%passages%size()
+            node = scene%passages%node(p)
+            count(node) = count(node) + 1
+            q = shown(node)
+            if (q > 0) then
+                if (rank(ps%mode(p)) < rank(ps%mode(q))) cycle
+                if (rank(ps%mode(p)) == rank(ps%mode(q)) .and. &
+                    .not. ps%tension_max(p) > ps%tension_max(q)) cycle
+            end if
+            shown(node) = int(p, int32)
+            code(node) = int(ps%mode(p), int32)
+            values(node, :) = [ps%flow(p), ps%tension_min(p), ps%tension_max(p), &
+                ps%critical(p), ps%angle(p)]
+        end do
+        call add_int32(vtu, 'passages', count)
+        call add_int32(vtu, 'passage', shown)
+        call add_int32(vtu, 'mode', code)
+        call add_reals(vtu, 'flow', values(:, 1), 1)
+        call add_reals(vtu, 'tension_min', values(:, 2), 1)
+        call add_reals(vtu, 'tension_max', values(:, 3), 1)
+        call add_reals(vtu, 'critical_tension', values(:, 4), 1)
+        call add_reals(vtu, 'wrap_angle', values(:, 5), 1)
+    end subroutine add_passage_data
 
     subroutine add_reals(vtu, label, values, components, field)
         type(vtu_builder_type), intent(inout) :: vtu

@@ -51,6 +51,7 @@ module yarnfort_output_writer
         !> (written by finish).
         type(step_state_type) :: last
         integer, allocatable :: last_mode(:)
+        real(wp), allocatable :: last_flow(:)
         logical :: state_due = .false.
         logical :: last_written = .true.
         !> Fingerprint of the input, stamped on the restart files (get_input_hash).
@@ -98,13 +99,14 @@ contains
     !> Lock the output folder, delete the files an earlier run listed in its manifest,
     !> and start the curve file; with `resume_step` (a restart), continue the folder's
     !> curve file and VTK states after that step instead (`resume_time`: the restart's
-    !> time, which the curve row of that step must have).
-    subroutine open_writer(self, scene, error, resume_step, resume_time)
+    !> time, which the curve row of that step must have; `resume_previous_time`: that of
+    !> the step before, for the row before).
+    subroutine open_writer(self, scene, error, resume_step, resume_time, resume_previous_time)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
         integer, intent(in), optional :: resume_step
-        real(wp), intent(in), optional :: resume_time
+        real(wp), intent(in), optional :: resume_time, resume_previous_time
         logical :: found
 
         self%vtk_every = scene%output%vtk_every
@@ -116,7 +118,8 @@ contains
             self%vtk%folder = self%folder
             call self%manifest%load(self%folder, found)
             if (present(resume_step)) then
-                call resume_files(self, scene, resume_step, error, resume_time)
+                call resume_files(self, scene, resume_step, error, resume_time, &
+                    resume_previous_time)
             else
                 call start_files(self, scene, error)
                 if (.not. allocated(error)) call start_contacts(self, error)
@@ -170,16 +173,16 @@ contains
     !> A restart after `step`: keep curve rows and the listed states up to that step,
     !> delete the listed states after it (and any that is incomplete), and rewrite the
     !> manifest and states.pvd with what is kept.
-    subroutine resume_files(self, scene, step, error, time)
+    subroutine resume_files(self, scene, step, error, time, previous_time)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         integer, intent(in) :: step
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: time
+        real(wp), intent(in), optional :: time, previous_time
         logical, allocatable :: keep(:)
         integer :: i
 
-        call self%curve%resume(self%folder, scene, step, error, time)
+        call self%curve%resume(self%folder, scene, step, error, time, previous_time)
         if (allocated(error)) return
         if (self%node_reactions) then
             call self%reactions%resume_table(self%folder, reactions_file_name, &
@@ -315,6 +318,11 @@ contains
         else
             self%last_mode = [integer :: ]
         end if
+        if (allocated(snapshot%flow)) then
+            self%last_flow = snapshot%flow
+        else
+            self%last_flow = [real(wp) :: ]
+        end if
         if (self%contact_state) then
             if (.not. allocated(snapshot%flow) .or. .not. allocated(snapshot%mode)) then
                 call fatal_error(error, "cannot write '" // self%contacts%path // "': the " &
@@ -346,7 +354,8 @@ contains
             self%last%time, error)
         if (.not. allocated(error)) then
             if (.not. allocated(self%last_mode)) self%last_mode = [integer :: ]
-            call self%vtk%write_state(scene, self%last, self%last_mode, error)
+            if (.not. allocated(self%last_flow)) self%last_flow = [real(wp) :: ]
+            call self%vtk%write_state(scene, self%last, self%last_mode, self%last_flow, error)
         end if
         call note_written(self, error)
     end subroutine write_last_state

@@ -21,6 +21,8 @@ module yarnfort_scene_builder
     use yarnfort_text, only: resolve_path
     use yarnfort_input_config, only: name_length
     use yarnfort_input_contact_node_checks, only: get_contact_node_sets, find_node_contact
+    use yarnfort_input_channel_checks, only: get_channel_names, get_channel_factors, &
+        find_channel, default_force_channel, default_displacement_channel
     implicit none
     private
 
@@ -49,10 +51,12 @@ contains
                 return
             end if
         end do
+        scene%path%channel = get_channel_names(config%path)
         call build_network(scene, config, error)
         if (allocated(error)) return
         call apply_prestress(scene, config, error)
         if (allocated(error)) return
+        call apply_element_lengths(scene, config)
         call build_constraints(scene, config, error)
         if (allocated(error)) return
         call build_links(scene, config, error)
@@ -66,8 +70,8 @@ contains
             if (config%fabric_support > 0) scene%fabric_set = config%fabric_support
         end if
         scene%path%time = config%path%time
-        scene%path%p_force = config%path%p_force
-        scene%path%p_disp = config%path%p_disp
+        scene%path%channel = get_channel_names(config%path)
+        scene%path%factor = get_channel_factors(config%path)
         scene%length_scale = sum(scene%network%length0) / size(scene%network%length0)
     end subroutine new_scene
 
@@ -204,19 +208,22 @@ contains
         type(scene_type), intent(inout) :: scene
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
-        integer :: n_coordinates, s, i, k, c, n, count
+        integer :: n_coordinates, s, i, k, c, n, count, channel
         integer, allocatable :: owner(:)
         character(len=1), parameter :: axis(3) = ['x', 'y', 'z']
         character(len=200) :: buffer
 
         n_coordinates = 3 * scene%network%n_nodes()
         allocate(owner(n_coordinates), source=0)
-        allocate(scene%dofs%base(n_coordinates), scene%dofs%delta(n_coordinates))
+        allocate(scene%dofs%base(n_coordinates), &
+            scene%dofs%delta(n_coordinates, size(scene%path%channel)))
         scene%dofs%base = 0.0_wp
         scene%dofs%delta = 0.0_wp
         allocate(scene%supports(size(config%supports)))
         do s = 1, size(config%supports)
             associate(support => config%supports(s))
+                channel = find_channel(scene%path%channel, support%channel, &
+                    default_displacement_channel, len_trim(config%path%channels(1)) > 0)
                 scene%supports(s)%name = support%name
                 allocate(scene%supports(s)%coordinates(0))
                 do i = 1, size(support%nodes)
@@ -234,7 +241,8 @@ contains
                         end if
                         owner(c) = s
                         scene%dofs%base(c) = scene%network%position(k, n)
-                        scene%dofs%delta(c) = support%displacement(k)
+                        ! Checked: a support without a channel has no displacement.
+                        if (channel > 0) scene%dofs%delta(c, channel) = support%displacement(k)
                         scene%supports(s)%coordinates = [scene%supports(s)%coordinates, c]
                     end do
                 end do
@@ -273,7 +281,7 @@ contains
                     if (owner(c) /= 0) cycle
                     owner(c) = size(config%supports) + o
                     scene%dofs%base(c) = scene%network%position(k, config%obstacles(o)%nodes(i))
-                    scene%dofs%delta(c) = 0.0_wp
+                    scene%dofs%delta(c, :) = 0.0_wp
                     held%coordinates = [held%coordinates, c]
                 end do
             end do
@@ -310,6 +318,29 @@ contains
         end do
     end subroutine apply_prestress
 
+    !> Per-element reference lengths of the yarns that give them (checked: one value per
+    !> element, > 0): `length0` as given, or `stretch` lambda as L0 = l / lambda (the
+    !> operation of apply_prestress, so that lambda_p per element gives its lengths).
+    subroutine apply_element_lengths(scene, config)
+        type(scene_type), intent(inout) :: scene
+        type(config_type), intent(in) :: config
+        integer :: y, first, last
+
+        do y = 1, size(config%yarns)
+            first = scene%network%yarn_first_element(y)
+            last = scene%network%yarn_first_element(y + 1) - 1
+            associate(yarn => config%yarns(y))
+                if (allocated(yarn%length0)) then
+                    if (size(yarn%length0) > 0) scene%network%length0(first:last) = yarn%length0
+                end if
+                if (allocated(yarn%stretch)) then
+                    if (size(yarn%stretch) > 0) scene%network%length0(first:last) = &
+                        scene%network%length0(first:last) / yarn%stretch
+                end if
+            end associate
+        end do
+    end subroutine apply_element_lengths
+
     !> Links (periodic images, eq. 53, and gap-holders): a follower node's coordinates
     !> share the unknowns of its leader (followed to the end of a chain), offset by their
     !> initial difference, plus the macroscopic stretch (periodic) or scaled by the gap
@@ -319,12 +350,15 @@ contains
         type(scene_type), intent(inout) :: scene
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
-        integer :: n_nodes, l, n, r, k, c, cr, hops
+        integer :: n_nodes, l, n, r, k, c, cr, hops, displacement_channel
         integer, allocatable :: leader(:), link_of(:), stretch_coordinates(:)
         real(wp) :: offset(3), macro(3), gap(3), step(3)
         character(len=200) :: buffer
 
         n_nodes = scene%network%n_nodes()
+        displacement_channel = max(1, find_channel(scene%path%channel, '', &
+            default_displacement_channel, .false.))
+        scene%dofs%gap_channel = displacement_channel
         allocate(scene%dofs%gap(3 * n_nodes), source=0.0_wp)
         if (allocated(config%fabric%gap_factor)) then
             scene%dofs%gap_p_disp = config%fabric%gap_factor_p_disp
@@ -386,12 +420,17 @@ contains
                 c = 3 * (n - 1) + k
                 cr = 3 * (r - 1) + k
                 scene%dofs%unknown(c) = scene%dofs%unknown(cr)
+                ! The macroscopic stretch follows p_disp (fabrics have the two default
+                ! channels; links come from fabrics only).
                 if (scene%dofs%unknown(cr) == 0) then
                     scene%dofs%base(c) = scene%dofs%base(cr) + offset(k)
-                    scene%dofs%delta(c) = scene%dofs%delta(cr) + macro(k)
+                    scene%dofs%delta(c, :) = scene%dofs%delta(cr, :)
+                    scene%dofs%delta(c, displacement_channel) = &
+                        scene%dofs%delta(cr, displacement_channel) + macro(k)
                 else
                     scene%dofs%base(c) = offset(k)
-                    scene%dofs%delta(c) = macro(k)
+                    scene%dofs%delta(c, :) = 0.0_wp
+                    scene%dofs%delta(c, displacement_channel) = macro(k)
                 end if
                 scene%dofs%gap(c) = gap(k)
             end do
@@ -428,17 +467,25 @@ contains
         end do
     end subroutine renumber_unknowns
 
+    !> External forces per load channel and the node sets of the &load groups.
     subroutine build_loads(scene, config)
         type(scene_type), intent(inout) :: scene
         type(config_type), intent(in) :: config
-        integer :: l, i, n
+        integer :: l, i, n, channel
 
-        allocate(scene%external_force(3 * scene%network%n_nodes()), source=0.0_wp)
+        allocate(scene%external_force(3 * scene%network%n_nodes(), size(scene%path%channel)), &
+            source=0.0_wp)
+        allocate(scene%loads(size(config%loads)))
         do l = 1, size(config%loads)
+            scene%loads(l)%nodes = config%loads(l)%nodes
+            channel = find_channel(scene%path%channel, config%loads(l)%channel, &
+                default_force_channel, len_trim(config%path%channels(1)) > 0)
+            ! Checked: a load without a channel has no force.
+            if (channel == 0) cycle
             do i = 1, size(config%loads(l)%nodes)
                 n = config%loads(l)%nodes(i)
-                scene%external_force(3 * n - 2:3 * n) = scene%external_force(3 * n - 2:3 * n) &
-                    + config%loads(l)%force
+                scene%external_force(3 * n - 2:3 * n, channel) = &
+                    scene%external_force(3 * n - 2:3 * n, channel) + config%loads(l)%force
             end do
         end do
     end subroutine build_loads

@@ -10,7 +10,8 @@ module yarnfort_scene_scene
     implicit none
     private
 
-    public :: scene_type, law_holder_type, support_set_type, load_path_type
+    public :: scene_type, law_holder_type, support_set_type, load_set_type, load_path_type
+    public :: get_applied_force, get_node_force_scale
 
     !> One yarn type's force law.
     type :: law_holder_type
@@ -25,11 +26,22 @@ module yarnfort_scene_scene
         integer, allocatable :: coordinates(:)
     end type support_set_type
 
-    !> Load path knots: load factors over pseudo-time, linear in between.
+    !> The nodes of one &load group (their mean displacement is reported per step).
+    type :: load_set_type
+        integer, allocatable :: nodes(:)
+    end type load_set_type
+
+    !> Load path knots: the factor of every load channel over pseudo-time, linear in
+    !> between. Without &path channels the channels are 'p_force' (every &load) and
+    !> 'p_disp' (every &support).
     type :: load_path_type
-        real(wp), allocatable :: time(:), p_force(:), p_disp(:)
+        real(wp), allocatable :: time(:)
+        !> Channel names, and the factor of each at each knot (n_knots, n_channels).
+        character(len=name_length), allocatable :: channel(:)
+        real(wp), allocatable :: factor(:, :)
     contains
         procedure :: get_factors
+        procedure :: n_channels
     end type load_path_type
 
     type :: scene_type
@@ -37,9 +49,11 @@ module yarnfort_scene_scene
         type(network_type) :: network
         type(law_holder_type), allocatable :: laws(:)
         type(dof_map_type) :: dofs
-        !> External nodal forces at p_force = 1, (3 * n_nodes).
-        real(wp), allocatable :: external_force(:)
+        !> External nodal forces at factor 1 of each load channel, (3 * n_nodes, n_channels):
+        !> the applied force is sum_c factor_c(t) * external_force(:, c).
+        real(wp), allocatable :: external_force(:, :)
         type(support_set_type), allocatable :: supports(:)
+        type(load_set_type), allocatable :: loads(:)
         type(load_path_type) :: path
         !> Sliding contact: passages and the friction laws they use (none: no sliding).
         type(passage_set_type) :: passages
@@ -51,8 +65,8 @@ module yarnfort_scene_scene
         !> material stiffness.
         real(wp) :: length_scale = 1.0_wp
         !> Generated fabrics (&fabric): the width (m) across which the fabric carries its
-        !> x force, the macroscopic strain at p_disp = 1, and the set of `supports` whose
-        !> x reaction is that force (fabric_set = 0: not a fabric).
+        !> x force, the macroscopic strain at p_disp = 1 (channel 2), and the set of
+        !> `supports` whose x reaction is that force (fabric_set = 0: not a fabric).
         real(wp) :: fabric_width = 0.0_wp
         real(wp) :: fabric_strain = 0.0_wp
         integer :: fabric_set = 0
@@ -64,31 +78,61 @@ module yarnfort_scene_scene
 
 contains
 
-    !> Load factors at pseudo-time t (clamped to the path's ends).
-    pure subroutine get_factors(self, t, p_force, p_disp)
+    !> Factors of every channel at pseudo-time t (clamped to the path's ends).
+    pure subroutine get_factors(self, t, factors)
         class(load_path_type), intent(in) :: self
         real(wp), intent(in) :: t
-        real(wp), intent(out) :: p_force, p_disp
+        real(wp), intent(out) :: factors(:)
         integer :: i, n
         real(wp) :: w
 
         n = size(self%time)
         if (t <= self%time(1)) then
-            p_force = self%p_force(1)
-            p_disp = self%p_disp(1)
+            factors = self%factor(1, :)
             return
         end if
         if (t >= self%time(n)) then
-            p_force = self%p_force(n)
-            p_disp = self%p_disp(n)
+            factors = self%factor(n, :)
             return
         end if
         do i = 1, n - 1
             if (t <= self%time(i + 1)) exit
         end do
         w = (t - self%time(i)) / (self%time(i + 1) - self%time(i))
-        p_force = (1.0_wp - w) * self%p_force(i) + w * self%p_force(i + 1)
-        p_disp = (1.0_wp - w) * self%p_disp(i) + w * self%p_disp(i + 1)
+        factors = (1.0_wp - w) * self%factor(i, :) + w * self%factor(i + 1, :)
     end subroutine get_factors
+
+    !> The applied nodal forces (3 * n_nodes) at the channels' factors.
+    pure subroutine get_applied_force(scene, factors, force)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: factors(:)
+        real(wp), intent(out) :: force(:)
+        integer :: c
+
+        force = 0.0_wp
+        do c = 1, size(scene%external_force, 2)
+            force = force + factors(c) * scene%external_force(:, c)
+        end do
+    end subroutine get_applied_force
+
+    !> An upper bound of the applied force's magnitude at node n: the sum over channels of
+    !> |factor| * |force of the channel| (with one loaded channel, exactly its magnitude).
+    pure real(wp) function get_node_force_scale(scene, factors, n) result(scale)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: factors(:)
+        integer, intent(in) :: n
+        integer :: c
+
+        scale = 0.0_wp
+        do c = 1, size(scene%external_force, 2)
+            scale = scale + abs(factors(c)) * norm2(scene%external_force(3 * n - 2:3 * n, c))
+        end do
+    end function get_node_force_scale
+
+    pure integer function n_channels(self)
+        class(load_path_type), intent(in) :: self
+        n_channels = 0
+        if (allocated(self%factor)) n_channels = size(self%factor, 2)
+    end function n_channels
 
 end module yarnfort_scene_scene

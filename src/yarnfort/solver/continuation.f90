@@ -69,8 +69,9 @@ contains
         type(restart_type), intent(in), optional :: restart
         integer, intent(in), optional :: max_steps
         logical, intent(out), optional :: stopped
-        real(wp) :: t, t_end, dt, t_next, p_force, p_disp, span, start, previous_load
+        real(wp) :: t, t_end, dt, t_next, span, start, previous_load
         real(wp) :: interval
+        real(wp), allocatable :: factors(:)
         integer :: step, cuts, knot, iterations, first_step
         type(newton_stats_type) :: stats
         type(step_state_type) :: state
@@ -79,6 +80,7 @@ contains
         character(len=200) :: buffer
 
         if (present(stopped)) stopped = .false.
+        allocate(factors(scene%path%n_channels()))
         associate(path => scene%path)
             t = path%time(1)
             t_end = path%time(size(path%time))
@@ -99,13 +101,17 @@ contains
                 knot = restart%knot
                 step = restart%step
                 previous_load = restart%previous_load
-                p_force = restart%p_force
-                p_disp = restart%p_disp
+                if (size(restart%factors) /= size(factors)) then
+                    call fatal_error(error, 'restart file: its load channels are not those ' &
+                        // 'of the load path')
+                    return
+                end if
+                factors = restart%factors
             else
                 ! Step 0: equilibrium at the first knot.
                 start = wall_time()
-                call path%get_factors(t, p_force, p_disp)
-                call stepper%try_step(p_force, p_disp, stats, iterations, error)
+                call path%get_factors(t, factors)
+                call stepper%try_step(factors, stats, iterations, error)
                 if (allocated(error)) then
                     call prefix_error(error, 'initial state (time 0)')
                     return
@@ -116,7 +122,7 @@ contains
                 knot = 2
                 call report(0)
                 if (allocated(error)) return
-                previous_load = p_force + p_disp
+                previous_load = sum(factors)
                 call checkpoint(t)
                 if (allocated(error)) return
             end if
@@ -141,8 +147,8 @@ contains
                 ! shorter step that stretch would undo (step_cut > 0.8: no cut at all).
                 if (cuts == 0 .and. path%time(knot) - t_next < 0.25_wp * dt * interval) &
                     t_next = path%time(knot)
-                call path%get_factors(t_next, p_force, p_disp)
-                call stepper%try_step(p_force, p_disp, stats, iterations, step_error)
+                call path%get_factors(t_next, factors)
+                call stepper%try_step(factors, stats, iterations, step_error)
                 if (allocated(step_error)) then
                     cuts = cuts + 1
                     call observer%on_cut(t, t_next - t, step_error%message)
@@ -191,10 +197,10 @@ contains
             if (step == 0) then
                 state%direction = 0
             else
-                state%direction = nint(sign(1.0_wp, (p_force + p_disp) - previous_load))
-                if (p_force + p_disp == previous_load) state%direction = 0
+                state%direction = nint(sign(1.0_wp, sum(factors) - previous_load))
+                if (sum(factors) == previous_load) state%direction = 0
             end if
-            previous_load = p_force + p_disp
+            previous_load = sum(factors)
             call observer%on_step(scene, state, error)
         end subroutine report
 
@@ -204,6 +210,8 @@ contains
             call stepper%save_state(snapshot)
             snapshot%step = step
             snapshot%time = time
+            ! t is still the time of the step before (checkpoint comes before t moves on).
+            snapshot%time_old = t
             snapshot%next_step = dt
             snapshot%knot = knot
             snapshot%previous_load = previous_load

@@ -17,7 +17,8 @@ module yarnfort_solver_elastic_problem
     type, extends(nonlinear_problem_type) :: elastic_problem_type
         type(scene_type), pointer :: scene => null()
         type(pattern_type) :: pattern
-        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
+        !> Factors of the load channels.
+        real(wp), allocatable :: factors(:)
         !> Current reference lengths of the elements.
         real(wp), allocatable :: length0(:)
         real(wp), allocatable :: x(:, :)
@@ -40,6 +41,7 @@ contains
         self%scene => scene
         call new_pattern(self%pattern, scene%network, scene%dofs)
         self%length0 = scene%network%length0
+        allocate(self%factors(scene%path%n_channels()), source=0.0_wp)
         allocate(self%x(3, scene%network%n_nodes()))
         self%length_scale = scene%length_scale
     end subroutine new_elastic_problem
@@ -66,8 +68,8 @@ contains
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: residual(:)
         type(error_type), allocatable, intent(out) :: error
-        call self%scene%dofs%expand(u, self%p_disp, self%x)
-        call assemble_residual(self%scene, self%x, self%length0, self%p_force, residual, error, &
+        call self%scene%dofs%expand(u, self%factors, self%x)
+        call assemble_residual(self%scene, self%x, self%length0, self%factors, residual, error, &
             self%spring)
     end subroutine evaluate_residual
 
@@ -76,7 +78,7 @@ contains
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
-        call self%scene%dofs%expand(u, self%p_disp, self%x)
+        call self%scene%dofs%expand(u, self%factors, self%x)
         call assemble_jacobian(self%scene, self%pattern, self%x, self%length0, values, error, &
             self%spring, self%tangent_spring)
     end subroutine evaluate_jacobian
@@ -91,8 +93,8 @@ contains
         real(wp) :: max_force
 
         allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
-        call self%scene%dofs%expand(u, self%p_disp, self%x)
-        call get_node_force_levels(self%scene, self%x, self%length0, self%p_force, self%spring, &
+        call self%scene%dofs%expand(u, self%factors, self%x)
+        call get_node_force_levels(self%scene, self%x, self%length0, self%factors, self%spring, &
             node_level, node_noise, max_force)
         call get_unknown_levels(self%scene, node_level, node_noise, level, noise)
     end subroutine get_row_levels

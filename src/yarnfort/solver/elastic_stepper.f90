@@ -21,8 +21,7 @@ module yarnfort_solver_elastic_stepper
         type(newton_solver_type) :: newton
         !> Accepted and trial unknowns and load factors.
         real(wp), allocatable :: u(:), u_trial(:)
-        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
-        real(wp) :: p_force_trial = 0.0_wp, p_disp_trial = 0.0_wp
+        real(wp), allocatable :: factors(:), factors_trial(:)
     contains
         procedure :: try_step
         procedure :: accept
@@ -48,37 +47,36 @@ contains
         allocate(self%u(scene%dofs%n_unknowns))
         call scene%dofs%restrict(scene%network%position, self%u)
         self%u_trial = self%u
+        allocate(self%factors(scene%path%n_channels()), source=0.0_wp)
+        self%factors_trial = self%factors
     end subroutine new_elastic_stepper
 
-    subroutine try_step(self, p_force, p_disp, stats, iterations, error)
+    subroutine try_step(self, factors, stats, iterations, error)
         class(elastic_stepper_type), intent(inout) :: self
-        real(wp), intent(in) :: p_force, p_disp
+        real(wp), intent(in) :: factors(:)
         type(newton_stats_type), intent(out) :: stats
         integer, intent(out) :: iterations
         type(error_type), allocatable, intent(out) :: error
 
-        self%problem%p_force = p_force
-        self%problem%p_disp = p_disp
+        self%problem%factors = factors
         self%u_trial = self%u
         call self%newton%solve(self%u_trial, stats, error)
         iterations = stats%iterations
-        self%p_force_trial = p_force
-        self%p_disp_trial = p_disp
+        self%factors_trial = factors
     end subroutine try_step
 
     subroutine accept(self)
         class(elastic_stepper_type), intent(inout) :: self
         self%u = self%u_trial
-        self%p_force = self%p_force_trial
-        self%p_disp = self%p_disp_trial
+        self%factors = self%factors_trial
     end subroutine accept
 
     subroutine get_state(self, state, error)
         class(elastic_stepper_type), intent(inout) :: self
         type(step_state_type), intent(inout) :: state
         type(error_type), allocatable, intent(out) :: error
-        call fill_step_state(self%scene, self%u, self%problem%length0, self%p_force, &
-            self%p_disp, state, error)
+        call fill_step_state(self%scene, self%u, self%problem%length0, self%factors, state, &
+            error)
     end subroutine get_state
 
     subroutine save_state(self, snapshot)
@@ -86,8 +84,7 @@ contains
         type(restart_type), intent(inout) :: snapshot
 
         snapshot%stepper = stepper_elastic
-        snapshot%p_force = self%p_force
-        snapshot%p_disp = self%p_disp
+        snapshot%factors = self%factors
         snapshot%u = self%u
         snapshot%length0 = self%problem%length0
     end subroutine save_state
@@ -116,10 +113,13 @@ contains
         end if
         self%u = snapshot%u
         self%u_trial = snapshot%u
-        self%p_force = snapshot%p_force
-        self%p_disp = snapshot%p_disp
-        self%p_force_trial = snapshot%p_force
-        self%p_disp_trial = snapshot%p_disp
+        if (size(snapshot%factors) /= size(self%factors)) then
+            call fatal_error(error, 'the restart file does not match the scene: other ' &
+                // 'load channels')
+            return
+        end if
+        self%factors = snapshot%factors
+        self%factors_trial = snapshot%factors
     end subroutine restore_state
 
     subroutine finalize(self)

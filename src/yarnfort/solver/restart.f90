@@ -20,22 +20,26 @@ module yarnfort_solver_restart
         character(len=16) :: input_hash = ''
         integer :: n_nodes = 0, n_elements = 0, n_unknowns = 0, n_passages = 0
         !> Continuation: the converged step, its pseudo-time, the next step size to try,
-        !> the path knot the next step heads for, and the step's p_force + p_disp (for
-        !> the loading direction of the next step).
+        !> the path knot the next step heads for, and the sum of the step's channel
+        !> factors (for the loading direction of the next step).
         integer :: step = 0, knot = 2
         real(wp) :: time = 0.0_wp, next_step = 0.0_wp, previous_load = 0.0_wp
         !> Load stepper: `stepper_elastic` or `stepper_friction`.
         character(len=16) :: stepper = ''
-        !> Accepted load factors, position unknowns and element reference lengths.
-        real(wp) :: p_force = 0.0_wp, p_disp = 0.0_wp
+        !> Accepted factors of the load channels, position unknowns and element
+        !> reference lengths.
+        real(wp), allocatable :: factors(:)
         real(wp), allocatable :: u(:), length0(:)
         !> Friction: flows and stick/slip mode of each passage; the accepted state before
-        !> (position unknowns, flows, p_force + p_disp) for the secant predictor, valid
+        !> (position unknowns, flows, sum of the factors) for the secant predictor, valid
         !> when `have_old`.
         real(wp), allocatable :: flow(:)
         integer, allocatable :: mode(:)
         logical :: have_old = .false.
         real(wp) :: load_old = 0.0_wp
+        !> Pseudo-time of the converged step before `step` (that of its curve row; the
+        !> step's own time for step 0), so that load_old can be checked against the path.
+        real(wp) :: time_old = 0.0_wp
         real(wp), allocatable :: u_old(:), flow_old(:)
     end type restart_type
 

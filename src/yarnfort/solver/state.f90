@@ -4,7 +4,7 @@ module yarnfort_solver_state
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_scene, only: scene_type, get_applied_force
     use yarnfort_assembly_assemble, only: assemble_internal_force
     use yarnfort_solver_stepper, only: step_state_type
     implicit none
@@ -15,29 +15,29 @@ module yarnfort_solver_state
 contains
 
     !> The state of the net for position unknowns u (the first n_unknowns entries are
-    !> used), reference lengths length0 and load factors.
-    subroutine fill_step_state(scene, u, length0, p_force, p_disp, state, error)
+    !> used), reference lengths length0 and the load channels' factors.
+    subroutine fill_step_state(scene, u, length0, factors, state, error)
         type(scene_type), intent(in) :: scene
-        real(wp), intent(in) :: u(:), length0(:), p_force, p_disp
+        real(wp), intent(in) :: u(:), length0(:), factors(:)
         type(step_state_type), intent(inout) :: state
         type(error_type), allocatable, intent(out) :: error
-        real(wp), allocatable :: internal(:)
+        real(wp), allocatable :: internal(:), applied(:)
         integer :: s, i, c, k, n_elements, n_coordinates
 
         n_elements = scene%network%n_elements()
-        state%p_force = p_force
-        state%p_disp = p_disp
+        state%factors = factors
         if (.not. allocated(state%position)) then
             allocate(state%position(3, scene%network%n_nodes()))
             allocate(state%tension(n_elements), state%stretch(n_elements))
         end if
         state%length0 = length0
-        call scene%dofs%expand(u(1:scene%dofs%n_unknowns), p_disp, state%position)
-        allocate(internal(3 * scene%network%n_nodes()))
+        call scene%dofs%expand(u(1:scene%dofs%n_unknowns), factors, state%position)
+        allocate(internal(3 * scene%network%n_nodes()), applied(3 * scene%network%n_nodes()))
         call assemble_internal_force(scene, state%position, length0, internal, state%tension, &
             state%stretch, error)
         if (allocated(error)) return
-        internal = internal - p_force * scene%external_force
+        call get_applied_force(scene, factors, applied)
+        internal = internal - applied
         if (allocated(state%reaction)) deallocate(state%reaction)
         allocate(state%reaction(3, size(scene%supports)), source=0.0_wp)
         if (allocated(state%coordinate_reaction)) deallocate(state%coordinate_reaction)

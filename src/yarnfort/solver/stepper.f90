@@ -14,7 +14,9 @@ module yarnfort_solver_stepper
     !> A converged state of the net.
     type :: step_state_type
         integer :: step = 0
-        real(wp) :: time = 0.0_wp, p_force = 0.0_wp, p_disp = 0.0_wp
+        real(wp) :: time = 0.0_wp
+        !> Factors of the load channels (scene%path%channel).
+        real(wp), allocatable :: factors(:)
         !> Node positions (3, n_nodes), element tension, stretch and reference length.
         real(wp), allocatable :: position(:, :), tension(:), stretch(:), length0(:)
         !> Force applied by each support set on the net, (3, n_supports).
@@ -36,7 +38,7 @@ module yarnfort_solver_stepper
 
     type, abstract :: load_stepper_type
     contains
-        !> Solve for the load factors from the last accepted state (which stays as is).
+        !> Solve for the channels' factors from the last accepted state (which stays as is).
         procedure(try_step_interface), deferred :: try_step
         !> Make the last successful trial the accepted state.
         procedure(accept_interface), deferred :: accept
@@ -49,10 +51,10 @@ module yarnfort_solver_stepper
     end type load_stepper_type
 
     abstract interface
-        subroutine try_step_interface(self, p_force, p_disp, stats, iterations, error)
+        subroutine try_step_interface(self, factors, stats, iterations, error)
             import :: load_stepper_type, wp, newton_stats_type, error_type
             class(load_stepper_type), intent(inout) :: self
-            real(wp), intent(in) :: p_force, p_disp
+            real(wp), intent(in) :: factors(:)
             type(newton_stats_type), intent(out) :: stats
             integer, intent(out) :: iterations
             type(error_type), allocatable, intent(out) :: error

@@ -30,8 +30,81 @@ contains
             new_unittest('slack_element_force_and_tangent', test_slack_element), &
             new_unittest('pattern_is_symmetric_and_sorted', test_pattern), &
             new_unittest('global_jacobian_matches_fd', test_global_jacobian), &
-            new_unittest('internal_forces_balance', test_internal_balance) ]
+            new_unittest('internal_forces_balance', test_internal_balance), &
+            new_unittest('load_channels_superpose', test_load_channels), &
+            new_unittest('path_factors_per_channel', test_path_factors) ]
     end subroutine collect_assembly
+
+    !> Two load channels: the residual at factors (a, b) is the internal force minus
+    !> a times the first channel's forces minus b times the second's, and the prescribed
+    !> coordinates move by a * delta_1 + b * delta_2.
+    subroutine test_load_channels(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(scene_type) :: scene
+        real(wp), allocatable :: u(:), x(:, :), x0(:, :), r(:), r0(:), expected(:)
+        real(wp), parameter :: a = 0.7_wp, b = -0.4_wp, identity = 100 * epsilon(1.0_wp)
+        real(wp) :: scale
+        integer :: c, node, k
+
+        call make_scene(scene, error)
+        if (allocated(error)) return
+        ! The scene's force is on channel 1; give channel 2 forces and displacements too.
+        scene%external_force(5, 2) = 0.25_wp
+        scene%external_force(11, 2) = -0.1_wp
+        do c = 1, size(scene%dofs%unknown)
+            if (scene%dofs%unknown(c) == 0) scene%dofs%delta(c, 1) = -0.02_wp * c
+        end do
+        allocate(u(scene%dofs%n_unknowns), x(3, 6), x0(3, 6), r(scene%dofs%n_unknowns), &
+            r0(scene%dofs%n_unknowns), expected(scene%dofs%n_unknowns))
+        call scene%dofs%restrict(scene%network%position, u)
+        call scene%dofs%expand(u, [a, b], x)
+        call scene%dofs%expand(u, [0.0_wp, 0.0_wp], x0)
+        scale = maxval(abs(scene%network%position))
+        do c = 1, 18
+            node = (c - 1) / 3 + 1
+            k = c - 3 * (node - 1)
+            call check_close(error, x(k, node) - x0(k, node), &
+                a * scene%dofs%delta(c, 1) + b * scene%dofs%delta(c, 2), identity, &
+                'prescribed displacement', abs_tol=identity * scale)
+            if (allocated(error)) return
+        end do
+        ! At the same positions the residuals differ by P^T (a f_1 + b f_2).
+        call assemble_residual(scene, x, scene%network%length0, [a, b], r, error)
+        if (allocated(error)) return
+        call assemble_residual(scene, x, scene%network%length0, [0.0_wp, 0.0_wp], r0, error)
+        if (allocated(error)) return
+        call scene%dofs%gather(a * scene%external_force(:, 1) + b * scene%external_force(:, 2), &
+            expected)
+        call check_close(error, r0 - r, expected, identity, 'residual of two channels', &
+            abs_tol=identity * maxval(abs(r0)))
+    end subroutine test_load_channels
+
+    !> Each channel is interpolated on its own column, clamped at the ends.
+    subroutine test_path_factors(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(scene_type) :: scene
+        real(wp) :: factors(3)
+
+        scene%path%time = [0.0_wp, 1.0_wp, 3.0_wp]
+        scene%path%factor = reshape([0.0_wp, 1.0_wp, 1.0_wp, &
+                                     0.0_wp, 0.0_wp, 2.0_wp, &
+                                     5.0_wp, -1.0_wp, 3.0_wp], [3, 3])
+        call check(error, scene%path%n_channels() == 3, 'three channels')
+        if (allocated(error)) return
+        call scene%path%get_factors(2.0_wp, factors)
+        call check_close(error, factors, [1.0_wp, 1.0_wp, 1.0_wp], 100 * epsilon(1.0_wp), &
+            'factors at t = 2')
+        if (allocated(error)) return
+        call scene%path%get_factors(0.5_wp, factors)
+        call check_close(error, factors, [0.5_wp, 0.0_wp, 2.0_wp], 100 * epsilon(1.0_wp), &
+            'factors at t = 0.5')
+        if (allocated(error)) return
+        call scene%path%get_factors(-1.0_wp, factors)
+        call check_close(error, factors, [0.0_wp, 0.0_wp, 5.0_wp], 0.0_wp, 'clamped before')
+        if (allocated(error)) return
+        call scene%path%get_factors(4.0_wp, factors)
+        call check_close(error, factors, [1.0_wp, 2.0_wp, 3.0_wp], 0.0_wp, 'clamped after')
+    end subroutine test_path_factors
 
     subroutine test_element_force(error)
         type(error_type), allocatable, intent(out) :: error
@@ -158,7 +231,7 @@ contains
         scene%network%yarn_first_element = [1, 9]
         scene%network%length0 = 0.9_wp * [1.0_wp, 1.0_wp, 1.0_wp, 1.1_wp, 1.0_wp, 1.1_wp, &
             1.0_wp, 1.4_wp]
-        allocate(scene%dofs%unknown(18), scene%dofs%base(18), scene%dofs%delta(18))
+        allocate(scene%dofs%unknown(18), scene%dofs%base(18), scene%dofs%delta(18, 2))
         scene%dofs%base = 0.0_wp
         scene%dofs%delta = 0.0_wp
         count = 0
@@ -166,15 +239,15 @@ contains
             if (any(prescribed == c)) then
                 scene%dofs%unknown(c) = 0
                 scene%dofs%base(c) = scene%network%position(mod(c - 1, 3) + 1, (c - 1) / 3 + 1)
-                scene%dofs%delta(c) = 0.05_wp * c
+                scene%dofs%delta(c, 2) = 0.05_wp * c
             else
                 count = count + 1
                 scene%dofs%unknown(c) = count
             end if
         end do
         scene%dofs%n_unknowns = count
-        allocate(scene%external_force(18), source=0.0_wp)
-        scene%external_force(8) = -0.3_wp
+        allocate(scene%external_force(18, 2), source=0.0_wp)
+        scene%external_force(8, 1) = -0.3_wp
         scene%solver%slack_stiffness = 1.0e-6_wp
     end subroutine make_scene
 
@@ -216,6 +289,7 @@ contains
         type(pattern_type) :: pattern
         real(wp), allocatable :: u(:), up(:), rp(:), rm(:), values(:), dense(:, :), x(:, :)
         real(wp), parameter :: p_disp = 0.7_wp, p_force = 0.4_wp
+        real(wp), parameter :: factors(2) = [p_force, p_disp]
         integer :: n, j, p
 
         call make_scene(scene, error)
@@ -225,7 +299,7 @@ contains
         allocate(u(n), rp(n), rm(n), values(pattern%nnz), dense(n, n), x(3, 6))
         call scene%dofs%restrict(scene%network%position, u)
         u = u + 0.03_wp * [(sin(real(3 * j, wp)), j = 1, n)]
-        call scene%dofs%expand(u, p_disp, x)
+        call scene%dofs%expand(u, factors, x)
         call assemble_jacobian(scene, pattern, x, scene%network%length0, values, error)
         if (allocated(error)) return
         dense = 0.0_wp
@@ -237,12 +311,12 @@ contains
         do j = 1, n
             up = u
             up(j) = u(j) + fd_step
-            call scene%dofs%expand(up, p_disp, x)
-            call assemble_residual(scene, x, scene%network%length0, p_force, rp, error)
+            call scene%dofs%expand(up, factors, x)
+            call assemble_residual(scene, x, scene%network%length0, factors, rp, error)
             if (allocated(error)) return
             up(j) = u(j) - fd_step
-            call scene%dofs%expand(up, p_disp, x)
-            call assemble_residual(scene, x, scene%network%length0, p_force, rm, error)
+            call scene%dofs%expand(up, factors, x)
+            call assemble_residual(scene, x, scene%network%length0, factors, rm, error)
             if (allocated(error)) return
             call check_close(error, dense(:, j), (rp - rm) / (2 * fd_step), fd_tolerance, &
                 'Jacobian column', abs_tol=fd_tolerance * maxval(abs(dense)))

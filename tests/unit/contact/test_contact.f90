@@ -138,7 +138,7 @@ contains
         allocate(u(scene%dofs%n_unknowns), x(3, scene%network%n_nodes()))
         call scene%dofs%restrict(scene%network%position, u)
         u = u + 0.01_wp * [(sin(real(3 * j, wp)), j = 1, size(u))]
-        call scene%dofs%expand(u, p_disp, x)
+        call scene%dofs%expand(u, [0.0_wp, p_disp], x)
         ! Generator order: warp node, weft node per crossing (crossing (0,0) first, warp
         ! over, gap 0.3); then the warp ends at x = 0 and x = 2 of warp 0.
         call check_close(error, x(:, 2) - x(:, 1), [0.0_wp, 0.0_wp, -0.3_wp * factor], &
@@ -258,7 +258,7 @@ contains
         call new_friction_problem(problem, scene, frozen)
         ! Every mode combination in turn (not chosen from the iterate).
         problem%semismooth = .false.
-        problem%p_disp = 0.6_wp
+        problem%factors = [0.0_wp, 0.6_wp]
         problem%flow_target = [(0.01_wp * cos(real(j, wp)), j = 1, problem%n_p)]
         allocate(x0(scene%dofs%n_unknowns))
         call scene%dofs%restrict(scene%network%position, x0)

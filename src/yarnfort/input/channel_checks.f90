@@ -1,0 +1,295 @@
+! SPDX-License-Identifier: MIT
+!> Load channels: the independent load factors of the path (`&path channels`, `factors`;
+!> without them the two channels 'p_force' and 'p_disp' with their columns `p_force` and
+!> `p_disp`), the channel of each &load and &support, and the checks that tie them
+!> together: names defined, unique, one word and no clash with another column of
+!> curve.csv; one factor per channel and knot; a nonzero load or displacement names its
+!> channel when channels are given.
+module yarnfort_input_channel_checks
+    use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_input_config, only: config_type, path_config_type, name_length
+    use yarnfort_input_fields, only: check_name, quoted_list
+    use yarnfort_text, only: format_integer, closest_name
+    implicit none
+    private
+
+    public :: get_channel_names, get_channel_factors, find_channel, check_channels
+    public :: default_force_channel, default_displacement_channel, fixed_curve_columns
+    public :: load_column_prefix
+
+    character(len=*), parameter :: default_force_channel = 'p_force'
+    character(len=*), parameter :: default_displacement_channel = 'p_disp'
+
+    !> The columns of curve.csv that are not named after a channel, support or load.
+    character(len=*), parameter :: fixed_curve_columns(11) = [character(len=17) :: &
+        'step', 'time', 'strain', 'force_per_width', 'direction', 'slipping', 'passages', &
+        'newton_iterations', 'residual', 'step_cuts', 'wall_time']
+
+contains
+
+    !> The channels of the path: the given `channels` (up to the first empty entry), or
+    !> 'p_force' and 'p_disp'.
+    pure function get_channel_names(path) result(names)
+        type(path_config_type), intent(in) :: path
+        character(len=name_length), allocatable :: names(:)
+        integer :: n
+
+        n = count_given(path)
+        if (n == 0) then
+            names = [character(len=name_length) :: default_force_channel, &
+                default_displacement_channel]
+        else
+            names = path%channels(:n)
+        end if
+    end function get_channel_names
+
+    !> The factor of each channel at each knot, (n_knots, n_channels).
+    pure function get_channel_factors(path) result(factor)
+        type(path_config_type), intent(in) :: path
+        real(wp), allocatable :: factor(:, :)
+        integer :: n
+
+        n = count_given(path)
+        if (n == 0) then
+            factor = reshape([path%p_force, path%p_disp], [size(path%time), 2])
+        else
+            ! factors is one row per knot: the channels' values, in order.
+            factor = transpose(reshape(path%factors, [n, size(path%time)]))
+        end if
+    end function get_channel_factors
+
+    !> Index in `names` of channel `name`, or of `default_name` when `name` is empty (only
+    !> without &path channels; with them an empty name has no channel); 0: not found.
+    pure integer function find_channel(names, name, default_name, given) result(index)
+        character(len=*), intent(in) :: names(:), name, default_name
+        logical, intent(in) :: given
+
+        index = 0
+        if (len_trim(name) == 0) then
+            if (given) return
+            do index = 1, size(names)
+                if (trim(names(index)) == default_name) return
+            end do
+            index = 0
+            return
+        end if
+        do index = 1, size(names)
+            if (trim(names(index)) == trim(name)) return
+        end do
+        index = 0
+    end function find_channel
+
+    !> Number of values of &path factors (0 when unallocated).
+    pure integer function n_factors(path)
+        type(path_config_type), intent(in) :: path
+        n_factors = 0
+        if (allocated(path%factors)) n_factors = size(path%factors)
+    end function n_factors
+
+    !> Number of given channel names (entries before the first empty one).
+    pure integer function count_given(path) result(n)
+        type(path_config_type), intent(in) :: path
+
+        do n = 0, size(path%channels) - 1
+            if (len_trim(path%channels(n + 1)) == 0) return
+        end do
+        n = size(path%channels)
+    end function count_given
+
+    !> The prefix of the displacement columns of &load #k in curve.csv.
+    pure function load_column_prefix(k) result(prefix)
+        integer, intent(in) :: k
+        character(len=:), allocatable :: prefix
+        prefix = 'load_' // format_integer(k)
+    end function load_column_prefix
+
+    !> Channels of the path and of every &load and &support (after check_path: the times
+    !> are known good; p_force and p_disp have one value per knot).
+    subroutine check_channels(config, error)
+        type(config_type), intent(in) :: config
+        type(error_type), allocatable, intent(out) :: error
+        character(len=name_length), allocatable :: names(:)
+        integer :: n, k, j, n_knots
+        logical :: given
+
+        associate(path => config%path)
+            n = count_given(path)
+            given = n > 0
+            n_knots = size(path%time)
+            do k = n + 2, size(path%channels)
+                if (len_trim(path%channels(k)) > 0) then
+                    call fatal_error(error, '&path: channels(' // format_integer(k) // ") = '" &
+                        // trim(path%channels(k)) // "' follows the empty channels(" &
+                        // format_integer(n + 1) // ') (give the names one after another)')
+                    return
+                end if
+            end do
+            ! A config built in code (tests, benchmarks) may leave factors unallocated.
+            if (.not. given) then
+                if (n_factors(path) > 0) then
+                    call fatal_error(error, '&path: factors is given but channels is not ' &
+                        // '(factors are the columns of the channels that channels names; ' &
+                        // 'without channels give p_force and p_disp)')
+                    return
+                end if
+            else
+                if (len_trim(config%fabric%kind) > 0) then
+                    call fatal_error(error, '&path: channels is given with &fabric (a ' &
+                        // "generated fabric is driven by the channels 'p_force' and " &
+                        // "'p_disp': give p_force and p_disp instead)")
+                    return
+                end if
+                if (any(path%p_force /= 0.0_wp) .or. any(path%p_disp /= 0.0_wp)) then
+                    call fatal_error(error, '&path: p_force or p_disp is set together with ' &
+                        // 'channels (with channels every factor comes from factors: give ' &
+                        // "'p_force' / 'p_disp' as channel names if you want them)")
+                    return
+                end if
+                if (n_factors(path) /= n * n_knots) then
+                    call fatal_error(error, '&path: factors has ' &
+                        // format_integer(n_factors(path)) // ' values but the ' &
+                        // format_integer(n) // ' channels (' // quoted_list(path%channels(:n)) &
+                        // ') at ' // format_integer(n_knots) // ' knots need ' &
+                        // format_integer(n * n_knots) // ' (one row per knot, one value per ' &
+                        // 'channel)')
+                    return
+                end if
+                do k = 1, n
+                    call check_name(error, '&path channels(' // format_integer(k) // ')', &
+                        path%channels(k))
+                    if (allocated(error)) return
+                    do j = 1, k - 1
+                        if (path%channels(j) == path%channels(k)) then
+                            call fatal_error(error, "&path: channel '" // trim(path%channels(k)) &
+                                // "' is named twice (channels(" // format_integer(j) &
+                                // ') and channels(' // format_integer(k) // '))')
+                            return
+                        end if
+                    end do
+                    if (any(fixed_curve_columns == path%channels(k))) then
+                        call fatal_error(error, '&path: channels(' // format_integer(k) &
+                            // ") = '" // trim(path%channels(k)) // "' is the name of " &
+                            // 'another column of curve.csv (' &
+                            // quoted_list(fixed_curve_columns) // '): choose another name')
+                        return
+                    end if
+                end do
+            end if
+        end associate
+        names = get_channel_names(config%path)
+        if (allocated(config%loads)) then
+            do k = 1, size(config%loads)
+                associate(load => config%loads(k))
+                    call check_one('&load #' // format_integer(k), load%channel, &
+                        default_force_channel, any(load%force /= 0.0_wp), 'force')
+                    if (allocated(error)) return
+                end associate
+            end do
+        end if
+        if (allocated(config%supports)) then
+            do k = 1, size(config%supports)
+                associate(support => config%supports(k))
+                    call check_one("&support '" // trim(support%name) // "'", &
+                        support%channel, default_displacement_channel, &
+                        any(support%displacement /= 0.0_wp), 'displacement')
+                    if (allocated(error)) return
+                end associate
+            end do
+        end if
+        call check_curve_columns(config, names, error)
+
+    contains
+
+        subroutine check_one(label, name, default_name, used, what)
+            character(len=*), intent(in) :: label, name, default_name, what
+            logical, intent(in) :: used
+            character(len=:), allocatable :: guess
+
+            if (find_channel(names, name, default_name, given) > 0) return
+            if (len_trim(name) == 0) then
+                if (.not. used) return
+                call fatal_error(error, label // ': channel is not set, and &path names its ' &
+                    // 'channels (' // quoted_list(names) // '): give the channel whose ' &
+                    // 'factor scales its ' // what)
+                return
+            end if
+            guess = closest_name(trim(name), names)
+            if (len(guess) > 0) guess = "; did you mean '" // guess // "'?"
+            call fatal_error(error, label // ": channel = '" // trim(name) // "' is not a " &
+                // 'channel of &path (channels: ' // quoted_list(names) // ')' // guess)
+        end subroutine check_one
+
+    end subroutine check_channels
+
+    !> No two columns of curve.csv with one name. Support names are unique and the fixed
+    !> columns end in no support suffix, so a clash needs a channel named like a fixed,
+    !> support or load column (e.g. 'a_rx' with a support 'a'), or a support named like a
+    !> load's columns ('load_2' with two loads): linear in the number of columns.
+    subroutine check_curve_columns(config, names, error)
+        type(config_type), intent(in) :: config
+        character(len=*), intent(in) :: names(:)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=3), parameter :: suffixes(6) = ['_rx', '_ry', '_rz', '_ux', '_uy', '_uz']
+        integer :: k, j, n_loads, length
+        character(len=:), allocatable :: name, stem
+
+        n_loads = 0
+        if (allocated(config%loads)) n_loads = size(config%loads)
+        do k = 1, size(names)
+            name = trim(names(k))
+            length = len(name)
+            if (length <= 3) cycle
+            if (.not. any(suffixes == name(length - 2:))) cycle
+            stem = name(:length - 3)
+            if (allocated(config%supports)) then
+                do j = 1, size(config%supports)
+                    if (trim(config%supports(j)%name) == stem) then
+                        call fatal_error(error, "curve.csv would have two columns '" // name &
+                            // "' (the factor of channel " // name // " and &support '" &
+                            // stem // "'): rename one")
+                        return
+                    end if
+                end do
+            end if
+            j = load_number(stem)
+            if (j > 0 .and. any(suffixes(4:) == name(length - 2:))) then
+                call fatal_error(error, "curve.csv would have two columns '" // name &
+                    // "' (the factor of channel " // name // ' and &load #' &
+                    // format_integer(j) // '): rename the channel')
+                return
+            end if
+        end do
+        if (allocated(config%supports)) then
+            do k = 1, size(config%supports)
+                j = load_number(trim(config%supports(k)%name))
+                if (j > 0) then
+                    call fatal_error(error, "curve.csv would have two columns '" &
+                        // trim(config%supports(k)%name) // "_ux' (&support '" &
+                        // trim(config%supports(k)%name) // "' and &load #" &
+                        // format_integer(j) // '): rename the support')
+                    return
+                end if
+            end do
+        end if
+    contains
+        !> k if `text` is load_column_prefix(k) of an existing &load, else 0.
+        integer function load_number(text)
+            character(len=*), intent(in) :: text
+            integer :: status
+
+            load_number = 0
+            if (len(text) < 6) return
+            if (text(:5) /= 'load_') return
+            if (verify(text(6:), '0123456789') /= 0) return
+            read(text(6:), *, iostat=status) load_number
+            if (status /= 0) load_number = 0
+            if (load_number < 1 .or. load_number > n_loads) then
+                load_number = 0
+            else if (load_column_prefix(load_number) /= text) then
+                load_number = 0          ! 'load_01' is no column name
+            end if
+        end function load_number
+    end subroutine check_curve_columns
+
+end module yarnfort_input_channel_checks
