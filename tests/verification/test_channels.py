@@ -217,6 +217,49 @@ def test_sideways_cycle_on_a_friction_ring_follows_the_return_mapping(run_yarnfo
     assert splits[at[3.0]] != pytest.approx(splits[at[5.0]], rel=1e-3)
 
 
+def ring_kind_text(folder: str = "out") -> str:
+    """The same ring as a `&ring` node (no stub yarn): the loads act on the ring's node."""
+    text = scene(nodes=np.array([RING_A, START, RING_B]),
+                 yarns=[dict(material="yarn", nodes=[1, 2, 3])],
+                 supports=[dict(name="a", nodes=[1]), dict(name="b", nodes=[3])],
+                 loads=[dict(nodes=[2], force=[0.0, -LOAD, 0.0], channel="down"),
+                        dict(nodes=[2], force=[SIDE, 0.0, 0.0], channel="side")],
+                 materials=[dict(name="yarn", law="linear", stiffness=YARN_EA)],
+                 path=dict(time=TIMES, channels=["down", "side"],
+                           factors=np.column_stack([DOWN, SIDEWAYS])),
+                 output=dict(folder=folder, progress=False))
+    text += group("ring", name="ring", nodes=[2])
+    text += group("contact", at="ring", law="coulomb", friction_coefficient=MU)
+    return text
+
+
+def test_sideways_cycle_on_a_ring_node_follows_the_return_mapping(run_yarnfort, tmp_path):
+    """The `&ring` kind on two channels: the same play operator as the stub-yarn ring
+    (the stub only passes the force on), and the load columns are the ring's own
+    displacement."""
+    folder = tmp_path / "ring_kind"
+    folder.mkdir()
+    done = run_yarnfort(ring_kind_text(), cwd=folder)
+    assert done.returncode == 0, done.stderr
+    curve, states = read_curve(folder / "out"), read_states(folder / "out")
+    loads = np.column_stack([SIDE * curve["side"], -LOAD * curve["down"]])
+    _, rings, tensions = return_mapping(loads)
+    position_error = max(np.max(np.abs(s.position[1] - r)) for s, r in zip(states, rings))
+    tension_error = max(np.max(np.abs(s.tension[:2] - t)) / np.linalg.norm(f)
+                        for s, t, f in zip(states, tensions, loads))
+    load_u = np.column_stack([curve[f"load_1_u{k}"] for k in "xyz"])
+    column_error = np.max(np.abs(load_u - (rings - START)))
+    print(f"&ring cycled sideways: {len(states)} steps; errors: ring {position_error / SIZE:.1e}"
+          f", load_1_u {column_error / SIZE:.1e} (of the span), tensions "
+          f"{tension_error:.1e} (of the load)")
+    assert position_error <= POSITION_RTOL * SIZE
+    assert column_error <= POSITION_RTOL * SIZE
+    assert tension_error <= FORCE_RTOL
+    x = [states[int(np.flatnonzero(np.isclose(curve["time"], t, rtol=0, atol=1e-12))[0])]
+         .position[1][0] for t in (1.0, 3.0, 5.0)]
+    assert abs(x[1] - x[0]) > 1e-3 * SIZE and abs(x[2] - x[1]) > 1e-3 * SIZE
+
+
 def test_two_stages_chained_by_restart_equal_one_run(run_yarnfort, tmp_path):
     whole = run_ring(run_yarnfort, tmp_path, "whole")
     curve = read_curve(whole)
