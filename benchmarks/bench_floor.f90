@@ -8,6 +8,8 @@
 !>   the same with the Symbolic object of the pattern alone (what yarnfort did before);
 !> - bare KLU: klu_l_refactor + klu_l_solve after klu_l_analyze (its defaults) and
 !>   klu_l_factor.
+!> Times are process CPU times (cpu_time): everything here runs on one thread, and on a
+!> machine shared with other work the CPU time of a run moves far less than its wall time.
 module bench_floor
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr, c_null_ptr, &
         c_null_funptr, c_associated
@@ -21,7 +23,6 @@ module bench_floor
         umfpack_dl_free_symbolic, umfpack_dl_free_numeric
     use yarnfort_linalg_klu_binding, only: klu_l_common, klu_l_defaults, klu_l_analyze, &
         klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_free_symbolic, klu_l_free_numeric
-    use yarnfort_solver_timer, only: wall_time
     implicit none
     private
 
@@ -41,6 +42,11 @@ module bench_floor
 
 contains
 
+    !> Process CPU time (s).
+    real(wp) function cpu_seconds()
+        call cpu_time(cpu_seconds)
+    end function cpu_seconds
+
     !> Time `solver_name` and the bare libraries on the CSC matrix (0-based indices).
     subroutine measure_floor(solver_name, n, col_ptr, row_index, values, floor, error)
         character(len=*), intent(in) :: solver_name
@@ -59,15 +65,15 @@ contains
         if (allocated(error)) return
         call solver%analyse(n, col_ptr, row_index, error)
         if (allocated(error)) return
-        start = wall_time()
+        start = cpu_seconds()
         call solver%factor(values, error)
         if (allocated(error)) return
         rhs = 1.0_wp
         call solver%solve(rhs, error)
         if (allocated(error)) return
-        first = wall_time() - start
+        first = cpu_seconds() - start
         repetitions = count_repetitions(first)
-        start = wall_time()
+        start = cpu_seconds()
         do k = 1, repetitions
             call solver%factor(values, error)
             if (allocated(error)) return
@@ -75,7 +81,7 @@ contains
             call solver%solve(rhs, error)
             if (allocated(error)) return
         end do
-        floor%yarnfort_ms = 1e3_wp * (wall_time() - start) / repetitions
+        floor%yarnfort_ms = 1e3_wp * (cpu_seconds() - start) / repetitions
         call solver%destroy()
 
         call time_umfpack(.true., floor%umfpack_ms, floor%strategy)
@@ -118,15 +124,15 @@ contains
             end if
             if (status /= umfpack_ok) return
             strategy = nint(info(umfpack_strategy_used))
-            start = wall_time()
+            start = cpu_seconds()
             status = umfpack_dl_numeric(col_ptr, row_index, values, symbolic, numeric, &
                 control, info)
             if (status == umfpack_ok) status = umfpack_dl_wsolve(umfpack_a, x=x, b=b, &
                 numeric=numeric, control=control, info=info, wi=wi, w=w)
-            first = wall_time() - start
+            first = cpu_seconds() - start
             if (status == umfpack_ok) then
                 repetitions = count_repetitions(first)
-                start = wall_time()
+                start = cpu_seconds()
                 do k = 1, repetitions
                     call umfpack_dl_free_numeric(numeric)
                     status = umfpack_dl_numeric(col_ptr, row_index, values, symbolic, numeric, &
@@ -134,7 +140,7 @@ contains
                     status = umfpack_dl_wsolve(umfpack_a, x=x, b=b, numeric=numeric, &
                         control=control, info=info, wi=wi, w=w)
                 end do
-                ms = 1e3_wp * (wall_time() - start) / repetitions
+                ms = 1e3_wp * (cpu_seconds() - start) / repetitions
             end if
             call umfpack_dl_free_numeric(numeric)
             call umfpack_dl_free_symbolic(symbolic)
@@ -154,20 +160,20 @@ contains
             common%user_data = c_null_ptr
             symbolic = klu_l_analyze(int(n, c_long), col_ptr, row_index, common)
             if (.not. c_associated(symbolic)) return
-            start = wall_time()
+            start = cpu_seconds()
             numeric = klu_l_factor(col_ptr, row_index, values, symbolic, common)
             if (c_associated(numeric)) then
                 b = 1.0_wp
                 ok = klu_l_solve(symbolic, numeric, int(n, c_long), 1_c_long, b, common)
-                first = wall_time() - start
+                first = cpu_seconds() - start
                 repetitions = count_repetitions(first)
-                start = wall_time()
+                start = cpu_seconds()
                 do k = 1, repetitions
                     ok = klu_l_refactor(col_ptr, row_index, values, symbolic, numeric, common)
                     b = 1.0_wp
                     ok = klu_l_solve(symbolic, numeric, int(n, c_long), 1_c_long, b, common)
                 end do
-                ms = 1e3_wp * (wall_time() - start) / repetitions
+                ms = 1e3_wp * (cpu_seconds() - start) / repetitions
                 ok = klu_l_free_numeric(numeric, common)
             end if
             ok = klu_l_free_symbolic(symbolic, common)

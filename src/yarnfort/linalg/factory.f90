@@ -10,6 +10,7 @@ module yarnfort_linalg_factory
     use yarnfort_linalg_cholmod, only: cholmod_solver_type
     use yarnfort_linalg_dense, only: dense_solver_type
     use yarnfort_linalg_fallback, only: fallback_solver_type
+    use yarnfort_linalg_threads, only: apply_thread_policy
     use yarnfort_text, only: to_lower
     implicit none
     private
@@ -32,6 +33,7 @@ contains
 
     !> Allocate `solver` as the solver called `name` ('umfpack', 'klu', 'cholmod' or
     !> 'dense'; case and surrounding blanks are ignored). Any old solver is destroyed.
+    !> The first call applies the thread policy of yarnfort_linalg_threads.
     subroutine new_linear_solver(solver, name, error, unsymmetric)
         class(linear_solver_type), allocatable, intent(out) :: solver
         character(len=*), intent(in) :: name
@@ -40,6 +42,7 @@ contains
         !> then keeps the sparser of its AMD and COLAMD orderings.
         logical, intent(in), optional :: unsymmetric
 
+        call apply_thread_policy()
         select case (to_lower(trim(adjustl(name))))
         case ('umfpack')
             allocate(umfpack_solver_type :: solver)
