@@ -173,6 +173,14 @@ contains
             have_good = .false.
             do round = 1, scene%solver%max_friction_iterations
                 problem%mode = self%mode_trial
+                ! The last step's active set, when it has no solution nearby, is cheaper to
+                ! replace by all-stick (below) than to push through Newton's fallbacks:
+                ! measured on a clamped 4 x 4 knit (stretch cycles to 2x), such failures
+                ! took 200-300 iterations each; solved fast (full steps only) the run
+                ! took 2591 Newton iterations instead of 4522 (same 81 steps), 1.15 s CPU
+                ! instead of 1.85 s. Fast solves of later rounds' guesses (several new
+                ! slips, with halving as the fallback) cut more steps: 156 steps, 2.4 s.
+                self%newton_full%quick = .not. have_good .and. any(self%mode_trial /= mode_stick)
                 call self%newton_full%solve(unknowns, stats, error)
                 iterations = iterations + stats%iterations
                 if (allocated(error)) then

@@ -110,6 +110,11 @@ module yarnfort_solver_newton
         type(adapter_type), pointer :: adapter => null()
         type(solver_config_type) :: options
         class(linear_solver_type), pointer :: linear => null()
+        !> Fail fast: full Newton steps only, given up after full_step_patience
+        !> iterations without progress; no line search, no pseudo-transient fallback, no
+        !> regularised predictor. For solves whose failure the caller handles more
+        !> cheaply than those fallbacks do (a guessed stick/slip active set).
+        logical :: quick = .false.
     contains
         !> Solve for unknowns u (in: initial guess, out: solution).
         procedure :: solve
@@ -229,7 +234,7 @@ contains
             problem%tangent_spring = spring
             call solve_once(self, u, stats, exact_error)
             if (.not. allocated(exact_error)) return
-            if (.not. (spring > 0.0_wp)) then
+            if (.not. (spring > 0.0_wp) .or. self%quick) then
                 call move_alloc(exact_error, error)
                 return
             end if
@@ -285,11 +290,11 @@ contains
 
         ! Full Newton steps first; with line_search, a failed attempt is repeated from
         ! the initial guess with KINSOL's line search (back-tracking where needed only).
-        n_attempts = merge(2, 1, self%options%line_search)
+        n_attempts = merge(2, 1, self%options%line_search .and. .not. self%quick)
         do attempt = 1, n_attempts
             strategy = merge(KIN_NONE, KIN_LINESEARCH, attempt == 1)
             self%problem%n_history = 0
-            self%problem%watch_stall = attempt < n_attempts
+            self%problem%watch_stall = attempt < n_attempts .or. self%quick
             self%problem%best_residual = huge(1.0_wp)
             self%problem%since_best = 0
             if (allocated(self%problem%error)) deallocate(self%problem%error)
@@ -337,7 +342,7 @@ contains
             end do
             if (converged) exit
         end do
-        if (.not. converged .and. self%options%line_search) then
+        if (.not. converged .and. self%options%line_search .and. .not. self%quick) then
             ! Neither full nor line-searched Newton steps: pseudo-transient continuation.
             call solve_transient(self, u, stats, converged, error)
             if (allocated(error)) return
