@@ -19,7 +19,8 @@ module yarnfort_contact_friction_stepper
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
+    use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
+        default_friction_solver_name
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
@@ -79,7 +80,8 @@ contains
 
     !> Set up the chosen scheme; `linear_name` is the linear solver for the elastic
     !> solves. The sliding systems are unsymmetric: they use the measured default for
-    !> unsymmetric systems when `linear_name` is a Cholesky solver, else `linear_name`.
+    !> unsymmetric systems (the monolithic one: for the friction Jacobian) when
+    !> `linear_name` is a Cholesky solver, else `linear_name`.
     subroutine new_friction_stepper(self, scene, linear_name, error)
         type(friction_stepper_type), intent(out) :: self
         type(scene_type), target, intent(in) :: scene
@@ -113,6 +115,8 @@ contains
         else
             allocate(self%full)
             call new_friction_problem(self%full, scene, positions_frozen=.false.)
+            if (linear_name == 'cholmod' .or. linear_name == 'cholmod+klu') general_name = &
+                default_friction_solver_name(int(scene%dofs%n_unknowns + n_p, 8))
             call new_linear_solver(linear, general_name, error, unsymmetric=.true.)
             if (allocated(error)) return
             call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)

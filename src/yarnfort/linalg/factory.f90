@@ -15,8 +15,8 @@ module yarnfort_linalg_factory
     implicit none
     private
 
-    public :: new_linear_solver, default_linear_solver_name
-    public :: linear_solver_names, klu_max_order
+    public :: new_linear_solver, default_linear_solver_name, default_friction_solver_name
+    public :: linear_solver_names, klu_max_order, friction_klu_max_order
 
     !> Names accepted by `new_linear_solver`.
     character(len=*), parameter :: linear_solver_names = &
@@ -28,6 +28,16 @@ module yarnfort_linalg_factory
     !> UMFPACK 3.7 / 108 / 3035 ms at 1e3 / 1e4 / 1e5 unknowns; design.md section 5 has
     !> UMFPACK 2.6x faster than KLU at 1e6, so the switch sits between 1e5 and 1e6.
     integer(ik), parameter :: klu_max_order = 200000_ik
+
+    !> Largest order for which KLU is the default for the monolithic friction Jacobian
+    !> (positions and flows). Measured on the woven nets of benchmarks/bench_friction
+    !> (4 elements per segment, final active set, CPU ms per factorisation + solve, L + U
+    !> nonzeros): 2.4e3 unknowns KLU 1.0 ms (8.0e4) against UMFPACK 2.8 ms (3.6e4);
+    !> 4.6e3: 5.5 ms (2.1e5) against 7.0 ms (7.7e4); 1.1e4: 118 ms (9.2e5) against 42 ms
+    !> (2.2e5), and KLU with COLAMD 1000 ms (3.7e6). UMFPACK analysed with the values
+    !> takes its symmetric strategy there and keeps 4x less fill than KLU; whole cycles at
+    !> 1.1e4 unknowns: 11.4 s CPU with UMFPACK against 33.6 s with KLU.
+    integer(ik), parameter :: friction_klu_max_order = 5000_ik
 
 contains
 
@@ -89,5 +99,18 @@ contains
             name = 'umfpack'
         end if
     end function default_linear_solver_name
+
+    !> Default solver for the monolithic friction Jacobian of order n (measurements
+    !> above): 'klu' up to friction_klu_max_order unknowns, 'umfpack' above.
+    pure function default_friction_solver_name(n) result(name)
+        integer(ik), intent(in) :: n
+        character(len=:), allocatable :: name
+
+        if (n <= friction_klu_max_order) then
+            name = 'klu'
+        else
+            name = 'umfpack'
+        end if
+    end function default_friction_solver_name
 
 end module yarnfort_linalg_factory
