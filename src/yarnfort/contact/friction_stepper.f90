@@ -4,7 +4,9 @@
 !>   stick/slip active set, which is updated like a return mapping until it settles;
 !> - staggered (the paper's two-step method, Fig. 4): an elastic solve with reference
 !>   lengths frozen, then a sliding solve with positions frozen, repeated until the
-!>   equilibrium residual is small and the active set no longer changes.
+!>   equilibrium residual is small and the active set no longer changes; once the
+!>   active set has held for a round, the step is finished by monolithic solves from the
+!>   alternation's state (finish_after_rounds).
 !> Active-set rules, per passage, after each solve:
 !>   stick -> slip forward  if T_after  > T_crit(T_before, alpha) (beyond tolerance);
 !>   stick -> slip backward if T_before > T_crit(T_after, alpha);
@@ -19,8 +21,7 @@ module yarnfort_contact_friction_stepper
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
-        default_friction_solver_name
+    use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
@@ -96,15 +97,21 @@ contains
         character(len=*), intent(in) :: linear_name
         type(error_type), allocatable, intent(out) :: error
         class(linear_solver_type), allocatable :: linear
-        character(len=:), allocatable :: general_name
+        character(len=:), allocatable :: general_name, full_name
         integer :: n_p
 
         self%scene => scene
         self%staggered = trim(scene%solver%scheme) == 'staggered'
         n_p = scene%passages%size()
+        ! The flows-only system of the staggered sliding step has order n_p, the
+        ! monolithic one (also the staggered step's finish) n_unknowns + n_p.
         general_name = linear_name
-        if (linear_name == 'cholmod' .or. linear_name == 'cholmod+klu') general_name = &
-            default_linear_solver_name(int(scene%dofs%n_unknowns + n_p, 8), .false.)
+        full_name = linear_name
+        if (linear_name == 'cholmod' .or. linear_name == 'cholmod+klu') then
+            general_name = default_linear_solver_name(int(n_p, 8), .false.)
+            full_name = default_linear_solver_name(int(scene%dofs%n_unknowns + n_p, 8), &
+                .false.)
+        end if
         if (self%staggered) then
             allocate(self%elastic, self%sliding)
             call new_elastic_problem(self%elastic, scene)
@@ -123,10 +130,7 @@ contains
             ! The monolithic finish of a step (finish_after_rounds).
             allocate(self%full)
             call new_friction_problem(self%full, scene, positions_frozen=.false.)
-            general_name = linear_name
-            if (linear_name == 'cholmod' .or. linear_name == 'cholmod+klu') general_name = &
-                default_friction_solver_name(int(scene%dofs%n_unknowns + n_p, 8))
-            call new_linear_solver(linear, general_name, error, unsymmetric=.true.)
+            call new_linear_solver(linear, full_name, error, unsymmetric=.true.)
             if (allocated(error)) return
             call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)
             if (allocated(error)) return
@@ -134,9 +138,7 @@ contains
         else
             allocate(self%full)
             call new_friction_problem(self%full, scene, positions_frozen=.false.)
-            if (linear_name == 'cholmod' .or. linear_name == 'cholmod+klu') general_name = &
-                default_friction_solver_name(int(scene%dofs%n_unknowns + n_p, 8))
-            call new_linear_solver(linear, general_name, error, unsymmetric=.true.)
+            call new_linear_solver(linear, full_name, error, unsymmetric=.true.)
             if (allocated(error)) return
             call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)
             if (allocated(error)) return

@@ -15,29 +15,27 @@ module yarnfort_linalg_factory
     implicit none
     private
 
-    public :: new_linear_solver, default_linear_solver_name, default_friction_solver_name
-    public :: linear_solver_names, klu_max_order, friction_klu_max_order
+    public :: new_linear_solver, default_linear_solver_name
+    public :: linear_solver_names, klu_max_order
 
     !> Names accepted by `new_linear_solver`.
     character(len=*), parameter :: linear_solver_names = &
         "'umfpack', 'klu', 'cholmod', 'cholmod+klu', 'dense'"
 
     !> Largest order for which KLU is the default for unsymmetric or indefinite
-    !> systems. Measured on cable-net tangents (benchmarks/run, 2 cores, one Newton
-    !> solve, numeric factorisation per iteration): KLU 1.2 / 52 / 2650 ms against
-    !> UMFPACK 3.7 / 108 / 3035 ms at 1e3 / 1e4 / 1e5 unknowns; design.md section 5 has
-    !> UMFPACK 2.6x faster than KLU at 1e6, so the switch sits between 1e5 and 1e6.
-    integer(ik), parameter :: klu_max_order = 200000_ik
-
-    !> Largest order for which KLU is the default for the monolithic friction Jacobian
-    !> (positions and flows). Measured on the woven nets of benchmarks/bench_friction
-    !> (4 elements per segment, final active set, CPU ms per factorisation + solve, L + U
-    !> nonzeros): 2.4e3 unknowns KLU 1.0 ms (8.0e4) against UMFPACK 2.8 ms (3.6e4);
-    !> 4.6e3: 5.5 ms (2.1e5) against 7.0 ms (7.7e4); 1.1e4: 118 ms (9.2e5) against 42 ms
-    !> (2.2e5), and KLU with COLAMD 1000 ms (3.7e6). UMFPACK analysed with the values
-    !> takes its symmetric strategy there and keeps 4x less fill than KLU; whole cycles at
-    !> 1.1e4 unknowns: 11.4 s CPU with UMFPACK against 33.6 s with KLU.
-    integer(ik), parameter :: friction_klu_max_order = 5000_ik
+    !> systems. Measured on cable-net tangents (benchmarks/bench_newton's floor columns,
+    !> 2 cores, CPU ms per factorisation + solve of the same Jacobian, one thread):
+    !> KLU 0.73 / 40 / 341 ms against UMFPACK 2.0 / 33 / 131 ms at 1e3 / 1e4 / 3e4
+    !> unknowns, now that UMFPACK is analysed with the values (symmetric strategy; with
+    !> the pattern alone it took 2.1 / 47 / 198 ms and the switch sat at 2e5). design.md
+    !> section 5 has UMFPACK 2.6x faster than KLU at 1e6. The monolithic friction
+    !> Jacobian gives the same switch (benchmarks/bench_friction's `factors:` line, woven
+    !> nets with 4 elements per segment, final active set, L + U nonzeros): 2.4e3
+    !> unknowns KLU 1.2 ms (8.0e4) against UMFPACK 3.8 ms (3.6e4); 4.6e3: 6.8 ms (2.1e5)
+    !> against 9.3 ms (7.7e4); 1.1e4: 152 ms (9.2e5) against 49 ms (2.2e5), KLU with
+    !> COLAMD 1300 ms (3.7e6); whole load cycles at 1.1e4: 13.0 s CPU with UMFPACK
+    !> against 34.5 s with KLU.
+    integer(ik), parameter :: klu_max_order = 5000_ik
 
 contains
 
@@ -99,18 +97,5 @@ contains
             name = 'umfpack'
         end if
     end function default_linear_solver_name
-
-    !> Default solver for the monolithic friction Jacobian of order n (measurements
-    !> above): 'klu' up to friction_klu_max_order unknowns, 'umfpack' above.
-    pure function default_friction_solver_name(n) result(name)
-        integer(ik), intent(in) :: n
-        character(len=:), allocatable :: name
-
-        if (n <= friction_klu_max_order) then
-            name = 'klu'
-        else
-            name = 'umfpack'
-        end if
-    end function default_friction_solver_name
 
 end module yarnfort_linalg_factory

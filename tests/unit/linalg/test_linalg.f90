@@ -8,7 +8,7 @@ module test_linalg
     use yarnfort_testing, only: unittest_type, new_unittest, check
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
-        klu_max_order, default_friction_solver_name, friction_klu_max_order
+        klu_max_order
     use yarnfort_linalg_klu, only: klu_solver_type
     use yarnfort_linalg_umfpack, only: umfpack_solver_type, umfpack_memory_type
     use yarnfort_linalg_threads, only: apply_thread_policy
@@ -689,11 +689,8 @@ contains
         call check(error, default_linear_solver_name(1000000_ik, .false.) == 'umfpack', &
             'default for 1e6 general should be umfpack')
         if (allocated(error)) return
-        call check(error, default_friction_solver_name(friction_klu_max_order) == 'klu', &
-            'default for a friction Jacobian of friction_klu_max_order should be klu')
-        if (allocated(error)) return
-        call check(error, default_friction_solver_name(friction_klu_max_order + 1) &
-            == 'umfpack', 'default for a larger friction Jacobian should be umfpack')
+        call check(error, default_linear_solver_name(klu_max_order + 1, .false.) &
+            == 'umfpack', 'default above klu_max_order general should be umfpack')
     end subroutine test_default_rule
 
     !> UMFPACK's symbolic analysis sees the values: on a matrix with a symmetric pattern
