@@ -45,7 +45,8 @@ end module bench_friction_counter
 !> Prints, for the whole cycle: unknowns, passages, load steps, Newton iterations and
 !> sparse factorisations per step, time per step, and the split of time between
 !> assembly, factorisation, solves and the rest; peak resident memory.
-!> Monolithic runs then print a second line, `factors:`, on the Jacobians at the final
+!> Then a second line, `factors:` (both schemes: the staggered one finishes its steps
+!> with monolithic solves), on the Jacobians at the final
 !> state (bench_floor, CPU ms per factorisation + solve, nonzeros of L + U): the friction
 !> Jacobian (final active set) with KLU's AMD and COLAMD orderings and UMFPACK, and the
 !> elastic Jacobian of the same net and state with KLU and yarnfort's CHOLMOD.
