@@ -45,6 +45,11 @@ end module bench_friction_counter
 !> Prints, for the whole cycle: unknowns, passages, load steps, Newton iterations and
 !> sparse factorisations per step, time per step, and the split of time between
 !> assembly, factorisation, solves and the rest; peak resident memory.
+!> Then a second line, `factors:` (both schemes: the staggered one finishes its steps
+!> with monolithic solves), on the Jacobians at the final
+!> state (bench_floor, CPU ms per factorisation + solve, nonzeros of L + U): the friction
+!> Jacobian (final active set) with KLU's AMD and COLAMD orderings and UMFPACK, and the
+!> elastic Jacobian of the same net and state with KLU and yarnfort's CHOLMOD.
 program bench_friction
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use yarnfort_kinds, only: wp
@@ -59,6 +64,9 @@ program bench_friction
     use yarnfort_solver_timer, only: wall_time
     use bench_friction_counter, only: counter_type
     use bench_common, only: peak_memory_mib, fail, number_grid_nodes
+    use bench_floor, only: floor_type, measure_floor
+    use yarnfort_kinds, only: ik
+    use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     implicit none
 
     type(config_type) :: config
@@ -112,8 +120,54 @@ program bench_friction
             100 * (total - assembly - factor - solve) / total, counter%max_slipping, &
             peak_memory_mib()
     end associate
+    if (associated(stepper%full)) call write_factors()
 
 contains
+
+    !> The `factors:` line (program notes).
+    subroutine write_factors()
+        type(floor_type) :: friction, elastic
+        type(elastic_problem_type), target :: problem
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        real(wp), allocatable :: values(:)
+        integer(ik) :: n, nnz, n_elastic, nnz_elastic
+
+        associate(full => stepper%full)
+            n = full%get_size()
+            nnz = full%get_nonzeros()
+            allocate(col_ptr(n + 1), row_index(nnz), values(nnz))
+            call full%copy_pattern(col_ptr, row_index)
+            full%mode = stepper%mode
+            call full%prepare_solve([stepper%u, stepper%flow], error)
+            if (allocated(error)) call fail('bench_friction', error)
+            call full%evaluate_jacobian([stepper%u, stepper%flow], values, error)
+            if (allocated(error)) call fail('bench_friction', error)
+            call measure_floor('klu', n, col_ptr, row_index, values, friction, error)
+            if (allocated(error)) call fail('bench_friction', error)
+        end associate
+        call new_elastic_problem(problem, scene)
+        call scene%passages%get_length0(scene%network%length0, stepper%flow, problem%length0)
+        problem%p_force = stepper%p_force
+        problem%p_disp = stepper%p_disp
+        n_elastic = problem%get_size()
+        nnz_elastic = problem%get_nonzeros()
+        deallocate(col_ptr, row_index, values)
+        allocate(col_ptr(n_elastic + 1), row_index(nnz_elastic), values(nnz_elastic))
+        call problem%copy_pattern(col_ptr, row_index)
+        call problem%evaluate_jacobian(stepper%u, values, error)
+        if (allocated(error)) call fail('bench_friction', error)
+        call measure_floor('cholmod', n_elastic, col_ptr, row_index, values, elastic, error)
+        if (allocated(error)) call fail('bench_friction', error)
+        write(output_unit, '(a, i0, a, i0, a, 4(es9.2, a, f8.2, a), a, i0, a, i0, a, &
+            & es9.2, a, f8.2, a, f8.2, a)') &
+            'factors: friction n ', n, ' nnz ', nnz, &
+            ' LU: klu-amd ', friction%klu_lu, ' (', friction%klu_ms, ' ms)  klu-colamd ', &
+            friction%klu_colamd_lu, ' (', friction%klu_colamd_ms, ' ms)  klu-amd-nobtf ', &
+            friction%klu_nobtf_lu, ' (', friction%klu_nobtf_ms, ' ms)  umfpack ', &
+            friction%umfpack_lu, ' (', friction%umfpack_ms, ' ms)', &
+            ' | elastic n ', n_elastic, ' nnz ', nnz_elastic, ' LU: klu-amd ', &
+            elastic%klu_lu, ' (', elastic%klu_ms, ' ms)  cholmod (', elastic%yarnfort_ms, ' ms)'
+    end subroutine write_factors
 
     !> side x side crossings of warp (along x) and weft (along y) yarns at unit
     !> spacing; crossing (i, j) sits at z = +-h in a checkerboard (crimp), so both yarns

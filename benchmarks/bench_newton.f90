@@ -10,9 +10,16 @@
 !> Numeric object, i.e. the LU factors (`umf_LU_B/dof`), and its peak during symbolic
 !> analysis and numeric factorisation (`umf_peak_B/dof`), with the ratios of the growth
 !> to each (`x_LU`, `x_peak`).
+!> Then the floor (bench_floor) on the Jacobian at the solution: ms per factorisation +
+!> solve of this solver in yarnfort (`yf_ms`), of bare UMFPACK analysed with the values
+!> (`umf_ms`, its strategy `st`) and with the pattern only (`umf_pat_ms`, `st`), and of bare
+!> KLU (`klu_ms`); the ratios of yarnfort's to the bare library of the same name
+!> (`x_bare`, '-' for cholmod and dense) and of a whole yarnfort Newton iteration to the
+!> faster bare library (`iter_x_floor`), all in process CPU time. `nnz` counts the free
+!> rows and columns only.
 program bench_newton
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-    use yarnfort_kinds, only: wp
+    use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_input_config, only: config_type
     use yarnfort_scene_scene, only: scene_type
@@ -24,6 +31,7 @@ program bench_newton
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_timer, only: wall_time
     use bench_common, only: peak_memory_mib, fail, number_grid_nodes
+    use bench_floor, only: floor_type, measure_floor
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
@@ -34,7 +42,7 @@ program bench_newton
     type(error_type), allocatable :: error
     real(wp), allocatable :: u(:)
     real(wp) :: t_residual, t_jacobian, t_analyse, t_factor, t_solve, total, start, other
-    real(wp) :: baseline_mib, growth
+    real(wp) :: baseline_mib, growth, cpu_start, cpu_total
     type(umfpack_memory_type) :: umfpack_memory
     logical :: have_umfpack
     integer :: side, setup_calls, n_factor, iterations
@@ -45,7 +53,8 @@ program bench_newton
         write(output_unit, '(a)') 'solver  setup  unknowns       nnz  iters  facts' // &
             '  residual_ms  jacobian_ms  factor_ms  solve_ms  other_ms  other_%' // &
             '  analyse_ms  total_s  peak_MiB  grow_B/dof  umf_LU_B/dof  umf_peak_B/dof' // &
-            '  x_LU  x_peak'
+            '  x_LU  x_peak  yf_ms  umf_ms st  umf_pat_ms st  klu_ms  x_bare' // &
+            '  iter_x_floor'
         stop
     end if
     read(argument, *) side
@@ -69,9 +78,12 @@ program bench_newton
     allocate(u(scene%dofs%n_unknowns))
     call scene%dofs%restrict(scene%network%position, u)
 
+    call cpu_time(cpu_start)
     start = wall_time()
     call newton%solve(u, stats, error)
     total = wall_time() - start
+    call cpu_time(cpu_total)
+    cpu_total = cpu_total - cpu_start
     if (allocated(error)) call fail('bench_newton', error)
     call newton%get_timings(t_residual, t_jacobian, t_analyse, t_factor, t_solve, n_factor)
     iterations = max(stats%iterations, 1)
@@ -91,19 +103,55 @@ program bench_newton
     if (have_umfpack) then
         associate(lu => umfpack_memory%numeric_bytes / scene%dofs%n_unknowns, &
                 peak => umfpack_memory%peak_bytes / scene%dofs%n_unknowns)
-            write(output_unit, '(f14.0, f16.0, f6.2, f8.2)') lu, peak, growth / lu, &
-                growth / peak
+            write(output_unit, '(f14.0, f16.0, f6.2, f8.2)', advance='no') lu, peak, &
+                growth / lu, growth / peak
         end associate
     else
-        write(output_unit, '(a14, a16, a6, a8)') '-', '-', '-', '-'
+        write(output_unit, '(a14, a16, a6, a8)', advance='no') '-', '-', '-', '-'
     end if
+    call write_floor()
 
 contains
 
+    !> Nonzeros of the Jacobian of the free unknowns (prescribed rows and columns are
+    !> eliminated, so not counted).
     integer function newton_nnz()
-        ! Nonzeros of the Jacobian: 3x3 blocks of coupled node pairs.
-        newton_nnz = 9 * (scene%network%n_nodes() + 2 * scene%network%n_elements())
+        newton_nnz = int(problem%get_nonzeros())
     end function newton_nnz
+
+    !> The floor columns on the Jacobian at the solution.
+    subroutine write_floor()
+        type(floor_type) :: floor
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        real(wp), allocatable :: values(:)
+        real(wp) :: bare, fastest
+        character(len=8) :: ratio
+
+        allocate(col_ptr(size(u) + 1), row_index(problem%get_nonzeros()), &
+            values(problem%get_nonzeros()))
+        call problem%copy_pattern(col_ptr, row_index)
+        call problem%evaluate_jacobian(u, values, error)
+        if (allocated(error)) call fail('bench_newton', error)
+        call measure_floor(trim(solver_name), int(size(u), ik), col_ptr, row_index, values, &
+            floor, error)
+        if (allocated(error)) call fail('bench_newton', error)
+        select case (trim(solver_name))
+        case ('umfpack')
+            bare = floor%umfpack_ms
+        case ('klu')
+            bare = floor%klu_ms
+        case default
+            bare = -1.0_wp
+        end select
+        ratio = '-'
+        if (bare > 0.0_wp) write(ratio, '(f8.2)') floor%yarnfort_ms / bare
+        fastest = minval(pack([floor%umfpack_ms, floor%klu_ms], &
+            [floor%umfpack_ms, floor%klu_ms] > 0.0_wp))
+        write(output_unit, '(f7.2, f8.2, i3, f12.2, i3, f8.2, a8, f14.2)') floor%yarnfort_ms, &
+            floor%umfpack_ms, floor%strategy, floor%umfpack_pattern_ms, &
+            floor%strategy_pattern, floor%klu_ms, trim(ratio), &
+            1e3_wp * cpu_total / iterations / fastest
+    end subroutine write_floor
 
     !> side x side interior nodes, unit spacing, cables along x and y ending on boundary
     !> nodes that are pulled outward by 2 % (pretension); a transverse force on every

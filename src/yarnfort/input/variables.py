@@ -51,7 +51,7 @@ GROUPS = [
                 "(`benchmarks/run`): "
                 "`'cholmod+klu'` for the elastic solves when `slack_stiffness > 0` (the tangent "
                 'of taut strings is positive semi-definite and slack strings get the '
-                "regularising spring's, see `slack_stiffness`), otherwise KLU up to 2e5 "
+                "regularising spring's, see `slack_stiffness`), otherwise KLU up to 5e3 "
                 'unknowns and UMFPACK above; the unsymmetric friction systems never use '
                 'CHOLMOD.'),
         Var('residual_tolerance', 'real', 1e-10, unit='1', range='> 0', preset=True,
@@ -115,7 +115,8 @@ GROUPS = [
             choices=['monolithic', 'staggered'], preset=True,
             doc="Friction: `'monolithic'` solves positions and sliding together with a "
                 "stick/slip active set; `'staggered'` is the paper's two-step scheme (elastic "
-                'solve, then sliding). Case-insensitive.'),
+                'solve, then sliding), each step finished by monolithic solves once its '
+                'active set holds (the alternation alone converges slowly). Case-insensitive.'),
         Var('max_friction_iterations', 'integer', 200, range='>= 1',
             doc='Friction: most stick/slip active-set updates (monolithic) or elastic/sliding '
                 'alternations (staggered) per load step. A slip front advances by about one '

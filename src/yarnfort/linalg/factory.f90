@@ -10,6 +10,7 @@ module yarnfort_linalg_factory
     use yarnfort_linalg_cholmod, only: cholmod_solver_type
     use yarnfort_linalg_dense, only: dense_solver_type
     use yarnfort_linalg_fallback, only: fallback_solver_type
+    use yarnfort_linalg_threads, only: apply_thread_policy
     use yarnfort_text, only: to_lower
     implicit none
     private
@@ -22,16 +23,25 @@ module yarnfort_linalg_factory
         "'umfpack', 'klu', 'cholmod', 'cholmod+klu', 'dense'"
 
     !> Largest order for which KLU is the default for unsymmetric or indefinite
-    !> systems. Measured on cable-net tangents (benchmarks/run, 2 cores, one Newton
-    !> solve, numeric factorisation per iteration): KLU 1.2 / 52 / 2650 ms against
-    !> UMFPACK 3.7 / 108 / 3035 ms at 1e3 / 1e4 / 1e5 unknowns; design.md section 5 has
-    !> UMFPACK 2.6x faster than KLU at 1e6, so the switch sits between 1e5 and 1e6.
-    integer(ik), parameter :: klu_max_order = 200000_ik
+    !> systems. Measured on cable-net tangents (benchmarks/bench_newton's floor columns,
+    !> 2 cores, CPU ms per factorisation + solve of the same Jacobian, one thread):
+    !> KLU 0.73 / 40 / 341 ms against UMFPACK 2.0 / 33 / 131 ms at 1e3 / 1e4 / 3e4
+    !> unknowns, now that UMFPACK is analysed with the values (symmetric strategy; with
+    !> the pattern alone it took 2.1 / 47 / 198 ms and the switch sat at 2e5). design.md
+    !> section 5 has UMFPACK 2.6x faster than KLU at 1e6. The monolithic friction
+    !> Jacobian gives the same switch (benchmarks/bench_friction's `factors:` line, woven
+    !> nets with 4 elements per segment, final active set, L + U nonzeros): 2.4e3
+    !> unknowns KLU 1.2 ms (8.0e4) against UMFPACK 3.8 ms (3.6e4); 4.6e3: 6.8 ms (2.1e5)
+    !> against 9.3 ms (7.7e4); 1.1e4: 152 ms (9.2e5) against 49 ms (2.2e5), KLU with
+    !> COLAMD 1300 ms (3.7e6); whole load cycles at 1.1e4: 410 ms per step with UMFPACK
+    !> against 2408 ms with KLU (wall time, same run).
+    integer(ik), parameter :: klu_max_order = 5000_ik
 
 contains
 
     !> Allocate `solver` as the solver called `name` ('umfpack', 'klu', 'cholmod' or
     !> 'dense'; case and surrounding blanks are ignored). Any old solver is destroyed.
+    !> The first call applies the thread policy of yarnfort_linalg_threads.
     subroutine new_linear_solver(solver, name, error, unsymmetric)
         class(linear_solver_type), allocatable, intent(out) :: solver
         character(len=*), intent(in) :: name
@@ -40,6 +50,7 @@ contains
         !> then keeps the sparser of its AMD and COLAMD orderings.
         logical, intent(in), optional :: unsymmetric
 
+        call apply_thread_policy()
         select case (to_lower(trim(adjustl(name))))
         case ('umfpack')
             allocate(umfpack_solver_type :: solver)

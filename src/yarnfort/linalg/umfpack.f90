@@ -1,8 +1,13 @@
 ! SPDX-License-Identifier: MIT
 !> Sparse LU with UMFPACK's 64-bit interface (`umfpack_dl_*`): the general solver for
-!> unsymmetric or indefinite matrices. The Symbolic object is kept while the pattern is
-!> unchanged (analyse builds it, factor only refactors numerically) and iterative
-!> refinement is off (design.md section 5: it makes solves 3-4x slower; Newton corrects).
+!> unsymmetric or indefinite matrices. The Symbolic object is built at the first
+!> factorisation after analyse, with the values: UMFPACK then sees which diagonal entries
+!> are nonzero and can choose its symmetric strategy (AMD on A + A^T, diagonal pivots
+!> preferred) where it fits; given the pattern alone it assumes a zero-free diagonal is
+!> unlikely and takes the unsymmetric one (measured 1.6-1.7x per iteration on the
+!> cable-net tangents). The object is kept while the pattern is unchanged (later
+!> factorisations are numeric only) and iterative refinement is off (design.md
+!> section 5: it makes solves 3-4x slower; Newton corrects).
 module yarnfort_linalg_umfpack
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr, c_null_ptr, c_associated
     use yarnfort_kinds, only: wp, ik
@@ -19,7 +24,8 @@ module yarnfort_linalg_umfpack
         umfpack_error_internal_error, umfpack_error_ordering_failed, umfpack_dl_defaults, &
         umfpack_dl_symbolic, umfpack_dl_numeric, umfpack_dl_wsolve, &
         umfpack_dl_free_symbolic, umfpack_dl_free_numeric, umfpack_size_of_unit, &
-        umfpack_numeric_size, umfpack_peak_memory, umfpack_lnz, umfpack_unz
+        umfpack_numeric_size, umfpack_peak_memory, umfpack_lnz, umfpack_unz, &
+        umfpack_strategy_used
     implicit none
     private
 
@@ -37,6 +43,9 @@ module yarnfort_linalg_umfpack
         real(wp) :: numeric_bytes = 0.0_wp, peak_bytes = 0.0_wp
         !> Nonzeros of L and U, diagonal included.
         real(wp) :: l_nonzeros = 0.0_wp, u_nonzeros = 0.0_wp
+        !> Strategy of the symbolic analysis (UMFPACK_STRATEGY_USED: 1 unsymmetric, 3
+        !> symmetric), 0 before the first factorisation.
+        integer :: strategy = 0
     end type umfpack_memory_type
 
     !> UMFPACK solver. Owns C handles: never copy an analysed object by assignment.
@@ -51,7 +60,8 @@ module yarnfort_linalg_umfpack
         real(c_double), allocatable :: real_work(:), rhs_copy(:)
         type(umfpack_memory_type) :: memory
     contains
-        !> UMFPACK's memory figures of the last numeric factorisation (benchmarks).
+        !> UMFPACK's memory figures of the last numeric factorisation and the strategy of its
+    !> symbolic analysis (benchmarks).
         procedure :: get_memory
         procedure :: analyse
         procedure :: factor
@@ -63,7 +73,7 @@ module yarnfort_linalg_umfpack
 
 contains
 
-    !> Keep a copy of the pattern and build the Symbolic object.
+    !> Keep a copy of the pattern; the Symbolic object follows at the first `factor`.
     subroutine analyse(self, n, col_ptr, row_index, error)
         class(umfpack_solver_type), intent(inout) :: self
         integer(ik), intent(in) :: n
@@ -76,14 +86,6 @@ contains
         call umfpack_dl_defaults(self%control)
         self%control(umfpack_irstep) = real(umfpack_refinement_steps, c_double)
         self%control(umfpack_prl) = real(umfpack_print_level, c_double)
-        status = umfpack_dl_symbolic(n, n, self%col_ptr, self%row_index, &
-            symbolic=self%symbolic, control=self%control, info=self%info)
-        if (status /= umfpack_ok) then
-            call fatal_error(error, 'umfpack: symbolic analysis failed: ' &
-                // status_message(status))
-            call self%destroy()
-            return
-        end if
         self%n = n
         allocate(self%int_work(n), self%real_work(n), self%rhs_copy(n))
     end subroutine analyse
@@ -96,10 +98,21 @@ contains
         integer(c_long) :: status
         character(len=24) :: rcond
 
-        call self%check_factor_call(c_associated(self%symbolic), values, error)
+        call self%check_factor_call(self%n > 0, values, error)
         if (allocated(error)) return
 
         call umfpack_dl_free_numeric(self%numeric)
+        if (.not. c_associated(self%symbolic)) then
+            status = umfpack_dl_symbolic(self%n, self%n, self%col_ptr, self%row_index, &
+                values, self%symbolic, self%control, self%info)
+            if (status /= umfpack_ok) then
+                call umfpack_dl_free_symbolic(self%symbolic)
+                call fatal_error(error, 'umfpack: symbolic analysis failed: ' &
+                    // status_message(status))
+                return
+            end if
+            self%memory%strategy = nint(self%info(umfpack_strategy_used))
+        end if
         status = umfpack_dl_numeric(self%col_ptr, self%row_index, values, self%symbolic, &
             self%numeric, self%control, self%info)
         if (status == umfpack_ok) then

@@ -9,7 +9,7 @@ module yarnfort_linalg_umfpack_binding
 
     public :: umfpack_control, umfpack_info
     public :: umfpack_size_of_unit, umfpack_numeric_size, umfpack_peak_memory, umfpack_lnz, &
-        umfpack_unz
+        umfpack_unz, umfpack_strategy_used
     public :: umfpack_prl, umfpack_irstep, umfpack_status, umfpack_rcond
     public :: umfpack_a
     public :: umfpack_ok, umfpack_warning_singular_matrix, umfpack_error_out_of_memory
@@ -33,6 +33,8 @@ module yarnfort_linalg_umfpack_binding
     !> and U (diagonal included).
     integer, parameter :: umfpack_size_of_unit = 3, umfpack_numeric_size = 40, &
         umfpack_peak_memory = 41, umfpack_lnz = 43, umfpack_unz = 44
+    !> 0-based index into Info: the strategy used (1 unsymmetric, 3 symmetric).
+    integer, parameter :: umfpack_strategy_used = 18
 
     !> System to solve: A x = b.
     integer(c_long), parameter :: umfpack_a = 0

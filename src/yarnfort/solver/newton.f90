@@ -39,6 +39,12 @@ module yarnfort_solver_newton
     !> Times KINSOL goes on from its solution when the row levels taken there ask for
     !> a smaller residual than those of the initial guess.
     integer, parameter :: max_level_rounds = 4
+    !> Full Newton steps (the first attempt of a solve, when a line search can follow)
+    !> are given up once this many iterations in a row bring no new smallest scaled
+    !> residual. Measured on the cable net of benchmarks/bench_newton (one load step):
+    !> the full steps jump to 4e3 times the initial residual and wander there for all
+    !> max_iterations (200 iterations wasted before the line search took 11).
+    integer, parameter :: full_step_patience = 5
     !> Iterations of the pseudo-transient fallback, in units of max_iterations.
     integer, parameter :: transient_iterations = 4
     !> The fallback gives up when its shift exceeds this multiple of the row levels per
@@ -78,6 +84,11 @@ module yarnfort_solver_newton
         integer(ik) :: n = 0, nnz = 0
         real(wp), allocatable :: history(:)
         integer :: n_history = 0
+        !> Give up (an error) after full_step_patience iterations without a new smallest
+        !> residual: the solve's first attempt of full steps, which a line search follows.
+        logical :: watch_stall = .false.
+        real(wp) :: best_residual = huge(1.0_wp)
+        integer :: since_best = 0
         !> KINSOL's residual scaling, 1 / (level_i + noise_i / tol).
         real(c_double), pointer :: row_weight(:) => null()
         type(error_type), allocatable :: error
@@ -99,6 +110,11 @@ module yarnfort_solver_newton
         type(adapter_type), pointer :: adapter => null()
         type(solver_config_type) :: options
         class(linear_solver_type), pointer :: linear => null()
+        !> Fail fast: full Newton steps only, given up after full_step_patience
+        !> iterations without progress; no line search, no pseudo-transient fallback, no
+        !> regularised predictor. For solves whose failure the caller handles more
+        !> cheaply than those fallbacks do (a guessed stick/slip active set).
+        logical :: quick = .false.
     contains
         !> Solve for unknowns u (in: initial guess, out: solution).
         procedure :: solve
@@ -218,7 +234,7 @@ contains
             problem%tangent_spring = spring
             call solve_once(self, u, stats, exact_error)
             if (.not. allocated(exact_error)) return
-            if (.not. (spring > 0.0_wp)) then
+            if (.not. (spring > 0.0_wp) .or. self%quick) then
                 call move_alloc(exact_error, error)
                 return
             end if
@@ -274,10 +290,13 @@ contains
 
         ! Full Newton steps first; with line_search, a failed attempt is repeated from
         ! the initial guess with KINSOL's line search (back-tracking where needed only).
-        n_attempts = merge(2, 1, self%options%line_search)
+        n_attempts = merge(2, 1, self%options%line_search .and. .not. self%quick)
         do attempt = 1, n_attempts
             strategy = merge(KIN_NONE, KIN_LINESEARCH, attempt == 1)
             self%problem%n_history = 0
+            self%problem%watch_stall = attempt < n_attempts .or. self%quick
+            self%problem%best_residual = huge(1.0_wp)
+            self%problem%since_best = 0
             if (allocated(self%problem%error)) deallocate(self%problem%error)
             if (allocated(self%problem%kinsol_message)) deallocate(self%problem%kinsol_message)
             if (allocated(self%adapter%error)) deallocate(self%adapter%error)
@@ -323,7 +342,7 @@ contains
             end do
             if (converged) exit
         end do
-        if (.not. converged .and. self%options%line_search) then
+        if (.not. converged .and. self%options%line_search .and. .not. self%quick) then
             ! Neither full nor line-searched Newton steps: pseudo-transient continuation.
             call solve_transient(self, u, stats, converged, error)
             if (allocated(error)) return
@@ -509,13 +528,28 @@ contains
         real(wp) :: start
         integer(c_int64_t), pointer :: p(:)
         real(c_double), pointer :: d(:)
+        real(wp) :: norm
 
         call c_f_pointer(user_data, problem)
         u => FN_VGetArrayPointer(sunvec_u)
         f => FN_VGetArrayPointer(sunvec_f)
+        norm = maxval([0.0_wp, abs(f) * problem%row_weight])
         if (problem%n_history < size(problem%history)) then
             problem%n_history = problem%n_history + 1
-            problem%history(problem%n_history) = maxval(abs(f) * problem%row_weight)
+            problem%history(problem%n_history) = norm
+        end if
+        if (problem%watch_stall) then
+            if (norm < problem%best_residual) then
+                problem%best_residual = norm
+                problem%since_best = 0
+            else
+                problem%since_best = problem%since_best + 1
+            end if
+            if (problem%since_best >= full_step_patience) then
+                call fatal_error(problem%error, 'full Newton steps made no progress')
+                ierr = -1
+                return
+            end if
         end if
         start = wall_time()
         n = problem%n
@@ -544,6 +578,8 @@ contains
         call c_f_pointer(user_data, problem)
         length = int(c_strlen(message))
         call c_f_pointer(message, text, [length])
+        ! KINSOL may report more than once in one call of FKINSol: keep the last message.
+        if (allocated(problem%kinsol_message)) deallocate(problem%kinsol_message)
         allocate(character(len=length) :: problem%kinsol_message)
         problem%kinsol_message = transfer(text, problem%kinsol_message)
     end subroutine error_handler

@@ -10,6 +10,8 @@ module test_linalg
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
         klu_max_order
     use yarnfort_linalg_klu, only: klu_solver_type
+    use yarnfort_linalg_umfpack, only: umfpack_solver_type, umfpack_memory_type
+    use yarnfort_linalg_threads, only: apply_thread_policy
     implicit none
     private
 
@@ -82,7 +84,9 @@ contains
             new_unittest('wrong array sizes are errors', test_wrong_sizes), &
             new_unittest('factory creates every named solver', test_factory_names), &
             new_unittest('factory rejects an unknown name', test_factory_unknown), &
-            new_unittest('default solver follows the measured table', test_default_rule) &
+            new_unittest('default solver follows the measured table', test_default_rule), &
+            new_unittest('umfpack analyses with the values', test_umfpack_strategy), &
+            new_unittest('thread policy applied once', test_thread_policy_once) &
             ]
     end subroutine collect_linalg
 
@@ -684,7 +688,53 @@ contains
         if (allocated(error)) return
         call check(error, default_linear_solver_name(1000000_ik, .false.) == 'umfpack', &
             'default for 1e6 general should be umfpack')
+        if (allocated(error)) return
+        call check(error, default_linear_solver_name(klu_max_order + 1, .false.) &
+            == 'umfpack', 'default above klu_max_order general should be umfpack')
     end subroutine test_default_rule
+
+    !> UMFPACK's symbolic analysis sees the values: on a matrix with a symmetric pattern
+    !> and a nonzero diagonal it takes the symmetric strategy (UMFPACK_STRATEGY_SYMMETRIC,
+    !> 3), and the solution is right.
+    subroutine test_umfpack_strategy(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(umfpack_solver_type) :: solver
+        type(umfpack_memory_type) :: memory
+        type(csc_type) :: a
+        real(wp), allocatable :: x_true(:), x(:)
+
+        a = test_matrix('spd')
+        x_true = random_vector(a%n, random_seed + 5)
+        call solver%analyse(a%n, a%col_ptr, a%row_index, error)
+        if (allocated(error)) return
+        memory = solver%get_memory()
+        call check(error, memory%strategy == 0, &
+            'umfpack: a strategy before the first factorisation')
+        if (allocated(error)) return
+        call solver%factor(a%values, error)
+        if (allocated(error)) return
+        memory = solver%get_memory()
+        call check(error, memory%strategy == 3, 'umfpack: strategy ' &
+            // format_integer(memory%strategy) &
+            // ' on an SPD matrix, expected 3 (symmetric)')
+        if (allocated(error)) return
+        x = multiply(a, x_true)
+        call solver%solve(x, error)
+        if (allocated(error)) return
+        call check_solution('umfpack symmetric strategy', a, multiply(a, x_true), x, x_true, &
+            error)
+    end subroutine test_umfpack_strategy
+
+    !> The thread policy acts at most once per process: a second call changes nothing.
+    subroutine test_thread_policy_once(error)
+        type(error_type), allocatable, intent(out) :: error
+        logical :: openmp_first, blas_first, openmp_again, blas_again
+
+        call apply_thread_policy(openmp_first, blas_first)
+        call apply_thread_policy(openmp_again, blas_again)
+        call check(error, openmp_first .eqv. openmp_again .and. (blas_first .eqv. blas_again), &
+            'the thread policy reported different actions on a second call')
+    end subroutine test_thread_policy_once
 
     ! ---- helpers: solving and checking ---------------------------------------------------
 

@@ -1,0 +1,49 @@
+! SPDX-License-Identifier: MIT
+!> Threads of the libraries under the linear solvers, chosen by measurement
+!> (benchmarks/bench_newton, cable nets, 2 cores shared with other work, ms per CHOLMOD
+!> factorisation at 1e4 / 3e4 unknowns):
+!> - Debian's CHOLMOD starts 4 OpenMP threads in its supernodal factorisation whatever
+!>   OMP_NUM_THREADS says: 38 / 117 ms with them against 17 / 99 ms on one thread
+!>   (reference BLAS), 19 / 121 against 8.5 / 35 ms with OpenBLAS. Off.
+!> - OpenBLAS (pthreads build) with 1 or 2 threads: 8.5 / 35 against 9.3 / 32 ms, equal
+!>   within the noise of a shared machine; one thread, which never competes with other
+!>   processes for the cores.
+!> The policy is applied once per process, at the first linear solver; OMP_THREAD_LIMIT
+!> and OPENBLAS_NUM_THREADS set by the user take precedence (threads.c).
+module yarnfort_linalg_threads
+    use, intrinsic :: iso_c_binding, only: c_int
+    implicit none
+    private
+
+    public :: apply_thread_policy, library_openmp, blas_threads
+
+    !> Let the libraries' own OpenMP regions run in parallel.
+    logical, parameter :: library_openmp = .false.
+    !> OpenBLAS threads.
+    integer, parameter :: blas_threads = 1
+
+    interface
+        function yarnfort_apply_thread_policy(openmp, threads) result(applied) &
+                bind(C, name='yarnfort_apply_thread_policy')
+            import :: c_int
+            integer(c_int), value :: openmp, threads
+            integer(c_int) :: applied
+        end function yarnfort_apply_thread_policy
+    end interface
+
+contains
+
+    !> Apply the policy (only the first call does anything). `openmp_limited` and
+    !> `blas_set`: what it changed (false where the user's environment decides, or the
+    !> library is not there).
+    subroutine apply_thread_policy(openmp_limited, blas_set)
+        logical, intent(out), optional :: openmp_limited, blas_set
+        integer(c_int) :: applied
+
+        applied = yarnfort_apply_thread_policy(merge(1_c_int, 0_c_int, library_openmp), &
+            int(blas_threads, c_int))
+        if (present(openmp_limited)) openmp_limited = iand(applied, 1_c_int) /= 0
+        if (present(blas_set)) blas_set = iand(applied, 2_c_int) /= 0
+    end subroutine apply_thread_policy
+
+end module yarnfort_linalg_threads
