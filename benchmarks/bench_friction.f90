@@ -147,8 +147,7 @@ contains
         end associate
         call new_elastic_problem(problem, scene)
         call scene%passages%get_length0(scene%network%length0, stepper%flow, problem%length0)
-        problem%p_force = stepper%p_force
-        problem%p_disp = stepper%p_disp
+        problem%factors = stepper%factors
         n_elastic = problem%get_size()
         nnz_elastic = problem%get_nonzeros()
         deallocate(col_ptr, row_index, values)

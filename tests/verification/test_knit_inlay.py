@@ -88,6 +88,12 @@ def test_clamped_sample_brings_knit_inlay_adhesion_into_play(run_yarnfort, tmp_p
         assert np.any(contacts["mode"][inlay] != "stick")
         curves.append(curve)
     nominal, sticky = curves
-    assert np.array_equal(nominal["time"], sticky["time"])
-    difference = np.abs(sticky["force_per_width"] - nominal["force_per_width"])
+    # Compared at the times both runs reached (the knots and most steps; a step cut in
+    # one run need not happen in the other).
+    _, i, j = np.intersect1d(nominal["time"], sticky["time"], return_indices=True)
+    assert len(i) >= 0.5 * min(len(nominal["time"]), len(sticky["time"]))
+    difference = np.abs(sticky["force_per_width"][j] - nominal["force_per_width"][i])
+    print(f"clamped 4 x 2: ikbeta {KBETA} -> {IKBETA} changes force_per_width by "
+          f"{difference.max() / nominal['force_per_width'].max():.2%} of its peak at "
+          f"{len(i)} common times")
     assert difference.max() > CLAMPED_EFFECT * nominal["force_per_width"].max()

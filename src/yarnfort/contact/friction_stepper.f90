@@ -398,8 +398,7 @@ contains
         solved = .false.
         associate(full => self%full, sliding => self%sliding)
             n_x = size(self%u_trial)
-            full%p_force = self%p_force_trial
-            full%p_disp = self%p_disp_trial
+            full%factors = self%factors_trial
             full%flow_target = sliding%flow_target
             full%locked = sliding%locked
             full%mode = self%mode_trial
