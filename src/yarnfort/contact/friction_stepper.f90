@@ -127,22 +127,16 @@ contains
             if (allocated(error)) return
             call new_newton_solver(self%newton_sliding, self%sliding, linear, scene%solver, error)
             if (allocated(error)) return
-            ! The monolithic finish of a step (finish_after_rounds).
-            allocate(self%full)
-            call new_friction_problem(self%full, scene, positions_frozen=.false.)
-            call new_linear_solver(linear, full_name, error, unsymmetric=.true.)
-            if (allocated(error)) return
-            call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)
-            if (allocated(error)) return
-            self%newton_full%quick = .true.
-        else
-            allocate(self%full)
-            call new_friction_problem(self%full, scene, positions_frozen=.false.)
-            call new_linear_solver(linear, full_name, error, unsymmetric=.true.)
-            if (allocated(error)) return
-            call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)
-            if (allocated(error)) return
         end if
+        ! The monolithic problem: the whole solve, or the staggered scheme's finish of a
+        ! step (finish_after_rounds), which takes full Newton steps only.
+        allocate(self%full)
+        call new_friction_problem(self%full, scene, positions_frozen=.false.)
+        call new_linear_solver(linear, full_name, error, unsymmetric=.true.)
+        if (allocated(error)) return
+        call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)
+        if (allocated(error)) return
+        self%newton_full%quick = self%staggered
         allocate(self%u(scene%dofs%n_unknowns))
         call scene%dofs%restrict(scene%network%position, self%u)
         allocate(self%flow(n_p), source=0.0_wp)
