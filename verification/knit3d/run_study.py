@@ -87,13 +87,25 @@ def main() -> None:
         say(f"{name} against planar: F {diff[0]:+.2f} %, {diff[1]:+.2f} %, {diff[2]:+.2f} %, "
             f"{diff[3]:+.2f} % at 0.1, 0.25, 0.5, 1; loop area "
             f"{100 * (r['area'] / base['area'] - 1):+.2f} %")
-    say("## depth sweep (one loop, the same cycle)")
-    for depth in (0.05e-3, 0.1e-3, 0.2e-3, 0.3e-3, 0.5e-3):
+    # TexGen's loop at step 0: its legs (the two elements each side of the cell's ends
+    # make one leg) and its heads and sinkers, which rise 0.056 mm in depth
+    start = read_states(OUT / "texgen")[0]
+    length = np.linalg.norm(start.position[start.elements[:, 1]]
+                            - start.position[start.elements[:, 0]], axis=1)
+    along_y = np.abs(start.position[start.elements[:, 1], 1]
+                     - start.position[start.elements[:, 0], 1]) > 0.25 * SPACING[1]
+    texgen_leg = 0.5 * np.sum(length[along_y])
+    say(f"TexGen loop: legs {texgen_leg * 1e3:.4f} mm each, heads and sinkers "
+        f"{np.sum(length[~along_y]) * 1e3:.4f} mm in all")
+    say("## depth sweep (one loop, the same cycle); the last: the depth that gives "
+        "TexGen's leg length")
+    for depth in (0.05e-3, 0.1e-3, 0.2e-3, 0.3e-3, 0.5e-3,
+                  np.sqrt(texgen_leg ** 2 - SPACING[1] ** 2)):
         folder = run("inputs/knit3d.nml", {"fabric.knit_depth": depth}, f"depth{depth:.2e}")
         curve = read_curve(folder)
         peak = int(np.argmax(curve["strain"]))
         leg = np.hypot(SPACING[1], depth)
-        say(f"d = {depth * 1e3:.2f} mm | leg {leg * 1e3:.4f} mm | F at 1 "
+        say(f"d = {depth * 1e3:.3f} mm | leg {leg * 1e3:.4f} mm | F at 1 "
             f"{curve['force_per_width'][peak]:.1f} N/m "
             f"({100 * (curve['force_per_width'][peak] / base['at'][3] - 1):+.2f} % of planar)")
     try:
