@@ -8,11 +8,11 @@ a gap-holder (0, 0, d). Checked here:
 
 (a) every head node has its foot partner exactly (0, 0, d) away (across the y period
     for the top course), in every state of a stretch: 2 per loop, no other;
-(b) the wrap angles the program reports at step 0 against closed forms of that
-    geometry: pi/2 at the loop contacts, and at the inlay crossings the turn of a leg
-    sloping in depth and of the inlay zig-zag about it;
-(c) symmetry: each loop mirror-symmetric about its wale's centre in every state, and a
-    2 x 2 cell gives the 1 x 1 cell's curve;
+(b) wrap angles: pi/2 at every loop contact at every step (the closed form of this
+    geometry: legs in planes x = const, heads and sinkers along x), and with an inlay
+    the reported angle at every passage is the turn of that state's polyline;
+(c) symmetry: a 2 x 2 cell gives the 1 x 1 cell's curve and its loops carry the same
+    tensions, both legs of a loop one tension, its two heads at one height and depth;
 (d) the effective curve against closed forms written here from the geometry and the
     yarn table (scipy's PCHIP, the interpolant the material code documents):
     bonded contacts: the heads and sinkers (along x) stretch with the cell, the legs
@@ -164,11 +164,14 @@ def test_loops_are_alike_and_cells_agree(run_yarnfort, tmp_path):
             <= ROUND_OFF * C
 
 
-def test_bonded_curve_is_the_yarn_law_of_the_heads_and_sinkers(run_yarnfort, tmp_path):
+@pytest.mark.parametrize("depth", [D, 0.0])
+def test_bonded_curve_is_the_yarn_law_of_the_heads_and_sinkers(run_yarnfort, tmp_path,
+                                                               depth):
+    """The same for the planar knit: without sliding the depth changes nothing."""
     # to strain 0.9: the heads' strain stays within the yarn table (to 1.0)
     curve = read_curve(run(run_yarnfort, {"path.time": [0.0, 1.0], "path.p_disp": [0.0, 0.9],
-                                          **bonded(1), "output.vtk_every": 0},
-                           tmp_path / "bonded"))
+                                          "fabric.knit_depth": depth, **bonded(1),
+                                          "output.vtk_every": 0}, tmp_path / "bonded"))
     law, strain_at = yarn_table()
     e0 = strain_at(PRESTRESS)
     expected = law((1 + curve["strain"]) * (1 + e0) - 1) / C
@@ -183,7 +186,7 @@ def test_friction_curve_is_the_capstan_limit_with_conserved_yarn(run_yarnfort, t
     folder = run(run_yarnfort, {**LOAD, "fabric.knit_depth": depth, "output.vtk_every": 0},
                  tmp_path / "friction")
     curve, contacts = read_curve(folder), read_contacts(folder)
-    law, strain_at = yarn_table()
+    _, strain_at = yarn_table()
     leg = np.hypot(C, depth)
     e0 = strain_at(PRESTRESS)
     reference = (2 * leg + W) / (1 + e0)
