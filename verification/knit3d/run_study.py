@@ -108,6 +108,27 @@ def main() -> None:
         say(f"d = {depth * 1e3:.3f} mm | leg {leg * 1e3:.4f} mm | F at 1 "
             f"{curve['force_per_width'][peak]:.1f} N/m "
             f"({100 * (curve['force_per_width'][peak] / base['at'][3] - 1):+.2f} % of planar)")
+    say("## clamped 4 x 2 samples (inputs/knit.nml's spacing 1.0 mm x 0.8 mm), one cycle "
+        "to strain 1: peak force per width")
+    for sides in ("rollers", "free"):
+        for inlay in (False, True):
+            row = []
+            for depth in (0.0, 0.2e-3):
+                values = {"fabric.cells": [4, 2], "fabric.boundary": "clamped",
+                          "fabric.sides": sides, "fabric.knit_depth": depth,
+                          "output.vtk_every": 0}
+                if not inlay:
+                    values.update({"fabric.inlay_material": None, "fabric.gap": None})
+                folder = OUT / "clamped"
+                text = patched_scene("inputs/knit.nml", {**CYCLE, **values}, folder)
+                proc = subprocess.run([str(EXE)], input=text, capture_output=True,
+                                      text=True, cwd=TOP)
+                if proc.returncode == 0:
+                    row.append(f"{read_curve(folder)['force_per_width'].max():.1f} N/m")
+                else:
+                    row.append("fails: " + proc.stderr.strip().splitlines()[-1][:160])
+            say(f"sides {sides:7s} {'with' if inlay else 'no':4s} inlay | planar {row[0]} | "
+                f"3D d = 0.2 mm {row[1]}")
     try:
         import matplotlib
         matplotlib.use("Agg")
