@@ -108,6 +108,13 @@ def main() -> None:
         say(f"d = {depth * 1e3:.3f} mm | leg {leg * 1e3:.4f} mm | F at 1 "
             f"{curve['force_per_width'][peak]:.1f} N/m "
             f"({100 * (curve['force_per_width'][peak] / base['at'][3] - 1):+.2f} % of planar)")
+    say("## periodic 4 x 2 cells of inputs/knit.nml's spacing (1.0 mm x 0.8 mm), no inlay: "
+        "peak force per width")
+    for depth in (0.0, 0.2e-3):
+        folder = run("inputs/knit3d.nml", {"fabric.spacing": [1.0e-3, 0.8e-3],
+                                           "fabric.cells": [4, 2], "fabric.knit_depth": depth},
+                     "cell4x2")
+        say(f"d = {depth * 1e3:.1f} mm | {read_curve(folder)['force_per_width'].max():.1f} N/m")
     say("## clamped 4 x 2 samples (inputs/knit.nml's spacing 1.0 mm x 0.8 mm), one cycle "
         "to strain 1: peak force per width")
     for sides in ("rollers", "free"):
