@@ -68,6 +68,39 @@ CASES = {
     "no_kind": ("kind = 'plain'", "", "kind is required"),
     "knit_needs_knit_material": ("kind = 'plain'", "kind = 'knit'",
                                  "&fabric: knit_material is required for kind = 'knit'"),
+    "knit_depth_on_weave": ("strain = 0.1", "strain = 0.1\n knit_depth = 0.1e-3",
+                            "&fabric: knit_depth does not apply to kind = 'plain'"),
+}
+
+#: A valid three-dimensional knit cell (knit_depth > 0), and its mistakes.
+KNIT_3D = """
+&material name = 'knit', law = 'linear', stiffness = 5.0, prestress = 0.02 /
+&fabric
+    kind = 'knit'
+    cells = 2, 2
+    spacing = 1.0e-3, 0.8e-3
+    knit_material = 'knit'
+    knit_depth = 0.2e-3
+    strain = 0.1
+/
+&path time = 0, 1, p_disp = 0, 1 /
+&output folder = 'out' /
+"""
+
+KNIT_3D_CASES = {
+    "negative": ("knit_depth = 0.2e-3", "knit_depth = -0.2e-3",
+                 "&fabric: knit_depth = -0.2000"),
+    "as_deep_as_spacing": ("knit_depth = 0.2e-3", "knit_depth = 0.8e-3",
+                           "must be 0 (a planar knit) or positive and smaller than the spacing"),
+    "nan": ("knit_depth = 0.2e-3", "knit_depth = NaN", "knit_depth = NaN"),
+    "gap_without_inlay": ("knit_depth = 0.2e-3", "knit_depth = 0.2e-3\n gap = 0.1e-3",
+                          "gap applies to woven fabrics and to the inlay of a knit"),
+    "gap_factor_too_large": ("knit_depth = 0.2e-3", "knit_depth = 0.2e-3\n"
+                             " gap_factor_p_disp = 0, 1\n gap_factor = 1.0, 5.0",
+                             "gap_factor must keep knit_depth * factor below the spacing"),
+    "gap_factor_negative": ("knit_depth = 0.2e-3", "knit_depth = 0.2e-3\n"
+                            " gap_factor_p_disp = 0, 1\n gap_factor = 1.0, -1.0",
+                            "gap_factor values must be positive and finite"),
 }
 
 
@@ -100,3 +133,18 @@ def test_knit_inlay_needs_gap(run_yarnfort, tmp_path):
     assert run.returncode == 2
     assert "&fabric: gap = -1.0" in run.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name", sorted(KNIT_3D_CASES))
+def test_bad_knit_depth(run_yarnfort, tmp_path, name):
+    old, new, words = KNIT_3D_CASES[name]
+    assert old in KNIT_3D
+    run = run_yarnfort(KNIT_3D.replace(old, new, 1), cwd=tmp_path)
+    assert run.returncode == 2, run.stderr
+    assert words in run.stderr, run.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_knit_3d_input_is_valid(run_yarnfort, tmp_path):
+    run = run_yarnfort(KNIT_3D, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr

@@ -90,6 +90,8 @@ contains
                     call fatal_error(error, trim(buffer))
                     return
                 end if
+                call forbid_depth(error)
+                if (allocated(error)) return
                 call check_texgen(error)
                 return
             end if
@@ -137,6 +139,13 @@ contains
                 if (allocated(error)) return
                 call require_range(error, 'head_width', fabric%head_width, 0.05_wp, 0.95_wp)
                 if (allocated(error)) return
+                if (.not. (fabric%knit_depth >= 0.0_wp .and. &
+                        fabric%knit_depth < minval(fabric%spacing))) then
+                    write(buffer, '(a, "knit_depth = ", g0, " must be 0 (a planar knit) or ", &
+                        & "positive and smaller than the spacing (m)")') label, fabric%knit_depth
+                    call fatal_error(error, trim(buffer))
+                    return
+                end if
                 if (len_trim(fabric%inlay_material) > 0) then
                     call require_range(error, 'inlay_offset', fabric%inlay_offset, 0.05_wp, &
                         0.95_wp)
@@ -155,10 +164,32 @@ contains
                 if (len_trim(fabric%inlay_material) > 0) then
                     call check_gap(error)
                     if (allocated(error)) return
-                else if (fabric%gap /= -1.0_wp .or. size(fabric%gap_factor) > 0) then
-                    call fatal_error(error, label // 'gap and gap_factor apply to woven ' &
-                        // 'fabrics and to the inlay of a knit; this knit has no inlay_material')
+                else if (fabric%gap /= -1.0_wp) then
+                    call fatal_error(error, label // 'gap applies to woven fabrics and to ' &
+                        // 'the inlay of a knit; this knit has no inlay_material')
                     return
+                else if (fabric%knit_depth > 0.0_wp) then
+                    ! The loop contacts' gap-holders take the gap factor.
+                    call check_gap_factor_positive(error)
+                    if (allocated(error)) return
+                    if (any(fabric%gap_factor * fabric%knit_depth >= minval(fabric%spacing))) then
+                        call fatal_error(error, label // 'gap_factor must keep knit_depth * ' &
+                            // 'factor below the spacing')
+                        return
+                    end if
+                else if (size(fabric%gap_factor) > 0) then
+                    call fatal_error(error, label // 'gap and gap_factor apply to woven ' &
+                        // 'fabrics, to the inlay of a knit and to a three-dimensional knit ' &
+                        // '(knit_depth > 0); this planar knit has no inlay_material')
+                    return
+                end if
+                if (fabric%knit_depth > 0.0_wp .and. size(fabric%gap_factor) > 0 .and. &
+                        len_trim(fabric%inlay_material) > 0) then
+                    if (any(fabric%gap_factor * fabric%knit_depth >= minval(fabric%spacing))) then
+                        call fatal_error(error, label // 'gap_factor must keep knit_depth * ' &
+                            // 'factor below the spacing')
+                        return
+                    end if
                 end if
             else
                 call require_material(error, 'warp_material', fabric%warp_material, .true.)
@@ -168,6 +199,8 @@ contains
                 call forbid_name(error, 'knit_material', fabric%knit_material)
                 if (allocated(error)) return
                 call forbid_name(error, 'inlay_material', fabric%inlay_material)
+                if (allocated(error)) return
+                call forbid_depth(error)
                 if (allocated(error)) return
                 call check_gap(error)
                 if (allocated(error)) return
@@ -292,6 +325,13 @@ contains
                     call fatal_error(error, label // 'gap_factor_p_disp must be finite')
             end associate
         end subroutine check_gap_factor_positive
+
+        subroutine forbid_depth(error)
+            type(error_type), allocatable, intent(out) :: error
+            if (config%fabric%knit_depth == 0.0_wp) return
+            call fatal_error(error, label // "knit_depth does not apply to kind = '" &
+                // trim(config%fabric%kind) // "'")
+        end subroutine forbid_depth
 
         subroutine forbid_name(error, variable, name)
             type(error_type), allocatable, intent(out) :: error

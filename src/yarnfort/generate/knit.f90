@@ -20,6 +20,18 @@
 !> planes of the loops, where no yarn slides through) and its y edges at the feet of
 !> course 0, which are periodic images of the top course's contacts. A clamped sample
 !> holds the yarn ends at x = 0 and pulls those at the right edge.
+!>
+!> Three-dimensional knit (knit_depth = d > 0): the same loops, interlaced in depth. Each
+!> course's feet and sinkers lie at z = +d/2 (in front), its heads at z = -d/2 (behind),
+!> and its legs slope between them, so a loop's legs pass in front of the head of the loop
+!> below where they are drawn through it. A loop contact is no longer a shared node: the
+!> head of loop (i,j) has its node at (x, (j+1)*c, -d/2), the foot of loop (i,j+1) its
+!> own at (x, (j+1)*c, +d/2), and a gap-holder of length d joins them (as at the inlay
+!> crossings). A leg is sqrt(c**2 + d**2) long, a loop 2*sqrt(c**2 + d**2) + w. The legs
+!> lie in planes x = const and the heads and sinkers along x, so the wrap angle at every
+!> loop contact is pi/2 on both yarns, as in the planar knit; the contact force has a
+!> component in depth, which the gap-holder carries. An inlay crosses the legs at their
+!> depth there, d/2 - inlay_offset*d, with the inlay's gap about it.
 module yarnfort_generate_knit
     use yarnfort_kinds, only: wp
     use yarnfort_input_config, only: fabric_config_type
@@ -48,6 +60,10 @@ contains
         logical :: periodic, has_inlay
         logical, allocatable :: inlaid(:)
 
+        if (fabric%knit_depth > 0.0_wp) then
+            call generate_knit_3d(fabric, net, width, pulled)
+            return
+        end if
         nw = fabric%cells(1)
         nc = fabric%cells(2)
         w = fabric%spacing(1)
@@ -149,5 +165,127 @@ contains
             end if
         end if
     end subroutine generate_knit
+
+    !> The three-dimensional knit (knit_depth > 0; see the module text): nodes of its own
+    !> for the head and the feet at every loop contact, joined by gap-holders.
+    subroutine generate_knit_3d(fabric, net, width, pulled)
+        type(fabric_config_type), intent(in) :: fabric
+        type(net_builder_type), intent(inout) :: net
+        real(wp), intent(out) :: width
+        integer, intent(out) :: pulled
+        integer :: nw, nc, i, j
+        real(wp) :: w, c, a, d, y_inlay, z_leg, half_gap, strain(3)
+        integer, allocatable :: foot_left(:, :), foot_right(:, :), head_left(:, :)
+        integer, allocatable :: head_right(:, :), sinker(:, :), leg_left(:, :), leg_right(:, :)
+        integer, allocatable :: inlay_left(:, :), inlay_right(:, :), inlay_end(:, :)
+        integer, allocatable :: course(:), inlay(:)
+        logical :: periodic
+        logical, allocatable :: inlaid(:)
+
+        nw = fabric%cells(1)
+        nc = fabric%cells(2)
+        w = fabric%spacing(1)
+        c = fabric%spacing(2)
+        a = 0.5_wp * (1.0_wp - fabric%head_width) * w
+        d = fabric%knit_depth
+        periodic = fabric%boundary == 'periodic'
+        strain = [fabric%strain, fabric%lateral_strain, 0.0_wp]
+        half_gap = 0.5_wp * max(fabric%gap, 0.0_wp)
+
+        allocate(inlaid(0:nc - 1), source=.false.)
+        if (len_trim(fabric%inlay_material) > 0) then
+            do j = 0, nc - 1
+                inlaid(j) = mod(j, fabric%inlay_every) == 0
+            end do
+        end if
+        allocate(foot_left(0:nw - 1, 0:nc - 1), foot_right(0:nw - 1, 0:nc - 1))
+        allocate(head_left(0:nw - 1, 0:nc - 1), head_right(0:nw - 1, 0:nc - 1))
+        allocate(leg_left(0:nw - 1, 0:nc - 1), leg_right(0:nw - 1, 0:nc - 1), source=0)
+        allocate(inlay_left(0:nw - 1, 0:nc - 1), inlay_right(0:nw - 1, 0:nc - 1), source=0)
+        allocate(sinker(2, 0:nc - 1), inlay_end(2, 0:nc - 1), source=0)
+        ! The legs run from z = d/2 at the feet to -d/2 at the heads; an inlay at height
+        ! inlay_offset*c above the course line crosses them at z_leg.
+        z_leg = 0.5_wp * d - fabric%inlay_offset * d
+        do j = 0, nc - 1
+            sinker(1, j) = net%add_node([0.0_wp, j * c, 0.5_wp * d])
+            sinker(2, j) = net%add_node([nw * w, j * c, 0.5_wp * d])
+            y_inlay = (j + fabric%inlay_offset) * c
+            do i = 0, nw - 1
+                foot_left(i, j) = net%add_node([i * w + a, j * c, 0.5_wp * d])
+                head_left(i, j) = net%add_node([i * w + a, (j + 1) * c, -0.5_wp * d])
+                head_right(i, j) = net%add_node([(i + 1) * w - a, (j + 1) * c, -0.5_wp * d])
+                foot_right(i, j) = net%add_node([(i + 1) * w - a, j * c, 0.5_wp * d])
+                if (.not. inlaid(j)) cycle
+                leg_left(i, j) = net%add_node([i * w + a, y_inlay, z_leg - half_gap])
+                inlay_left(i, j) = net%add_node([i * w + a, y_inlay, z_leg + half_gap])
+                call net%add_link(inlay_left(i, j), leg_left(i, j), [0.0_wp, 0.0_wp, 0.0_wp], &
+                    .true.)
+                leg_right(i, j) = net%add_node([(i + 1) * w - a, y_inlay, z_leg + half_gap])
+                inlay_right(i, j) = net%add_node([(i + 1) * w - a, y_inlay, z_leg - half_gap])
+                call net%add_link(inlay_right(i, j), leg_right(i, j), &
+                    [0.0_wp, 0.0_wp, 0.0_wp], .true.)
+            end do
+            if (.not. inlaid(j)) cycle
+            inlay_end(1, j) = net%add_node([0.0_wp, y_inlay, z_leg])
+            inlay_end(2, j) = net%add_node([nw * w, y_inlay, z_leg])
+        end do
+
+        do j = 0, nc - 1
+            course = [sinker(1, j)]
+            do i = 0, nw - 1
+                course = [course, foot_left(i, j)]
+                if (inlaid(j)) course = [course, leg_left(i, j)]
+                course = [course, head_left(i, j), head_right(i, j)]
+                if (inlaid(j)) course = [course, leg_right(i, j)]
+                course = [course, foot_right(i, j)]
+            end do
+            course = [course, sinker(2, j)]
+            call net%add_yarn(fabric%knit_material, course, fabric%elements_per_segment)
+            if (.not. inlaid(j)) cycle
+            inlay = [inlay_end(1, j)]
+            do i = 0, nw - 1
+                inlay = [inlay, inlay_left(i, j), inlay_right(i, j)]
+            end do
+            inlay = [inlay, inlay_end(2, j)]
+            call net%add_yarn(fabric%inlay_material, inlay, fabric%elements_per_segment)
+        end do
+
+        ! Loop contacts: the feet of course j + 1 follow the head of course j, d in front.
+        do j = 0, nc - 2
+            do i = 0, nw - 1
+                call net%add_link(foot_left(i, j + 1), head_left(i, j), strain, .true.)
+                call net%add_link(foot_right(i, j + 1), head_right(i, j), strain, .true.)
+            end do
+        end do
+
+        width = nc * c
+        pulled = 0
+        if (periodic) then
+            ! The heads of the top course wrap the feet of course 0's image one y period
+            ! up: gap-holders across the lattice vector (0, nc*c, 0).
+            do i = 0, nw - 1
+                call net%add_link(head_left(i, nc - 1), foot_left(i, 0), strain, .true., &
+                    [0.0_wp, nc * c, 0.0_wp])
+                call net%add_link(head_right(i, nc - 1), foot_right(i, 0), strain, .true., &
+                    [0.0_wp, nc * c, 0.0_wp])
+            end do
+            do j = 0, nc - 1
+                call net%add_link(sinker(2, j), sinker(1, j), strain, .false.)
+                if (inlaid(j)) call net%add_link(inlay_end(2, j), inlay_end(1, j), strain, &
+                    .false.)
+            end do
+            call net%add_support('anchor', [foot_left(0, 0)], 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
+        else
+            call net%add_support('left', [sinker(1, :), pack(inlay_end(1, :), inlaid)], 'xyz', &
+                [0.0_wp, 0.0_wp, 0.0_wp])
+            call net%add_support('right', [sinker(2, :), pack(inlay_end(2, :), inlaid)], 'xyz', &
+                [fabric%strain * nw * w, 0.0_wp, 0.0_wp])
+            pulled = 2
+            if (fabric%sides == 'rollers') then
+                call net%add_support('sides', [foot_left(:, 0), foot_right(:, 0), &
+                    head_left(:, nc - 1), head_right(:, nc - 1)], 'y', [0.0_wp, 0.0_wp, 0.0_wp])
+            end if
+        end if
+    end subroutine generate_knit_3d
 
 end module yarnfort_generate_knit

@@ -303,6 +303,14 @@ GROUPS = [
         Var('texgen_samples', 'integer', 16, range='[2, 1000]', checked_by='fabric',
             doc='TexGen: points per master-node span of the sampled centre lines on which '
                 'contacts are searched.'),
+        Var('knit_depth', 'real', 0.0, unit='m', checked_by='fabric',
+            type_doc='real, 0 <= knit_depth < min(spacing)',
+            doc="Knit: 0 makes the planar knit (a loop's head and the feet of the loop above "
+                'share one node). A positive value makes it three-dimensional: the feet and '
+                'sinkers lie at z = +knit_depth/2, the heads at -knit_depth/2, the legs slope '
+                'between them, and each loop contact has a node on either yarn joined by a '
+                'gap-holder of this length (the distance between the yarn axes: the yarn '
+                'thickness). See *Three-dimensional knit* below.'),
     ]),
     Group('nodes', 'singleton',
           'Node coordinates (node ids 1..n in list order).', [
