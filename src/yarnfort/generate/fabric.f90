@@ -170,7 +170,7 @@ contains
                     return
                 else if (fabric%knit_depth > 0.0_wp) then
                     ! The loop contacts' gap-holders take the gap factor.
-                    call check_gap_factor_positive(error)
+                    call check_gap_table(error, below_spacing=.false.)
                     if (allocated(error)) return
                     if (any(fabric%gap_factor * fabric%knit_depth >= minval(fabric%spacing))) then
                         call fatal_error(error, label // 'gap_factor must keep knit_depth * ' &
@@ -295,36 +295,10 @@ contains
                         // 'them)')
                     return
                 end if
-                call check_gap_factor_positive(error)
+                call check_gap_table(error, below_spacing=.false.)
             end associate
         end subroutine check_texgen
 
-        subroutine check_gap_factor_positive(error)
-            type(error_type), allocatable, intent(out) :: error
-            associate(p => config%fabric%gap_factor_p_disp, f => config%fabric%gap_factor)
-                if (size(p) /= size(f)) then
-                    write(buffer, '(a, "gap_factor_p_disp has ", i0, " values but gap_factor ", &
-                        & "has ", i0)') label, size(p), size(f)
-                    call fatal_error(error, trim(buffer))
-                    return
-                end if
-                do k = 2, size(p)
-                    if (.not. (p(k) > p(k - 1))) then
-                        write(buffer, '(a, "gap_factor_p_disp must increase strictly: value ", &
-                            & i0, " (", g0, ") follows ", g0)') label, k, p(k), p(k - 1)
-                        call fatal_error(error, trim(buffer))
-                        return
-                    end if
-                end do
-                if (any(.not. (f > 0.0_wp .and. f < huge(1.0_wp)))) then
-                    call fatal_error(error, label // 'gap_factor values must be positive and ' &
-                        // 'finite')
-                    return
-                end if
-                if (any(p /= p) .or. any(abs(p) > huge(1.0_wp))) &
-                    call fatal_error(error, label // 'gap_factor_p_disp must be finite')
-            end associate
-        end subroutine check_gap_factor_positive
 
         subroutine forbid_depth(error)
             type(error_type), allocatable, intent(out) :: error
@@ -350,7 +324,7 @@ contains
                 call fatal_error(error, trim(buffer))
                 return
             end if
-            call check_gap_table(error)
+            call check_gap_table(error, below_spacing=.true.)
         end subroutine check_gap
 
         !> A periodic weave must hold whole repeats of its pattern.
@@ -365,8 +339,11 @@ contains
             call fatal_error(error, trim(buffer))
         end subroutine check_repeat
 
-        subroutine check_gap_table(error)
+        !> The gap-factor table: knots increasing and finite, factors positive (and, where
+        !> a gap is given, keeping it below the yarn spacing).
+        subroutine check_gap_table(error, below_spacing)
             type(error_type), allocatable, intent(out) :: error
+            logical, intent(in) :: below_spacing
             associate(p => config%fabric%gap_factor_p_disp, f => config%fabric%gap_factor)
                 if (size(p) /= size(f)) then
                     write(buffer, '(a, "gap_factor_p_disp has ", i0, " values but gap_factor ", &
@@ -382,7 +359,14 @@ contains
                         return
                     end if
                 end do
-                do k = 1, size(f)
+                if (.not. below_spacing) then
+                    if (any(.not. (f > 0.0_wp .and. f < huge(1.0_wp)))) then
+                        call fatal_error(error, label // 'gap_factor values must be positive ' &
+                            // 'and finite')
+                        return
+                    end if
+                end if
+                do k = 1, merge(size(f), 0, below_spacing)
                     if (.not. (f(k) > 0.0_wp .and. f(k) * config%fabric%gap &
                             < minval(config%fabric%spacing))) then
                         write(buffer, '(a, "gap_factor value ", i0, " (", g0, ") must be ", &
