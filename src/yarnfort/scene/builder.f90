@@ -345,13 +345,17 @@ contains
     !> share the unknowns of its leader (followed to the end of a chain), offset by their
     !> initial difference, plus the macroscopic stretch (periodic) or scaled by the gap
     !> factor (gap-holder). Periodic followers that move with the x stretch form the
-    !> force set 'stretch': its x reaction is the force carried across the cell.
+    !> force set 'stretch': its x reaction is the force carried across the cell. A
+    !> follower coordinate of a prescribed root is prescribed too; it is listed among the
+    !> followers of the root's support set, whose reaction at the root is then the whole
+    !> force on the root and every coordinate that follows it.
     subroutine build_links(scene, config, error)
         type(scene_type), intent(inout) :: scene
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
-        integer :: n_nodes, l, n, r, k, c, cr, hops, displacement_channel
+        integer :: n_nodes, l, n, r, k, c, cr, hops, displacement_channel, s, i
         integer, allocatable :: leader(:), link_of(:), stretch_coordinates(:)
+        integer, allocatable :: set_of(:), place_of(:)
         real(wp) :: offset(3), macro(3), gap(3), step(3)
         character(len=200) :: buffer
 
@@ -387,6 +391,15 @@ contains
             end if
             leader(n) = config%links(l)%leader
             link_of(n) = l
+        end do
+        ! The support set of every prescribed coordinate and its place in that set.
+        allocate(set_of(3 * n_nodes), place_of(3 * n_nodes), source=0)
+        do s = 1, size(scene%supports)
+            associate(coordinates => scene%supports(s)%coordinates)
+                set_of(coordinates) = s
+                place_of(coordinates) = [(i, i = 1, size(coordinates))]
+            end associate
+            allocate(scene%supports(s)%followers(0), scene%supports(s)%follows(0))
         end do
         allocate(stretch_coordinates(0))
         do n = 1, n_nodes
@@ -433,6 +446,12 @@ contains
                     scene%dofs%delta(c, displacement_channel) = macro(k)
                 end if
                 scene%dofs%gap(c) = gap(k)
+                if (scene%dofs%unknown(cr) == 0 .and. set_of(cr) > 0) then
+                    associate(set => scene%supports(set_of(cr)))
+                        set%followers = [set%followers, c]
+                        set%follows = [set%follows, place_of(cr)]
+                    end associate
+                end if
             end do
             if (macro(1) /= 0.0_wp) stretch_coordinates = [stretch_coordinates, 3 * n - 2]
         end do
@@ -442,6 +461,7 @@ contains
                 type(support_set_type) :: stretch
                 stretch%name = 'stretch'
                 stretch%coordinates = stretch_coordinates
+                allocate(stretch%followers(0), stretch%follows(0))
                 scene%supports = [scene%supports, stretch]
                 if (config%fabric_width > 0.0_wp) scene%fabric_set = size(scene%supports)
             end block

@@ -24,6 +24,9 @@ module yarnfort_scene_scene
         character(len=name_length) :: name = ''
         !> Coordinates 3*(node-1)+k of the set.
         integer, allocatable :: coordinates(:)
+        !> Coordinates that follow coordinates(follows(j)) (images of a periodic cell,
+        !> gap-holders): prescribed with it, their forces add to its reaction.
+        integer, allocatable :: followers(:), follows(:)
     end type support_set_type
 
     !> The nodes of one &load group (their mean displacement is reported per step).

@@ -22,7 +22,7 @@ contains
         type(step_state_type), intent(inout) :: state
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: internal(:), applied(:)
-        integer :: s, i, c, k, n_elements, n_coordinates
+        integer :: s, i, k, n_elements, n_coordinates, first
 
         n_elements = scene%network%n_elements()
         state%factors = factors
@@ -48,13 +48,27 @@ contains
         allocate(state%coordinate_reaction(n_coordinates))
         n_coordinates = 0
         do s = 1, size(scene%supports)
-            do i = 1, size(scene%supports(s)%coordinates)
-                c = scene%supports(s)%coordinates(i)
-                k = mod(c - 1, 3) + 1
-                state%reaction(k, s) = state%reaction(k, s) + internal(c)
-                n_coordinates = n_coordinates + 1
-                state%coordinate_reaction(n_coordinates) = internal(c)
-            end do
+            associate(set => scene%supports(s))
+                ! The reaction of a prescribed coordinate is the force on it and on every
+                ! coordinate that follows it (its prescribed value moves them all).
+                first = n_coordinates
+                do i = 1, size(set%coordinates)
+                    n_coordinates = n_coordinates + 1
+                    state%coordinate_reaction(n_coordinates) = internal(set%coordinates(i))
+                end do
+                if (allocated(set%followers)) then
+                    do i = 1, size(set%followers)
+                        state%coordinate_reaction(first + set%follows(i)) = &
+                            state%coordinate_reaction(first + set%follows(i)) &
+                            + internal(set%followers(i))
+                    end do
+                end if
+                do i = 1, size(set%coordinates)
+                    k = mod(set%coordinates(i) - 1, 3) + 1
+                    state%reaction(k, s) = state%reaction(k, s) &
+                        + state%coordinate_reaction(first + i)
+                end do
+            end associate
             if (.not. all(ieee_is_finite(state%reaction(:, s)))) then
                 call fatal_error(error, "the reaction of support set '" &
                     // trim(scene%supports(s)%name) // "' is not a finite number (its " &
