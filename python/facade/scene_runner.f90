@@ -13,7 +13,7 @@ module yarnfort_facade_scene_runner
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_input_config, only: config_type
-    use yarnfort_input_namelist, only: read_config, check_config
+    use yarnfort_input_namelist, only: read_config_from_file, check_config
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_output_writer, only: output_writer_type
     use yarnfort_driver, only: solve_with_outputs
@@ -35,9 +35,6 @@ module yarnfort_facade_scene_runner
 
     !> Marker status of the error that unwinds the continuation after a stop request.
     integer, parameter :: status_stop_request = -1
-
-    !> Longest I/O error message kept.
-    integer, parameter :: iomsg_length = 512
 
     abstract interface
         !> Called after every converged step (step 0 included) once its files are written;
@@ -95,7 +92,7 @@ contains
         n_steps = 0
         outcome = outcome_done
         folder = ''
-        call read_scene_file(path, config, error)
+        call read_config_from_file(path, config, error, from_working_directory=.true.)
         if (.not. allocated(error)) then
             folder = trim(config%output%folder)
             call check_config(config, error)
@@ -117,25 +114,6 @@ contains
         if (writer%stop_requested .and. .not. allocated(error)) outcome = outcome_stopped
         if (allocated(error)) call set_stage(error, stage, status)
     end subroutine run_scene_from_file
-
-    !> Read the namelist file `path` with relative names taken from the working
-    !> directory (as for standard input).
-    subroutine read_scene_file(path, config, error)
-        character(len=*), intent(in) :: path
-        type(config_type), intent(out) :: config
-        type(error_type), allocatable, intent(out) :: error
-        character(len=iomsg_length) :: iomsg
-        integer :: unit, stat
-
-        open(newunit=unit, file=path, status='old', action='read', form='formatted', &
-            access='sequential', iostat=stat, iomsg=iomsg)
-        if (stat /= 0) then
-            call fatal_error(error, "cannot open input file '" // path // "': " // trim(iomsg))
-            return
-        end if
-        call read_config(unit, config, error)
-        close(unit)
-    end subroutine read_scene_file
 
     !> Write the step with the parent writer, count it, and report it to the call-back.
     subroutine on_step(self, scene, state, error)

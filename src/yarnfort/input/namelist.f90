@@ -180,11 +180,13 @@ contains
     end subroutine read_groups
 
     !> Read the namelist input from the file `path`; relative file names in it are
-    !> resolved against the folder of `path`.
-    subroutine read_config_from_file(path, config, error)
+    !> resolved against the folder of `path`, or with `from_working_directory` against
+    !> the working directory (as for standard input).
+    subroutine read_config_from_file(path, config, error, from_working_directory)
         character(len=*), intent(in) :: path
         type(config_type), intent(out) :: config
         type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: from_working_directory
         character(len=message_length) :: message
         integer :: unit, stat
 
@@ -197,6 +199,13 @@ contains
         if (stat /= 0) then
             call fatal_error(error, "cannot open input file '" // path // "': " // trim(message))
             return
+        end if
+        if (present(from_working_directory)) then
+            if (from_working_directory) then
+                call read_config(unit, config, error)
+                close(unit)
+                return
+            end if
         end if
         call read_config(unit, config, error, folder_of(path))
         close(unit)
