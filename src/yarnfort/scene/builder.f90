@@ -26,7 +26,7 @@ module yarnfort_scene_builder
     implicit none
     private
 
-    public :: new_scene, new_force_law
+    public :: new_scene, new_force_law, new_friction_law
 
 contains
 
@@ -104,10 +104,7 @@ contains
                 type(table_law_type), allocatable :: table
                 allocate(table)
                 path = trim(material%table_file)
-                if (present(folder)) then
-                    if (len_trim(folder) > 0 .and. path(1:1) /= '/') &
-                        path = trim(folder) // '/' // path
-                end if
+                if (present(folder)) path = resolve_path(path, folder)
                 call read_table_law(table, path, error)
                 call move_alloc(table, law)
             end block
