@@ -18,11 +18,13 @@ from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
-from .results import Curve, State
+from .results import GAP_HOLDER, Curve, ResultError, State, read_curve, read_states
 
 __all__ = ["plot_curve", "plot_hysteresis", "plot_fabric_hysteresis", "plot_network",
-           "plot_fan", "save_figure", "supports", "reaction_component"]
+           "plot_states", "nearest_states", "plot_fan", "save_figure", "supports",
+           "reaction_component"]
 
 #: Index of each Cartesian component in a reaction or position row.
 COMPONENTS: dict[str, int] = {"x": 0, "y": 1, "z": 2}
@@ -38,6 +40,9 @@ BRANCH_STYLES: dict[str, dict[str, str]] = {
     "loading": {"color": "tab:blue", "linestyle": "-"},
     "unloading": {"color": "tab:red", "linestyle": "--"},
 }
+#: A target of :func:`nearest_states` may lie outside the values of the run by this
+#: fraction of their range (rounding of the strain column).
+TARGET_TOLERANCE = 1e-9
 #: Value of the ``direction`` column for each branch.
 BRANCH_DIRECTIONS: dict[str, int] = {"loading": 1, "unloading": -1}
 
@@ -216,8 +221,34 @@ def _plot_branches(ax: Axes, abscissa: np.ndarray, ordinate: np.ndarray,
             line.set_gid(branch)
 
 
+#: Length units of the state plots: name -> metres per unit.
+LENGTH_UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "um": 1e-6}
+#: ``mode`` point data of a node whose passage slips (forward, backward).
+SLIP_MODES = (2, 3)
+
+
+def _image_shifts(state: State, images: tuple[int, ...]) -> np.ndarray:
+    """Shifts (m) of the periodic images of ``state``: every combination of 0 ..
+    images[k] - 1 times its period k (:meth:`State.periods`)."""
+    counts = [int(n) for n in images]
+    if any(n < 1 for n in counts):
+        raise ValueError(f"images must be at least 1 per period, not {tuple(images)}")
+    wanted = [k for k, n in enumerate(counts) if n > 1]
+    if not wanted:
+        return np.zeros((1, 3))
+    periods = state.periods()
+    if len(periods) <= max(wanted):
+        raise ValueError(f"images {tuple(images)} need {max(wanted) + 1} periods; this state"
+                         f" has {len(periods)} (the periodic links of a periodic cell)")
+    counts = (counts + [1] * len(periods))[:len(periods)]
+    grid = np.stack(np.meshgrid(*[np.arange(n) for n in counts], indexing="ij"), axis=-1)
+    return grid.reshape(-1, len(periods)) @ periods
+
+
 def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
-                 cmap: str = "viridis", colorbar: bool = True) -> Axes:
+                 cmap: str = "viridis", colorbar: bool = True, norm: Normalize | None = None,
+                 images: tuple[int, ...] = (1, 1), unit: str = "m", gap_holders: bool = True,
+                 nodes: bool = True, slipping: bool = False, depth_scale: float = 1.0) -> Axes:
     """The deformed network of ``state`` as line segments coloured by element tension.
 
     Parameters
@@ -225,38 +256,293 @@ def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
     state : State
         A converged state (``read_state``).
     ax : Axes, optional
-        Where to draw; a new figure when omitted.
-    projection : {'xy', 'xz', 'yz'}
-        The two coordinates drawn (the other one is dropped).
+        Where to draw (a 3D Axes for ``projection='3d'``); a new figure when omitted.
+    projection : {'xy', 'xz', 'yz', '3d'}
+        The two coordinates drawn (the other one is dropped), or a perspective view.
     cmap : str
         Matplotlib colormap for the tension.
     colorbar : bool
         Add a colorbar labelled "tension (N)".
+    norm : Normalize, optional
+        The tension range of the colours (default: this state's minimum to maximum).
+    images : tuple of int
+        Periodic images drawn along each period of a periodic cell (its periodic links,
+        :meth:`State.periods`), e.g. ``(3, 3)``; ``(1, 1)``: the cell alone.
+    unit : {'m', 'mm', 'um'}
+        Length unit of the axes.
+    gap_holders : bool
+        Draw the gap-holders as thin grey lines.
+    nodes : bool
+        Mark the nodes with small black dots.
+    slipping : bool
+        Circle in red the nodes whose passage slips (``mode`` point data forward or
+        backward; see ``contacts.csv``).
+    depth_scale : float
+        How many times z is stretched in the drawing (``'3d'`` and the projections
+        with z; the tick labels stay true lengths).
 
     Returns
     -------
     Axes
+
+    Raises
+    ------
+    ValueError
+        For an unknown projection or unit, or images of a state that is no periodic
+        cell.
     """
-    if len(projection) != 2 or not set(projection) <= set(COMPONENTS):
-        raise ValueError(f"projection must be two of 'x', 'y', 'z', not {projection!r}")
-    ax = _axes(ax)
-    columns = [COMPONENTS[c] for c in projection]
-    segments = state.position[:, columns][state.elements]
-    tension = np.asarray(state.tension, dtype=float)
-    low, high = (float(tension.min()), float(tension.max())) if tension.size else (0, 1)
-    if high <= low:
-        high = low + 1.0
-    lines = LineCollection(segments, cmap=cmap, norm=Normalize(low, high), linewidths=2)
+    three_d = projection == "3d"
+    if not three_d and (len(projection) != 2 or not set(projection) <= set(COMPONENTS)):
+        raise ValueError(f"projection must be two of 'x', 'y', 'z' or '3d', not"
+                         f" {projection!r}")
+    if unit not in LENGTH_UNITS:
+        raise ValueError(f"unit must be one of {', '.join(LENGTH_UNITS)}, not {unit!r}")
+    if ax is None:
+        figure = Figure(layout="constrained")
+        ax = figure.add_subplot(projection="3d") if three_d else figure.add_subplot()
+    columns = [0, 1, 2] if three_d else [COMPONENTS[c] for c in projection]
+    scale = 1.0 / LENGTH_UNITS[unit]
+    shifts = _image_shifts(state, images)
+    points = np.concatenate([state.position + shift for shift in shifts])[:, columns] * scale
+    offsets = np.arange(len(shifts))[:, None, None] * len(state.position)
+    elements = (state.elements[None, :, :] + offsets).reshape(-1, 2)
+    tension = np.tile(np.asarray(state.tension, dtype=float), len(shifts))
+    if norm is None:
+        low, high = (float(tension.min()), float(tension.max())) if tension.size else (0, 1)
+        norm = Normalize(low, high if high > low else low + 1.0)
+    if three_d:
+        from mpl_toolkits.mplot3d.art3d import Line3DCollection
+        collection = Line3DCollection
+    else:
+        collection = LineCollection
+    lines = collection(points[elements], cmap=cmap, norm=norm, linewidths=2)
     lines.set_array(tension)
-    ax.add_collection(lines)
-    ax.plot(*state.position[:, columns].T, "k.", markersize=3)
-    ax.autoscale_view()
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel(f"{projection[0]} (m)")
-    ax.set_ylabel(f"{projection[1]} (m)")
+    lines.set_gid("elements")
+    holder = state.link_kind == GAP_HOLDER
+    if gap_holders and np.any(holder):
+        # A gap-holder to a periodic image (cell data `period`) is drawn to that image.
+        period = np.asarray(state.link_data.get("period", np.zeros((len(holder), 3))),
+                            dtype=float).reshape(-1, 3)[holder]
+        ends = np.stack([state.position[state.links[holder, 0]],
+                         state.position[state.links[holder, 1]] - period], axis=1)
+        ends = (ends[None, :, :, :] + shifts[:, None, None, :]).reshape(-1, 2, 3)
+        grey = collection(ends[:, :, columns] * scale, colors="0.55", linewidths=1)
+        grey.set_gid("gap_holders")
+        lines = [grey, lines]
+    else:
+        lines = [lines]
+    for drawn in lines:
+        if three_d:
+            ax.add_collection3d(drawn)
+        else:
+            ax.add_collection(drawn)
+    lines = lines[-1]
+    if nodes:
+        ax.plot(*points.T, "k.", markersize=3)
+    mode = state.point_data.get("mode")
+    if slipping and mode is not None:
+        slip = np.flatnonzero(np.isin(np.ravel(mode), SLIP_MODES))
+        where = np.concatenate([slip + k * len(state.position) for k in range(len(shifts))])
+        ax.plot(*points[where].T, "o", markersize=7, markerfacecolor="none",
+                markeredgecolor="tab:red", label="slipping passage", gid="slipping")
+    names = ["xyz"[c] for c in columns]
+    ax.set_xlabel(f"{names[0]} ({unit})")
+    ax.set_ylabel(f"{names[1]} ({unit})")
+    if three_d:
+        low, high = points.min(axis=0), points.max(axis=0)
+        extent = np.where(high > low, high - low, 1.0)
+        ax.set_xlim(low[0], low[0] + extent[0])
+        ax.set_ylim(low[1], low[1] + extent[1])
+        ax.set_zlim(low[2], low[2] + extent[2])
+        ax.set_box_aspect((extent[0], extent[1], depth_scale * extent[2]))
+        ax.zaxis.set_major_locator(MaxNLocator(3))
+        ax.set_zlabel(f"z ({unit})")
+    else:
+        ax.autoscale_view()
+        # z drawn depth_scale times: the aspect is the ratio of the vertical unit to the
+        # horizontal one on the screen.
+        aspect = 1.0
+        if columns[1] == 2:
+            aspect = depth_scale
+        elif columns[0] == 2:
+            aspect = 1.0 / depth_scale
+        ax.set_aspect(aspect, adjustable="datalim")
     if colorbar:
         ax.figure.colorbar(lines, ax=ax, label="tension (N)")
     return ax
+
+
+def nearest_states(folder: str | Path, targets: tuple[float, ...] = (0.0, 0.5, 1.0),
+                   by: str = "strain", of_peak: bool = False
+                   ) -> list[tuple[State, float]]:
+    """The saved states of a run nearest to given values of a curve column, on its
+    first loading.
+
+    The candidates are the states written (``states.pvd``) whose step is in
+    ``curve.csv`` up to the first step where ``by`` reaches its largest value (the
+    first loading, so a cycle's unloading is not picked). For each target the nearest
+    candidate is taken (the earlier one on a tie).
+
+    Parameters
+    ----------
+    folder : str or Path
+        A run's output folder.
+    targets : tuple of float
+        Values of ``by`` wanted (with ``of_peak``: fractions of its largest value).
+    by : str
+        The curve column: ``'strain'`` for a fabric, ``'p_disp'``, ``'time'``, ...
+    of_peak : bool
+        Targets are fractions of the largest value of ``by`` on the first loading
+        (``1`` is the peak): for a fabric stretched less than the targets.
+
+    Returns
+    -------
+    list of (State, float)
+        Per target: the state and its value of ``by``.
+
+    Raises
+    ------
+    ResultError
+        If the folder is missing, holds no curve.csv, a curve without rows, or no
+        states of steps in the curve.
+    KeyError
+        If the curve has no column ``by``.
+    ValueError
+        If there are no targets, or a target lies outside the values of ``by`` on the
+        first loading (by more than :data:`TARGET_TOLERANCE` of their range).
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ResultError(f"no output folder {str(folder)!r}")
+    if not (folder / "curve.csv").is_file():
+        raise ResultError(f"{str(folder)!r} holds no curve.csv: not a yarnfort output folder")
+    if len(targets) == 0:
+        raise ValueError("no strains asked for")
+    curve = read_curve(folder)
+    if len(curve) == 0:
+        raise ResultError(f"{folder / 'curve.csv'} has no rows: the run wrote no converged"
+                          " step")
+    values = curve[by]
+    last = int(np.argmax(values))
+    first_loading = {int(step): float(value)
+                     for step, value in zip(curve["step"][:last + 1], values[:last + 1])}
+    states = [state for state in read_states(folder) if state.step in first_loading]
+    if not states:
+        raise ResultError(f"{folder}: no VTK state of a step of the first loading (steps 0"
+                          f" to {int(curve['step'][last])}); run with &output vtk_every > 0")
+    found = np.array([first_loading[state.step] for state in states])
+    low, high = float(values[:last + 1].min()), float(values[last])
+    slack = TARGET_TOLERANCE * max(high - low, abs(high), abs(low), np.finfo(float).tiny)
+    chosen = []
+    for target in targets:
+        value = float(target) * high if of_peak else float(target)
+        if not low - slack <= value <= high + slack:
+            raise ValueError(f"{by} = {value:g} is outside the run's first loading"
+                             f" ({low:g} to {high:g})"
+                             + ("" if of_peak else "; targets as fractions of the peak:"
+                                " of_peak (--of-peak)"))
+        k = int(np.argmin(np.abs(found - value)))
+        chosen.append((states[k], float(found[k])))
+    return chosen
+
+
+def _common_limits(axes: list[Axes], three_d: bool, depth_scale: float) -> None:
+    """The same limits on every Axes of a row (the union of what each shows), so that
+    the panels compare at one scale."""
+    if three_d:
+        limits = [(min(getattr(ax, f"get_{k}lim")()[0] for ax in axes),
+                   max(getattr(ax, f"get_{k}lim")()[1] for ax in axes)) for k in "xyz"]
+        for ax in axes:
+            for k, (low, high) in zip("xyz", limits):
+                getattr(ax, f"set_{k}lim")(low, high)
+            extent = [high - low for low, high in limits]
+            ax.set_box_aspect((extent[0], extent[1], depth_scale * extent[2]))
+        return
+    bounds = np.array([ax.dataLim.extents for ax in axes])
+    low, high = bounds[:, :2].min(axis=0), bounds[:, 2:].max(axis=0)
+    margin = 0.04 * np.where(high > low, high - low, 1.0)
+    for ax in axes:
+        ax.set_xlim(low[0] - margin[0], high[0] + margin[0])
+        ax.set_ylim(low[1] - margin[1], high[1] + margin[1])
+        ax.set_adjustable("box")
+
+
+def plot_states(folder: str | Path, strains: tuple[float, ...] = (0.0, 0.5, 1.0), *,
+                by: str = "strain", of_peak: bool = False, images: tuple[int, ...] = (1, 1),
+                projections: tuple[str, ...] = ("xy",), unit: str = "mm",
+                cmap: str = "viridis", depth_scale: float = 1.0, slipping: bool = True,
+                title: str | None = None) -> Figure:
+    """Deformed states of a run, one panel per requested strain, coloured by tension on
+    one common scale.
+
+    The states drawn are those :func:`nearest_states` picks (the saved steps nearest to
+    ``strains`` on the first loading); each panel is titled with the value it shows.
+    One row of panels per entry of ``projections``, one colorbar (tension, N) for all.
+
+    Parameters
+    ----------
+    folder : str or Path
+        A run's output folder (curve.csv and VTK states).
+    strains : tuple of float
+        Values of ``by`` (with ``of_peak``: fractions of its peak).
+    by, of_peak
+        As in :func:`nearest_states`.
+    images : tuple of int
+        Periodic images per period, as in :func:`plot_network`.
+    projections : tuple of str
+        Views, one row each: ``'xy'``, ``'xz'``, ``'yz'`` or ``'3d'``.
+    unit : {'mm', 'm', 'um'}
+        Length unit of the axes.
+    cmap : str
+        Colormap of the tension.
+    depth_scale : float
+        z stretched this many times in ``'3d'`` views.
+    slipping : bool
+        Circle the nodes whose passage slips.
+    title : str, optional
+        Title of the figure.
+
+    Returns
+    -------
+    Figure
+        In every panel the elements are the collection of gid ``'elements'``; its
+        ``norm`` is the common tension range (min to max over the states drawn).
+
+    Raises
+    ------
+    ResultError, KeyError, ValueError
+        As :func:`nearest_states` and :func:`plot_network`.
+    """
+    chosen = nearest_states(folder, strains, by=by, of_peak=of_peak)
+    for projection in projections:  # before any drawing: a clear error
+        if projection != "3d" and (len(projection) != 2
+                                   or not set(projection) <= set(COMPONENTS)):
+            raise ValueError(f"projection must be two of 'x', 'y', 'z' or '3d', not"
+                             f" {projection!r}")
+    tensions = np.concatenate([np.asarray(state.tension, dtype=float)
+                               for state, _ in chosen])
+    low, high = float(tensions.min()), float(tensions.max())
+    norm = Normalize(low, high if high > low else low + 1.0)
+    figure = Figure(figsize=(4.2 * len(chosen) + 1.2, 3.6 * len(projections)),
+                    layout="constrained")
+    label = "strain" if by == "strain" else by
+    lines = None
+    for row, projection in enumerate(projections):
+        for column, (state, value) in enumerate(chosen):
+            ax = figure.add_subplot(len(projections), len(chosen),
+                                    row * len(chosen) + column + 1,
+                                    projection="3d" if projection == "3d" else None)
+            plot_network(state, ax=ax, projection=projection, cmap=cmap, colorbar=False,
+                         norm=norm, images=images, unit=unit, slipping=slipping,
+                         depth_scale=depth_scale)
+            if row == 0:
+                ax.set_title(f"{label} {value:.3g} (step {state.step})")
+            lines = [c for c in ax.collections if c.get_gid() == "elements"][0]
+        _common_limits(figure.axes[-len(chosen):], projection == "3d", depth_scale)
+    figure.colorbar(lines, ax=figure.axes, label="tension (N)", shrink=0.8)
+    if title:
+        figure.suptitle(title)
+    return figure
 
 
 def plot_fan(curves: dict[str, Curve], support: str, component: str = "y",

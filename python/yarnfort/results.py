@@ -5,7 +5,9 @@ the VTK states (``states.pvd`` and the ``state_*.vtu`` files it lists).
 States are read with :mod:`meshio` when it is installed (any VTK XML encoding: ASCII,
 inline or appended binary); without it, a small reader of the ASCII encoding is used.
 What a state holds: node positions (the VTK points), the two-node elements (the
-``line`` cells) and every point and cell data array of the file, by name. The element
+``line`` cells of ``kind`` 0), the links (gap-holders and periodic images, the cells of
+another ``kind``), the field data (``step``, ``time``, load factors, a fabric's
+``strain``) and every point and cell data array of the file, by name. The element
 arrays ``tension``, ``stretch`` and ``L0`` are required; any others (displacement,
 yarn or material ids, contact state, ...) are kept in :attr:`State.point_data` and
 :attr:`State.cell_data`.
@@ -22,6 +24,12 @@ import numpy as np
 
 __all__ = ["Curve", "State", "ResultError", "read_curve", "read_reactions", "read_contacts",
            "read_state", "read_states", "read_run"]
+
+#: ``kind`` of the link cells of a VTK state (0 is a yarn element).
+GAP_HOLDER = 1
+PERIODIC_LINK = 2
+#: Periodic links along one period agree to this fraction of the longest link.
+PERIOD_TOLERANCE = 1e-9
 
 #: Columns of text (not numbers) in the long-format step files.
 _TEXT_COLUMNS = {"reactions.csv": ("support",), "contacts.csv": ("mode",)}
@@ -162,7 +170,19 @@ class State:
     tension, stretch, length0 : numpy.ndarray
         Per element: tension (N), stretch l/L0 and reference length L0 (m).
     point_data, cell_data : dict of str to numpy.ndarray
-        Every array of the file, by name (the three above included in ``cell_data``).
+        Every array of the file, by name (the three above included in ``cell_data``,
+        which holds the elements' values only).
+    links : numpy.ndarray
+        Node indices (from 0) of each link: gap-holder or periodic image, shape
+        (n_links, 2); empty for a state without them.
+    link_kind : numpy.ndarray
+        The ``kind`` of each link: :data:`GAP_HOLDER` or :data:`PERIODIC_LINK`.
+    link_data : dict of str to numpy.ndarray
+        The cell data of the links, by name (``period``: the lattice vector each
+        spans, m).
+    field_data : dict of str to numpy.ndarray
+        The file's field data: ``step``, ``time``, the load factors and, for a fabric,
+        ``strain`` and ``force_per_width`` (one value each).
     """
 
     position: np.ndarray
@@ -172,6 +192,78 @@ class State:
     length0: np.ndarray
     point_data: dict[str, np.ndarray] = field(default_factory=dict)
     cell_data: dict[str, np.ndarray] = field(default_factory=dict)
+    links: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
+    link_kind: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    link_data: dict[str, np.ndarray] = field(default_factory=dict)
+    field_data: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def step(self) -> int | None:
+        """The load step of this state (field data ``step``), or None if the file has
+        no such field."""
+        if "step" not in self.field_data:
+            return None
+        return int(np.ravel(self.field_data["step"])[0])
+
+    def periods(self) -> np.ndarray:
+        """The current period vectors of a periodic cell, from its links.
+
+        Each link's cell data ``period`` is the lattice vector it spans (a periodic
+        link joins a node to its image one period away; a gap-holder may join a node
+        to the image of its partner); files without that array give the vectors of the
+        periodic links (image minus node). Vectors along the same period are grouped
+        (they agree to :data:`PERIOD_TOLERANCE` of the longest, up to sign); the
+        vectors returned are independent, ordered by the axis each mostly runs along
+        (x first), each with that component positive.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n_periods, 3), m; (0, 3) for a state without periodic links.
+
+        Raises
+        ------
+        ResultError
+            If a lattice vector is no integer combination of the periods found (not a
+            periodic cell as yarnfort writes it).
+        """
+        if "period" in self.link_data:
+            vectors = np.asarray(self.link_data["period"], dtype=float).reshape(-1, 3)
+        else:
+            pairs = self.links[self.link_kind == PERIODIC_LINK]
+            vectors = self.position[pairs[:, 1]] - self.position[pairs[:, 0]]
+        lengths = np.linalg.norm(vectors, axis=1)
+        vectors = vectors[lengths > 0]
+        if len(vectors) == 0:
+            return np.zeros((0, 3))
+        # One sign per vector: its largest component positive.
+        largest = np.argmax(np.abs(vectors), axis=1)
+        vectors *= np.sign(vectors[np.arange(len(vectors)), largest])[:, None]
+        scale = np.linalg.norm(vectors, axis=1).max()
+        groups: list[list[np.ndarray]] = []
+        for vector in vectors[np.argsort(np.linalg.norm(vectors, axis=1))]:
+            for group in groups:
+                if np.linalg.norm(vector - group[0]) <= PERIOD_TOLERANCE * scale:
+                    group.append(vector)
+                    break
+            else:
+                groups.append([vector])
+        basis: list[np.ndarray] = []
+        for group in groups:
+            mean = np.mean(group, axis=0)
+            if np.linalg.matrix_rank(np.array(basis + [mean]),
+                                     tol=PERIOD_TOLERANCE * scale) > len(basis):
+                basis.append(mean)
+            else:
+                # A combination of periods (a corner link): it must be one exactly.
+                coefficients, *_ = np.linalg.lstsq(np.array(basis).T, mean, rcond=None)
+                if (np.abs(coefficients - np.round(coefficients)).max() > PERIOD_TOLERANCE
+                        or np.linalg.norm(np.array(basis).T @ np.round(coefficients)
+                                          - mean) > PERIOD_TOLERANCE * scale):
+                    raise ResultError("periodic links that are no combination of the"
+                                      " cell's periods: not a periodic cell")
+        basis.sort(key=lambda vector: int(np.argmax(np.abs(vector))))
+        return np.array(basis)
 
 
 def _curve_file(path: str | Path, name: str = "curve.csv") -> Path:
@@ -299,10 +391,13 @@ def _ascii_array(piece: ET.Element, section: str, name: str | None) -> np.ndarra
     raise KeyError(name)
 
 
-def _read_ascii(path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict]:
-    piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
+def _read_ascii(path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict, dict]:
+    grid = ET.parse(path).getroot().find("UnstructuredGrid")
+    piece = grid.find("Piece") if grid is not None else None
     if piece is None:
         raise ResultError(f"{path}: not a VTK UnstructuredGrid file")
+    field_data = {node.get("Name"): _ascii_array(grid, "FieldData", node.get("Name"))
+                  for node in grid.iterfind("FieldData/DataArray")}
     points = _ascii_array(piece, "Points", None).reshape(-1, 3)
     connectivity = _ascii_array(piece, "Cells", "connectivity").astype(int)
     point_data = {node.get("Name"): _ascii_array(piece, "PointData", node.get("Name"))
@@ -313,10 +408,10 @@ def _read_ascii(path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict]:
         for name, values in data.items():
             if count and values.size != count and values.size % count == 0:
                 data[name] = values.reshape(count, -1)
-    return points, connectivity.reshape(-1, 2), point_data, cell_data
+    return points, connectivity.reshape(-1, 2), point_data, cell_data, field_data
 
 
-def _read_meshio(meshio: Any, path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict]:
+def _read_meshio(meshio: Any, path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict, dict]:
     mesh = meshio.read(path)
     blocks = [k for k, block in enumerate(mesh.cells) if block.type == "line"]
     if not blocks:
@@ -325,12 +420,13 @@ def _read_meshio(meshio: Any, path: Path) -> tuple[np.ndarray, np.ndarray, dict,
     cell_data = {name: np.concatenate([np.asarray(arrays[k]) for k in blocks])
                  for name, arrays in mesh.cell_data.items()}
     point_data = {name: np.asarray(values) for name, values in mesh.point_data.items()}
-    return np.asarray(mesh.points, dtype=float), elements, point_data, cell_data
+    field_data = {name: np.asarray(values) for name, values in mesh.field_data.items()}
+    return np.asarray(mesh.points, dtype=float), elements, point_data, cell_data, field_data
 
 
 def read_state(path: str | Path) -> State:
-    """Read one VTK state file (``state_*.vtu``) written by yarnfort: its yarn elements
-    (links, the cells of another ``kind``, are left out).
+    """Read one VTK state file (``state_*.vtu``) written by yarnfort: its yarn elements,
+    and apart from them its links (the cells of another ``kind``).
 
     Parameters
     ----------
@@ -353,7 +449,7 @@ def read_state(path: str | Path) -> State:
     except ImportError:
         meshio = None
     try:
-        points, elements, point_data, cell_data = (
+        points, elements, point_data, cell_data, field_data = (
             _read_meshio(meshio, path) if meshio is not None else _read_ascii(path))
     except (ET.ParseError, KeyError, ValueError) as error:
         if isinstance(error, ResultError):
@@ -362,16 +458,22 @@ def read_state(path: str | Path) -> State:
     missing = [name for name in ("tension", "stretch", "L0") if name not in cell_data]
     if missing:
         raise ResultError(f"{path}: no cell data {', '.join(missing)}")
-    # Links (gap-holders, periodic images) are cells of another `kind`: keep elements.
+    # Links (gap-holders, periodic images) are cells of another `kind`.
+    links, link_kind = np.zeros((0, 2), dtype=int), np.zeros(0, dtype=int)
+    link_data: dict[str, np.ndarray] = {}
     if "kind" in cell_data:
-        element = np.ravel(cell_data["kind"]) == 0
+        kind = np.ravel(cell_data["kind"]).astype(int)
+        element = kind == 0
+        links, link_kind = elements[~element], kind[~element]
         elements = elements[element]
+        link_data = {name: np.asarray(values)[~element] for name, values in cell_data.items()}
         cell_data = {name: np.asarray(values)[element] for name, values in cell_data.items()}
     return State(position=points, elements=elements,
                  tension=np.ravel(cell_data["tension"]),
                  stretch=np.ravel(cell_data["stretch"]),
                  length0=np.ravel(cell_data["L0"]),
-                 point_data=point_data, cell_data=cell_data)
+                 point_data=point_data, cell_data=cell_data, links=links,
+                 link_kind=link_kind, link_data=link_data, field_data=field_data)
 
 
 def read_states(folder: str | Path) -> list[State]:

@@ -3,7 +3,7 @@
 !>     ./yarnfort < scene.nml
 !> Progress goes to stderr; results to the &output folder. Exit code 0 only on success.
 program yarnfort_main
-    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64, real64
     use yarnfort_error, only: error_type
     use yarnfort_version, only: yarnfort_version_string
     use yarnfort_input_config, only: config_type
@@ -21,18 +21,22 @@ program yarnfort_main
     type(error_type), allocatable :: error
     character(len=:), allocatable :: stage
     integer :: status
+    integer(int64) :: clock_start, clock_end, clock_rate
+    character(len=16) :: seconds
     logical :: stopped
 
     call handle_arguments()
     ! A write past a file size limit then fails like any other write (exit 1, message).
     call ignore_file_size_signal()
 
+    call system_clock(clock_start, clock_rate)
     call read_config_from_stdin(config, error)
     if (allocated(error)) call fail('input', error, 2)
     call check_config(config, error)
     if (allocated(error)) call fail('input', error, 2)
     call new_scene(scene, config, error)
     if (allocated(error)) call fail('input', error, 2)
+    call system_clock(clock_end)
 
     write(error_unit, '(a, i0, a, i0, a, i0, a, a)') 'yarnfort: ', scene%network%n_nodes(), &
         ' nodes, ', scene%network%n_elements(), ' elements, ', scene%dofs%n_unknowns, &
@@ -40,6 +44,10 @@ program yarnfort_main
     if (config%fabric%kind == 'texgen') write(error_unit, '(a, i0, a, i0, a)') &
         'yarnfort: TexGen model: ', config%texgen_yarns, ' yarns, ', config%texgen_contacts, &
         ' contacts (one gap-holder each)'
+    write(seconds, '(f16.6)') &
+        real(clock_end - clock_start, real64) / real(max(clock_rate, 1_int64), real64)
+    write(error_unit, '(a)') 'yarnfort: scene built in ' // trim(adjustl(seconds)) &
+        // ' s (input read and checked, fabric generated or imported)'
     if (scene%passages%size() > 0) write(error_unit, '(a, i0, a, a, a)') 'yarnfort: ', &
         scene%passages%size(), ' sliding passages, ', trim(scene%solver%scheme), ' scheme'
     if (config%control%check_only) then

@@ -16,7 +16,9 @@
 !>   wrap_angle (as in contacts.csv; 0 at nodes without a passage);
 !> - cell data: kind (0 yarn element, 1 gap-holder, 2 periodic link), yarn and material
 !>   (1-based, in input order; 0 for links), tension (N; 0 for links), stretch
-!>   (current over reference length) and L0 (reference length).
+!>   (current over reference length), L0 (reference length) and period (the current
+!>   lattice vector a link spans: a periodic link's, a gap-holder's to a periodic
+!>   image; zero for elements and links inside the cell).
 !> The data are appended base64-encoded binary (VTK XML 1.0, UInt64 headers) by
 !> default, or inline ASCII (&output vtk_format).
 module yarnfort_output_vtk
@@ -99,8 +101,8 @@ contains
         integer :: n_nodes, n_elements, n_links, n_cells, e, l, p, node, y
         integer(int64), allocatable :: connectivity(:), offsets(:)
         integer(int32), allocatable :: cell_kind(:), yarn(:), material(:), contact(:)
-        real(wp), allocatable :: tension(:), stretch(:), length0(:)
-        real(wp) :: now(3), before(3)
+        real(wp), allocatable :: tension(:), stretch(:), length0(:), period(:, :)
+        real(wp) :: now(3), before(3), p_disp
 
         name = get_state_name(state%step)
         path = self%folder // '/' // name
@@ -113,6 +115,10 @@ contains
         allocate(connectivity(2 * n_cells), offsets(n_cells))
         allocate(cell_kind(n_cells), yarn(n_cells), material(n_cells))
         allocate(tension(n_cells), stretch(n_cells), length0(n_cells))
+        allocate(period(3, n_cells), source=0.0_wp)
+        p_disp = 0.0_wp
+        if (scene%dofs%gap_channel >= 1 .and. scene%dofs%gap_channel <= size(state%factors)) &
+            p_disp = state%factors(scene%dofs%gap_channel)
         do e = 1, n_elements
             connectivity(2 * e - 1:2 * e) = scene%network%element_nodes(:, e) - 1
         end do
@@ -138,6 +144,8 @@ contains
                 length0(e) = norm2(before)
                 stretch(e) = 1.0_wp
                 if (length0(e) > 0.0_wp) stretch(e) = norm2(now) / length0(e)
+                period(:, e) = scene%link_period(:, l) &
+                    * (1.0_wp + p_disp * scene%link_strain(:, l))
             end associate
         end do
         offsets = [(2_int64 * e, e = 1, n_cells)]
@@ -186,6 +194,7 @@ contains
         call add_reals(vtu, 'tension', tension, 1)
         call add_reals(vtu, 'stretch', stretch, 1)
         call add_reals(vtu, 'L0', length0, 1)
+        call add_reals(vtu, 'period', reshape(period, [3 * n_cells]), 3)
         call add_int32(vtu, 'kind', cell_kind)
         call add_int32(vtu, 'yarn', yarn)
         call add_int32(vtu, 'material', material)

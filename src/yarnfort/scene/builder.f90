@@ -366,11 +366,23 @@ contains
             scene%dofs%gap_factor = config%fabric%gap_factor
         end if
         allocate(scene%link_nodes(2, 0), scene%link_is_gap(0))
+        allocate(scene%link_period(3, 0), scene%link_strain(3, 0))
         if (.not. allocated(config%links)) return
         if (size(config%links) == 0) return
         scene%link_nodes = reshape([(config%links(l)%leader, config%links(l)%follower, &
             l = 1, size(config%links))], [2, size(config%links)])
         scene%link_is_gap = config%links%gap
+        deallocate(scene%link_period, scene%link_strain)
+        allocate(scene%link_period(3, size(config%links)), scene%link_strain(3, &
+            size(config%links)))
+        do l = 1, size(config%links)
+            associate(link => config%links(l))
+                scene%link_strain(:, l) = link%strain
+                scene%link_period(:, l) = link%period
+                if (.not. link%gap) scene%link_period(:, l) = scene%network%position(:, &
+                    link%follower) - scene%network%position(:, link%leader)
+            end associate
+        end do
         allocate(leader(n_nodes), link_of(n_nodes), source=0)
         do l = 1, size(config%links)
             n = config%links(l)%follower

@@ -77,6 +77,10 @@ module yarnfort_scene_scene
         !> node pairs (2, n_links), and whether each is a gap-holder.
         integer, allocatable :: link_nodes(:, :)
         logical, allocatable :: link_is_gap(:)
+        !> The lattice vector each link spans at p_disp = 0 (3, n_links): a periodic link's
+        !> initial offset, a gap-holder's period (zero inside the cell); at factor p of
+        !> dofs%gap_channel it is link_period * (1 + p * link_strain), componentwise.
+        real(wp), allocatable :: link_period(:, :), link_strain(:, :)
     end type scene_type
 
 contains
