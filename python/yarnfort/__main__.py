@@ -1,10 +1,16 @@
 # SPDX-License-Identifier: MIT
-"""Command line: ``python -m yarnfort plot <output folder> [--support NAME] [--out FILE]``.
+"""Command line:
 
-Writes a PNG with the force–displacement (hysteresis) plot of one support set (for a
-generated fabric: force per unit width against strain) and the final deformed network
-coloured by tension. Exit codes: 0 success, 2 bad arguments, a
-missing or unreadable output folder, or an unknown support set.
+- ``python -m yarnfort plot <output folder> [--support NAME] [--out FILE]`` writes a PNG
+  with the force–displacement (hysteresis) plot of one support set (for a generated
+  fabric: force per unit width against strain) and the final deformed network coloured
+  by tension;
+- ``python -m yarnfort plot-states <output folder> [-o FILE] [--strains 0 0.5 1] ...``
+  writes a PNG of the deformed states nearest to the given strains, coloured by tension
+  on one scale (:func:`yarnfort.plots.plot_states`).
+
+Exit codes: 0 success, 2 bad arguments, a missing or unreadable output folder, an
+unknown support set, or strains the run does not reach.
 """
 from __future__ import annotations
 
@@ -24,6 +30,8 @@ from .results import Curve, read_curve, read_states
 EXIT_BAD_INPUT = 2
 #: File name of the default plot inside the output folder.
 DEFAULT_PLOT = "plot.png"
+#: File name of the default state plot inside the output folder.
+DEFAULT_STATES_PLOT = "states.png"
 
 
 class CommandError(Exception):
@@ -173,7 +181,41 @@ def _parser() -> argparse.ArgumentParser:
                       help="support set to plot (default: the first that moves)")
     plot.add_argument("--out", type=Path, metavar="FILE",
                       help=f"PNG to write (default: <folder>/{DEFAULT_PLOT})")
+    states = commands.add_parser(
+        "plot-states", help="write a PNG: deformed states at given strains",
+        description="Write a PNG of the saved states nearest to the given strains on the"
+        " first loading, the yarns coloured by tension on one scale.")
+    states.add_argument("folder", type=Path, help="output folder of a run (curve.csv and"
+                        " VTK states)")
+    states.add_argument("-o", "--out", type=Path, metavar="FILE",
+                        help=f"PNG to write (default: <folder>/{DEFAULT_STATES_PLOT})")
+    states.add_argument("--strains", type=float, nargs="+", default=[0.0, 0.5, 1.0],
+                        metavar="S", help="values of the --by column (default 0 0.5 1)")
+    states.add_argument("--by", default="strain", metavar="COLUMN",
+                        help="curve.csv column the strains are values of (default strain;"
+                        " p_disp for a scene that is no fabric)")
+    states.add_argument("--of-peak", action="store_true",
+                        help="strains are fractions of the largest value on the first"
+                        " loading")
+    states.add_argument("--images", type=int, nargs="+", default=[1, 1], metavar="N",
+                        help="periodic images per period of a periodic cell (e.g. 3 3)")
+    states.add_argument("--projection", nargs="+", default=["xy"], metavar="VIEW",
+                        help="views, one row each: xy, xz, yz or 3d (default xy)")
+    states.add_argument("--depth-scale", type=float, default=1.0, metavar="F",
+                        help="draw z this many times stretched (default 1)")
+    states.add_argument("--title", help="figure title")
     return parser
+
+
+def plot_states_command(args: argparse.Namespace) -> Path:
+    """Write the state plot that ``plot-states`` asks for; the PNG written."""
+    from .plots import plot_states, save_figure
+
+    figure = plot_states(args.folder, tuple(args.strains), by=args.by, of_peak=args.of_peak,
+                         images=tuple(args.images), projections=tuple(args.projection),
+                         depth_scale=args.depth_scale, title=args.title)
+    return save_figure(figure, args.out if args.out is not None
+                       else args.folder / DEFAULT_STATES_PLOT)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -193,8 +235,12 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "plot":
             path = plot_folder(args.folder, args.support, args.out)
-            print(f"yarnfort: wrote {path}")
-    except (CommandError, OSError, ValueError) as error:
+        else:
+            path = plot_states_command(args)
+        print(f"yarnfort: wrote {path}")
+    except (CommandError, OSError, ValueError, KeyError) as error:
+        if isinstance(error, KeyError):
+            error = error.args[0] if error.args else error
         print(f"yarnfort {args.command}: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
     return 0

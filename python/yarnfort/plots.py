@@ -10,6 +10,7 @@ files hold is drawn.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import matplotlib
@@ -227,6 +228,14 @@ LENGTH_UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "um": 1e-6}
 SLIP_MODES = (2, 3)
 
 
+def _check_projection(projection: str) -> None:
+    """A view of :func:`plot_network`: two different axes of 'x', 'y', 'z', or '3d'."""
+    if projection != "3d" and (len(projection) != 2 or len(set(projection)) != 2
+                               or not set(projection) <= set(COMPONENTS)):
+        raise ValueError(f"projection must be two of 'x', 'y', 'z' or '3d', not"
+                         f" {projection!r}")
+
+
 def _image_shifts(state: State, images: tuple[int, ...]) -> np.ndarray:
     """Shifts (m) of the periodic images of ``state``: every combination of 0 ..
     images[k] - 1 times its period k (:meth:`State.periods`)."""
@@ -291,10 +300,8 @@ def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
         For an unknown projection or unit, or images of a state that is no periodic
         cell.
     """
+    _check_projection(projection)
     three_d = projection == "3d"
-    if not three_d and (len(projection) != 2 or not set(projection) <= set(COMPONENTS)):
-        raise ValueError(f"projection must be two of 'x', 'y', 'z' or '3d', not"
-                         f" {projection!r}")
     if unit not in LENGTH_UNITS:
         raise ValueError(f"unit must be one of {', '.join(LENGTH_UNITS)}, not {unit!r}")
     if ax is None:
@@ -515,10 +522,7 @@ def plot_states(folder: str | Path, strains: tuple[float, ...] = (0.0, 0.5, 1.0)
     """
     chosen = nearest_states(folder, strains, by=by, of_peak=of_peak)
     for projection in projections:  # before any drawing: a clear error
-        if projection != "3d" and (len(projection) != 2
-                                   or not set(projection) <= set(COMPONENTS)):
-            raise ValueError(f"projection must be two of 'x', 'y', 'z' or '3d', not"
-                             f" {projection!r}")
+        _check_projection(projection)
     tensions = np.concatenate([np.asarray(state.tension, dtype=float)
                                for state, _ in chosen])
     low, high = float(tensions.min()), float(tensions.max())
@@ -596,9 +600,22 @@ def save_figure(fig: Figure | Axes, path: str | Path, dpi: int = 150) -> Path:
     -------
     pathlib.Path
         The path written.
+
+    Raises
+    ------
+    OSError
+        If the file cannot be written (nothing is left at ``path`` then, or the old
+        file stays).
     """
     figure = fig.figure if isinstance(fig, Axes) else fig
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, format="png", dpi=dpi)
+    # Through a temporary file renamed over the target: a failed write leaves no
+    # half-written PNG.
+    partial = path.with_name(path.name + ".tmp")
+    try:
+        figure.savefig(partial, format="png", dpi=dpi)
+        os.replace(partial, path)
+    finally:
+        partial.unlink(missing_ok=True)
     return path
