@@ -157,12 +157,11 @@ def main() -> None:
 def plot_states() -> None:
     """knit3d_states.png: the 3D knit at strain 0, 0.5 and 1 (loading), 3 x 3 periodic
     cells, seen from the front (x-y, top row) and in perspective with depth drawn 6 times
-    (bottom row), elements coloured by tension, gap-holders grey."""
+    (bottom row), elements coloured by tension, gap-holders grey
+    (yarnfort.plots.plot_states)."""
     import matplotlib
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.collections import LineCollection
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+    from yarnfort.plots import plot_states as draw_states, save_figure
 
     folder = OUT / "knit3d_states"
     text = patched_scene("inputs/knit3d.nml", {
@@ -171,58 +170,11 @@ def plot_states() -> None:
     proc = subprocess.run([str(EXE)], input=text, capture_output=True, text=True, cwd=TOP)
     if proc.returncode != 0:
         raise SystemExit(proc.stderr)
-    curve, states = read_curve(folder), read_states(folder)
-    depth = 0.2e-3  # inputs/knit3d.nml's knit_depth
-    fig = plt.figure(figsize=(13, 8))
-    top = max(state.tension.max() for state in states)
-    for column, target in enumerate((0.0, 0.5, 1.0)):
-        k = int(np.argmin(np.abs(curve["strain"] - target)))
-        state = states[k]
-        cell = np.array([SPACING[0] * (1.0 + curve["strain"][k]), SPACING[1], 0.0])
-        segments, colours, holders = [], [], []
-        heads = np.flatnonzero(state.position[:, 2] < 0.0)
-        for i in range(3):
-            for j in range(3):
-                shift = np.array([i, j, 0]) * cell
-                for (p, q), tension in zip(state.elements, state.tension):
-                    segments.append([state.position[p] + shift, state.position[q] + shift])
-                    colours.append(tension)
-                for h in heads:  # head node and its partner d in front
-                    holders.append([state.position[h] + shift,
-                                    state.position[h] + shift + [0.0, 0.0, depth]])
-        segments = np.array(segments) * 1e3
-        front = fig.add_subplot(2, 3, column + 1)
-        lines = LineCollection(segments[:, :, :2], array=np.array(colours), cmap="viridis",
-                               linewidths=2)
-        lines.set_clim(0.0, top)
-        front.add_collection(lines)
-        front.autoscale()
-        front.set_aspect("equal")
-        front.set_title(f"strain {curve['strain'][k]:.2f}")
-        front.set_xlabel("x (mm)")
-        front.set_ylabel("y (mm)")
-        view = fig.add_subplot(2, 3, column + 4, projection="3d")
-        lines3 = Line3DCollection(segments, array=np.array(colours), cmap="viridis",
-                                  linewidths=1.5)
-        lines3.set_clim(0.0, top)
-        view.add_collection3d(lines3)
-        view.add_collection3d(Line3DCollection(np.array(holders) * 1e3, colors="0.5",
-                                               linewidths=1.0))
-        low, high = segments.reshape(-1, 3).min(axis=0), segments.reshape(-1, 3).max(axis=0)
-        view.set_xlim(low[0], high[0])
-        view.set_ylim(low[1], high[1])
-        view.set_zlim(low[2], high[2])
-        extent = high - low
-        view.set_box_aspect((extent[0], extent[1], 6 * extent[2]))
-        view.view_init(elev=25, azim=-70)
-        view.set_xlabel("x (mm)")
-        view.set_ylabel("y (mm)")
-        view.set_zlabel("z (mm)")
-    fig.subplots_adjust(left=0.04, right=0.9, wspace=0.15)
-    fig.colorbar(lines, cax=fig.add_axes([0.93, 0.25, 0.012, 0.5]), label="tension (N)")
-    fig.suptitle("3D knit (knit_depth 0.2 mm), 3 x 3 periodic cells: front (x-y) and "
-                 "perspective (depth x 6); computed, illustrative yarn table")
-    fig.savefig(HERE / "knit3d_states.png", dpi=110)
+    figure = draw_states(folder, (0.0, 0.5, 1.0), images=(3, 3), projections=("xy", "3d"),
+                         depth_scale=6.0, title="3D knit (knit_depth 0.2 mm), 3 x 3 periodic"
+                         " cells: front (x-y) and perspective (depth x 6); computed,"
+                         " illustrative yarn table")
+    save_figure(figure, HERE / "knit3d_states.png", dpi=110)
 
 
 if __name__ == "__main__":

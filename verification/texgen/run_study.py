@@ -124,12 +124,10 @@ def main() -> None:
 
 def plot_states() -> None:
     """knit_states.png: the TexGen knit at strain 0, 0.5 and 1 (loading), 3 x 3 cells,
-    seen from the front (x-y), elements coloured by tension."""
+    seen from the front (x-y), elements coloured by tension (yarnfort.plots.plot_states)."""
     import matplotlib
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.collections import LineCollection
-    from yarnfort import read_states
+    from yarnfort.plots import plot_states as draw_states, save_figure
 
     folder = OUT / "knit_states"
     text = patched_scene("inputs/texgen_knit.nml", {
@@ -138,34 +136,9 @@ def plot_states() -> None:
     proc = subprocess.run([str(EXE)], input=text, capture_output=True, text=True, cwd=TOP)
     if proc.returncode != 0:
         raise SystemExit(proc.stderr)
-    curve, states = read_curve(folder), read_states(folder)
-    period = np.array([1.2e-3, 1.0e-3])  # inputs/texgen_knit.tg3's repeats (m)
-    fig, axes = plt.subplots(1, 3, figsize=(12, 4.2))
-    top = max(state.tension.max() for state in states)
-    for ax, target in zip(axes, (0.0, 0.5, 1.0)):
-        k = int(np.argmin(np.abs(curve["strain"] - target)))
-        state = states[k]
-        cell = period * [1.0 + curve["strain"][k], 1.0]
-        segments, colours = [], []
-        for i in range(3):
-            for j in range(3):
-                shift = np.array([i * cell[0], j * cell[1]])
-                for (a, b), tension in zip(state.elements, state.tension):
-                    segments.append([state.position[a, :2] + shift,
-                                     state.position[b, :2] + shift])
-                    colours.append(tension)
-        lines = LineCollection(np.array(segments) * 1e3, array=np.array(colours),
-                               cmap="viridis", linewidths=2)
-        lines.set_clim(0.0, top)
-        ax.add_collection(lines)
-        ax.autoscale()
-        ax.set_aspect("equal")
-        ax.set_title(f"strain {curve['strain'][k]:.2f}")
-        ax.set_xlabel("x (mm)")
-    axes[0].set_ylabel("y (mm)")
-    fig.colorbar(lines, ax=axes, label="tension (N)", shrink=0.8)
-    fig.suptitle("TexGen weft knit, 3 x 3 periodic cells (computed; illustrative yarn table)")
-    fig.savefig(Path(__file__).with_name("knit_states.png"), dpi=110)
+    figure = draw_states(folder, (0.0, 0.5, 1.0), images=(3, 3), title="TexGen weft knit,"
+                         " 3 x 3 periodic cells (computed; illustrative yarn table)")
+    save_figure(figure, Path(__file__).with_name("knit_states.png"), dpi=110)
 
 
 if __name__ == "__main__":
