@@ -222,6 +222,9 @@ def _plot_branches(ax: Axes, abscissa: np.ndarray, ordinate: np.ndarray,
             line.set_gid(branch)
 
 
+#: Width of one panel of :func:`plot_states` and the largest height of a row (inches).
+PANEL_WIDTH = 4.2
+ROW_HEIGHT = 3.6
 #: Length units of the state plots: name -> metres per unit.
 LENGTH_UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "um": 1e-6}
 #: ``mode`` point data of a node whose passage slips (forward, backward).
@@ -453,6 +456,14 @@ def nearest_states(folder: str | Path, targets: tuple[float, ...] = (0.0, 0.5, 1
     return chosen
 
 
+def _row_height(ax: Axes) -> float:
+    """Height (inches) of a row of 2D panels of width :data:`PANEL_WIDTH` that shows
+    ``ax``'s limits at its aspect, with room for the title and labels."""
+    width = np.ptp(ax.get_xlim())
+    ratio = np.ptp(ax.get_ylim()) * ax.get_aspect() / width if width > 0 else 1.0
+    return float(np.clip(PANEL_WIDTH * ratio, 0.4, ROW_HEIGHT) + 1.1)
+
+
 def _common_limits(axes: list[Axes], three_d: bool, depth_scale: float) -> None:
     """The same limits on every Axes of a row (the union of what each shows), so that
     the panels compare at one scale."""
@@ -527,10 +538,11 @@ def plot_states(folder: str | Path, strains: tuple[float, ...] = (0.0, 0.5, 1.0)
                                for state, _ in chosen])
     low, high = float(tensions.min()), float(tensions.max())
     norm = Normalize(low, high if high > low else low + 1.0)
-    figure = Figure(figsize=(4.2 * len(chosen) + 1.2, 3.6 * len(projections)),
+    figure = Figure(figsize=(PANEL_WIDTH * len(chosen) + 1.2, ROW_HEIGHT * len(projections)),
                     layout="constrained")
     label = "strain" if by == "strain" else by
     lines = None
+    heights = []
     for row, projection in enumerate(projections):
         for column, (state, value) in enumerate(chosen):
             ax = figure.add_subplot(len(projections), len(chosen),
@@ -542,7 +554,11 @@ def plot_states(folder: str | Path, strains: tuple[float, ...] = (0.0, 0.5, 1.0)
             if row == 0:
                 ax.set_title(f"{label} {value:.3g} (step {state.step})")
             lines = [c for c in ax.collections if c.get_gid() == "elements"][0]
-        _common_limits(figure.axes[-len(chosen):], projection == "3d", depth_scale)
+        row_axes = figure.axes[-len(chosen):]
+        _common_limits(row_axes, projection == "3d", depth_scale)
+        heights.append(ROW_HEIGHT if projection == "3d" else _row_height(row_axes[0]))
+    # Rows as tall as their drawings (a flat weave seen from the side is a thin strip).
+    figure.set_size_inches(PANEL_WIDTH * len(chosen) + 1.2, sum(heights))
     figure.colorbar(lines, ax=figure.axes, label="tension (N)", shrink=0.8)
     if title:
         figure.suptitle(title)
