@@ -338,15 +338,14 @@ def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
         ends = (ends[None, :, :, :] + shifts[:, None, None, :]).reshape(-1, 2, 3)
         grey = collection(ends[:, :, columns] * scale, colors="0.55", linewidths=1)
         grey.set_gid("gap_holders")
-        lines = [grey, lines]
+        drawn = [grey, lines]
     else:
-        lines = [lines]
-    for drawn in lines:
+        drawn = [lines]
+    for each in drawn:
         if three_d:
-            ax.add_collection3d(drawn)
+            ax.add_collection3d(each)
         else:
-            ax.add_collection(drawn)
-    lines = lines[-1]
+            ax.add_collection(each)
     if nodes:
         ax.plot(*points.T, "k.", markersize=3)
     mode = state.point_data.get("mode")

@@ -405,10 +405,13 @@ def test_states_read_alike_with_and_without_meshio(workdir):
     run = yarnfort.run_scene(scene_file)
     for path in sorted(run.folder.glob("state_*.vtu"))[-2:]:
         state = results.read_state(path)
-        points, elements, _, cells = results._read_ascii(path)
+        points, elements, _, cells, fields = results._read_ascii(path)
         np.testing.assert_array_equal(state.position, points)
         np.testing.assert_array_equal(state.elements, elements)
         np.testing.assert_array_equal(state.tension, cells["tension"])
+        assert set(state.field_data) == set(fields)
+        for name, values in fields.items():
+            np.testing.assert_array_equal(np.ravel(state.field_data[name]), values)
 
 
 def test_built_scene_with_an_obstacle_and_a_ring(workdir):
