@@ -106,6 +106,10 @@ def test_example_run_writes_curve_vtk_and_echo(run_yarnfort, tmp_path):
     assert (tmp_path / "again" / "curve.csv").read_text().count("\n") == \
         (out / "curve.csv").read_text().count("\n")
     assert "step    20" in run.stderr
+    # The build time is reported once, before any step, as a number of seconds.
+    built = re.findall(r"^yarnfort: scene built in (\S+) s \(", run.stderr, re.MULTILINE)
+    assert len(built) == 1 and float(built[0]) >= 0.0
+    assert run.stderr.index("scene built in") < run.stderr.index("step     0")
 
 
 def test_rerun_into_same_folder_leaves_no_stale_states(run_yarnfort, tmp_path):

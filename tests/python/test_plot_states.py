@@ -131,6 +131,26 @@ def test_images_and_periods(knit, run_yarnfort, tmp_path):
         plot_states(knit, (1.0,), images=(1, 1, 2))
 
 
+def test_gap_holders_to_images_drawn_at_their_length(run_yarnfort, tmp_path):
+    """TexGen's weave joins nodes to the images of their partners: the periods come from
+    those gap-holders' `period`, and each is drawn to the image, as long as the gap."""
+    weave = run_example(run_yarnfort, "texgen_weave", tmp_path / "weave",
+                        **{"path.time": [0.0, 1.0], "path.p_disp": [0.0, 1.0]})
+    last = read_states(weave)[-1]
+    # inputs/texgen_weave.tg3: a 2 x 2 cell of 1 mm spacing; strain 0.15 along x.
+    np.testing.assert_allclose(last.periods(), [[2.3e-3, 0, 0], [0, 2.0e-3, 0]],
+                               rtol=1e-12, atol=1e-15)
+    wide = last.position[last.links[:, 1]] - last.position[last.links[:, 0]]
+    assert np.linalg.norm(wide, axis=1).max() > 1e-3  # some links do cross the cell
+    ax = plot_states(weave, (1.0,), of_peak=True, images=(2, 2)).axes[0]
+    holders = [c for c in ax.collections if c.get_gid() == "gap_holders"][0]
+    drawn = np.linalg.norm(np.diff(np.array(holders.get_segments()), axis=1)[:, 0], axis=1)
+    assert len(drawn) == 4 * np.sum(last.link_kind == 1)
+    # The axis gap at a crossing is 0.2 mm (yarn centres, texgen_weave.nml): in the x-y
+    # view a holder is at most that long, far below the 1 mm spacing.
+    assert drawn.max() <= 0.2 * (1 + 1e-9)
+
+
 def test_errors(knit, run_yarnfort, tmp_path):
     with pytest.raises(ResultError, match="no output folder"):
         nearest_states(tmp_path / "missing")
