@@ -195,7 +195,7 @@ def _parser() -> argparse.ArgumentParser:
                         help="curve.csv column the strains are values of (default strain;"
                         " p_disp for a scene that is no fabric)")
     states.add_argument("--of-peak", action="store_true",
-                        help="strains are fractions of the largest value on the first"
+                        help="strains are fractions of the peak (largest magnitude) on the first"
                         " loading")
     states.add_argument("--images", type=int, nargs="+", default=[1, 1], metavar="N",
                         help="periodic images per period of a periodic cell (e.g. 3 3)")

@@ -388,7 +388,7 @@ def nearest_states(folder: str | Path, targets: tuple[float, ...] = (0.0, 0.5, 1
     first loading.
 
     The candidates are the states written (``states.pvd``) whose step is in
-    ``curve.csv`` up to the first step where ``by`` reaches its largest value (the
+    ``curve.csv`` up to the first step where ``by`` reaches its largest magnitude (the
     first loading, so a cycle's unloading is not picked). For each target the nearest
     candidate is taken (the earlier one on a tie).
 
@@ -397,12 +397,12 @@ def nearest_states(folder: str | Path, targets: tuple[float, ...] = (0.0, 0.5, 1
     folder : str or Path
         A run's output folder.
     targets : tuple of float
-        Values of ``by`` wanted (with ``of_peak``: fractions of its largest value).
+        Values of ``by`` wanted (with ``of_peak``: fractions of its peak).
     by : str
         The curve column: ``'strain'`` for a fabric, ``'p_disp'``, ``'time'``, ...
     of_peak : bool
-        Targets are fractions of the largest value of ``by`` on the first loading
-        (``1`` is the peak): for a fabric stretched less than the targets.
+        Targets are fractions of the peak of ``by`` (its value of largest magnitude;
+        ``1`` is the peak): for a fabric stretched less than the targets.
 
     Returns
     -------
@@ -431,8 +431,12 @@ def nearest_states(folder: str | Path, targets: tuple[float, ...] = (0.0, 0.5, 1
     if len(curve) == 0:
         raise ResultError(f"{folder / 'curve.csv'} has no rows: the run wrote no converged"
                           " step")
+    if by not in curve.names:
+        raise KeyError(f"curve has no column {by!r} (a &fabric run has 'strain'): choose"
+                       f" one of {', '.join(curve.channels + ['time', 'step'])} (by,"
+                       " --by)")
     values = curve[by]
-    last = int(np.argmax(values))
+    last = int(np.argmax(np.abs(values)))
     first_loading = {int(step): float(value)
                      for step, value in zip(curve["step"][:last + 1], values[:last + 1])}
     states = [state for state in read_states(folder) if state.step in first_loading]
@@ -440,11 +444,12 @@ def nearest_states(folder: str | Path, targets: tuple[float, ...] = (0.0, 0.5, 1
         raise ResultError(f"{folder}: no VTK state of a step of the first loading (steps 0"
                           f" to {int(curve['step'][last])}); run with &output vtk_every > 0")
     found = np.array([first_loading[state.step] for state in states])
-    low, high = float(values[:last + 1].min()), float(values[last])
+    peak = float(values[last])
+    low, high = float(values[:last + 1].min()), float(values[:last + 1].max())
     slack = TARGET_TOLERANCE * max(high - low, abs(high), abs(low), np.finfo(float).tiny)
     chosen = []
     for target in targets:
-        value = float(target) * high if of_peak else float(target)
+        value = float(target) * peak if of_peak else float(target)
         if not low - slack <= value <= high + slack:
             raise ValueError(f"{by} = {value:g} is outside the run's first loading"
                              f" ({low:g} to {high:g})"
