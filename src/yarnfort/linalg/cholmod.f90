@@ -54,8 +54,7 @@ contains
         end if
         status = yarnfort_cholmod_analyze(self%handle, n, self%col_ptr, self%row_index)
         if (status < cholmod_ok) then
-            call fatal_error(error, 'cholmod: symbolic analysis failed: ' &
-                // status_message(status))
+            call self%fail(error, 'symbolic analysis', status_message(status))
             call self%destroy()
             return
         end if
@@ -79,11 +78,11 @@ contains
         if (status == cholmod_ok .or. status == cholmod_dsmall) then
             self%factored = .true.
         else if (status == cholmod_not_posdef) then
-            call fatal_error(error, 'cholmod: factorisation failed: matrix is not positive ' &
+            call self%fail(error, 'factorisation', 'matrix is not positive ' &
                 // 'definite (pivot of column ' // format_integer(int(minor, ik)) &
                 // ' in the fill-reducing order is not positive; use umfpack or klu)')
         else
-            call fatal_error(error, 'cholmod: factorisation failed: ' // status_message(status))
+            call self%fail(error, 'factorisation', status_message(status))
         end if
     end subroutine factor
 
@@ -99,7 +98,7 @@ contains
 
         status = yarnfort_cholmod_solve(self%handle, self%n, rhs)
         if (status < cholmod_ok) then
-            call fatal_error(error, 'cholmod: solve failed: ' // status_message(status))
+            call self%fail(error, 'solve', status_message(status))
         end if
     end subroutine solve
 

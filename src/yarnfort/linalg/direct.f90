@@ -1,8 +1,9 @@
 ! SPDX-License-Identifier: MIT
-!> The bookkeeping the sparse direct solvers (UMFPACK, KLU, CHOLMOD) share: the copy of
-!> the CSC pattern they read again at factor time, the checks of the call sequence and
-!> of array sizes, and forgetting it all on destroy. Each solver keeps its own C objects
-!> and status codes.
+!> The bookkeeping every linear solver over a kept pattern shares (UMFPACK, KLU, CHOLMOD,
+!> dense LAPACK and the CHOLMOD-then-KLU fallback): the copy of the CSC pattern read
+!> again at factor time, the checks of the call sequence and of array sizes, forgetting
+!> it all on destroy, and the messages of a failed library call and of a status code.
+!> Each solver keeps only its library calls, its own objects and its table of codes.
 module yarnfort_linalg_direct
     use, intrinsic :: iso_c_binding, only: c_long
     use yarnfort_kinds, only: wp, ik
@@ -14,7 +15,7 @@ module yarnfort_linalg_direct
 
     public :: direct_solver_type, describe_status
 
-    !> A linear solver over a library that needs the pattern as 64-bit C arrays.
+    !> A linear solver that keeps the pattern (as 64-bit C arrays, what the libraries read).
     type, abstract, extends(linear_solver_type) :: direct_solver_type
         !> Matrix order, 0 before `analyse`.
         integer(ik) :: n = 0
@@ -23,12 +24,16 @@ module yarnfort_linalg_direct
     contains
         !> Check a pattern and keep a copy of it (after destroying what was there).
         procedure :: keep_pattern
+        !> Keep a copy of a pattern without checking it (a solver that only delegates).
+        procedure :: copy_pattern
         !> Check that `factor` may run (analysed) with these values.
         procedure :: check_factor_call
         !> Check that `solve` may run (`factored`) on this right-hand side.
         procedure :: check_solve_call
         !> Drop the pattern copy (for `destroy`).
         procedure :: forget_pattern
+        !> Set `error` to '<name>: <stage> failed: <reason>'.
+        procedure :: fail
     end type direct_solver_type
 
 contains
@@ -42,9 +47,17 @@ contains
         call self%destroy()
         call check_csc_pattern(self%get_name(), n, col_ptr, row_index, error)
         if (allocated(error)) return
-        self%col_ptr = col_ptr
-        self%row_index = row_index(1:col_ptr(n + 1))
+        call self%copy_pattern(n, col_ptr, row_index)
     end subroutine keep_pattern
+
+    subroutine copy_pattern(self, n, col_ptr, row_index)
+        class(direct_solver_type), intent(inout) :: self
+        integer(ik), intent(in) :: n
+        integer(ik), intent(in) :: col_ptr(:), row_index(:)
+
+        self%col_ptr = col_ptr(1:n + 1)
+        self%row_index = row_index(1:col_ptr(n + 1))
+    end subroutine copy_pattern
 
     subroutine check_factor_call(self, analysed, values, error)
         class(direct_solver_type), intent(in) :: self
@@ -81,6 +94,14 @@ contains
         if (allocated(self%col_ptr)) deallocate(self%col_ptr)
         if (allocated(self%row_index)) deallocate(self%row_index)
     end subroutine forget_pattern
+
+    subroutine fail(self, error, stage, reason)
+        class(direct_solver_type), intent(in) :: self
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: stage, reason
+
+        call fatal_error(error, self%get_name() // ': ' // stage // ' failed: ' // reason)
+    end subroutine fail
 
     !> The text of a library status code from the library's table of codes and texts
     !> (its header's name and what it means), or '<library> status <code>'.

@@ -6,17 +6,17 @@ module yarnfort_linalg_fallback
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_direct, only: direct_solver_type
     implicit none
     private
 
     public :: fallback_solver_type
 
-    type, extends(linear_solver_type) :: fallback_solver_type
+    !> The pattern is kept (unchecked: the solvers check it) to analyse the secondary solver
+    !> when switching.
+    type, extends(direct_solver_type) :: fallback_solver_type
         class(linear_solver_type), allocatable :: primary, secondary
         logical :: switched = .false.
-        !> The pattern, kept to analyse the secondary solver when switching.
-        integer(ik) :: n = 0
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
     contains
         procedure :: analyse
         procedure :: factor
@@ -34,8 +34,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         self%n = n
-        self%col_ptr = col_ptr(1:n + 1)
-        self%row_index = row_index(1:col_ptr(n + 1))
+        call self%copy_pattern(n, col_ptr, row_index)
         if (self%switched) then
             call self%secondary%analyse(n, col_ptr, row_index, error)
         else
@@ -54,7 +53,8 @@ contains
             deallocate(error)
             self%switched = .true.
             call self%primary%destroy()
-            call self%secondary%analyse(self%n, self%col_ptr, self%row_index, error)
+            call self%secondary%analyse(self%n, int(self%col_ptr, ik), int(self%row_index, ik), &
+                error)
             if (allocated(error)) return
         end if
         call self%secondary%factor(values, error)

@@ -77,8 +77,7 @@ contains
         self%common_ready = .true.
         self%symbolic = klu_l_analyze(n, self%col_ptr, self%row_index, self%common)
         if (.not. c_associated(self%symbolic)) then
-            call fatal_error(error, 'klu: symbolic analysis failed: ' &
-                // status_message(self%common%status))
+            call self%fail(error, 'symbolic analysis', status_message(self%common%status))
             call self%destroy()
             return
         end if
@@ -116,12 +115,11 @@ contains
             self%common)
         if (c_associated(self%numeric)) return
         if (self%common%status == klu_singular) then
-            call fatal_error(error, 'klu: factorisation failed: matrix is singular (zero ' &
-                // 'pivot in column ' // format_integer(int(self%common%singular_col, ik)) &
+            call self%fail(error, 'factorisation', 'matrix is singular (zero pivot in ' &
+                // 'column ' // format_integer(int(self%common%singular_col, ik)) &
                 // ', KLU_SINGULAR)')
         else
-            call fatal_error(error, 'klu: factorisation failed: ' &
-                // status_message(self%common%status))
+            call self%fail(error, 'factorisation', status_message(self%common%status))
         end if
     contains
         !> Factor with the COLAMD analysis; keep it if its factors are sparser than
@@ -164,7 +162,7 @@ contains
 
         ok = klu_l_solve(self%symbolic, self%numeric, self%n, 1_c_long, rhs, self%common)
         if (ok /= c_true) then
-            call fatal_error(error, 'klu: solve failed: ' // status_message(self%common%status))
+            call self%fail(error, 'solve', status_message(self%common%status))
         end if
     end subroutine solve
 

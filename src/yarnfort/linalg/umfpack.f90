@@ -107,8 +107,7 @@ contains
                 values, self%symbolic, self%control, self%info)
             if (status /= umfpack_ok) then
                 call umfpack_dl_free_symbolic(self%symbolic)
-                call fatal_error(error, 'umfpack: symbolic analysis failed: ' &
-                    // status_message(status))
+                call self%fail(error, 'symbolic analysis', status_message(status))
                 return
             end if
             self%memory%strategy = nint(self%info(umfpack_strategy_used))
@@ -128,12 +127,11 @@ contains
         call umfpack_dl_free_numeric(self%numeric)
         if (status == umfpack_warning_singular_matrix) then
             write(rcond, '(es10.3)') self%info(umfpack_rcond)
-            call fatal_error(error, 'umfpack: numeric factorisation failed: matrix is ' &
+            call self%fail(error, 'numeric factorisation', 'matrix is ' &
                 // 'singular (zero pivot, UMFPACK_WARNING_singular_matrix, rcond = ' &
                 // trim(adjustl(rcond)) // ')')
         else
-            call fatal_error(error, 'umfpack: numeric factorisation failed: ' &
-                // status_message(status))
+            call self%fail(error, 'numeric factorisation', status_message(status))
         end if
     end subroutine factor
 
@@ -151,7 +149,7 @@ contains
         status = umfpack_dl_wsolve(umfpack_a, x=rhs, b=self%rhs_copy, numeric=self%numeric, &
             control=self%control, info=self%info, wi=self%int_work, w=self%real_work)
         if (status /= umfpack_ok) then
-            call fatal_error(error, 'umfpack: solve failed: ' // status_message(status))
+            call self%fail(error, 'solve', status_message(status))
         end if
     end subroutine solve
 
