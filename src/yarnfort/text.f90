@@ -13,7 +13,7 @@ module yarnfort_text
     public :: string_type, read_line, to_lower, format_integer, format_real, quote_string
     public :: split_words, parse_integer, parse_real, edit_distance, closest_name
     public :: join_names, folder_of, resolve_path, is_folder, max_line_length
-    public :: byte_order_mark, remove_characters, read_file_text
+    public :: byte_order_mark, remove_characters, read_file_text, open_to_read
 
     interface format_integer
         module procedure format_default_integer, format_long_integer
@@ -465,6 +465,34 @@ contains
         if (stat /= 0) folder = .false.
     end function is_folder
 
+    !> Open file `path` to read, formatted and sequential or, with `stream`, as a stream
+    !> of bytes. `what` names the file in the messages: what is a folder, cannot be opened.
+    subroutine open_to_read(path, what, unit, error, stream)
+        character(len=*), intent(in) :: path, what
+        integer, intent(out) :: unit
+        type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: stream
+        character(len=512) :: message
+        integer :: stat
+        logical :: bytes
+
+        unit = -1
+        bytes = .false.
+        if (present(stream)) bytes = stream
+        if (is_folder(path)) then
+            call fatal_error(error, what // ' is a folder, not a file')
+            return
+        end if
+        if (bytes) then
+            open(newunit=unit, file=path, status='old', action='read', access='stream', &
+                form='unformatted', iostat=stat, iomsg=message)
+        else
+            open(newunit=unit, file=path, status='old', action='read', form='formatted', &
+                access='sequential', iostat=stat, iomsg=message)
+        end if
+        if (stat /= 0) call fatal_error(error, 'cannot open ' // what // ': ' // trim(message))
+    end subroutine open_to_read
+
     !> The whole content of file `path`, read as a stream (much faster than record by
     !> record). `what` names the file in the messages ("file 'a.geo'", "it"): what is
     !> a folder, cannot be opened, read, sized or held in memory.
@@ -476,16 +504,8 @@ contains
         integer :: unit, stat
         integer(int64) :: file_size
 
-        if (is_folder(path)) then
-            call fatal_error(error, what // ' is a folder, not a file')
-            return
-        end if
-        open(newunit=unit, file=path, status='old', action='read', access='stream', &
-            form='unformatted', iostat=stat, iomsg=message)
-        if (stat /= 0) then
-            call fatal_error(error, 'cannot open ' // what // ': ' // trim(message))
-            return
-        end if
+        call open_to_read(path, what, unit, error, stream=.true.)
+        if (allocated(error)) return
         inquire(unit=unit, size=file_size)
         if (file_size < 0) then
             call fatal_error(error, 'cannot get the size of ' // what)

@@ -9,12 +9,12 @@ module yarnfort_input_fields
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_text, only: to_lower, format_integer, format_real, join_names, closest_name, &
         parse_integer, parse_real
-    use yarnfort_input_scan, only: namelist_scan_type, assignment_type
+    use yarnfort_input_scan, only: namelist_scan_type, assignment_type, group_label
     use yarnfort_text, only: string_type
     implicit none
     private
 
-    public :: message_length, max_list, max_coordinates, indent
+    public :: max_list, max_coordinates, indent
     public :: post_read_error, group_label, take_scalar, take_array, list_length
     public :: check_real, check_at_least, check_choice, check_law_parameter
     public :: not_finite, suggestion, quoted_list, check_name
@@ -24,7 +24,6 @@ module yarnfort_input_fields
     integer, parameter :: max_list = 100000
     !> Most values of &nodes xyz (3 per node); larger scenes use &geometry.
     integer, parameter :: max_coordinates = 3 * max_list
-    integer, parameter :: message_length = 512
     !> Indent of the variables in the echo, and values per line of its lists.
     character(len=*), parameter :: indent = '    '
     integer, parameter :: integers_per_line = 10, reals_per_line = 3
@@ -33,16 +32,6 @@ module yarnfort_input_fields
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
 
 contains
-
-    !> '&name' for a singleton (occurrence 0), '&name #k' for the k-th of a repeatable.
-    pure function group_label(name, occurrence) result(label)
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: occurrence
-        character(len=:), allocatable :: label
-
-        label = '&' // name
-        if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
-    end function group_label
 
     !> An error of a group found after reading it, with the group's line.
     subroutine post_read_error(error, scan, name, occurrence, text)

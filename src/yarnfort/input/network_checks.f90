@@ -11,8 +11,8 @@ module yarnfort_input_network_checks
     use yarnfort_input_config, only: config_type, name_length, yarn_config_type
     use yarnfort_input_groups, only: check_yarn_variables, check_support_variables, &
         check_load_variables
-    use yarnfort_input_fields, only: quoted_list, check_name
-    use yarnfort_text, only: format_integer, format_real, closest_name
+    use yarnfort_input_fields, only: quoted_list, check_name, suggestion
+    use yarnfort_text, only: format_integer, format_real
     implicit none
     private
 
@@ -85,7 +85,7 @@ contains
         integer(int64) :: n_elements, n_new_nodes
         logical, allocatable :: used(:)
         real(wp) :: scale, length
-        character(len=:), allocatable :: label, guess
+        character(len=:), allocatable :: label
         character(len=name_length), allocatable :: material_names(:)
         character(len=80) :: counts
 
@@ -113,11 +113,10 @@ contains
                     return
                 end if
                 if (.not. any(material_names == yarn%material)) then
-                    guess = closest_name(trim(yarn%material), material_names)
-                    if (len(guess) > 0) guess = "; did you mean '" // guess // "'?"
                     call fatal_error(error, label // ": material = '" // trim(yarn%material) &
                         // "' is not defined by any &material (defined: " &
-                        // quoted_list(material_names) // ')' // guess)
+                        // quoted_list(material_names) // ')' &
+                        // suggestion(yarn%material, material_names))
                     return
                 end if
                 if (allocated(yarn%length0) .and. allocated(yarn%stretch)) then
