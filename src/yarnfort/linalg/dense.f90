@@ -43,49 +43,38 @@ module yarnfort_linalg_dense
         !> Dense matrix, overwritten by its LU factors.
         real(wp), allocatable :: lu(:, :)
         integer, allocatable :: pivots(:)
-        logical :: factored = .false.
     contains
-        procedure :: analyse
-        procedure :: factor
-        procedure :: solve
+        procedure :: analyse_pattern
+        procedure :: factor_values
+        procedure :: solve_rhs
         procedure :: destroy
         procedure :: get_name
     end type dense_solver_type
 
 contains
 
-    !> Keep a copy of the pattern and allocate the dense matrix.
-    subroutine analyse(self, n, col_ptr, row_index, error)
+    !> Allocate the dense matrix.
+    subroutine analyse_pattern(self, error)
         class(dense_solver_type), intent(inout) :: self
-        integer(ik), intent(in) :: n
-        integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
 
-        call self%keep_pattern(n, col_ptr, row_index, error)
-        if (allocated(error)) return
-        if (n > dense_max_order) then
-            call fatal_error(error, 'dense: matrix order n = ' // format_integer(n) &
+        if (self%n > dense_max_order) then
+            call fatal_error(error, 'dense: matrix order n = ' // format_integer(self%n) &
                 // ' exceeds dense_max_order = ' // format_integer(dense_max_order))
-            call self%destroy()
             return
         end if
-        self%n = n
-        allocate(self%lu(n, n), self%pivots(n))
-    end subroutine analyse
+        allocate(self%lu(self%n, self%n), self%pivots(self%n))
+    end subroutine analyse_pattern
 
     !> Scatter the values into the dense matrix and factor it; singular is an error.
-    subroutine factor(self, values, error)
+    subroutine factor_values(self, values, error)
         class(dense_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         integer(ik) :: j, k
         integer :: info, n
 
-        self%factored = .false.
-        call self%check_factor_call(self%n > 0, values, error)
-        if (allocated(error)) return
         n = int(self%n)
-
         self%lu(:, :) = 0.0_wp
         do j = 1, self%n
             do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
@@ -100,20 +89,15 @@ contains
         else if (info < 0) then
             call fatal_error(error, 'dense: dgetrf rejected argument ' &
                 // format_integer(int(-info, ik)))
-        else
-            self%factored = .true.
         end if
-    end subroutine factor
+    end subroutine factor_values
 
     !> Overwrite rhs with the solution.
-    subroutine solve(self, rhs, error)
+    subroutine solve_rhs(self, rhs, error)
         class(dense_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
         integer :: info, n
-
-        call self%check_solve_call(self%factored, rhs, error)
-        if (allocated(error)) return
 
         n = int(self%n)
         call dgetrs('N', n, 1, self%lu, n, self%pivots, rhs, n, info)
@@ -121,13 +105,12 @@ contains
             call fatal_error(error, 'dense: dgetrs rejected argument ' &
                 // format_integer(int(-info, ik)))
         end if
-    end subroutine solve
+    end subroutine solve_rhs
 
     !> Free the dense matrix and the pattern copy (safe to call twice).
     subroutine destroy(self)
         class(dense_solver_type), intent(inout) :: self
 
-        self%factored = .false.
         call self%forget_pattern()
         if (allocated(self%lu)) deallocate(self%lu)
         if (allocated(self%pivots)) deallocate(self%pivots)
