@@ -17,7 +17,7 @@ module yarnfort_input_fields
     public :: max_list, max_coordinates, indent
     public :: post_read_error, group_label, take_scalar, take_array, list_length
     public :: check_real, check_at_least, check_choice, check_law_parameter
-    public :: not_finite, suggestion, quoted_list, check_name
+    public :: not_finite, suggestion, quoted_list, check_name, check_item_name
     public :: put, put_list, format_logical
 
     !> Most node ids in one &yarn, &support or &load group, and most knots in &path.
@@ -431,6 +431,36 @@ contains
                 // "only letters, digits, '_', '-' and '.'")
         end if
     end subroutine check_name
+
+    !> The name of item k of a group of named items (`labels`: their '&group #i'): set
+    !> (else "<label>: name is empty" and `hint`), one word, and not that of an earlier
+    !> item ("&group: name = 'x' is <twice> twice (<label i> and <label k><note>)", '#k'
+    !> alone for an item of the same group).
+    subroutine check_item_name(error, names, labels, k, hint, twice, note)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: names(:), labels(:), hint, twice, note
+        integer, intent(in) :: k
+        character(len=:), allocatable :: group, second
+        integer :: other
+
+        if (len_trim(names(k)) == 0) then
+            call fatal_error(error, trim(labels(k)) // ': name is empty' // hint)
+            return
+        end if
+        call check_name(error, trim(labels(k)), names(k))
+        if (allocated(error)) return
+        group = labels(k)(:index(labels(k), ' #') - 1)
+        do other = 1, k - 1
+            if (names(other) /= names(k)) cycle
+            second = trim(labels(k))
+            if (labels(other)(:index(labels(other), ' #') - 1) == group) &
+                second = second(len(group) + 2:)
+            call fatal_error(error, group // ": name = '" // trim(names(k)) // "' is " &
+                // twice // ' twice (' // trim(labels(other)) // ' and ' // second // note &
+                // ')')
+            return
+        end do
+    end subroutine check_item_name
 
     !> Write one line. A failed write does not stop the program: the caller that needs
     !> the file whole checks it when closing it (yarnfort_output_filesystem compares its
