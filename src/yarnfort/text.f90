@@ -6,13 +6,14 @@ module yarnfort_text
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
     use, intrinsic :: iso_fortran_env, only: int64
     use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type, fatal_error
     implicit none
     private
 
     public :: string_type, read_line, to_lower, format_integer, format_real, quote_string
     public :: split_words, parse_integer, parse_real, edit_distance, closest_name
     public :: join_names, folder_of, resolve_path, is_folder, max_line_length
-    public :: byte_order_mark, remove_characters
+    public :: byte_order_mark, remove_characters, read_file_text, open_to_read
 
     interface format_integer
         module procedure format_default_integer, format_long_integer
@@ -463,5 +464,65 @@ contains
         inquire(file=trim(path) // '/.', exist=folder, iostat=stat)
         if (stat /= 0) folder = .false.
     end function is_folder
+
+    !> Open file `path` to read, formatted and sequential or, with `stream`, as a stream
+    !> of bytes. `what` names the file in the messages: what is a folder, cannot be opened.
+    subroutine open_to_read(path, what, unit, error, stream)
+        character(len=*), intent(in) :: path, what
+        integer, intent(out) :: unit
+        type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: stream
+        character(len=512) :: message
+        integer :: stat
+        logical :: bytes
+
+        unit = -1
+        bytes = .false.
+        if (present(stream)) bytes = stream
+        if (is_folder(path)) then
+            call fatal_error(error, what // ' is a folder, not a file')
+            return
+        end if
+        if (bytes) then
+            open(newunit=unit, file=path, status='old', action='read', access='stream', &
+                form='unformatted', iostat=stat, iomsg=message)
+        else
+            open(newunit=unit, file=path, status='old', action='read', form='formatted', &
+                access='sequential', iostat=stat, iomsg=message)
+        end if
+        if (stat /= 0) call fatal_error(error, 'cannot open ' // what // ': ' // trim(message))
+    end subroutine open_to_read
+
+    !> The whole content of file `path`, read as a stream (much faster than record by
+    !> record). `what` names the file in the messages ("file 'a.geo'", "it"): what is
+    !> a folder, cannot be opened, read, sized or held in memory.
+    subroutine read_file_text(path, what, content, error)
+        character(len=*), intent(in) :: path, what
+        character(len=:), allocatable, intent(out) :: content
+        type(error_type), allocatable, intent(out) :: error
+        character(len=512) :: message
+        integer :: unit, stat
+        integer(int64) :: file_size
+
+        call open_to_read(path, what, unit, error, stream=.true.)
+        if (allocated(error)) return
+        inquire(unit=unit, size=file_size)
+        if (file_size < 0) then
+            call fatal_error(error, 'cannot get the size of ' // what)
+            close(unit)
+            return
+        end if
+        allocate(character(len=file_size) :: content, stat=stat, errmsg=message)
+        if (stat /= 0) then
+            close(unit)
+            call fatal_error(error, what // ' (' // format_integer(file_size) &
+                // ' bytes) does not fit in memory: ' // trim(message))
+            return
+        end if
+        stat = 0
+        if (file_size > 0) read(unit, iostat=stat, iomsg=message) content
+        close(unit)
+        if (stat /= 0) call fatal_error(error, 'cannot read ' // what // ': ' // trim(message))
+    end subroutine read_file_text
 
 end module yarnfort_text

@@ -84,3 +84,26 @@ def test_echo_has_every_variable_with_its_default(run_yarnfort):
                 assert list(value) == default, (group.name, var.name)
             else:
                 assert value == default, (group.name, var.name)
+
+
+def test_presets_table_matches_the_description():
+    """The preset columns of the *Presets* table of REFERENCE.md are the values that
+    variables.py gives each preset (its other columns are measurements)."""
+    solver = next(g for g in GROUPS if g.name == "solver")
+    described = [v for v in solver.variables if v.presets]
+    lines = REFERENCE.read_text().split("### Presets", 1)[1].splitlines()
+    header = next(line for line in lines if line.startswith("| preset |"))
+    columns = [c.strip().strip("`") for c in header.strip("|").split("|")]
+    rows = {}
+    for line in lines[lines.index(header) + 2:]:
+        if not line.startswith("|"):
+            break
+        cells = [c.strip().strip("`").strip("'") for c in line.strip("|").split("|")]
+        rows[cells[0]] = dict(zip(columns, cells))
+    assert {v.name for v in described} <= set(columns)
+    for var in described:
+        # 'custom' is the table's defaults.
+        for preset, value in {**var.presets, "custom": var.default}.items():
+            text = rows[preset][var.name]
+            assert (float(text) if var.type == "real" else text) == value, \
+                (preset, var.name, text, value)

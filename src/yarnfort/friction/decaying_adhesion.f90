@@ -23,9 +23,10 @@ module yarnfort_friction_decaying_adhesion
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_friction_law, only: friction_law_type, scaled_exp, capped_product, &
-        capped_quotient, expm1, cap_critical_tension, check_parameter, format_real, rate_limit, &
+        capped_quotient, expm1, cap_critical_tension, check_parameter, rate_limit, &
         no_kink
     use yarnfort_friction_coulomb, only: coulomb_law_type
+    use yarnfort_text, only: format_real
     use yarnfort_friction_adhesion, only: adhesion_law_type
     implicit none
     private

@@ -30,8 +30,9 @@ module yarnfort_friction_general
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
+    use yarnfort_text, only: format_integer, format_real
     use yarnfort_friction_law, only: friction_law_type, tension_limit, rate_limit, no_kink, &
-        scaled_exp, capped_product, capped_quotient, expm1, cap_critical_tension, format_real
+        scaled_exp, capped_product, capped_quotient, expm1, cap_critical_tension
     implicit none
     private
 
@@ -163,11 +164,11 @@ contains
         if (size(rate) /= n) then
             write(index, '(i0)') size(rate)
             call fatal_error(error, law_name // ': rate has ' // trim(index) &
-                // ' values, tension has ' // itoa(n))
+                // ' values, tension has ' // format_integer(n))
             return
         end if
         if (n < 2) then
-            call fatal_error(error, law_name // ': needs at least 2 points, got ' // itoa(n))
+            call fatal_error(error, law_name // ': needs at least 2 points, got ' // format_integer(n))
             return
         end if
         do i = 1, n
@@ -236,12 +237,12 @@ contains
         if (allocated(error)) return
         n = size(tension)
         if (n < 2) then
-            call fatal_error(error, context // ': found ' // itoa(n) // ' data rows, at ' &
+            call fatal_error(error, context // ': found ' // format_integer(n) // ' data rows, at ' &
                 // 'least 2 are needed (the first at T = 0)')
             return
         end if
         if (rate(n) < rate(n - 1)) then
-            call fatal_error(error, context // ', line ' // itoa(lines(n)) // ': the last ' &
+            call fatal_error(error, context // ', line ' // format_integer(lines(n)) // ': the last ' &
                 // 'piece falls (g = ' // format_real(rate(n - 1)) // ' to ' &
                 // format_real(rate(n)) // '); g continues with that slope beyond the ' &
                 // 'table and would reach 0: add a row where g no longer falls')
@@ -692,15 +693,5 @@ contains
             gain = scaled_exp(scale, z) - scale
         end if
     end function advance_on_piece
-
-    !> An integer as text.
-    pure function itoa(value) result(text)
-        integer, intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=20) :: buffer
-
-        write(buffer, '(i0)') value
-        text = trim(buffer)
-    end function itoa
 
 end module yarnfort_friction_general

@@ -25,13 +25,14 @@ module yarnfort_friction_law
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_text, only: format_real
     implicit none
     private
 
     public :: friction_law_type
     public :: tension_limit, rate_limit, no_kink
     public :: scaled_exp, capped_product, capped_quotient, expm1, cap_critical_tension
-    public :: check_parameter, format_real
+    public :: check_parameter
 
     !> Largest critical tension (and derivative) a law returns, about 1.7e302. Below huge()
     !> by a factor that leaves callers and the Runge-Kutta stages headroom above it.
@@ -213,15 +214,5 @@ contains
                 // format_real(minimum) // ', got ' // format_real(value))
         end if
     end subroutine check_parameter
-
-    !> A real number as a short string for messages ("-1.5E+00", "NaN", "Infinity").
-    pure function format_real(value) result(text)
-        real(wp), intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=40) :: buffer
-
-        write(buffer, '(es12.5)') value
-        text = trim(adjustl(buffer))
-    end function format_real
 
 end module yarnfort_friction_law

@@ -9,6 +9,7 @@
 !> must read the file without Python, so this is the one XML reader of the project.
 module yarnfort_generate_xml_subset
     use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_text, only: read_file_text
     implicit none
     private
 
@@ -43,24 +44,9 @@ contains
         type(xml_document_type), intent(out) :: document
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: text
-        character(len=300) :: message
-        integer :: unit, stat, size_bytes
 
-        open(newunit=unit, file=path, access='stream', form='unformatted', status='old', &
-            action='read', iostat=stat, iomsg=message)
-        if (stat /= 0) then
-            call fatal_error(error, 'cannot open it: ' // trim(message))
-            return
-        end if
-        inquire(unit=unit, size=size_bytes)
-        if (size_bytes < 0) size_bytes = 0
-        allocate(character(len=size_bytes) :: text)
-        if (size_bytes > 0) read(unit, iostat=stat, iomsg=message) text
-        close(unit)
-        if (stat /= 0) then
-            call fatal_error(error, 'cannot read it: ' // trim(message))
-            return
-        end if
+        call read_file_text(path, 'it', text, error)
+        if (allocated(error)) return
         call parse_xml(text, document, error)
     end subroutine read_xml_file
 
@@ -84,32 +70,16 @@ contains
                 cycle
             end if
             if (starts(i, '<!--')) then
-                close_at = find_from(i + 4, '-->')
-                if (close_at == 0) then
-                    call fail(i, 'a comment is not closed (-->)')
-                    return
-                end if
+                if (.not. closed_by(4, '-->', 'a comment is not closed (-->)')) return
                 i = close_at + 3
             else if (starts(i, '<![CDATA[')) then
-                close_at = find_from(i + 9, ']]>')
-                if (close_at == 0) then
-                    call fail(i, 'a CDATA section is not closed (]]>)')
-                    return
-                end if
+                if (.not. closed_by(9, ']]>', 'a CDATA section is not closed (]]>)')) return
                 i = close_at + 3
             else if (starts(i, '<?') .or. starts(i, '<!')) then
-                close_at = find_from(i + 2, '>')
-                if (close_at == 0) then
-                    call fail(i, "a declaration is not closed ('>')")
-                    return
-                end if
+                if (.not. closed_by(2, '>', "a declaration is not closed ('>')")) return
                 i = close_at + 1
             else if (starts(i, '</')) then
-                close_at = find_from(i + 2, '>')
-                if (close_at == 0) then
-                    call fail(i, "a closing tag is not closed ('>')")
-                    return
-                end if
+                if (.not. closed_by(2, '>', "a closing tag is not closed ('>')")) return
                 name = trim(adjustl(text(i + 2:close_at - 1)))
                 if (current == 0) then
                     call fail(i, "closing tag </" // name // "> without an open element")
@@ -140,6 +110,24 @@ contains
         end if
         if (document%n_elements == 0) call fail(1, 'no elements (not an XML file?)')
     contains
+        !> Whether `closer` follows text(i + skip); close_at: where. An error if not.
+        logical function closed_by(skip, closer, what)
+            integer, intent(in) :: skip
+            character(len=*), intent(in) :: closer, what
+            close_at = find_from(i + skip, closer)
+            closed_by = close_at /= 0
+            if (.not. closed_by) call fail(i, what)
+        end function closed_by
+
+        !> Move j past blanks.
+        subroutine skip_blanks(j)
+            integer, intent(inout) :: j
+            do while (j <= n)
+                if (.not. is_blank(text(j:j))) exit
+                j = j + 1
+            end do
+        end subroutine skip_blanks
+
         logical function starts(at, prefix)
             integer, intent(in) :: at
             character(len=*), intent(in) :: prefix
@@ -194,10 +182,7 @@ contains
             allocate(element%attribute_names(0), element%attribute_values(0))
             self_closing = .false.
             do
-                do while (j <= n)
-                    if (.not. is_blank(text(j:j))) exit
-                    j = j + 1
-                end do
+                call skip_blanks(j)
                 if (j > n) then
                     call fail(at, "tag <" // element%name // " is not closed ('>')")
                     return
@@ -214,19 +199,13 @@ contains
                     j = j + 1
                 end do
                 attribute_name = text(name_start:j - 1)
-                do while (j <= n)
-                    if (.not. is_blank(text(j:j))) exit
-                    j = j + 1
-                end do
+                call skip_blanks(j)
                 if (len(attribute_name) == 0 .or. j >= n .or. text(j:j) /= '=') then
                     call fail(at, "tag <" // element%name // ">: an attribute without '=value'")
                     return
                 end if
                 j = j + 1
-                do while (j <= n)
-                    if (.not. is_blank(text(j:j))) exit
-                    j = j + 1
-                end do
+                call skip_blanks(j)
                 quote = ' '
                 if (j <= n) quote = text(j:j)
                 if (quote /= '"' .and. quote /= "'") then

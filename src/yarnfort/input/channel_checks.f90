@@ -9,8 +9,8 @@ module yarnfort_input_channel_checks
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, path_config_type, name_length
-    use yarnfort_input_fields, only: check_name, quoted_list
-    use yarnfort_text, only: format_integer, closest_name
+    use yarnfort_input_fields, only: check_name, quoted_list, suggestion
+    use yarnfort_text, only: format_integer
     implicit none
     private
 
@@ -204,7 +204,6 @@ contains
         subroutine check_one(label, name, default_name, used, what)
             character(len=*), intent(in) :: label, name, default_name, what
             logical, intent(in) :: used
-            character(len=:), allocatable :: guess
 
             if (find_channel(names, name, default_name, given) > 0) return
             if (len_trim(name) == 0) then
@@ -214,10 +213,9 @@ contains
                     // 'factor scales its ' // what)
                 return
             end if
-            guess = closest_name(trim(name), names)
-            if (len(guess) > 0) guess = "; did you mean '" // guess // "'?"
             call fatal_error(error, label // ": channel = '" // trim(name) // "' is not a " &
-                // 'channel of &path (channels: ' // quoted_list(names) // ')' // guess)
+                // 'channel of &path (channels: ' // quoted_list(names) // ')' &
+                // suggestion(name, names))
         end subroutine check_one
 
     end subroutine check_channels

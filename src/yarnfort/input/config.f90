@@ -9,8 +9,7 @@ module yarnfort_input_config
     use yarnfort_input_groups, only: control_config_type, solver_config_type, &
         material_config_type, contact_config_type, fabric_config_type, geometry_config_type, &
         yarn_config_type, support_config_type, load_config_type, path_config_type, &
-        output_config_type, obstacle_config_type, ring_config_type, name_length, path_length, &
-        solver_presets => solver_preset_choices
+        output_config_type, obstacle_config_type, ring_config_type, name_length, path_length
     implicit none
     private
 
@@ -19,7 +18,6 @@ module yarnfort_input_config
     public :: output_config_type, geometry_config_type, name_length, path_length
     public :: contact_config_type, fabric_config_type, link_config_type
     public :: obstacle_config_type, ring_config_type
-    public :: solver_presets, get_solver_preset
 
     !> A node that follows another one: a periodic image (eq. 53) or the other side of
     !> a gap-holder. Made by the fabric generators.
@@ -70,42 +68,5 @@ module yarnfort_input_config
         !> file names in the input are resolved ('' = the working directory, as for stdin).
         character(len=path_length) :: input_folder = ''
     end type config_type
-
-contains
-
-    !> The &solver defaults of preset `name` (lower case, one of solver_presets): the type's
-    !> defaults with initial_step = max_step, residual_tolerance and scheme of the preset,
-    !> and preset = name. The values come from verification/speed_accuracy/presets.py
-    !> (every scene of tests/verification/test_defaults.py against its exact reference):
-    !> at the steps the error follows the tolerance, the step (a fraction of the knot
-    !> interval) sets how finely the curve is drawn, and the monolithic scheme was the
-    !> faster one. `found` is false for an unknown name (then the type's defaults).
-    pure subroutine get_solver_preset(name, solver, found)
-        character(len=*), intent(in) :: name
-        type(solver_config_type), intent(out) :: solver
-        logical, intent(out) :: found
-        real(wp) :: step, tolerance
-
-        found = .true.
-        solver%preset = name
-        select case (name)
-        case ('fast')           ! 4 steps per knot interval
-            step = 0.25_wp
-            tolerance = 1.0e-6_wp
-        case ('balanced')       ! 20 steps per knot interval
-            step = 0.05_wp
-            tolerance = 1.0e-9_wp
-        case ('accurate')       ! 100 steps per knot interval
-            step = 0.01_wp
-            tolerance = 1.0e-11_wp
-        case default
-            found = name == 'custom'
-            return
-        end select
-        solver%initial_step = step
-        solver%max_step = step
-        solver%residual_tolerance = tolerance
-        solver%scheme = 'monolithic'
-    end subroutine get_solver_preset
 
 end module yarnfort_input_config

@@ -7,7 +7,7 @@ module yarnfort_input_contact_node_checks
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, name_length
-    use yarnfort_input_fields, only: suggestion, quoted_list, check_name
+    use yarnfort_input_fields, only: suggestion, quoted_list, check_item_name, group_label
     use yarnfort_input_network_checks, only: check_node_list, yarn_label
     use yarnfort_text, only: format_integer, format_real
     implicit none
@@ -91,6 +91,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer, allocatable :: set_of(:), visits(:), nodes(:)
         character(len=name_length), allocatable :: names(:)
+        character(len=24), allocatable :: labels(:)
         character(len=:), allocatable :: label, group, what
         integer :: n_obstacles, n_sets, n_nodes, s, other, i, y, node, l, k
 
@@ -102,34 +103,27 @@ contains
         if (allocated(config%rings)) n_sets = n_sets + size(config%rings)
         if (n_sets == 0) return
         allocate(set_of(n_nodes), source=0)
-        allocate(names(n_sets))
+        allocate(names(n_sets), labels(n_sets))
         do s = 1, n_sets
             if (s <= n_obstacles) then
-                group = '&obstacle'
                 names(s) = config%obstacles(s)%name
-                nodes = config%obstacles(s)%nodes
-                label = group // ' #' // format_integer(s)
+                labels(s) = group_label('obstacle', s)
             else
-                group = '&ring'
                 names(s) = config%rings(s - n_obstacles)%name
+                labels(s) = group_label('ring', s - n_obstacles)
+            end if
+        end do
+        do s = 1, n_sets
+            group = labels(s)(:index(labels(s), ' #') - 1)
+            if (s <= n_obstacles) then
+                nodes = config%obstacles(s)%nodes
+            else
                 nodes = config%rings(s - n_obstacles)%nodes
-                label = group // ' #' // format_integer(s - n_obstacles)
             end if
-            if (len_trim(names(s)) == 0) then
-                call fatal_error(error, label // ': name is empty (give each ' // group(2:) &
-                    // " a name; &contact at = 'name' gives its friction law)")
-                return
-            end if
-            call check_name(error, label, names(s))
+            call check_item_name(error, names, labels, s, ' (give each ' // group(2:) &
+                // " a name; &contact at = 'name' gives its friction law)", 'used', &
+                '; &contact at names one of them')
             if (allocated(error)) return
-            do other = 1, s - 1
-                if (names(other) == names(s)) then
-                    call fatal_error(error, group // ": name = '" // trim(names(s)) &
-                        // "' is used twice (" // numbered(other) // ' and ' // numbered(s) &
-                        // '; &contact at names one of them)')
-                    return
-                end if
-            end do
             if (allocated(config%supports)) then
                 do other = 1, size(config%supports)
                     if (config%supports(other)%name == names(s)) then
@@ -208,17 +202,6 @@ contains
                 end do
             end do
         end do
-    contains
-        function numbered(s) result(text)
-            integer, intent(in) :: s
-            character(len=:), allocatable :: text
-
-            if (s <= n_obstacles) then
-                text = '&obstacle #' // format_integer(s)
-            else
-                text = '&ring #' // format_integer(s - n_obstacles)
-            end if
-        end function numbered
     end subroutine check_contact_nodes
 
     !> A &contact with `at` set (contact c): `at` names an &obstacle or &ring,

@@ -27,7 +27,7 @@ class Var:
     adjust: bool = True
     selects: bool = False
     laws: list[str] | None = None
-    preset: bool = False
+    presets: dict[str, object] | None = None
     checked_by: str | None = None
     default_doc: str | None = None
     type_doc: str | None = None
@@ -71,6 +71,11 @@ class Group:
         names = [v.name for v in self.variables]
         if len(set(names)) != len(names):
             raise ValueError(f"&{self.name}: a variable is described twice")
+        choices = next((v.choices for v in self.variables if v.name == "preset"), None) or []
+        for v in self.variables:
+            if v.presets and not set(v.presets) <= set(choices):
+                raise ValueError(f"&{self.name} {v.name}: presets {sorted(v.presets)} are not "
+                                 "all choices of the group's preset variable")
         selectors = [v for v in self.variables if v.selects]
         for v in self.variables:
             for law in v.laws or []:

@@ -9,22 +9,21 @@ module yarnfort_input_fields
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_text, only: to_lower, format_integer, format_real, join_names, closest_name, &
         parse_integer, parse_real
-    use yarnfort_input_scan, only: namelist_scan_type, assignment_type
+    use yarnfort_input_scan, only: namelist_scan_type, assignment_type, group_label
     use yarnfort_text, only: string_type
     implicit none
     private
 
-    public :: message_length, max_list, max_coordinates, indent
+    public :: max_list, max_coordinates, indent
     public :: post_read_error, group_label, take_scalar, take_array, list_length
     public :: check_real, check_at_least, check_choice, check_law_parameter
-    public :: not_finite, suggestion, quoted_list, check_name
+    public :: not_finite, suggestion, quoted_list, check_name, check_item_name
     public :: put, put_list, format_logical
 
     !> Most node ids in one &yarn, &support or &load group, and most knots in &path.
     integer, parameter :: max_list = 100000
     !> Most values of &nodes xyz (3 per node); larger scenes use &geometry.
     integer, parameter :: max_coordinates = 3 * max_list
-    integer, parameter :: message_length = 512
     !> Indent of the variables in the echo, and values per line of its lists.
     character(len=*), parameter :: indent = '    '
     integer, parameter :: integers_per_line = 10, reals_per_line = 3
@@ -33,16 +32,6 @@ module yarnfort_input_fields
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
 
 contains
-
-    !> '&name' for a singleton (occurrence 0), '&name #k' for the k-th of a repeatable.
-    pure function group_label(name, occurrence) result(label)
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: occurrence
-        character(len=:), allocatable :: label
-
-        label = '&' // name
-        if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
-    end function group_label
 
     !> An error of a group found after reading it, with the group's line.
     subroutine post_read_error(error, scan, name, occurrence, text)
@@ -442,6 +431,36 @@ contains
                 // "only letters, digits, '_', '-' and '.'")
         end if
     end subroutine check_name
+
+    !> The name of item k of a group of named items (`labels`: their '&group #i'): set
+    !> (else "<label>: name is empty" and `hint`), one word, and not that of an earlier
+    !> item ("&group: name = 'x' is <twice> twice (<label i> and <label k><note>)", '#k'
+    !> alone for an item of the same group).
+    subroutine check_item_name(error, names, labels, k, hint, twice, note)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: names(:), labels(:), hint, twice, note
+        integer, intent(in) :: k
+        character(len=:), allocatable :: group, second
+        integer :: other
+
+        if (len_trim(names(k)) == 0) then
+            call fatal_error(error, trim(labels(k)) // ': name is empty' // hint)
+            return
+        end if
+        call check_name(error, trim(labels(k)), names(k))
+        if (allocated(error)) return
+        group = labels(k)(:index(labels(k), ' #') - 1)
+        do other = 1, k - 1
+            if (names(other) /= names(k)) cycle
+            second = trim(labels(k))
+            if (labels(other)(:index(labels(other), ' #') - 1) == group) &
+                second = second(len(group) + 2:)
+            call fatal_error(error, group // ": name = '" // trim(names(k)) // "' is " &
+                // twice // ' twice (' // trim(labels(other)) // ' and ' // second // note &
+                // ')')
+            return
+        end do
+    end subroutine check_item_name
 
     !> Write one line. A failed write does not stop the program: the caller that needs
     !> the file whole checks it when closing it (yarnfort_output_filesystem compares its

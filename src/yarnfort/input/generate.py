@@ -273,21 +273,27 @@ def read_routine(group: Group) -> list[str]:
 
 
 def preset_routine(group: Group) -> list[str]:
-    preset = [v for v in group.variables if v.preset]
+    preset = [v for v in group.variables if v.presets]
     if not preset:
         return []
-    i2 = INDENT * 2
-    out = [f"{INDENT}!> The values of `preset` for the variables of &{group.name} that a "
-           "preset sets and",
-           f"{INDENT}!> the input does not.",
-           f"{INDENT}subroutine apply_{group.name}_preset(scan, preset, value)",
+    i2, i3 = INDENT * 2, INDENT * 3
+    out = [f"{INDENT}!> The values the preset named by `value%preset` gives the variables of "
+           f"&{group.name}",
+           f"{INDENT}!> that the input does not set (none for another name).",
+           f"{INDENT}subroutine apply_{group.name}_preset(scan, value)",
            f"{i2}type(namelist_scan_type), intent(in) :: scan",
-           f"{i2}type({group.type_name}), intent(in) :: preset",
-           f"{i2}type({group.type_name}), intent(inout) :: value", ""]
-    for var in preset:
-        out += wrap_statement(f"if (.not. scan%is_set('{group.name}', 1, '{var.name}')) "
-                              f"value%{var.name} = preset%{var.name}", i2)
-    return out + [f"{INDENT}end subroutine apply_{group.name}_preset", ""]
+           f"{i2}type({group.type_name}), intent(inout) :: value", "",
+           f"{i2}select case (trim(value%preset))"]
+    names = [c for c in next(v for v in group.variables if v.name == "preset").choices
+             if any(c in v.presets for v in preset)]
+    for name in names:
+        out.append(f"{i2}case ('{name}')")
+        for var in preset:
+            if name in var.presets:
+                out += wrap_statement(f"if (.not. scan%is_set('{group.name}', 1, '{var.name}')) "
+                                      f"value%{var.name} = {fortran_value(var, var.presets[name])}",
+                                      i3)
+    return out + [f"{i2}end select", f"{INDENT}end subroutine apply_{group.name}_preset", ""]
 
 
 def write_routine(group: Group) -> list[str]:

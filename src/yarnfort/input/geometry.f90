@@ -11,12 +11,11 @@
 !> defined exactly once, in any order. A yarn line ending in '&' continues on the next
 !> line. Node and yarn lines may be mixed in any order.
 module yarnfort_input_geometry
-    use, intrinsic :: iso_fortran_env, only: int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: yarn_config_type, name_length
     use yarnfort_text, only: string_type, to_lower, format_integer, split_words, &
-        parse_integer, parse_real, is_folder, byte_order_mark
+        parse_integer, parse_real, read_file_text, byte_order_mark
     implicit none
     private
 
@@ -42,8 +41,11 @@ contains
         character(len=256) :: message
 
         content = ''
-        call read_whole_file(path, content, error)
-        if (allocated(error)) return
+        call read_file_text(path, "file '" // path // "'", content, error)
+        if (allocated(error)) then
+            error%message = '&geometry: ' // error%message
+            return
+        end if
         ! Some editors start a UTF-8 file with a byte order mark: not text of the file.
         if (index(content, byte_order_mark) == 1) content = content(len(byte_order_mark) + 1:)
         allocate(node_ids(1024), node_lines(1024), node_xyz(3, 1024), yarns(16), &
@@ -292,50 +294,6 @@ contains
         end subroutine fail
 
     end subroutine read_geometry_file
-
-    !> The whole content of a file (read as a stream: much faster than record by record).
-    subroutine read_whole_file(path, content, error)
-        character(len=*), intent(in) :: path
-        character(len=:), allocatable, intent(out) :: content
-        type(error_type), allocatable, intent(out) :: error
-        character(len=512) :: message
-        integer :: unit, stat
-        integer(int64) :: file_size
-        character(len=20) :: size_text
-
-        if (is_folder(path)) then
-            call fatal_error(error, "&geometry: file '" // path // "' is a folder, not a file")
-            return
-        end if
-        open(newunit=unit, file=path, status='old', action='read', access='stream', &
-            form='unformatted', iostat=stat, iomsg=message)
-        if (stat /= 0) then
-            call fatal_error(error, "&geometry: cannot open file '" // path // "': " &
-                // trim(message))
-            return
-        end if
-        inquire(unit=unit, size=file_size)
-        if (file_size < 0) then
-            call fatal_error(error, "&geometry: cannot get the size of file '" // path // "'")
-            close(unit)
-            return
-        end if
-        allocate(character(len=file_size) :: content, stat=stat, errmsg=message)
-        if (stat /= 0) then
-            close(unit)
-            write(size_text, '(i0)') file_size
-            call fatal_error(error, "&geometry: file '" // path // "' (" // trim(size_text) &
-                // ' bytes) does not fit in memory: ' // trim(message))
-            return
-        end if
-        stat = 0
-        if (file_size > 0) read(unit, iostat=stat, iomsg=message) content
-        close(unit)
-        if (stat /= 0) then
-            call fatal_error(error, "&geometry: cannot read file '" // path // "': " &
-                // trim(message))
-        end if
-    end subroutine read_whole_file
 
     !> The line of `content` starting at `position` (without its end: LF, CR LF or a lone
     !> CR, as old Mac editors write); `position` moves to the start of the next line.

@@ -11,17 +11,17 @@ module yarnfort_input_namelist
     use, intrinsic :: iso_fortran_env, only: input_unit
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: config_type, solver_config_type, get_solver_preset
+    use yarnfort_input_config, only: config_type
     use yarnfort_input_groups, only: group_names, singleton_names, nodes_config_type, &
         read_control_groups, read_solver_groups, read_material_groups, read_contact_groups, &
         read_fabric_groups, read_nodes_groups, read_geometry_groups, read_yarn_groups, &
         read_support_groups, read_load_groups, read_path_groups, read_output_groups, &
         read_obstacle_groups, read_ring_groups, apply_solver_preset
-    use yarnfort_input_fields, only: max_list, max_coordinates, message_length, &
+    use yarnfort_input_fields, only: max_list, max_coordinates, &
         post_read_error
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
     use yarnfort_input_geometry, only: read_geometry_file
-    use yarnfort_text, only: format_integer, folder_of, resolve_path, is_folder
+    use yarnfort_text, only: format_integer, folder_of, resolve_path, open_to_read
     use yarnfort_input_validate, only: check_config
     use yarnfort_generate_fabric, only: generate_fabric
     implicit none
@@ -119,18 +119,15 @@ contains
         type(namelist_scan_type), intent(in) :: scan
         type(config_type), intent(inout) :: config
         type(error_type), allocatable, intent(out) :: error
-        type(solver_config_type) :: preset
         type(nodes_config_type) :: nodes
-        logical :: known
         integer :: n
 
         call read_control_groups(scan, config%control, error)
         if (allocated(error)) return
         call read_solver_groups(scan, config%solver, error)
         if (allocated(error)) return
-        ! An unknown preset gives the plain defaults here; check_config rejects its name.
-        call get_solver_preset(trim(config%solver%preset), preset, known)
-        call apply_solver_preset(scan, preset, config%solver)
+        ! An unknown preset leaves the plain defaults here; check_config rejects its name.
+        call apply_solver_preset(scan, config%solver)
         call read_material_groups(scan, config%materials, error)
         if (allocated(error)) return
         call read_contact_groups(scan, config%contacts, error)
@@ -187,19 +184,10 @@ contains
         type(config_type), intent(out) :: config
         type(error_type), allocatable, intent(out) :: error
         logical, intent(in), optional :: from_working_directory
-        character(len=message_length) :: message
-        integer :: unit, stat
+        integer :: unit
 
-        if (is_folder(path)) then
-            call fatal_error(error, "input file '" // path // "' is a folder, not a file")
-            return
-        end if
-        open(newunit=unit, file=path, status='old', action='read', form='formatted', &
-            access='sequential', iostat=stat, iomsg=message)
-        if (stat /= 0) then
-            call fatal_error(error, "cannot open input file '" // path // "': " // trim(message))
-            return
-        end if
+        call open_to_read(path, "input file '" // path // "'", unit, error)
+        if (allocated(error)) return
         if (present(from_working_directory)) then
             if (from_working_directory) then
                 call read_config(unit, config, error)

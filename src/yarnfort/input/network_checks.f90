@@ -11,8 +11,8 @@ module yarnfort_input_network_checks
     use yarnfort_input_config, only: config_type, name_length, yarn_config_type
     use yarnfort_input_groups, only: check_yarn_variables, check_support_variables, &
         check_load_variables
-    use yarnfort_input_fields, only: quoted_list, check_name
-    use yarnfort_text, only: format_integer, format_real, closest_name
+    use yarnfort_input_fields, only: quoted_list, suggestion, check_item_name, group_label
+    use yarnfort_text, only: format_integer, format_real
     implicit none
     private
 
@@ -85,7 +85,7 @@ contains
         integer(int64) :: n_elements, n_new_nodes
         logical, allocatable :: used(:)
         real(wp) :: scale, length
-        character(len=:), allocatable :: label, guess
+        character(len=:), allocatable :: label
         character(len=name_length), allocatable :: material_names(:)
         character(len=80) :: counts
 
@@ -113,11 +113,10 @@ contains
                     return
                 end if
                 if (.not. any(material_names == yarn%material)) then
-                    guess = closest_name(trim(yarn%material), material_names)
-                    if (len(guess) > 0) guess = "; did you mean '" // guess // "'?"
                     call fatal_error(error, label // ": material = '" // trim(yarn%material) &
                         // "' is not defined by any &material (defined: " &
-                        // quoted_list(material_names) // ')' // guess)
+                        // quoted_list(material_names) // ')' &
+                        // suggestion(yarn%material, material_names))
                     return
                 end if
                 if (allocated(yarn%length0) .and. allocated(yarn%stretch)) then
@@ -349,30 +348,20 @@ contains
         type(config_type), intent(in) :: config
         integer, allocatable, intent(out) :: owner(:, :)
         type(error_type), allocatable, intent(out) :: error
-        integer :: s, other, i, k, n_nodes, node
+        integer :: s, i, k, n_nodes, node
         character(len=:), allocatable :: label
+        character(len=24), allocatable :: labels(:)
 
         n_nodes = size(config%node_positions, 2)
         allocate(owner(3, n_nodes), source=0)
         if (.not. allocated(config%supports)) return
+        labels = [character(len=24) :: (group_label('support', s), s = 1, size(config%supports))]
         do s = 1, size(config%supports)
             associate(support => config%supports(s))
-                label = '&support #' // format_integer(s)
-                if (len_trim(support%name) == 0) then
-                    call fatal_error(error, label // ': name is empty (give each support a name)')
-                    return
-                end if
-                call check_name(error, label, support%name)
+                call check_item_name(error, config%supports%name, labels, s, &
+                    ' (give each support a name)', 'used', '')
                 if (allocated(error)) return
                 label = "&support '" // trim(support%name) // "'"
-                do other = 1, s - 1
-                    if (config%supports(other)%name == support%name) then
-                        call fatal_error(error, "&support: name = '" // trim(support%name) &
-                            // "' is used twice (&support #" // format_integer(other) &
-                            // ' and #' // format_integer(s) // ')')
-                        return
-                    end if
-                end do
                 call check_fix(error, label, support%fix)
                 if (allocated(error)) return
                 call check_support_variables(support, label, error)

@@ -14,6 +14,7 @@ module yarnfort_input_scan
     private
 
     public :: namelist_scan_type, scan_namelist, assignment_type, get_assignments
+    public :: group_label
 
     !> A word of a group's text: a variable name (followed by '=') or a value (empty,
     !> last < first, for a null value).
@@ -453,8 +454,7 @@ contains
         integer :: k, n, j, m, g, paren
         logical :: ok
 
-        label = '&' // name
-        if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
+        label = group_label(name, occurrence)
         g = scan%find_group(name, max(occurrence, 1))
         associate(group => scan%groups(g))
             allocate(sets(count(group%tokens(:group%n_tokens)%is_name)))
@@ -543,6 +543,16 @@ contains
 
         text = self%lines(token%line)%text(token%first:token%last)
     end function token_text
+
+    !> '&name' for a singleton (occurrence 0), '&name #k' for the k-th of a repeatable.
+    pure function group_label(name, occurrence) result(label)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: occurrence
+        character(len=:), allocatable :: label
+
+        label = '&' // name
+        if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
+    end function group_label
 
     !> A variable name without subscript, lower case.
     pure function base_name(text) result(name)

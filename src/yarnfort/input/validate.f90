@@ -13,7 +13,7 @@ module yarnfort_input_validate
         material_config_type, path_config_type
     use yarnfort_input_groups, only: check_control_variables, check_solver_variables, &
         check_material_variables, check_path_variables, check_output_variables
-    use yarnfort_input_fields, only: check_name
+    use yarnfort_input_fields, only: check_item_name, group_label
     use yarnfort_input_magnitudes, only: check_scene_size, check_prescribed_reach
     use yarnfort_input_network_checks, only: check_nodes, check_yarns, &
         check_duplicate_segments, check_supports, check_loads, coincidence_tolerance
@@ -113,38 +113,23 @@ contains
     subroutine check_materials(materials, error)
         type(material_config_type), intent(in), allocatable :: materials(:)
         type(error_type), allocatable, intent(out) :: error
-        integer :: m, other
-        character(len=:), allocatable :: label
+        character(len=24), allocatable :: labels(:)
+        integer :: m
+        logical :: none
 
-        if (.not. allocated(materials)) then
+        none = .not. allocated(materials)
+        if (.not. none) none = size(materials) == 0
+        if (none) then
             call fatal_error(error, 'no &material group: at least one material is needed')
             return
         end if
-        if (size(materials) == 0) then
-            call fatal_error(error, 'no &material group: at least one material is needed')
-            return
-        end if
+        labels = [character(len=24) :: (group_label('material', m), m = 1, size(materials))]
         do m = 1, size(materials)
-            associate(material => materials(m))
-                label = '&material #' // format_integer(m)
-                if (len_trim(material%name) == 0) then
-                    call fatal_error(error, label // ': name is empty')
-                    return
-                end if
-                call check_name(error, label, material%name)
-                if (allocated(error)) return
-                label = "&material '" // trim(material%name) // "'"
-                do other = 1, m - 1
-                    if (materials(other)%name == material%name) then
-                        call fatal_error(error, "&material: name = '" // trim(material%name) &
-                            // "' is defined twice (&material #" // format_integer(other) &
-                            // ' and #' // format_integer(m) // ')')
-                        return
-                    end if
-                end do
-                call check_material_variables(material, label, error)
-                if (allocated(error)) return
-            end associate
+            call check_item_name(error, materials%name, labels, m, '', 'defined', '')
+            if (allocated(error)) return
+            call check_material_variables(materials(m), "&material '" &
+                // trim(materials(m)%name) // "'", error)
+            if (allocated(error)) return
         end do
     end subroutine check_materials
 

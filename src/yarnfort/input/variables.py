@@ -11,7 +11,8 @@ unit, range (">= 0", "> 0", "(0, 1)", "[a, b]", "finite"), choices (allowed valu
 case-folded), lower (fold the value to lower case), adjust (drop leading blanks),
 selects (the variable choosing the law whose parameters the others are), laws (the
 values of the selecting variable that use this one: required for those, an error for
-the others), preset (&solver: set by a preset unless given), checked_by (checked by
+the others), presets (the value each named preset of the group's `preset` variable
+gives it unless the input sets it), checked_by (checked by
 another module, named here: range and choices are documentation only), default_doc
 and type_doc (table text where the value alone does not say it), doc (the meaning).
 """
@@ -38,6 +39,11 @@ GROUPS = [
     Group('solver', 'singleton',
           'Nonlinear and linear solver settings, continuation step control and the friction '
           'scheme.', [
+        # The presets' values (initial_step = max_step, residual_tolerance, scheme) come
+        # from verification/speed_accuracy/presets.py (every scene of
+        # tests/verification/test_defaults.py against its exact reference): at these steps
+        # the error follows the tolerance, the step sets how finely the curve is drawn, and
+        # the monolithic scheme was the faster one.
         Var('preset', 'character', 'custom', length=16, lower=True,
             choices=['custom', 'fast', 'balanced', 'accurate'],
             doc='Named defaults for `initial_step`, `max_step`, `residual_tolerance` and '
@@ -54,7 +60,8 @@ GROUPS = [
                 "regularising spring's, see `slack_stiffness`), otherwise KLU up to 5e3 "
                 'unknowns and UMFPACK above; the unsymmetric friction systems never use '
                 'CHOLMOD.'),
-        Var('residual_tolerance', 'real', 1e-10, unit='1', range='> 0', preset=True,
+        Var('residual_tolerance', 'real', 1e-10, unit='1', range='> 0',
+            presets={'fast': 1e-6, 'balanced': 1e-9, 'accurate': 1e-11},
             doc='Relative. Newton stops when every row meets \\|F_i\\| <= residual_tolerance * '
                 'level_i + noise_i. For a node, level_i is the largest force that meets there '
                 '(the tensions of its elements, its applied load), at least 1e-6 times the '
@@ -91,7 +98,8 @@ GROUPS = [
                 'falling from 0.1 to `slack_stiffness` by factors of 10, and then corrected with '
                 'the exact law from there. 0 switches both off (a net at zero tension then has a '
                 'singular tangent).'),
-        Var('initial_step', 'real', 0.1, unit='knot interval', range='> 0', preset=True,
+        Var('initial_step', 'real', 0.1, unit='knot interval', range='> 0',
+            presets={'fast': 0.25, 'balanced': 0.05, 'accurate': 0.01},
             doc='First continuation step, as a fraction of the knot interval; at least '
                 'min_step, capped at max_step.'),
         Var('min_step', 'real', 1e-06, unit='knot interval', range='> 0',
@@ -99,7 +107,8 @@ GROUPS = [
                 'max_step, and min_step times every knot interval at least `100 * epsilon` '
                 'times the largest absolute `&path time` (a shorter step would not advance the '
                 'pseudo-time).'),
-        Var('max_step', 'real', 0.25, unit='knot interval', range='> 0', preset=True,
+        Var('max_step', 'real', 0.25, unit='knot interval', range='> 0',
+            presets={'fast': 0.25, 'balanced': 0.05, 'accurate': 0.01},
             doc='Largest step, as a fraction of the knot interval being followed: a path of N '
                 'knot intervals takes at least N / max_step steps, whatever the spacing of its '
                 'knots.'),
@@ -112,7 +121,8 @@ GROUPS = [
         Var('max_step_cuts', 'integer', 30, range='>= 0',
             doc='Give up after this many consecutive step cuts.'),
         Var('scheme', 'character', 'monolithic', length=16, lower=True,
-            choices=['monolithic', 'staggered'], preset=True,
+            choices=['monolithic', 'staggered'],
+            presets={'fast': 'monolithic', 'balanced': 'monolithic', 'accurate': 'monolithic'},
             doc="Friction: `'monolithic'` solves positions and sliding together with a "
                 "stick/slip active set; `'staggered'` is the paper's two-step scheme (elastic "
                 'solve, then sliding), each step finished by monolithic solves once its '

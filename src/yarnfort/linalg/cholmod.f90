@@ -25,11 +25,10 @@ module yarnfort_linalg_cholmod
         private
         !> Opaque cholmod_shim.c handle (common, factor, solve workspaces).
         type(c_ptr) :: handle = c_null_ptr
-        logical :: factored = .false.
     contains
-        procedure :: analyse
-        procedure :: factor
-        procedure :: solve
+        procedure :: analyse_pattern
+        procedure :: factor_values
+        procedure :: solve_rhs
         procedure :: destroy
         procedure :: get_name
         final :: finalize
@@ -37,71 +36,55 @@ module yarnfort_linalg_cholmod
 
 contains
 
-    !> Keep a copy of the pattern, order it and build the symbolic factor.
-    subroutine analyse(self, n, col_ptr, row_index, error)
+    !> Order the pattern and build the symbolic factor.
+    subroutine analyse_pattern(self, error)
         class(cholmod_solver_type), intent(inout) :: self
-        integer(ik), intent(in) :: n
-        integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
         integer(c_int) :: status
 
-        call self%keep_pattern(n, col_ptr, row_index, error)
-        if (allocated(error)) return
         self%handle = yarnfort_cholmod_create()
         if (.not. c_associated(self%handle)) then
             call fatal_error(error, 'cholmod: could not start CHOLMOD (cholmod_l_start)')
             return
         end if
-        status = yarnfort_cholmod_analyze(self%handle, n, self%col_ptr, self%row_index)
-        if (status < cholmod_ok) then
-            call fatal_error(error, 'cholmod: symbolic analysis failed: ' &
-                // status_message(status))
-            call self%destroy()
-            return
-        end if
-        self%n = n
-    end subroutine analyse
+        status = yarnfort_cholmod_analyze(self%handle, self%n, self%col_ptr, self%row_index)
+        if (status < cholmod_ok) call self%fail(error, 'symbolic analysis', &
+            status_message(status))
+    end subroutine analyse_pattern
 
     !> Numeric LL' factorisation; not positive definite is an error.
-    subroutine factor(self, values, error)
+    subroutine factor_values(self, values, error)
         class(cholmod_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         integer(c_int) :: status
         integer(c_long) :: minor
 
-        self%factored = .false.
-        call self%check_factor_call(self%n > 0, values, error)
-        if (allocated(error)) return
-
         status = yarnfort_cholmod_factorize(self%handle, self%n, self%col_ptr, &
             self%row_index, values, minor)
         if (status == cholmod_ok .or. status == cholmod_dsmall) then
-            self%factored = .true.
+            return
         else if (status == cholmod_not_posdef) then
-            call fatal_error(error, 'cholmod: factorisation failed: matrix is not positive ' &
+            call self%fail(error, 'factorisation', 'matrix is not positive ' &
                 // 'definite (pivot of column ' // format_integer(int(minor, ik)) &
                 // ' in the fill-reducing order is not positive; use umfpack or klu)')
         else
-            call fatal_error(error, 'cholmod: factorisation failed: ' // status_message(status))
+            call self%fail(error, 'factorisation', status_message(status))
         end if
-    end subroutine factor
+    end subroutine factor_values
 
     !> Overwrite rhs with the solution (workspaces allocated once, by the first solve).
-    subroutine solve(self, rhs, error)
+    subroutine solve_rhs(self, rhs, error)
         class(cholmod_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
         integer(c_int) :: status
 
-        call self%check_solve_call(self%factored, rhs, error)
-        if (allocated(error)) return
-
         status = yarnfort_cholmod_solve(self%handle, self%n, rhs)
         if (status < cholmod_ok) then
-            call fatal_error(error, 'cholmod: solve failed: ' // status_message(status))
+            call self%fail(error, 'solve', status_message(status))
         end if
-    end subroutine solve
+    end subroutine solve_rhs
 
     !> Free the CHOLMOD handle and the pattern copies (safe to call twice).
     subroutine destroy(self)
@@ -109,7 +92,6 @@ contains
 
         if (c_associated(self%handle)) call yarnfort_cholmod_free(self%handle)
         self%handle = c_null_ptr
-        self%factored = .false.
         call self%forget_pattern()
     end subroutine destroy
 

@@ -5,8 +5,8 @@
 module yarnfort_linalg_dense
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size, format_integer
+    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_csc_pattern, only: format_integer
     implicit none
     private
 
@@ -38,113 +38,80 @@ module yarnfort_linalg_dense
     end interface
 
     !> Dense LAPACK solver (no C handles; destroy only frees memory).
-    type, extends(linear_solver_type) :: dense_solver_type
+    type, extends(direct_solver_type) :: dense_solver_type
         private
-        !> Matrix order, 0 before `analyse`.
-        integer :: n = 0
-        !> Copy of the pattern, 0-based as given.
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
         !> Dense matrix, overwritten by its LU factors.
         real(wp), allocatable :: lu(:, :)
         integer, allocatable :: pivots(:)
-        logical :: factored = .false.
     contains
-        procedure :: analyse
-        procedure :: factor
-        procedure :: solve
+        procedure :: analyse_pattern
+        procedure :: factor_values
+        procedure :: solve_rhs
         procedure :: destroy
         procedure :: get_name
     end type dense_solver_type
 
 contains
 
-    !> Keep a copy of the pattern and allocate the dense matrix.
-    subroutine analyse(self, n, col_ptr, row_index, error)
+    !> Allocate the dense matrix.
+    subroutine analyse_pattern(self, error)
         class(dense_solver_type), intent(inout) :: self
-        integer(ik), intent(in) :: n
-        integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
 
-        call self%destroy()
-        call check_csc_pattern('dense', n, col_ptr, row_index, error)
-        if (allocated(error)) return
-        if (n > dense_max_order) then
-            call fatal_error(error, 'dense: matrix order n = ' // format_integer(n) &
+        if (self%n > dense_max_order) then
+            call fatal_error(error, 'dense: matrix order n = ' // format_integer(self%n) &
                 // ' exceeds dense_max_order = ' // format_integer(dense_max_order))
             return
         end if
-
-        self%col_ptr = col_ptr
-        self%row_index = row_index(1:col_ptr(n + 1))
-        self%n = int(n)
-        allocate(self%lu(n, n), self%pivots(n))
-    end subroutine analyse
+        allocate(self%lu(self%n, self%n), self%pivots(self%n))
+    end subroutine analyse_pattern
 
     !> Scatter the values into the dense matrix and factor it; singular is an error.
-    subroutine factor(self, values, error)
+    subroutine factor_values(self, values, error)
         class(dense_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         integer(ik) :: j, k
-        integer :: info
+        integer :: info, n
 
-        self%factored = .false.
-        if (self%n == 0) then
-            call fatal_error(error, 'dense: factor called before analyse')
-            return
-        end if
-        call check_array_size('dense', 'values', size(values, kind=ik), &
-            size(self%row_index, kind=ik), error, at_least=.true.)
-        if (allocated(error)) return
-
+        n = int(self%n)
         self%lu(:, :) = 0.0_wp
         do j = 1, self%n
             do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
                 self%lu(self%row_index(k) + 1, j) = values(k)
             end do
         end do
-        call dgetrf(self%n, self%n, self%lu, self%n, self%pivots, info)
+        call dgetrf(n, n, self%lu, n, self%pivots, info)
         if (info > 0) then
-            call fatal_error(error, 'dense: factorisation failed: matrix is singular ' &
+            call self%fail(error, 'factorisation', 'matrix is singular ' &
                 // '(dgetrf: U(' // format_integer(int(info, ik)) // ',' &
                 // format_integer(int(info, ik)) // ') is exactly zero)')
         else if (info < 0) then
             call fatal_error(error, 'dense: dgetrf rejected argument ' &
                 // format_integer(int(-info, ik)))
-        else
-            self%factored = .true.
         end if
-    end subroutine factor
+    end subroutine factor_values
 
     !> Overwrite rhs with the solution.
-    subroutine solve(self, rhs, error)
+    subroutine solve_rhs(self, rhs, error)
         class(dense_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
-        integer :: info
+        integer :: info, n
 
-        if (.not. self%factored) then
-            call fatal_error(error, 'dense: solve called without a valid factorisation')
-            return
-        end if
-        call check_array_size('dense', 'rhs', size(rhs, kind=ik), int(self%n, ik), error)
-        if (allocated(error)) return
-
-        call dgetrs('N', self%n, 1, self%lu, self%n, self%pivots, rhs, self%n, info)
+        n = int(self%n)
+        call dgetrs('N', n, 1, self%lu, n, self%pivots, rhs, n, info)
         if (info /= 0) then
             call fatal_error(error, 'dense: dgetrs rejected argument ' &
                 // format_integer(int(-info, ik)))
         end if
-    end subroutine solve
+    end subroutine solve_rhs
 
     !> Free the dense matrix and the pattern copy (safe to call twice).
     subroutine destroy(self)
         class(dense_solver_type), intent(inout) :: self
 
-        self%n = 0
-        self%factored = .false.
-        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
-        if (allocated(self%row_index)) deallocate(self%row_index)
+        call self%forget_pattern()
         if (allocated(self%lu)) deallocate(self%lu)
         if (allocated(self%pivots)) deallocate(self%pivots)
     end subroutine destroy

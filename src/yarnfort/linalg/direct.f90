@@ -1,8 +1,10 @@
 ! SPDX-License-Identifier: MIT
-!> The bookkeeping the sparse direct solvers (UMFPACK, KLU, CHOLMOD) share: the copy of
-!> the CSC pattern they read again at factor time, the checks of the call sequence and
-!> of array sizes, and forgetting it all on destroy. Each solver keeps its own C objects
-!> and status codes.
+!> The bookkeeping every linear solver over a kept pattern shares (UMFPACK, KLU, CHOLMOD,
+!> dense LAPACK and the CHOLMOD-then-KLU fallback): `analyse`, `factor` and `solve` check
+!> the pattern, the call sequence and the array sizes, keep the copy of the CSC pattern
+!> the libraries read again at factor time and the state (analysed, factored), and call
+!> the solver's own `analyse_pattern`, `factor_values` and `solve_rhs`, which hold only
+!> the library calls. Also the messages of a failed library call and of a status code.
 module yarnfort_linalg_direct
     use, intrinsic :: iso_c_binding, only: c_long
     use yarnfort_kinds, only: wp, ik
@@ -14,26 +16,57 @@ module yarnfort_linalg_direct
 
     public :: direct_solver_type, describe_status
 
-    !> A linear solver over a library that needs the pattern as 64-bit C arrays.
+    !> A linear solver that keeps the pattern (as 64-bit C arrays, what the libraries read).
     type, abstract, extends(linear_solver_type) :: direct_solver_type
-        !> Matrix order, 0 before `analyse`.
+        !> Matrix order, 0 before a successful `analyse`.
         integer(ik) :: n = 0
         !> Copies of the pattern (the libraries read them again at factor time).
         integer(c_long), allocatable :: col_ptr(:), row_index(:)
+        !> The last `factor` succeeded (and nothing was destroyed since).
+        logical :: factored = .false.
     contains
-        !> Check a pattern and keep a copy of it (after destroying what was there).
-        procedure :: keep_pattern
-        !> Check that `factor` may run (analysed) with these values.
-        procedure :: check_factor_call
-        !> Check that `solve` may run (`factored`) on this right-hand side.
-        procedure :: check_solve_call
-        !> Drop the pattern copy (for `destroy`).
+        procedure :: analyse
+        procedure :: factor
+        procedure :: solve
+        !> The solver's analysis of the kept pattern (n, col_ptr, row_index are set); a
+        !> failure destroys the solver.
+        procedure(analyse_pattern_interface), deferred :: analyse_pattern
+        !> The solver's factorisation of these values (enough of them, after analyse).
+        procedure(factor_values_interface), deferred :: factor_values
+        !> The solver's solve with the last factorisation (rhs of size n).
+        procedure(solve_rhs_interface), deferred :: solve_rhs
+        !> Drop the pattern copy and the state (for `destroy`).
         procedure :: forget_pattern
+        !> Set `error` to '<name>: <stage> failed: <reason>'.
+        procedure :: fail
     end type direct_solver_type
+
+    abstract interface
+        subroutine analyse_pattern_interface(self, error)
+            import :: direct_solver_type, error_type
+            class(direct_solver_type), intent(inout) :: self
+            type(error_type), allocatable, intent(out) :: error
+        end subroutine analyse_pattern_interface
+
+        subroutine factor_values_interface(self, values, error)
+            import :: direct_solver_type, wp, error_type
+            class(direct_solver_type), intent(inout) :: self
+            real(wp), intent(in) :: values(:)
+            type(error_type), allocatable, intent(out) :: error
+        end subroutine factor_values_interface
+
+        subroutine solve_rhs_interface(self, rhs, error)
+            import :: direct_solver_type, wp, error_type
+            class(direct_solver_type), intent(inout) :: self
+            real(wp), intent(inout) :: rhs(:)
+            type(error_type), allocatable, intent(out) :: error
+        end subroutine solve_rhs_interface
+    end interface
 
 contains
 
-    subroutine keep_pattern(self, n, col_ptr, row_index, error)
+    !> Check the pattern, keep a copy of it (after destroying what was there) and analyse it.
+    subroutine analyse(self, n, col_ptr, row_index, error)
         class(direct_solver_type), intent(inout) :: self
         integer(ik), intent(in) :: n
         integer(ik), intent(in) :: col_ptr(:), row_index(:)
@@ -44,43 +77,61 @@ contains
         if (allocated(error)) return
         self%col_ptr = col_ptr
         self%row_index = row_index(1:col_ptr(n + 1))
-    end subroutine keep_pattern
+        self%n = n
+        call self%analyse_pattern(error)
+        if (allocated(error)) call self%destroy()
+    end subroutine analyse
 
-    subroutine check_factor_call(self, analysed, values, error)
-        class(direct_solver_type), intent(in) :: self
-        logical, intent(in) :: analysed
+    !> Factor the matrix with the analysed pattern and these values.
+    subroutine factor(self, values, error)
+        class(direct_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
 
-        if (.not. analysed) then
+        self%factored = .false.
+        if (self%n == 0) then
             call fatal_error(error, self%get_name() // ': factor called before analyse')
             return
         end if
         call check_array_size(self%get_name(), 'values', size(values, kind=ik), &
             int(size(self%row_index), ik), error, at_least=.true.)
-    end subroutine check_factor_call
+        if (allocated(error)) return
+        call self%factor_values(values, error)
+        self%factored = .not. allocated(error)
+    end subroutine factor
 
-    subroutine check_solve_call(self, factored, rhs, error)
-        class(direct_solver_type), intent(in) :: self
-        logical, intent(in) :: factored
-        real(wp), intent(in) :: rhs(:)
+    !> Overwrite rhs with the solution, using the last factorisation.
+    subroutine solve(self, rhs, error)
+        class(direct_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
 
-        if (.not. factored) then
+        if (.not. self%factored) then
             call fatal_error(error, self%get_name() &
                 // ': solve called without a valid factorisation')
             return
         end if
         call check_array_size(self%get_name(), 'rhs', size(rhs, kind=ik), self%n, error)
-    end subroutine check_solve_call
+        if (allocated(error)) return
+        call self%solve_rhs(rhs, error)
+    end subroutine solve
 
     subroutine forget_pattern(self)
         class(direct_solver_type), intent(inout) :: self
 
         self%n = 0
+        self%factored = .false.
         if (allocated(self%col_ptr)) deallocate(self%col_ptr)
         if (allocated(self%row_index)) deallocate(self%row_index)
     end subroutine forget_pattern
+
+    subroutine fail(self, error, stage, reason)
+        class(direct_solver_type), intent(in) :: self
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: stage, reason
+
+        call fatal_error(error, self%get_name() // ': ' // stage // ' failed: ' // reason)
+    end subroutine fail
 
     !> The text of a library status code from the library's table of codes and texts
     !> (its header's name and what it means), or '<library> status <code>'.

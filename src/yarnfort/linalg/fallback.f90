@@ -6,44 +6,41 @@ module yarnfort_linalg_fallback
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_direct, only: direct_solver_type
     implicit none
     private
 
     public :: fallback_solver_type
 
-    type, extends(linear_solver_type) :: fallback_solver_type
+    !> The pattern (checked and kept by direct_solver_type) analyses the secondary solver
+    !> when switching.
+    type, extends(direct_solver_type) :: fallback_solver_type
         class(linear_solver_type), allocatable :: primary, secondary
         logical :: switched = .false.
-        !> The pattern, kept to analyse the secondary solver when switching.
-        integer(ik) :: n = 0
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
     contains
-        procedure :: analyse
-        procedure :: factor
-        procedure :: solve
+        procedure :: analyse_pattern
+        procedure :: factor_values
+        procedure :: solve_rhs
         procedure :: destroy
         procedure :: get_name
     end type fallback_solver_type
 
 contains
 
-    subroutine analyse(self, n, col_ptr, row_index, error)
+    subroutine analyse_pattern(self, error)
         class(fallback_solver_type), intent(inout) :: self
-        integer(ik), intent(in) :: n
-        integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
 
-        self%n = n
-        self%col_ptr = col_ptr(1:n + 1)
-        self%row_index = row_index(1:col_ptr(n + 1))
         if (self%switched) then
-            call self%secondary%analyse(n, col_ptr, row_index, error)
+            call self%secondary%analyse(self%n, int(self%col_ptr, ik), &
+                int(self%row_index, ik), error)
         else
-            call self%primary%analyse(n, col_ptr, row_index, error)
+            call self%primary%analyse(self%n, int(self%col_ptr, ik), int(self%row_index, ik), &
+                error)
         end if
-    end subroutine analyse
+    end subroutine analyse_pattern
 
-    subroutine factor(self, values, error)
+    subroutine factor_values(self, values, error)
         class(fallback_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
@@ -54,27 +51,30 @@ contains
             deallocate(error)
             self%switched = .true.
             call self%primary%destroy()
-            call self%secondary%analyse(self%n, self%col_ptr, self%row_index, error)
+            call self%analyse_pattern(error)
             if (allocated(error)) return
         end if
         call self%secondary%factor(values, error)
-    end subroutine factor
+    end subroutine factor_values
 
-    subroutine solve(self, rhs, error)
+    subroutine solve_rhs(self, rhs, error)
         class(fallback_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
+
         if (self%switched) then
             call self%secondary%solve(rhs, error)
         else
             call self%primary%solve(rhs, error)
         end if
-    end subroutine solve
+    end subroutine solve_rhs
 
     subroutine destroy(self)
         class(fallback_solver_type), intent(inout) :: self
+
         if (allocated(self%primary)) call self%primary%destroy()
         if (allocated(self%secondary)) call self%secondary%destroy()
+        call self%forget_pattern()
     end subroutine destroy
 
     pure function get_name(self) result(name)

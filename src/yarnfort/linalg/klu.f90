@@ -48,9 +48,9 @@ module yarnfort_linalg_klu
         !> The COLAMD analysis, until the first factorisation has chosen between the two.
         type(c_ptr) :: symbolic_colamd = c_null_ptr
     contains
-        procedure :: analyse
-        procedure :: factor
-        procedure :: solve
+        procedure :: analyse_pattern
+        procedure :: factor_values
+        procedure :: solve_rhs
         procedure :: destroy
         procedure :: get_name
         final :: finalize
@@ -58,15 +58,11 @@ module yarnfort_linalg_klu
 
 contains
 
-    !> Keep a copy of the pattern and order it (BTF + AMD).
-    subroutine analyse(self, n, col_ptr, row_index, error)
+    !> Order the pattern (BTF + AMD).
+    subroutine analyse_pattern(self, error)
         class(klu_solver_type), intent(inout) :: self
-        integer(ik), intent(in) :: n
-        integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
 
-        call self%keep_pattern(n, col_ptr, row_index, error)
-        if (allocated(error)) return
         if (klu_l_defaults(self%common) /= c_true) then
             call fatal_error(error, 'klu: klu_l_defaults failed')
             return
@@ -75,31 +71,25 @@ contains
         self%common%user_data = c_null_ptr
         self%common%halt_if_singular = c_true
         self%common_ready = .true.
-        self%symbolic = klu_l_analyze(n, self%col_ptr, self%row_index, self%common)
+        self%symbolic = klu_l_analyze(self%n, self%col_ptr, self%row_index, self%common)
         if (.not. c_associated(self%symbolic)) then
-            call fatal_error(error, 'klu: symbolic analysis failed: ' &
-                // status_message(self%common%status))
-            call self%destroy()
+            call self%fail(error, 'symbolic analysis', status_message(self%common%status))
             return
         end if
         if (self%unsymmetric_ordering) then
             self%common%ordering = 1
-            self%symbolic_colamd = klu_l_analyze(n, self%col_ptr, self%row_index, &
+            self%symbolic_colamd = klu_l_analyze(self%n, self%col_ptr, self%row_index, &
                 self%common)
             self%common%ordering = 0
         end if
-        self%n = n
-    end subroutine analyse
+    end subroutine analyse_pattern
 
     !> Refactor with the old pivot order when possible, else factor with pivoting.
-    subroutine factor(self, values, error)
+    subroutine factor_values(self, values, error)
         class(klu_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: ok
-
-        call self%check_factor_call(c_associated(self%symbolic), values, error)
-        if (allocated(error)) return
 
         if (c_associated(self%numeric)) then
             ok = klu_l_refactor(self%col_ptr, self%row_index, values, self%symbolic, &
@@ -116,12 +106,11 @@ contains
             self%common)
         if (c_associated(self%numeric)) return
         if (self%common%status == klu_singular) then
-            call fatal_error(error, 'klu: factorisation failed: matrix is singular (zero ' &
-                // 'pivot in column ' // format_integer(int(self%common%singular_col, ik)) &
+            call self%fail(error, 'factorisation', 'matrix is singular (zero pivot in ' &
+                // 'column ' // format_integer(int(self%common%singular_col, ik)) &
                 // ', KLU_SINGULAR)')
         else
-            call fatal_error(error, 'klu: factorisation failed: ' &
-                // status_message(self%common%status))
+            call self%fail(error, 'factorisation', status_message(self%common%status))
         end if
     contains
         !> Factor with the COLAMD analysis; keep it if its factors are sparser than
@@ -150,23 +139,20 @@ contains
             end if
             self%symbolic_colamd = c_null_ptr
         end subroutine choose_ordering
-    end subroutine factor
+    end subroutine factor_values
 
     !> Overwrite rhs with the solution (in place, no allocation).
-    subroutine solve(self, rhs, error)
+    subroutine solve_rhs(self, rhs, error)
         class(klu_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: ok
 
-        call self%check_solve_call(c_associated(self%numeric), rhs, error)
-        if (allocated(error)) return
-
         ok = klu_l_solve(self%symbolic, self%numeric, self%n, 1_c_long, rhs, self%common)
         if (ok /= c_true) then
-            call fatal_error(error, 'klu: solve failed: ' // status_message(self%common%status))
+            call self%fail(error, 'solve', status_message(self%common%status))
         end if
-    end subroutine solve
+    end subroutine solve_rhs
 
     !> Free the Numeric and Symbolic objects and the pattern copies (safe to call twice).
     subroutine destroy(self)

@@ -63,9 +63,9 @@ module yarnfort_linalg_umfpack
         !> UMFPACK's memory figures of the last numeric factorisation and the strategy of its
     !> symbolic analysis (benchmarks).
         procedure :: get_memory
-        procedure :: analyse
-        procedure :: factor
-        procedure :: solve
+        procedure :: analyse_pattern
+        procedure :: factor_values
+        procedure :: solve_rhs
         procedure :: destroy
         procedure :: get_name
         final :: finalize
@@ -73,33 +73,24 @@ module yarnfort_linalg_umfpack
 
 contains
 
-    !> Keep a copy of the pattern; the Symbolic object follows at the first `factor`.
-    subroutine analyse(self, n, col_ptr, row_index, error)
+    !> Set the controls; the Symbolic object follows at the first factorisation.
+    subroutine analyse_pattern(self, error)
         class(umfpack_solver_type), intent(inout) :: self
-        integer(ik), intent(in) :: n
-        integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
-        integer(c_long) :: status
 
-        call self%keep_pattern(n, col_ptr, row_index, error)
-        if (allocated(error)) return
         call umfpack_dl_defaults(self%control)
         self%control(umfpack_irstep) = real(umfpack_refinement_steps, c_double)
         self%control(umfpack_prl) = real(umfpack_print_level, c_double)
-        self%n = n
-        allocate(self%int_work(n), self%real_work(n), self%rhs_copy(n))
-    end subroutine analyse
+        allocate(self%int_work(self%n), self%real_work(self%n), self%rhs_copy(self%n))
+    end subroutine analyse_pattern
 
     !> Numeric factorisation with the analysed Symbolic object; a singular matrix is an error.
-    subroutine factor(self, values, error)
+    subroutine factor_values(self, values, error)
         class(umfpack_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: status
         character(len=24) :: rcond
-
-        call self%check_factor_call(self%n > 0, values, error)
-        if (allocated(error)) return
 
         call umfpack_dl_free_numeric(self%numeric)
         if (.not. c_associated(self%symbolic)) then
@@ -107,8 +98,7 @@ contains
                 values, self%symbolic, self%control, self%info)
             if (status /= umfpack_ok) then
                 call umfpack_dl_free_symbolic(self%symbolic)
-                call fatal_error(error, 'umfpack: symbolic analysis failed: ' &
-                    // status_message(status))
+                call self%fail(error, 'symbolic analysis', status_message(status))
                 return
             end if
             self%memory%strategy = nint(self%info(umfpack_strategy_used))
@@ -128,32 +118,28 @@ contains
         call umfpack_dl_free_numeric(self%numeric)
         if (status == umfpack_warning_singular_matrix) then
             write(rcond, '(es10.3)') self%info(umfpack_rcond)
-            call fatal_error(error, 'umfpack: numeric factorisation failed: matrix is ' &
+            call self%fail(error, 'numeric factorisation', 'matrix is ' &
                 // 'singular (zero pivot, UMFPACK_WARNING_singular_matrix, rcond = ' &
                 // trim(adjustl(rcond)) // ')')
         else
-            call fatal_error(error, 'umfpack: numeric factorisation failed: ' &
-                // status_message(status))
+            call self%fail(error, 'numeric factorisation', status_message(status))
         end if
-    end subroutine factor
+    end subroutine factor_values
 
     !> Overwrite rhs with the solution, without refinement and without allocation.
-    subroutine solve(self, rhs, error)
+    subroutine solve_rhs(self, rhs, error)
         class(umfpack_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: status
 
-        call self%check_solve_call(c_associated(self%numeric), rhs, error)
-        if (allocated(error)) return
-
         self%rhs_copy(:) = rhs
         status = umfpack_dl_wsolve(umfpack_a, x=rhs, b=self%rhs_copy, numeric=self%numeric, &
             control=self%control, info=self%info, wi=self%int_work, w=self%real_work)
         if (status /= umfpack_ok) then
-            call fatal_error(error, 'umfpack: solve failed: ' // status_message(status))
+            call self%fail(error, 'solve', status_message(status))
         end if
-    end subroutine solve
+    end subroutine solve_rhs
 
     !> Free the Numeric and Symbolic objects and the pattern copies (safe to call twice).
     subroutine destroy(self)

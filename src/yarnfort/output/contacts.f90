@@ -5,6 +5,7 @@
 !> resumed on restart).
 module yarnfort_output_contacts
     use yarnfort_kinds, only: wp
+    use yarnfort_output_csv_rows, only: csv_rows_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_contact_geometry, only: get_wrap_angle
@@ -116,45 +117,27 @@ contains
         integer, intent(in) :: mode(:)
         real(wp), intent(in) :: flow(:)
         character(len=:), allocatable :: rows
-        character(len=:), allocatable :: step_text, buffer
-        character(len=32) :: field
         type(passage_state_type) :: passages_state
-        integer :: p, used
+        type(csv_rows_type) :: table
+        integer :: p
 
         call get_passage_states(scene, state, mode, flow, passages_state)
-        ! Filled in place (appending to a growing string would copy it for every field):
-        ! a row has 4 integers and 5 reals of at most 32 characters and a mode word.
-        allocate(character(len=max(scene%passages%size(), 1) * (10 * (len(field) + 1) + 1)) :: &
-            buffer)
-        used = 0
-        write(field, '(i0)') state%step
-        step_text = trim(field)
         associate(passages => scene%passages, ps => passages_state)
             do p = 1, passages%size()
-                if (used > 0) call put(achar(10))
-                write(field, '(i0, ",", i0, ",", i0)') p, passages%node(p), passages%yarn(p)
-                call put(step_text // ',' // trim(field))
-                call append(ps%flow(p))
-                call put(',' // trim(mode_names(ps%mode(p))))
-                call append(ps%tension_min(p))
-                call append(ps%tension_max(p))
-                call append(ps%critical(p))
-                call append(ps%angle(p))
+                call table%new_row()
+                call table%add(state%step)
+                call table%add(p)
+                call table%add(passages%node(p))
+                call table%add(passages%yarn(p))
+                call table%add(ps%flow(p))
+                call table%add(trim(mode_names(ps%mode(p))))
+                call table%add(ps%tension_min(p))
+                call table%add(ps%tension_max(p))
+                call table%add(ps%critical(p))
+                call table%add(ps%angle(p))
             end do
         end associate
-        rows = buffer(:used)
-    contains
-        subroutine append(value)
-            real(wp), intent(in) :: value
-            write(field, '(es24.16e3)') value
-            call put(',' // trim(adjustl(field)))
-        end subroutine append
-
-        subroutine put(text)
-            character(len=*), intent(in) :: text
-            buffer(used + 1:used + len(text)) = text
-            used = used + len(text)
-        end subroutine put
+        rows = table%get()
     end function get_contact_rows
 
 end module yarnfort_output_contacts

@@ -9,6 +9,7 @@ module yarnfort_output_curve
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_text, only: read_line
+    use yarnfort_output_csv_rows, only: csv_rows_type, format_csv_real
     use yarnfort_input_channel_checks, only: load_column_prefix
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, open_append, &
         flush_checked, truncate_file
@@ -217,8 +218,8 @@ contains
                 call remove_file(temporary, ignored)
                 write(text, '(i0)') step
                 call fatal_error(error, "&control restart: the restart file's time " &
-                    // format_real_text(time) // ' is not that of step ' // trim(text) &
-                    // " in '" // path // "' (" // format_real_text(row_time) &
+                    // format_csv_real(time) // ' is not that of step ' // trim(text) &
+                    // " in '" // path // "' (" // format_csv_real(row_time) &
                     // '): the two files are not of the same run')
                 return
             end if
@@ -231,9 +232,9 @@ contains
                 call remove_file(temporary, ignored)
                 write(text, '(i0)') step - 1
                 call fatal_error(error, "&control restart: the restart file's previous " &
-                    // 'time ' // format_real_text(previous_time) // ' is not that of step ' &
+                    // 'time ' // format_csv_real(previous_time) // ' is not that of step ' &
                     // trim(text) // " in '" // path // "' (" &
-                    // format_real_text(row_time_previous) // '): the two files are not ' &
+                    // format_csv_real(row_time_previous) // '): the two files are not ' &
                     // 'of the same run')
                 return
             end if
@@ -287,59 +288,40 @@ contains
         type(scene_type), intent(in) :: scene
         type(step_state_type), intent(in) :: state
         type(error_type), allocatable, intent(out) :: error
-        character(len=32) :: field
-        character(len=:), allocatable :: row
-        integer :: s, k
-        real(wp) :: displacement(3)
+        type(csv_rows_type) :: row
+        integer :: s
 
-        write(field, '(i0)') state%step
-        row = trim(field)
-        call append(state%time)
-        do s = 1, size(state%factors)
-            call append(state%factors(s))
-        end do
+        call row%add(state%step)
+        call row%add(state%time)
+        call row%add(state%factors)
         do s = 1, size(state%reaction, 2)
-            do k = 1, 3
-                call append(state%reaction(k, s))
-            end do
+            call row%add(state%reaction(:, s))
         end do
         do s = 1, size(scene%supports)
-            displacement = get_support_displacement(scene, state, s)
-            do k = 1, 3
-                call append(displacement(k))
-            end do
+            call row%add(get_support_displacement(scene, state, s))
         end do
         if (allocated(scene%loads)) then
             do s = 1, size(scene%loads)
-                displacement = get_load_displacement(scene, state, s)
-                do k = 1, 3
-                    call append(displacement(k))
-                end do
+                call row%add(get_load_displacement(scene, state, s))
             end do
         end if
         if (scene%fabric_set > 0) then
             ! A fabric has the two default channels: p_disp is channel 2.
-            call append(state%factors(2) * scene%fabric_strain)
-            call append(state%reaction(1, scene%fabric_set) / scene%fabric_width)
+            call row%add(state%factors(2) * scene%fabric_strain)
+            call row%add(state%reaction(1, scene%fabric_set) / scene%fabric_width)
         end if
-        write(field, '(i0, ",", i0, ",", i0, ",", i0)') state%direction, state%n_slipping, &
-            state%n_passages, state%newton_iterations
-        row = row // ',' // trim(field)
-        call append(state%newton%residual_norm)
-        write(field, '(i0)') state%step_cuts
-        row = row // ',' // trim(field)
-        call append(state%wall_time)
+        call row%add(state%direction)
+        call row%add(state%n_slipping)
+        call row%add(state%n_passages)
+        call row%add(state%newton_iterations)
+        call row%add(state%newton%residual_norm)
+        call row%add(state%step_cuts)
+        call row%add(state%wall_time)
         if (self%unit == -1) then
             call fatal_error(error, "cannot write '" // self%path // "': it is not open")
             return
         end if
-        call self%put_line(row, error)
-    contains
-        subroutine append(value)
-            real(wp), intent(in) :: value
-            write(field, '(es24.16e3)') value
-            row = row // ',' // trim(adjustl(field))
-        end subroutine append
+        call self%put_line(row%get(), error)
     end subroutine write_step
 
     !> Mean displacement (m, from the initial position) of the coordinates support set s
@@ -394,14 +376,5 @@ contains
         self%unit = -1
         if (present(error) .and. allocated(close_error)) call move_alloc(close_error, error)
     end subroutine close_curve
-
-    !> A real with 17 significant digits (the curve file's format).
-    pure function format_real_text(value) result(text)
-        real(wp), intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=32) :: buffer
-        write(buffer, '(es24.16e3)') value
-        text = trim(adjustl(buffer))
-    end function format_real_text
 
 end module yarnfort_output_curve

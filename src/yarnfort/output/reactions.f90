@@ -4,6 +4,7 @@
 !> `curve_writer_type` (header, rows appended and flushed per step, resumed on restart).
 module yarnfort_output_reactions
     use yarnfort_kinds, only: wp
+    use yarnfort_output_csv_rows, only: csv_rows_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     implicit none
@@ -25,19 +26,11 @@ contains
         type(scene_type), intent(in) :: scene
         type(step_state_type), intent(in) :: state
         character(len=:), allocatable :: rows
-        character(len=:), allocatable :: step_text, buffer
+        type(csv_rows_type) :: table
         real(wp) :: force(3)
-        integer :: s, i, j, first, node, c, used
-        character(len=32) :: field
+        integer :: s, i, j, first, node, c
         logical, allocatable :: done(:)
 
-        ! Filled in place (appending to a growing string would copy it for every field):
-        ! a row has at most one per coordinate, a set name and 5 numbers of <= 32 characters.
-        allocate(character(len=max(size(state%coordinate_reaction), 1) &
-            * (len(scene%supports(1)%name) + 6 * (len(field) + 1) + 1)) :: buffer)
-        used = 0
-        write(field, '(i0)') state%step
-        step_text = trim(field)
         first = 0
         do s = 1, size(scene%supports)
             associate(coordinates => scene%supports(s)%coordinates)
@@ -52,26 +45,17 @@ contains
                         force(mod(c - 1, 3) + 1) = state%coordinate_reaction(first + j)
                         done(j) = .true.
                     end do
-                    if (used > 0) call put(achar(10))
-                    write(field, '(i0)') node
-                    call put(step_text // ',' // trim(scene%supports(s)%name) // ',' &
-                        // trim(field))
-                    do j = 1, 3
-                        write(field, '(es24.16e3)') force(j)
-                        call put(',' // trim(adjustl(field)))
-                    end do
+                    call table%new_row()
+                    call table%add(state%step)
+                    call table%add(trim(scene%supports(s)%name))
+                    call table%add(node)
+                    call table%add(force)
                 end do
                 first = first + size(coordinates)
                 deallocate(done)
             end associate
         end do
-        rows = buffer(:used)
-    contains
-        subroutine put(text)
-            character(len=*), intent(in) :: text
-            buffer(used + 1:used + len(text)) = text
-            used = used + len(text)
-        end subroutine put
+        rows = table%get()
     end function get_reaction_rows
 
 end module yarnfort_output_reactions

@@ -28,6 +28,7 @@ module yarnfort_output_vtk
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked
+    use yarnfort_text, only: format_integer
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
     implicit none
     private
@@ -484,13 +485,5 @@ contains
             order = 'BigEndian'
         end if
     end function get_byte_order
-
-    pure function format_integer(value) result(text)
-        integer, intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=16) :: buffer
-        write(buffer, '(i0)') value
-        text = trim(buffer)
-    end function format_integer
 
 end module yarnfort_output_vtk

@@ -571,8 +571,9 @@ contains
     subroutine test_invalid_pattern(error)
         type(error_type), allocatable, intent(out) :: error
         class(linear_solver_type), allocatable :: solver
-        character(len=7), parameter :: names(4) = [character(len=7) :: 'umfpack', 'klu', &
-            'cholmod', 'dense']
+        ! 'cholmod+klu' checks the pattern itself before keeping it for the switch.
+        character(len=11), parameter :: names(5) = [character(len=11) :: 'umfpack', 'klu', &
+            'cholmod', 'dense', 'cholmod+klu']
         integer :: i
 
         do i = 1, size(names)
