@@ -36,7 +36,12 @@ module yarnfort_linalg_condensed
         integer(ik) :: n_reduced = 0
         !> Diagonal of each eliminated unknown's row (0 for the others).
         real(wp), allocatable :: pivot(:)
-        !> The last values (their eliminated columns are needed by `solve`).
+        !> Entry of each candidate's diagonal (0 if not stored), and the off-diagonal
+        !> entries of the candidate rows with their rows: what decides which rows are
+        !> trivial, found once per pattern.
+        integer(ik), allocatable :: diagonal(:), candidate_entry(:), candidate_row(:)
+        !> The last values of the candidate columns (entries col_ptr(first_candidate) + 1
+        !> onwards: `solve` moves the eliminated columns to the right-hand side).
         real(wp), allocatable :: values(:)
         logical :: analysed = .false., inner_analysed = .false., factored = .false.
         !> Analyses of the reduced system so far (each set of eliminated unknowns).
@@ -70,6 +75,7 @@ contains
         allocate(self%reduced(n), source=0_ik)
         self%n_reductions = 0
         allocate(self%pivot(n), source=0.0_wp)
+        call find_candidate_entries(self)
         self%analysed = .true.
     end subroutine analyse
 
@@ -91,25 +97,19 @@ contains
             int(size(self%row_index), ik), error, at_least=.true.)
         if (allocated(error)) return
         ! A candidate row is trivial when its only nonzero value is a nonzero diagonal.
-        allocate(trivial(self%n), source=.false.)
-        trivial(self%first_candidate:) = .true.
         self%pivot = 0.0_wp
-        do j = 1, self%n
-            do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
-                i = self%row_index(k) + 1
-                if (i == j) then
-                    self%pivot(j) = values(k)
-                else if (values(k) /= 0.0_wp) then
-                    trivial(i) = .false.
-                end if
-            end do
+        do j = self%first_candidate, self%n
+            if (self%diagonal(j) > 0) self%pivot(j) = values(self%diagonal(j))
         end do
-        trivial = trivial .and. self%pivot /= 0.0_wp
+        trivial = self%pivot /= 0.0_wp
+        do k = 1, size(self%candidate_entry, kind=ik)
+            if (values(self%candidate_entry(k)) /= 0.0_wp) &
+                trivial(self%candidate_row(k)) = .false.
+        end do
         where (.not. trivial) self%pivot = 0.0_wp
         if (self%n_reductions == 0 .or. any(trivial .neqv. (self%reduced == 0))) &
             call reduce(trivial)
-        if (allocated(error)) return
-        self%values = values(1:size(self%row_index))
+        self%values = values(self%col_ptr(self%first_candidate) + 1:size(self%row_index))
         if (self%n_reduced > 0) then
             if (.not. self%inner_analysed) then
                 call self%inner%analyse(self%n_reduced, self%reduced_col_ptr, &
@@ -170,7 +170,7 @@ contains
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: part(:)
-        integer(ik) :: j, k, i
+        integer(ik) :: j, k, i, offset
 
         if (.not. self%factored) then
             call fatal_error(error, self%get_name() &
@@ -179,12 +179,13 @@ contains
         end if
         call check_array_size(self%get_name(), 'rhs', size(rhs, kind=ik), self%n, error)
         if (allocated(error)) return
-        do j = 1, self%n
+        offset = self%col_ptr(self%first_candidate)
+        do j = self%first_candidate, self%n
             if (self%reduced(j) /= 0) cycle
             rhs(j) = rhs(j) / self%pivot(j)
             do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
                 i = self%row_index(k) + 1
-                if (self%reduced(i) /= 0) rhs(i) = rhs(i) - self%values(k) * rhs(j)
+                if (self%reduced(i) /= 0) rhs(i) = rhs(i) - self%values(k - offset) * rhs(j)
             end do
         end do
         if (self%n_reduced == 0) return
@@ -198,6 +199,39 @@ contains
             if (self%reduced(j) /= 0) rhs(j) = part(self%reduced(j))
         end do
     end subroutine solve
+
+    !> The diagonal entries of the candidate columns and the off-diagonal entries of the
+    !> candidate rows (first_candidate clipped to 1..n + 1).
+    subroutine find_candidate_entries(self)
+        type(condensed_solver_type), intent(inout) :: self
+        integer(ik) :: j, k, i, count
+
+        self%first_candidate = min(max(self%first_candidate, 1_ik), self%n + 1)
+        allocate(self%diagonal(self%n), source=0_ik)
+        count = 0
+        do j = 1, self%n
+            do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
+                i = self%row_index(k) + 1
+                if (i < self%first_candidate) cycle
+                if (i == j) then
+                    self%diagonal(j) = k
+                else
+                    count = count + 1
+                end if
+            end do
+        end do
+        allocate(self%candidate_entry(count), self%candidate_row(count))
+        count = 0
+        do j = 1, self%n
+            do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
+                i = self%row_index(k) + 1
+                if (i < self%first_candidate .or. i == j) cycle
+                count = count + 1
+                self%candidate_entry(count) = k
+                self%candidate_row(count) = i
+            end do
+        end do
+    end subroutine find_candidate_entries
 
     !> Free the reduced system's solver and every copy (safe to call twice).
     subroutine destroy(self)
@@ -216,6 +250,9 @@ contains
         if (allocated(self%reduced_row_index)) deallocate(self%reduced_row_index)
         if (allocated(self%source)) deallocate(self%source)
         if (allocated(self%pivot)) deallocate(self%pivot)
+        if (allocated(self%diagonal)) deallocate(self%diagonal)
+        if (allocated(self%candidate_entry)) deallocate(self%candidate_entry)
+        if (allocated(self%candidate_row)) deallocate(self%candidate_row)
         if (allocated(self%values)) deallocate(self%values)
     end subroutine destroy
 
