@@ -50,6 +50,11 @@ end module bench_friction_counter
 !> state (bench_floor, CPU ms per factorisation + solve, nonzeros of L + U): the friction
 !> Jacobian (final active set) with KLU's AMD and COLAMD orderings and UMFPACK, and the
 !> elastic Jacobian of the same net and state with KLU and yarnfort's CHOLMOD.
+!> Then, when the monolithic solver eliminates stick flows, a line `reduced:` (the
+!> reduced system at the final state, as the `factors:` line, and the reductions per
+!> step), and a line `iteration:`: one Newton iteration of each problem at the final
+!> state with the solvers yarnfort uses, and the cycle's CPU time per step against the
+!> elastic one (write_iterations).
 program bench_friction
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use yarnfort_kinds, only: wp
@@ -67,6 +72,10 @@ program bench_friction
     use bench_floor, only: floor_type, measure_floor
     use yarnfort_kinds, only: ik
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
+    use yarnfort_solver_problem, only: nonlinear_problem_type
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_factory, only: new_linear_solver
+    use yarnfort_linalg_condensed, only: condensed_solver_type
     implicit none
 
     type(config_type) :: config
@@ -74,7 +83,7 @@ program bench_friction
     type(friction_stepper_type) :: stepper
     type(counter_type) :: counter
     type(error_type), allocatable :: error
-    real(wp) :: total, start, times(3, 5)
+    real(wp) :: total, start, times(3, 5), cpu_start, cpu_total
     integer :: side, per_segment, factorisations(3)
     character(len=32) :: argument, scheme
 
@@ -98,9 +107,12 @@ program bench_friction
     if (allocated(error)) call fail('bench_friction', error)
     call new_friction_stepper(stepper, scene, get_linear_solver_name(scene), error)
     if (allocated(error)) call fail('bench_friction', error)
+    call cpu_time(cpu_start)
     start = wall_time()
     call run_continuation(scene, stepper, counter, error)
     total = wall_time() - start
+    call cpu_time(cpu_total)
+    cpu_total = cpu_total - cpu_start
     if (allocated(error)) call fail('bench_friction', error)
     times = 0.0_wp
     factorisations = 0
@@ -121,8 +133,99 @@ program bench_friction
             peak_memory_mib()
     end associate
     if (associated(stepper%full)) call write_factors()
+    if (associated(stepper%full)) call write_iterations()
 
 contains
+
+    !> The `iteration:` line: CPU ms of one Newton iteration at the final state
+    !> (residual, Jacobian, factorisation and solve with the solver the run used) of the
+    !> monolithic friction problem and of the elastic problem of the same net (its
+    !> default solver), the cycle's CPU ms per load step and its ratio to the elastic
+    !> iteration.
+    subroutine write_iterations()
+        type(elastic_problem_type), target :: problem
+        class(linear_solver_type), allocatable :: elastic_solver
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        real(wp), allocatable :: values(:), residual(:), u(:)
+        real(wp) :: friction_ms(2), elastic_ms(2)
+        character(len=:), allocatable :: elastic_name
+        type(floor_type) :: reduced
+
+        associate(full => stepper%full)
+            u = [stepper%u, stepper%flow]
+            full%mode = stepper%mode
+            call full%prepare_solve(u, error)
+            if (allocated(error)) call fail('bench_friction', error)
+            allocate(values(full%get_nonzeros()), residual(size(u)))
+            call time_iteration(full, stepper%newton_full%linear, u, values, residual, &
+                friction_ms)
+        end associate
+        select type (linear => stepper%newton_full%linear)
+        type is (condensed_solver_type)
+            call measure_floor('klu', linear%n_reduced, linear%reduced_col_ptr, &
+                linear%reduced_row_index, values(linear%source), reduced, error)
+            if (allocated(error)) call fail('bench_friction', error)
+            write(output_unit, '(a, i0, a, i0, a, f8.2, a, 2(es9.2, a, f8.2, a))') &
+                'reduced: n ', linear%n_reduced, ' nnz ', size(linear%source), &
+                ' reductions/step ', real(linear%n_reductions, wp) / counter%steps, &
+                ' LU: klu-amd ', reduced%klu_lu, ' (', reduced%klu_ms, ' ms)  umfpack ', &
+                reduced%umfpack_lu, ' (', reduced%umfpack_ms, ' ms)'
+        end select
+        call new_elastic_problem(problem, scene)
+        call scene%passages%get_length0(scene%network%length0, stepper%flow, problem%length0)
+        problem%factors = stepper%factors
+        elastic_name = get_linear_solver_name(scene)
+        call new_linear_solver(elastic_solver, elastic_name, error)
+        if (allocated(error)) call fail('bench_friction', error)
+        allocate(col_ptr(problem%get_size() + 1), row_index(problem%get_nonzeros()))
+        call problem%copy_pattern(col_ptr, row_index)
+        call elastic_solver%analyse(int(problem%get_size(), ik), col_ptr, row_index, error)
+        if (allocated(error)) call fail('bench_friction', error)
+        deallocate(values, residual)
+        allocate(values(problem%get_nonzeros()), residual(problem%get_size()))
+        call time_iteration(problem, elastic_solver, stepper%u, values, residual, elastic_ms)
+        write(output_unit, '(a, 2(f9.3, a), f9.3, a, f9.3, a, f9.2, a, f8.2)') &
+            'iteration: friction ', sum(friction_ms), ' ms (assembly ', friction_ms(1), &
+            ' ms, ' // stepper%newton_full%linear%get_name() // ') | elastic ', &
+            sum(elastic_ms), ' ms (assembly ', elastic_ms(1), ' ms, ' // elastic_name // &
+            ') | cpu ms/step ', 1e3_wp * cpu_total / counter%steps, ' = elastic x ', &
+            1e3_wp * cpu_total / counter%steps / sum(elastic_ms)
+    end subroutine write_iterations
+
+    !> CPU ms of residual + Jacobian (times(1)) and factorisation + solve (times(2)),
+    !> the mean of repetitions filling about 0.3 s.
+    subroutine time_iteration(problem, solver, u, values, residual, times)
+        class(nonlinear_problem_type), intent(inout) :: problem
+        class(linear_solver_type), intent(inout) :: solver
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(inout) :: values(:), residual(:)
+        real(wp), intent(out) :: times(2)
+        real(wp) :: t0, t1, t2
+        integer :: repetitions
+
+        times = 0.0_wp
+        repetitions = 0
+        call cpu_time(t0)
+        t2 = t0
+        do while (t2 - t0 < 0.3_wp .or. repetitions < 3)
+            call cpu_time(t1)
+            call problem%evaluate_residual(u, residual, error)
+            if (allocated(error)) call fail('bench_friction', error)
+            call problem%evaluate_jacobian(u, values, error)
+            if (allocated(error)) call fail('bench_friction', error)
+            call cpu_time(t2)
+            times(1) = times(1) + (t2 - t1)
+            call solver%factor(values, error)
+            if (allocated(error)) call fail('bench_friction', error)
+            call solver%solve(residual, error)
+            if (allocated(error)) call fail('bench_friction', error)
+            call cpu_time(t1)
+            times(2) = times(2) + (t1 - t2)
+            t2 = t1
+            repetitions = repetitions + 1
+        end do
+        times = 1e3_wp * times / repetitions
+    end subroutine time_iteration
 
     !> The `factors:` line (program notes).
     subroutine write_factors()

@@ -1,0 +1,270 @@
+! SPDX-License-Identifier: MIT
+!> A linear solver that first eliminates the unknowns whose rows hold nothing but their
+!> diagonal (in the friction Jacobian: the rows k (s - s_target) of sticking passages),
+!> then hands the remaining system to another solver. Exact: for such a row
+!> x_j = b_j / a_jj, and column j moves to the right-hand side of the other rows. The
+!> reduced system is analysed again whenever the set of eliminated unknowns changes
+!> (between the stick/slip active-set rounds of a step) and refactored otherwise.
+!> Why: a sticking flow's column couples every coordinate of the two segments it
+!> bounds, which is what makes the friction Jacobian's factors dense (benchmarks/
+!> results-friction-factor.md); with the stick flows gone the reduced system is the
+!> elastic tangent plus the slipping flows.
+module yarnfort_linalg_condensed
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size
+    implicit none
+    private
+
+    public :: condensed_solver_type
+
+    !> Eliminates trivial rows, then calls `inner` on the rest.
+    type, extends(linear_solver_type) :: condensed_solver_type
+        !> The solver of the reduced system (owned).
+        class(linear_solver_type), allocatable :: inner
+        !> Only unknowns first_candidate..n may be eliminated (1-based): the owner knows
+        !> which rows can be trivial (the flows); a coordinate row that happens to hold
+        !> only its diagonal for one matrix would make the reduced pattern flicker.
+        integer(ik) :: first_candidate = 1
+        integer(ik) :: n = 0
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        !> Reduced index of each unknown (1-based), 0 for an eliminated one; the reduced
+        !> pattern and, for each of its entries, the entry of the full matrix.
+        integer(ik), allocatable :: reduced(:)
+        integer(ik), allocatable :: reduced_col_ptr(:), reduced_row_index(:), source(:)
+        integer(ik) :: n_reduced = 0
+        !> Diagonal of each eliminated unknown's row (0 for the others).
+        real(wp), allocatable :: pivot(:)
+        !> Entry of each candidate's diagonal (0 if not stored), and the off-diagonal
+        !> entries of the candidate rows with their rows: what decides which rows are
+        !> trivial, found once per pattern.
+        integer(ik), allocatable :: diagonal(:), candidate_entry(:), candidate_row(:)
+        !> The last values of the candidate columns (entries col_ptr(first_candidate) + 1
+        !> onwards: `solve` moves the eliminated columns to the right-hand side).
+        real(wp), allocatable :: values(:)
+        logical :: analysed = .false., inner_analysed = .false., factored = .false.
+        !> Analyses of the reduced system so far (each set of eliminated unknowns).
+        integer :: n_reductions = 0
+    contains
+        procedure :: analyse
+        procedure :: factor
+        procedure :: solve
+        procedure :: destroy
+        procedure :: get_name
+    end type condensed_solver_type
+
+contains
+
+    subroutine analyse(self, n, col_ptr, row_index, error)
+        class(condensed_solver_type), intent(inout) :: self
+        integer(ik), intent(in) :: n
+        integer(ik), intent(in) :: col_ptr(:), row_index(:)
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%destroy()
+        if (.not. allocated(self%inner)) then
+            call fatal_error(error, self%get_name() // ': no solver for the reduced system')
+            return
+        end if
+        call check_csc_pattern(self%get_name(), n, col_ptr, row_index, error)
+        if (allocated(error)) return
+        self%n = n
+        self%col_ptr = col_ptr
+        self%row_index = row_index(1:col_ptr(n + 1))
+        allocate(self%reduced(n), source=0_ik)
+        self%n_reductions = 0
+        allocate(self%pivot(n), source=0.0_wp)
+        call find_candidate_entries(self)
+        self%analysed = .true.
+    end subroutine analyse
+
+    !> Find the trivial rows of these values, reduce (analysing the reduced pattern
+    !> again if the set changed) and factor the reduced matrix.
+    subroutine factor(self, values, error)
+        class(condensed_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        logical, allocatable :: trivial(:)
+        integer(ik) :: j, k, i, m
+
+        self%factored = .false.
+        if (.not. self%analysed) then
+            call fatal_error(error, self%get_name() // ': factor called before analyse')
+            return
+        end if
+        call check_array_size(self%get_name(), 'values', size(values, kind=ik), &
+            int(size(self%row_index), ik), error, at_least=.true.)
+        if (allocated(error)) return
+        ! A candidate row is trivial when its only nonzero value is a nonzero diagonal.
+        self%pivot = 0.0_wp
+        do j = self%first_candidate, self%n
+            if (self%diagonal(j) > 0) self%pivot(j) = values(self%diagonal(j))
+        end do
+        trivial = self%pivot /= 0.0_wp
+        do k = 1, size(self%candidate_entry, kind=ik)
+            if (values(self%candidate_entry(k)) /= 0.0_wp) &
+                trivial(self%candidate_row(k)) = .false.
+        end do
+        where (.not. trivial) self%pivot = 0.0_wp
+        if (self%n_reductions == 0 .or. any(trivial .neqv. (self%reduced == 0))) &
+            call reduce(trivial)
+        self%values = values(self%col_ptr(self%first_candidate) + 1:size(self%row_index))
+        if (self%n_reduced > 0) then
+            if (.not. self%inner_analysed) then
+                call self%inner%analyse(self%n_reduced, self%reduced_col_ptr, &
+                    self%reduced_row_index, error)
+                if (allocated(error)) return
+                self%inner_analysed = .true.
+            end if
+            call self%inner%factor(values(self%source), error)
+            if (allocated(error)) return
+        end if
+        self%factored = .true.
+    contains
+        !> The reduced pattern: the stored entries whose row and column both stay.
+        subroutine reduce(trivial)
+            logical, intent(in) :: trivial(:)
+            integer(ik) :: kept
+
+            m = 0
+            do j = 1, self%n
+                if (trivial(j)) then
+                    self%reduced(j) = 0
+                else
+                    m = m + 1
+                    self%reduced(j) = m
+                end if
+            end do
+            self%n_reduced = m
+            if (allocated(self%reduced_col_ptr)) deallocate(self%reduced_col_ptr)
+            if (allocated(self%reduced_row_index)) deallocate(self%reduced_row_index)
+            if (allocated(self%source)) deallocate(self%source)
+            allocate(self%reduced_col_ptr(m + 1), self%reduced_row_index(size(self%row_index)), &
+                self%source(size(self%row_index)))
+            self%reduced_col_ptr(1) = 0
+            kept = 0
+            do j = 1, self%n
+                if (trivial(j)) cycle
+                do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
+                    i = self%row_index(k) + 1
+                    if (trivial(i)) cycle
+                    kept = kept + 1
+                    self%reduced_row_index(kept) = self%reduced(i) - 1
+                    self%source(kept) = k
+                end do
+                self%reduced_col_ptr(self%reduced(j) + 1) = kept
+            end do
+            self%reduced_row_index = self%reduced_row_index(1:kept)
+            self%source = self%source(1:kept)
+            if (self%inner_analysed) call self%inner%destroy()
+            self%inner_analysed = .false.
+            self%n_reductions = self%n_reductions + 1
+        end subroutine reduce
+    end subroutine factor
+
+    !> Eliminated unknowns from their rows, their columns moved to the right-hand side,
+    !> then the reduced system.
+    subroutine solve(self, rhs, error)
+        class(condensed_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: part(:)
+        integer(ik) :: j, k, i, offset
+
+        if (.not. self%factored) then
+            call fatal_error(error, self%get_name() &
+                // ': solve called without a valid factorisation')
+            return
+        end if
+        call check_array_size(self%get_name(), 'rhs', size(rhs, kind=ik), self%n, error)
+        if (allocated(error)) return
+        offset = self%col_ptr(self%first_candidate)
+        do j = self%first_candidate, self%n
+            if (self%reduced(j) /= 0) cycle
+            rhs(j) = rhs(j) / self%pivot(j)
+            do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
+                i = self%row_index(k) + 1
+                if (self%reduced(i) /= 0) rhs(i) = rhs(i) - self%values(k - offset) * rhs(j)
+            end do
+        end do
+        if (self%n_reduced == 0) return
+        allocate(part(self%n_reduced))
+        do j = 1, self%n
+            if (self%reduced(j) /= 0) part(self%reduced(j)) = rhs(j)
+        end do
+        call self%inner%solve(part, error)
+        if (allocated(error)) return
+        do j = 1, self%n
+            if (self%reduced(j) /= 0) rhs(j) = part(self%reduced(j))
+        end do
+    end subroutine solve
+
+    !> The diagonal entries of the candidate columns and the off-diagonal entries of the
+    !> candidate rows (first_candidate clipped to 1..n + 1).
+    subroutine find_candidate_entries(self)
+        type(condensed_solver_type), intent(inout) :: self
+        integer(ik) :: j, k, i, count
+
+        self%first_candidate = min(max(self%first_candidate, 1_ik), self%n + 1)
+        allocate(self%diagonal(self%n), source=0_ik)
+        count = 0
+        do j = 1, self%n
+            do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
+                i = self%row_index(k) + 1
+                if (i < self%first_candidate) cycle
+                if (i == j) then
+                    self%diagonal(j) = k
+                else
+                    count = count + 1
+                end if
+            end do
+        end do
+        allocate(self%candidate_entry(count), self%candidate_row(count))
+        count = 0
+        do j = 1, self%n
+            do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
+                i = self%row_index(k) + 1
+                if (i < self%first_candidate .or. i == j) cycle
+                count = count + 1
+                self%candidate_entry(count) = k
+                self%candidate_row(count) = i
+            end do
+        end do
+    end subroutine find_candidate_entries
+
+    !> Free the reduced system's solver and every copy (safe to call twice).
+    subroutine destroy(self)
+        class(condensed_solver_type), intent(inout) :: self
+
+        if (allocated(self%inner)) call self%inner%destroy()
+        self%inner_analysed = .false.
+        self%analysed = .false.
+        self%factored = .false.
+        self%n = 0
+        self%n_reduced = 0
+        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
+        if (allocated(self%row_index)) deallocate(self%row_index)
+        if (allocated(self%reduced)) deallocate(self%reduced)
+        if (allocated(self%reduced_col_ptr)) deallocate(self%reduced_col_ptr)
+        if (allocated(self%reduced_row_index)) deallocate(self%reduced_row_index)
+        if (allocated(self%source)) deallocate(self%source)
+        if (allocated(self%pivot)) deallocate(self%pivot)
+        if (allocated(self%diagonal)) deallocate(self%diagonal)
+        if (allocated(self%candidate_entry)) deallocate(self%candidate_entry)
+        if (allocated(self%candidate_row)) deallocate(self%candidate_row)
+        if (allocated(self%values)) deallocate(self%values)
+    end subroutine destroy
+
+    pure function get_name(self) result(name)
+        class(condensed_solver_type), intent(in) :: self
+        character(len=:), allocatable :: name
+
+        if (allocated(self%inner)) then
+            name = 'condensed+' // self%inner%get_name()
+        else
+            name = 'condensed'
+        end if
+    end function get_name
+
+end module yarnfort_linalg_condensed
