@@ -164,31 +164,39 @@ contains
                     right(:, nc - 1)], 'y', [0.0_wp, 0.0_wp, 0.0_wp])
             else
                 call add_edge_threads(fabric, net, reshape([left(:, -1), right(:, -1)], &
-                    [nw, 2]), reshape([left(:, nc - 1), right(:, nc - 1)], [nw, 2]), &
-                    [0.0_wp, nc * c])
+                    [nw, 2]), reshape([left(:, nc - 1), right(:, nc - 1)], [nw, 2]))
             end if
         end if
     end subroutine generate_knit
 
     !> Free sides of a clamped knit: a cast-on thread through the feet of the first
     !> course (`feet(i, 1:2)`: left and right foot of loop i) and a bind-off thread
-    !> through the heads of the last course, each a yarn of the knit material straight
-    !> along its course line at height `line(1)`, `line(2)`, its ends held by the clamps
-    !> (sets `edge_left`, `edge_right`: their force is not the fabric's).
-    subroutine add_edge_threads(fabric, net, feet, heads, line)
+    !> through the heads of the last course (`heads`), each straight along its course
+    !> line, its ends held by the clamps (sets `edge_left`, `edge_right`, not `left`,
+    !> `right`: their force is not the fabric's). The threads are sewn to the loops:
+    !> each has its own node at every foot or head, bonded to it (a gap-holder of
+    !> length 0 that makes no passage), so neither yarn slides there, as before.
+    subroutine add_edge_threads(fabric, net, feet, heads)
         type(fabric_config_type), intent(in) :: fabric
         type(net_builder_type), intent(inout) :: net
         integer, intent(in) :: feet(:, :), heads(:, :)
-        real(wp), intent(in) :: line(2)
         integer :: ends(2, 2), nw, i, j, k, loop_node
         integer, allocatable :: thread(:)
-        real(wp) :: length
+        real(wp) :: length, first(3)
+        character(len=:), allocatable :: material
 
         nw = size(feet, 1)
         length = nw * fabric%spacing(1)
+        material = trim(fabric%edge_material)
+        if (len(material) == 0) material = trim(fabric%knit_material)
         do k = 1, 2
-            ends(1, k) = net%add_node([0.0_wp, line(k), net%position(3, feet(1, 1))])
-            ends(2, k) = net%add_node([length, line(k), net%position(3, feet(1, 1))])
+            if (k == 1) then
+                first = net%position(:, feet(1, 1))
+            else
+                first = net%position(:, heads(1, 1))
+            end if
+            ends(1, k) = net%add_node([0.0_wp, first(2), first(3)])
+            ends(2, k) = net%add_node([length, first(2), first(3)])
             thread = [ends(1, k)]
             do i = 1, nw
                 do j = 1, 2
@@ -197,15 +205,13 @@ contains
                     else
                         loop_node = heads(i, j)
                     end if
-                    ! The thread's own node there, held on the loop's by a gap-holder of
-                    ! length 0 (one contact, two yarns; no string on top of another).
                     thread = [thread, net%add_node(net%position(:, loop_node))]
                     call net%add_link(thread(size(thread)), loop_node, [0.0_wp, 0.0_wp, &
-                        0.0_wp], .true.)
+                        0.0_wp], .true., bonded=.true.)
                 end do
             end do
             thread = [thread, ends(2, k)]
-            call net%add_yarn(fabric%knit_material, thread, fabric%elements_per_segment)
+            call net%add_yarn(material, thread, fabric%elements_per_segment)
         end do
         call net%add_support('edge_left', ends(1, :), 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
         call net%add_support('edge_right', ends(2, :), 'xyz', &
@@ -330,6 +336,10 @@ contains
             if (fabric%sides == 'rollers') then
                 call net%add_support('sides', [foot_left(:, 0), foot_right(:, 0), &
                     head_left(:, nc - 1), head_right(:, nc - 1)], 'y', [0.0_wp, 0.0_wp, 0.0_wp])
+            else
+                call add_edge_threads(fabric, net, reshape([foot_left(:, 0), &
+                    foot_right(:, 0)], [nw, 2]), reshape([head_left(:, nc - 1), &
+                    head_right(:, nc - 1)], [nw, 2]))
             end if
         end if
     end subroutine generate_knit_3d

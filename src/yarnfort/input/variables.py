@@ -316,6 +316,11 @@ GROUPS = [
                 'between them, and each loop contact has a node on either yarn joined by a '
                 'gap-holder of this length (the distance between the yarn axes: the yarn '
                 'thickness). See *Three-dimensional knit* below.'),
+        Var('edge_material', 'character', '', length='name_length', checked_by='fabric',
+            default_doc='`knit_material`',
+            doc="Knit, clamped with `sides = 'free'`: yarn type of the cast-on and bind-off "
+                'threads that close the first and the last course (see *Clamped knit edges* '
+                'below).'),
     ]),
     Group('nodes', 'singleton',
           'Node coordinates (node ids 1..n in list order).', [
