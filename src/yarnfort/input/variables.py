@@ -240,12 +240,9 @@ GROUPS = [
             doc="Clamped: `'free'` side edges or `'rollers'`. Woven: rollers hold the weft ends "
                 'in y and z (a selvedge); free weft ends of pre-stressed weft yarns cannot carry '
                 'their tension, so woven strips need rollers. Knit: rollers hold the contacts of '
-                'the first and last course in y. With free sides the feet of the first course '
-                'and the heads of the last touch one yarn only: a yarn bent there at a free '
-                'node is in equilibrium only slack, so the edge loops go slack, Newton meets '
-                'singular matrices and the run stalls or stops with an error (clamped 8 x 2: '
-                'stops at strain 0.018; 4 x 4: 32 Newton iterations a step). With rollers '
-                'clamped knits take 3-4 a step, as periodic cells do.'),
+                'the first and last course in y. With free sides a cast-on and a bind-off '
+                'thread close the first and the last course (`edge_material`; see *Clamped '
+                'knit edges* below).'),
         Var('elements_per_segment', 'integer', 1, range='>= 1', checked_by='fabric',
             doc='Elements per yarn segment between generated nodes. A string under tension is '
                 'straight between contacts, so 1 is exact: `verification/fabrics` finds 2, 4 and '
