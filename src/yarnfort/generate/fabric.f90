@@ -255,10 +255,11 @@ contains
                     call fatal_error(error, label // "texgen_file is required for kind = 'texgen'")
                     return
                 end if
-                if (fabric%boundary /= 'periodic') then
-                    call fatal_error(error, label // "boundary = '" // trim(fabric%boundary) &
-                        // "': a TexGen model is imported as its periodic cell only (use " &
-                        // "boundary = 'periodic')")
+                if (fabric%boundary == 'clamped' .and. (any(fabric%cells < 1) .or. &
+                        real(fabric%cells(1), wp) * fabric%cells(2) > max_generated_cells)) then
+                    write(buffer, '(a, "cells = ", i0, ", ", i0, " must be at least 1 and ", &
+                        & "at most ", i0, " in all")') label, fabric%cells, max_generated_cells
+                    call fatal_error(error, trim(buffer))
                     return
                 end if
                 given = 0
