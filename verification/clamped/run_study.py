@@ -42,13 +42,29 @@ EXE = Path(os.environ.get("YARNFORT_EXE", TOP / "build" / "yarnfort"))
 OUT = TOP / "out" / "clamped_study"
 WORKERS = 2
 NOTE = "computed with illustrative yarn tables; no measured data"
-KNIT, BELT = "inputs/knit.nml", "inputs/belt.nml"
+KNIT, BELT, TEXGEN = "inputs/knit.nml", "inputs/belt.nml", "inputs/texgen_weave.nml"
 #: Sizes (n x n repeats) of each route; the woven ones need even counts for the cell.
 KNIT_SIZES = (2, 4, 8, 16, 20)
 WOVEN_SIZES = (4, 8, 16, 24, 40)
+#: Copies of inputs/texgen_weave.tg3's 2 x 2 cell (n x n copies: 2n x 2n crossings).
+TEXGEN_COPIES = (1, 2, 4, 8, 12)
 #: Sizes of the iteration table (item 1).
 TABLE_SIZES = (4, 8, 16)
+#: A holding thread pulled taut (the knit yarn's table, 1 N prestress) for the free
+#: sides of the knit samples (edge_material); the default thread is the knit yarn itself.
+THREAD = """
+&material
+    name = 'thread'
+    law = 'table'
+    table_file = 'inputs/data/knit_yarn.csv'
+    prestress = 1.0
+/
+"""
 LINES: list[str] = []
+#: Route, sizes, and the periodic cell it is compared with.
+ROUTES = (("knit", KNIT_SIZES, "knit_periodic_2"), ("plain", WOVEN_SIZES, "plain_periodic_4"),
+          ("twill", WOVEN_SIZES, "twill_periodic_4"),
+          ("texgen", TEXGEN_COPIES, "texgen_periodic_1"))
 
 
 def say(line: str = "") -> None:
@@ -56,11 +72,14 @@ def say(line: str = "") -> None:
     print(line, flush=True)
 
 
-def knit_values(n: int, boundary: str, sides: str | None = None) -> dict:
+def knit_values(n: int, boundary: str, sides: str | None = None,
+                thread: bool = False) -> dict:
     values = {**LOADING, "output.vtk_every": 0, "fabric.cells": [n, n],
               "fabric.boundary": boundary}
     if boundary == "clamped":
         values.update({"fabric.lateral_strain": None, "fabric.sides": sides})
+    if thread:
+        values["fabric.edge_material"] = "thread"
     return values
 
 
@@ -75,7 +94,10 @@ def woven_values(kind: str, n: int, boundary: str) -> dict:
 def run(case: tuple[str, str, dict]):
     name, base, values = case
     folder = OUT / name
-    proc, wall = run_scene(patched_scene(base, values, folder), EXE, timeout=900)
+    text = patched_scene(base, values, folder)
+    if values.get("fabric.edge_material") == "thread":
+        text += THREAD
+    proc, wall = run_scene(text, EXE, timeout=900)
     if proc.returncode != 0:
         return name, None, wall, proc.stderr.strip().splitlines()[-1:]
     return name, read_curve(folder), wall, []
@@ -119,13 +141,19 @@ def main() -> None:
     cases = [(f"knit_periodic_2", KNIT, knit_values(2, "periodic"))]
     for n in sorted(set(KNIT_SIZES) | set(TABLE_SIZES)):
         cases.append((f"knit_rollers_{n}", KNIT, knit_values(n, "clamped", "rollers")))
-        cases.append((f"knit_free_{n}", KNIT, knit_values(n, "clamped", "free")))
+        cases.append((f"knit_free_{n}", KNIT, knit_values(n, "clamped", "free", True)))
     for n in TABLE_SIZES:
         cases.append((f"knit_periodic_{n}", KNIT, knit_values(n, "periodic")))
+        cases.append((f"knit_default_{n}", KNIT, knit_values(n, "clamped", "free")))
     for kind in ("plain", "twill"):
         cases.append((f"{kind}_periodic_4", BELT, woven_values(kind, 4, "periodic")))
         for n in WOVEN_SIZES:
             cases.append((f"{kind}_rollers_{n}", BELT, woven_values(kind, n, "clamped")))
+    cases.append(("texgen_periodic_1", TEXGEN, {**LOADING, "output.vtk_every": 0}))
+    for n in TEXGEN_COPIES:
+        cases.append((f"texgen_rollers_{n}", TEXGEN, {
+            **LOADING, "output.vtk_every": 0, "fabric.boundary": "clamped",
+            "fabric.cells": [n, n], "fabric.sides": "rollers"}))
     results = run_all(cases)
     curves = {name: curve for name, (curve, _) in results.items()}
     walls = {name: wall for name, (_, wall) in results.items()}
@@ -139,14 +167,14 @@ def main() -> None:
     say("| sample | steps | Newton iterations | per step | initial state | wall s |")
     say("|---|---:|---:|---:|---:|---:|")
     for n in TABLE_SIZES:
-        for kind in ("periodic", "free", "rollers"):
+        for kind in ("periodic", "default", "free", "rollers"):
             name = f"knit_{kind}_{n}"
             if curves.get(name) is None:
                 say(f"| {kind} {n} x {n} | failed | | | | {walls[name]:.1f} |")
                 continue
             steps, total, first, per = iterations(curves[name])
-            label = {"periodic": "periodic", "free": "clamped, free sides",
-                     "rollers": "clamped, rollers"}[kind]
+            label = {"periodic": "periodic", "default": "clamped, free, knit-yarn threads",
+                     "free": "clamped, free, taut thread", "rollers": "clamped, rollers"}[kind]
             say(f"| {label} {n} x {n} | {steps} | {total} | {per:.1f} | {first} | "
                 f"{walls[name]:.2f} |")
     say()
@@ -154,15 +182,13 @@ def main() -> None:
     say("## 2-3. Curve per width against sample size")
     say()
     summary = {}
-    for route, sizes, cell_name in (("knit", KNIT_SIZES, "knit_periodic_2"),
-                                    ("plain", WOVEN_SIZES, "plain_periodic_4"),
-                                    ("twill", WOVEN_SIZES, "twill_periodic_4")):
+    for route, sizes, cell_name in ROUTES:
         cell = curves.get(cell_name)
         say(f"### {route}: periodic cell F(end) = "
             f"{cell['force_per_width'][-1]:.1f} N/m at strain {cell['strain'][-1]:.3g}")
         say()
         say("| sample (rollers) | F(end) N/m | e(n) = max \\|F - F_cell\\| / max F_cell | "
-            "free sides F(end) | wall s |")
+            "free sides (taut thread) F(end) | wall s |")
         say("|---|---:|---:|---:|---:|")
         ns, es = [], []
         for n in sizes:
@@ -201,10 +227,8 @@ def plot(curves, summary) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
-    for ax, (route, sizes, cell_name) in zip(axes, (
-            ("knit", KNIT_SIZES, "knit_periodic_2"), ("plain", WOVEN_SIZES, "plain_periodic_4"),
-            ("twill", WOVEN_SIZES, "twill_periodic_4"))):
+    fig, axes = plt.subplots(1, 4, figsize=(19, 4.6))
+    for ax, (route, sizes, cell_name) in zip(axes, ROUTES):
         cell = curves[cell_name]
         ax.plot(cell["strain"], cell["force_per_width"], "k-", lw=2.5, label="periodic cell")
         for n in sizes:
@@ -218,7 +242,8 @@ def plot(curves, summary) -> None:
                         label=f"{n} x {n}, free sides")
         ax.set_xlabel("strain")
         ax.set_ylabel("force per width (N/m)")
-        ax.set_title(f"{route}: clamped samples\n({NOTE})", fontsize=9)
+        unit = " copies of the 2 x 2 cell" if route == "texgen" else ""
+        ax.set_title(f"{route}: clamped samples (n x n{unit})\n({NOTE})", fontsize=9)
         ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(HERE / "clamped_curves.png", dpi=110)

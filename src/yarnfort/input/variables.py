@@ -207,12 +207,14 @@ GROUPS = [
             choices=['knit', 'plain', 'twill', 'texgen'],
             checked_by='fabric', default_doc='required',
             doc="`'knit'` (weft-knitted single jersey, optional inlay), `'plain'` (plain weave), "
-                "`'twill'` (2/2 twill) or `'texgen'` (a periodic cell from a TexGen model file, "
+                "`'twill'` (2/2 twill) or `'texgen'` (a periodic cell, or a clamped sample of "
+                "copies of it, from a TexGen model file, "
                 '`texgen_file`).'),
         Var('cells', 'integer', [4, 4], shape=2, range='>= 1', checked_by='fabric',
             doc='Repeats along x and y: wales x courses (knit); weft yarns (crossings along x) x '
                 'warp yarns (woven). A periodic plain weave needs even counts, a periodic twill '
-                'multiples of 4.'),
+                'multiples of 4. TexGen: copies of the cell in a clamped sample (not used for '
+                'a periodic cell).'),
         Var('spacing', 'real', [-1.0, -1.0], shape=2, unit='m', range='> 0', checked_by='fabric',
             default_doc='required',
             doc='Repeat spacing along x and y: wale and course spacing (knit); weft and warp '
@@ -222,7 +224,8 @@ GROUPS = [
             doc="`'periodic'`: a unit cell whose edge nodes are tied to the opposite edge (paper "
                 'eq. 53), stretched by the macroscopic strain below; one node (`anchor`) is held '
                 "against rigid translation. `'clamped'`: a finite sample, yarn ends at x = 0 "
-                'held (`left`), those at the right edge pulled (`right`).'),
+                'held (`left`), those at the right edge pulled (`right`); for `texgen`, '
+                '`cells` copies of the cell.'),
         Var('strain', 'real', 1.0, unit='1', range='[-0.9, 100]', checked_by='fabric',
             doc='Engineering strain along x at p_disp = 1 (`1.0` stretches to twice the length). '
                 "Periodic: of the cell's x period; clamped: of the sample's length."),
