@@ -108,3 +108,39 @@ def test_larger_sample_with_rollers_lies_nearer_the_periodic_cell(run_yarnfort, 
     print(f"max |F - F_cell| / max F_cell: 2 x 2 {errors[0] / cell['force_per_width'].max():.3f},"
           f" 4 x 4 {errors[1] / cell['force_per_width'].max():.3f}")
     assert errors[1] < errors[0]
+
+
+def test_texgen_sample_of_copies_balances_and_approaches_its_cell(run_yarnfort, tmp_path):
+    """inputs/texgen_weave.tg3 (2 x 2 crossings) as a clamped sample of n x n copies with
+    rollers: 2 n yarns along x and 2 n along y, one yarn each through all copies; the
+    reactions balance; 4 x 4 copies lie nearer the periodic cell than 1 copy."""
+    base = "inputs/texgen_weave.nml"
+    values = {**LOADING, "solver.max_step": 0.1, "output.vtk_every": 0}
+
+    def texgen(extra, name):
+        folder = tmp_path / name
+        result = run_yarnfort(patched_scene(base, {**values, **extra}, folder), cwd=TOP)
+        assert result.returncode == 0, result.stderr
+        return read_curve(folder), folder
+
+    cell, _ = texgen({}, "cell")
+    errors = []
+    for n in (1, 4):
+        curve, folder = texgen({"fabric.boundary": "clamped", "fabric.cells": [n, n],
+                                "fabric.sides": "rollers", "output.vtk_every": 1},
+                               f"copies{n}")
+        yarn = read_states(folder)[0].cell_data["yarn"]
+        assert yarn.max() == 4 * n
+        scale = np.max(np.abs(curve["right_rx"]))
+        for axis in ("rx", "ry", "rz"):
+            total = sum(curve[f"{s}_{axis}"] for s in ("left", "right", "sides"))
+            assert np.max(np.abs(total)) <= BALANCE * scale, axis
+        width = n * 2.0e-3  # n copies of the 2 mm cell
+        np.testing.assert_allclose(curve["force_per_width"] * width, curve["right_rx"],
+                                   rtol=1e-12, atol=0.0)
+        reference = np.interp(curve["strain"], cell["strain"], cell["force_per_width"])
+        errors.append(np.max(np.abs(curve["force_per_width"] - reference))
+                      / cell["force_per_width"].max())
+    print(f"TexGen plain weave, max |F - F_cell| / max F_cell: 1 copy {errors[0]:.4f}, "
+          f"4 x 4 copies {errors[1]:.4f}")
+    assert errors[1] < errors[0]
