@@ -19,7 +19,9 @@
 !> Boundaries: a periodic cell has its x edges at the middle of the sinkers (symmetry
 !> planes of the loops, where no yarn slides through) and its y edges at the feet of
 !> course 0, which are periodic images of the top course's contacts. A clamped sample
-!> holds the yarn ends at x = 0 and pulls those at the right edge.
+!> holds the yarn ends at x = 0 and pulls those at the right edge. Its first course's
+!> feet and last course's heads touch one yarn only; rollers hold them in y, or (free
+!> sides) a cast-on and a bind-off thread sewn to them close the edges (add_edge_threads).
 !>
 !> Three-dimensional knit (knit_depth = d > 0): the same loops, interlaced in depth. Each
 !> course's feet and sinkers lie at z = +d/2 (in front), its heads at z = -d/2 (behind),
