@@ -16,7 +16,9 @@ every course) made a clamped sample:
     and behind the right ones), and so is the load: the deformed state is too, and the
     two clamps pull equally;
 (d) a larger sample with rollers lies nearer the periodic cell than a smaller one (the
-    edge layer at the clamps is a fixed number of loops wide).
+    edge layer at the clamps is a fixed number of loops wide);
+(e) a clamped sample of copies of a TexGen plain-weave cell: one yarn through all
+    copies, reactions balanced, the cell's curve.
 """
 from __future__ import annotations
 
@@ -110,10 +112,12 @@ def test_larger_sample_with_rollers_lies_nearer_the_periodic_cell(run_yarnfort, 
     assert errors[1] < errors[0]
 
 
-def test_texgen_sample_of_copies_balances_and_approaches_its_cell(run_yarnfort, tmp_path):
+def test_texgen_sample_of_copies_balances_and_equals_its_cell(run_yarnfort, tmp_path):
     """inputs/texgen_weave.tg3 (2 x 2 crossings) as a clamped sample of n x n copies with
     rollers: 2 n yarns along x and 2 n along y, one yarn each through all copies; the
-    reactions balance; 4 x 4 copies lie nearer the periodic cell than 1 copy."""
+    reactions balance; and, as the built-in plain weave (verification/fabrics, section
+    5), the sample is a union of cells (its yarn ends, cut in line, lie on the weave's
+    symmetry elements), so its curve per width is the cell's at every size."""
     base = "inputs/texgen_weave.nml"
     values = {**LOADING, "solver.max_step": 0.1, "output.vtk_every": 0}
 
@@ -124,8 +128,7 @@ def test_texgen_sample_of_copies_balances_and_approaches_its_cell(run_yarnfort, 
         return read_curve(folder), folder
 
     cell, _ = texgen({}, "cell")
-    errors = []
-    for n in (1, 4):
+    for n in (1, 3):
         curve, folder = texgen({"fabric.boundary": "clamped", "fabric.cells": [n, n],
                                 "fabric.sides": "rollers", "output.vtk_every": 1},
                                f"copies{n}")
@@ -138,9 +141,6 @@ def test_texgen_sample_of_copies_balances_and_approaches_its_cell(run_yarnfort, 
         width = n * 2.0e-3  # n copies of the 2 mm cell
         np.testing.assert_allclose(curve["force_per_width"] * width, curve["right_rx"],
                                    rtol=1e-12, atol=0.0)
-        reference = np.interp(curve["strain"], cell["strain"], cell["force_per_width"])
-        errors.append(np.max(np.abs(curve["force_per_width"] - reference))
-                      / cell["force_per_width"].max())
-    print(f"TexGen plain weave, max |F - F_cell| / max F_cell: 1 copy {errors[0]:.4f}, "
-          f"4 x 4 copies {errors[1]:.4f}")
-    assert errors[1] < errors[0]
+        np.testing.assert_array_equal(curve["strain"], cell["strain"])
+        difference = np.abs(curve["force_per_width"] - cell["force_per_width"])
+        assert np.max(difference) <= BALANCE * np.max(cell["force_per_width"])

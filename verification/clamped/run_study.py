@@ -66,6 +66,7 @@ THREAD = """
 /
 """
 LINES: list[str] = []
+REUSED: list[str] = []
 #: Route, sizes, and the periodic cell it is compared with.
 ROUTES = (("knit", KNIT_SIZES, "knit_periodic_2"), ("plain", WOVEN_SIZES, "plain_periodic_4"),
           ("twill", WOVEN_SIZES, "twill_periodic_4"),
@@ -106,6 +107,7 @@ def run(case: tuple[str, str, dict]):
     if REUSE and scene.exists() and scene.read_text() == text and (REUSE == "any" or (
             folder / "curve.csv").stat().st_mtime > EXE.stat().st_mtime):
         curve = read_curve(folder)
+        REUSED.append(name)
         return name, curve, float(np.sum(curve["wall_time"])), []
     proc, wall = run_scene(text, EXE, timeout=900)
     if proc.returncode != 0:
@@ -228,7 +230,9 @@ def main() -> None:
     cpu1 = os.times()
     cpu = (cpu1.children_user + cpu1.children_system) - (cpu0.children_user
                                                           + cpu0.children_system)
-    say(f"total wall {time.perf_counter() - start:.0f} s, CPU of the runs {cpu:.0f} s")
+    say(f"total wall {time.perf_counter() - start:.0f} s, CPU of the runs {cpu:.0f} s "
+        f"({len(REUSED)} of {len(cases)} runs reused from out/clamped_study; wall s of a "
+        "reused run is the sum of its steps')")
     (HERE / "results.txt").write_text("\n".join(LINES) + "\n")
     plot(curves, summary)
 

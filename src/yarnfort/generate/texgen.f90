@@ -772,6 +772,10 @@ contains
                 gaps = [s(2:n) - s(1:n - 1), s(1) + total - s(n)]
                 k = maxloc(gaps, dim=1)
                 cut = modulo(s(k) + 0.5_wp * gaps(k), total)
+                ! A clamped sample: of equally long stretches the one whose middle lies
+                ! first along the yarn's period (modulo the cell), so that the yarns of
+                ! one direction end in line.
+                if (fabric%boundary == 'clamped') call first_of_ties(yarns(y), s, gaps, cut)
             end if
             ! From the cut onwards; points before it lie one period on.
             allocate(list(0), chain(3, n))
@@ -855,6 +859,27 @@ contains
         end do
         call net%add_support('anchor', [anchor], 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
     contains
+        subroutine first_of_ties(yarn, s, gaps, cut)
+            type(texgen_yarn_type), intent(in) :: yarn
+            real(wp), intent(in) :: s(:), gaps(:)
+            real(wp), intent(inout) :: cut
+            real(wp) :: candidate, key, best, direction(2)
+            integer :: j
+            direction = abs(yarn%period(1:2)) / norm2(yarn%period(1:2))
+            best = huge(1.0_wp)
+            do j = 1, size(gaps)
+                if (gaps(j) < (1.0_wp - lattice_tolerance) * maxval(gaps)) cycle
+                candidate = modulo(s(j) + 0.5_wp * gaps(j), total)
+                key = modulo(dot_product(point_at(yarn, candidate), [direction, 0.0_wp] &
+                    * [1.0_wp / cell(1), 1.0_wp / cell(2), 0.0_wp]) + lattice_tolerance, &
+                    1.0_wp)
+                if (key < best) then
+                    best = key
+                    cut = candidate
+                end if
+            end do
+        end subroutine first_of_ties
+
         logical function positive(v)
             real(wp), intent(in) :: v(3)
             real(wp) :: small
