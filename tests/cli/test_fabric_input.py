@@ -70,6 +70,8 @@ CASES = {
                                  "&fabric: knit_material is required for kind = 'knit'"),
     "knit_depth_on_weave": ("strain = 0.1", "strain = 0.1\n knit_depth = 0.1e-3",
                             "&fabric: knit_depth does not apply to kind = 'plain'"),
+    "edge_material_on_weave": ("strain = 0.1", "strain = 0.1\n edge_material = 'warp'",
+                               "&fabric: edge_material does not apply to kind = 'plain'"),
 }
 
 #: A valid three-dimensional knit cell (knit_depth > 0), and its mistakes.
@@ -101,6 +103,18 @@ KNIT_3D_CASES = {
     "gap_factor_negative": ("knit_depth = 0.2e-3", "knit_depth = 0.2e-3\n"
                             " gap_factor_p_disp = 0, 1\n gap_factor = 1.0, -1.0",
                             "gap_factor values must be positive and finite"),
+    # The cast-on and bind-off threads close a clamped knit's free sides only.
+    "edge_material_on_cell": ("strain = 0.1", "strain = 0.1\n edge_material = 'knit'",
+                              "&fabric: edge_material applies to a clamped knit with "
+                              "sides = 'free'"),
+    "edge_material_with_rollers": ("strain = 0.1", "strain = 0.1\n edge_material = 'knit'"
+                                   "\n boundary = 'clamped'\n sides = 'rollers'",
+                                   "edge_material applies to a clamped knit with sides = "
+                                   "'free'"),
+    "edge_material_unknown": ("strain = 0.1", "strain = 0.1\n edge_material = 'silk'"
+                              "\n boundary = 'clamped'",
+                              "&fabric: edge_material = 'silk' is not the name of any "
+                              "&material"),
 }
 
 
@@ -148,3 +162,14 @@ def test_bad_knit_depth(run_yarnfort, tmp_path, name):
 def test_knit_3d_input_is_valid(run_yarnfort, tmp_path):
     run = run_yarnfort(KNIT_3D, cwd=tmp_path)
     assert run.returncode == 0, run.stderr
+
+
+def test_clamped_knit_with_edge_material_is_valid(run_yarnfort, tmp_path):
+    text = KNIT_3D.replace("strain = 0.1", "strain = 0.1\n boundary = 'clamped'\n"
+                           " edge_material = 'thread'").replace(
+        "&fabric", "&material name = 'thread', law = 'linear', stiffness = 5.0, "
+        "prestress = 0.5 /\n&fabric", 1)
+    run = run_yarnfort(text, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    header = (tmp_path / "out" / "curve.csv").read_text().splitlines()[0].split(",")
+    assert "edge_right_rx" in header and "edge_left_rx" in header

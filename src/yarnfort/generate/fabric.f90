@@ -137,6 +137,14 @@ contains
                 if (allocated(error)) return
                 call require_material(error, 'inlay_material', fabric%inlay_material, .false.)
                 if (allocated(error)) return
+                call require_material(error, 'edge_material', fabric%edge_material, .false.)
+                if (allocated(error)) return
+                if (len_trim(fabric%edge_material) > 0 .and. .not. (fabric%boundary == &
+                        'clamped' .and. fabric%sides == 'free')) then
+                    call fatal_error(error, label // "edge_material applies to a clamped " &
+                        // "knit with sides = 'free' (the threads that close its edge courses)")
+                    return
+                end if
                 call require_range(error, 'head_width', fabric%head_width, 0.05_wp, 0.95_wp)
                 if (allocated(error)) return
                 if (.not. (fabric%knit_depth >= 0.0_wp .and. &
@@ -200,6 +208,8 @@ contains
                 if (allocated(error)) return
                 call forbid_name(error, 'inlay_material', fabric%inlay_material)
                 if (allocated(error)) return
+                call forbid_name(error, 'edge_material', fabric%edge_material)
+                if (allocated(error)) return
                 call forbid_depth(error)
                 if (allocated(error)) return
                 call check_gap(error)
@@ -245,10 +255,11 @@ contains
                     call fatal_error(error, label // "texgen_file is required for kind = 'texgen'")
                     return
                 end if
-                if (fabric%boundary /= 'periodic') then
-                    call fatal_error(error, label // "boundary = '" // trim(fabric%boundary) &
-                        // "': a TexGen model is imported as its periodic cell only (use " &
-                        // "boundary = 'periodic')")
+                if (fabric%boundary == 'clamped' .and. (any(fabric%cells < 1) .or. &
+                        real(fabric%cells(1), wp) * fabric%cells(2) > max_generated_cells)) then
+                    write(buffer, '(a, "cells = ", i0, ", ", i0, " must be at least 1 and ", &
+                        & "at most ", i0, " in all")') label, fabric%cells, max_generated_cells
+                    call fatal_error(error, trim(buffer))
                     return
                 end if
                 given = 0
@@ -284,6 +295,8 @@ contains
                 call forbid_name(error, 'knit_material', fabric%knit_material)
                 if (allocated(error)) return
                 call forbid_name(error, 'inlay_material', fabric%inlay_material)
+                if (allocated(error)) return
+                call forbid_name(error, 'edge_material', fabric%edge_material)
                 if (allocated(error)) return
                 call forbid_name(error, 'warp_material', fabric%warp_material)
                 if (allocated(error)) return

@@ -19,7 +19,9 @@
 !> Boundaries: a periodic cell has its x edges at the middle of the sinkers (symmetry
 !> planes of the loops, where no yarn slides through) and its y edges at the feet of
 !> course 0, which are periodic images of the top course's contacts. A clamped sample
-!> holds the yarn ends at x = 0 and pulls those at the right edge.
+!> holds the yarn ends at x = 0 and pulls those at the right edge. Its first course's
+!> feet and last course's heads touch one yarn only; rollers hold them in y, or (free
+!> sides) a cast-on and a bind-off thread sewn to them close the edges (add_edge_threads).
 !>
 !> Three-dimensional knit (knit_depth = d > 0): the same loops, interlaced in depth. Each
 !> course's feet and sinkers lie at z = +d/2 (in front), its heads at z = -d/2 (behind),
@@ -162,9 +164,61 @@ contains
             if (fabric%sides == 'rollers') then
                 call net%add_support('sides', [left(:, -1), right(:, -1), left(:, nc - 1), &
                     right(:, nc - 1)], 'y', [0.0_wp, 0.0_wp, 0.0_wp])
+            else
+                call add_edge_threads(fabric, net, reshape([left(:, -1), right(:, -1)], &
+                    [nw, 2]), reshape([left(:, nc - 1), right(:, nc - 1)], [nw, 2]))
             end if
         end if
     end subroutine generate_knit
+
+    !> Free sides of a clamped knit: a cast-on thread through the feet of the first
+    !> course (`feet(i, 1:2)`: left and right foot of loop i) and a bind-off thread
+    !> through the heads of the last course (`heads`), each straight along its course
+    !> line, its ends held by the clamps (sets `edge_left`, `edge_right`, not `left`,
+    !> `right`: their force is not the fabric's). The threads are sewn to the loops:
+    !> each has its own node at every foot or head, bonded to it (a gap-holder of
+    !> length 0 that makes no passage), so neither yarn slides there, as before.
+    subroutine add_edge_threads(fabric, net, feet, heads)
+        type(fabric_config_type), intent(in) :: fabric
+        type(net_builder_type), intent(inout) :: net
+        integer, intent(in) :: feet(:, :), heads(:, :)
+        integer :: ends(2, 2), nw, i, j, k, loop_node
+        integer, allocatable :: thread(:)
+        real(wp) :: length, first(3)
+        character(len=:), allocatable :: material
+
+        nw = size(feet, 1)
+        length = nw * fabric%spacing(1)
+        material = trim(fabric%edge_material)
+        if (len(material) == 0) material = trim(fabric%knit_material)
+        do k = 1, 2
+            if (k == 1) then
+                first = net%position(:, feet(1, 1))
+            else
+                first = net%position(:, heads(1, 1))
+            end if
+            ends(1, k) = net%add_node([0.0_wp, first(2), first(3)])
+            ends(2, k) = net%add_node([length, first(2), first(3)])
+            thread = [ends(1, k)]
+            do i = 1, nw
+                do j = 1, 2
+                    if (k == 1) then
+                        loop_node = feet(i, j)
+                    else
+                        loop_node = heads(i, j)
+                    end if
+                    thread = [thread, net%add_node(net%position(:, loop_node))]
+                    call net%add_link(thread(size(thread)), loop_node, [0.0_wp, 0.0_wp, &
+                        0.0_wp], .true., bonded=.true.)
+                end do
+            end do
+            thread = [thread, ends(2, k)]
+            call net%add_yarn(material, thread, fabric%elements_per_segment)
+        end do
+        call net%add_support('edge_left', ends(1, :), 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
+        call net%add_support('edge_right', ends(2, :), 'xyz', &
+            [fabric%strain * length, 0.0_wp, 0.0_wp])
+    end subroutine add_edge_threads
 
     !> The three-dimensional knit (knit_depth > 0; see the module text): nodes of its own
     !> for the head and the feet at every loop contact, joined by gap-holders.
@@ -284,6 +338,10 @@ contains
             if (fabric%sides == 'rollers') then
                 call net%add_support('sides', [foot_left(:, 0), foot_right(:, 0), &
                     head_left(:, nc - 1), head_right(:, nc - 1)], 'y', [0.0_wp, 0.0_wp, 0.0_wp])
+            else
+                call add_edge_threads(fabric, net, reshape([foot_left(:, 0), &
+                    foot_right(:, 0)], [nw, 2]), reshape([head_left(:, nc - 1), &
+                    head_right(:, nc - 1)], [nw, 2]))
             end if
         end if
     end subroutine generate_knit_3d

@@ -75,13 +75,15 @@ contains
 
     !> Node `follower` follows `leader`: a periodic image (strain: macroscopic strain at
     !> p_disp = 1) or a gap-holder partner (gap = .true.); a gap-holder between a node
-    !> and a periodic image of its partner also takes the lattice vector `period`.
-    subroutine add_link(self, follower, leader, strain, gap, period)
+    !> and a periodic image of its partner also takes the lattice vector `period`;
+    !> `bonded`: the two nodes are sewn together, not one contact.
+    subroutine add_link(self, follower, leader, strain, gap, period, bonded)
         class(net_builder_type), intent(inout) :: self
         integer, intent(in) :: follower, leader
         real(wp), intent(in) :: strain(3)
         logical, intent(in) :: gap
         real(wp), intent(in), optional :: period(3)
+        logical, intent(in), optional :: bonded
         type(link_config_type), allocatable :: grown(:)
 
         if (.not. allocated(self%links)) allocate(self%links(64))
@@ -97,6 +99,8 @@ contains
         self%links(self%n_links)%gap = gap
         self%links(self%n_links)%period = 0.0_wp
         if (present(period)) self%links(self%n_links)%period = period
+        self%links(self%n_links)%bonded = .false.
+        if (present(bonded)) self%links(self%n_links)%bonded = bonded
     end subroutine add_link
 
     subroutine hand_over(self, config)

@@ -1,5 +1,6 @@
 ! SPDX-License-Identifier: MIT
-!> A periodic cell from a TexGen model file (.tg3, XML; read without TexGen).
+!> A periodic cell from a TexGen model file (.tg3, XML; read without TexGen), or a
+!> clamped sample of copies of it.
 !>
 !> Read: the (one) textile's yarns with their master nodes (Position, Up), interpolation
 !> (linear, or a cubic through the nodes for TexGen's Bezier and cubic kinds), repeat
@@ -27,7 +28,7 @@
 module yarnfort_generate_texgen
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: fabric_config_type
+    use yarnfort_input_config, only: fabric_config_type, link_config_type
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_xml_subset, only: xml_document_type, read_xml_file
     implicit none
@@ -66,8 +67,9 @@ module yarnfort_generate_texgen
 contains
 
     !> Fill `net` from fabric%texgen_file (relative to `folder` unless absolute); also the
-    !> cell's y period (the width across which the x force is carried), pulled = 0 (a
-    !> periodic cell), and the counts of yarns and contacts found.
+    !> width across which the x force is carried (the cell's y period, or the sample's
+    !> height), the support pulled along x (0 for a periodic cell), and the counts of
+    !> yarns and contacts found (in the cell).
     subroutine generate_texgen(fabric, path, net, width, pulled, n_yarns, n_contacts, error)
         type(fabric_config_type), intent(in) :: fabric
         character(len=*), intent(in) :: path
@@ -78,6 +80,7 @@ contains
         type(xml_document_type) :: document
         type(texgen_yarn_type), allocatable :: yarns(:)
         type(contact_type), allocatable :: contacts(:)
+        type(net_builder_type) :: unit_cell
         real(wp) :: cell(2), scale
 
         width = 0.0_wp
@@ -91,6 +94,15 @@ contains
         n_yarns = size(yarns)
         call find_contacts(yarns, cell, fabric%texgen_contact_tolerance, contacts)
         n_contacts = size(contacts)
+        if (fabric%boundary == 'clamped') then
+            call build_cell(fabric, yarns, cell, scale, contacts, unit_cell, error)
+            if (allocated(error)) goto 100
+            call tile_sample(fabric, unit_cell, cell * scale, net, error)
+            if (allocated(error)) goto 100
+            width = fabric%cells(2) * cell(2) * scale
+            pulled = 2
+            return
+        end if
         call build_cell(fabric, yarns, cell, scale, contacts, net, error)
         if (allocated(error)) goto 100
         width = cell(2) * scale
@@ -760,6 +772,10 @@ contains
                 gaps = [s(2:n) - s(1:n - 1), s(1) + total - s(n)]
                 k = maxloc(gaps, dim=1)
                 cut = modulo(s(k) + 0.5_wp * gaps(k), total)
+                ! A clamped sample: of equally long stretches the one whose middle lies
+                ! first along the yarn's period (modulo the cell), so that the yarns of
+                ! one direction end in line.
+                if (fabric%boundary == 'clamped') call first_of_ties(yarns(y), s, gaps, cut)
             end if
             ! From the cut onwards; points before it lie one period on.
             allocate(list(0), chain(3, n))
@@ -843,6 +859,27 @@ contains
         end do
         call net%add_support('anchor', [anchor], 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
     contains
+        subroutine first_of_ties(yarn, s, gaps, cut)
+            type(texgen_yarn_type), intent(in) :: yarn
+            real(wp), intent(in) :: s(:), gaps(:)
+            real(wp), intent(inout) :: cut
+            real(wp) :: candidate, key, best, direction(2)
+            integer :: j
+            direction = abs(yarn%period(1:2)) / norm2(yarn%period(1:2))
+            best = huge(1.0_wp)
+            do j = 1, size(gaps)
+                if (gaps(j) < (1.0_wp - lattice_tolerance) * maxval(gaps)) cycle
+                candidate = modulo(s(j) + 0.5_wp * gaps(j), total)
+                key = modulo(dot_product(point_at(yarn, candidate), [direction, 0.0_wp] &
+                    * [1.0_wp / cell(1), 1.0_wp / cell(2), 0.0_wp]) + lattice_tolerance, &
+                    1.0_wp)
+                if (key < best) then
+                    best = key
+                    cut = candidate
+                end if
+            end do
+        end subroutine first_of_ties
+
         logical function positive(v)
             real(wp), intent(in) :: v(3)
             real(wp) :: small
@@ -861,6 +898,179 @@ contains
             name = trim(fabric%texgen_materials(min(y, last_given)))
         end function material_of
     end subroutine build_cell
+
+    !> A clamped sample of fabric%cells(1) x fabric%cells(2) copies of the periodic cell
+    !> `unit` (lattice `period`, m). Each yarn runs on through the copies along its own
+    !> period as one yarn (it may slide across the cells' edges); its ends are the first
+    !> and the last copy's. A gap-holder whose partner lies in a copy outside the sample
+    !> is dropped with its two contact nodes (the yarns run straight past them). Yarns
+    !> along x are held at their left end (`left`) and pulled at the right (`right`,
+    !> strain * sample length); the others' ends are free or held in y and z ('rollers',
+    !> set `sides`), as for the woven generator.
+    subroutine tile_sample(fabric, unit, period, net, error)
+        type(fabric_config_type), intent(in) :: fabric
+        type(net_builder_type), intent(in) :: unit
+        real(wp), intent(in) :: period(2)
+        type(net_builder_type), intent(inout) :: net
+        type(error_type), allocatable, intent(out) :: error
+        integer :: nx, ny, a, b, k, y, n, step(2), shift(2), node, first, last
+        integer, allocatable :: id(:, :, :), chain(:), left(:), right(:), sides(:)
+        integer, allocatable :: moved(:, :)
+        logical, allocatable :: orphan(:, :, :)
+        real(wp) :: offset(3)
+        character(len=200) :: buffer
+
+        nx = fabric%cells(1)
+        ny = fabric%cells(2)
+        n = unit%n_nodes
+        allocate(id(n, 0:nx - 1, 0:ny - 1), source=0)
+        allocate(orphan(n, 0:nx - 1, 0:ny - 1), source=.false.)
+        allocate(left(0), right(0), sides(0))
+        call get_window_shifts(error)
+        if (allocated(error)) return
+        ! Gap-holders: the leader of the follower in copy (a, b) is in copy (a, b) + its
+        ! lattice part; outside the sample both contact nodes go.
+        do k = 1, unit%n_links
+            associate(link => unit%links(k))
+                if (.not. link%gap) cycle
+                shift = lattice_part(link)
+                do b = 0, ny - 1
+                    do a = 0, nx - 1
+                        if (inside(a + shift(1), b + shift(2))) cycle
+                        orphan(link%follower, a, b) = .true.
+                    end do
+                end do
+                do b = 0, ny - 1
+                    do a = 0, nx - 1
+                        if (inside(a - shift(1), b - shift(2))) cycle
+                        orphan(link%leader, a, b) = .true.
+                    end do
+                end do
+            end associate
+        end do
+        do y = 1, size(unit%yarns)
+            associate(list => unit%yarns(y)%nodes)
+                first = list(1)
+                last = list(size(list))
+                offset = unit%position(:, last) - unit%position(:, first)
+                step = nint(offset(1:2) / period)
+                if (any(abs(offset(1:2) - step * period) > lattice_tolerance &
+                        * maxval(period)) .or. all(step == 0)) then
+                    write(buffer, '("yarn ", i0, " does not end one lattice vector from its ", &
+                        & "start: cannot tile it into a sample")') y - 1
+                    call fatal_error(error, trim(buffer))
+                    return
+                end if
+                ! One yarn per chain of copies along `step`, from each copy whose
+                ! predecessor lies outside the sample.
+                do b = 0, ny - 1
+                    do a = 0, nx - 1
+                        if (inside(a - step(1), b - step(2))) cycle
+                        chain = [node_of(first, a, b)]
+                        shift = [a, b]
+                        do while (inside(shift(1), shift(2)))
+                            do k = 2, size(list)
+                                if (orphan(list(k), shift(1), shift(2))) cycle
+                                chain = [chain, node_of(list(k), shift(1), shift(2))]
+                            end do
+                            shift = shift + step
+                        end do
+                        call net%add_yarn(unit%yarns(y)%material, chain, &
+                            unit%yarns(y)%elements_per_segment)
+                        if (step(1) /= 0) then
+                            if (step(1) > 0) then
+                                left = [left, chain(1)]
+                                right = [right, chain(size(chain))]
+                            else
+                                left = [left, chain(size(chain))]
+                                right = [right, chain(1)]
+                            end if
+                        else
+                            sides = [sides, chain(1), chain(size(chain))]
+                        end if
+                    end do
+                end do
+            end associate
+        end do
+        do k = 1, unit%n_links
+            associate(link => unit%links(k))
+                if (.not. link%gap) cycle
+                shift = lattice_part(link)
+                do b = 0, ny - 1
+                    do a = 0, nx - 1
+                        if (orphan(link%follower, a, b)) cycle
+                        call net%add_link(node_of(link%follower, a, b), node_of(link%leader, &
+                            a + shift(1), b + shift(2)), [0.0_wp, 0.0_wp, 0.0_wp], .true.)
+                    end do
+                end do
+            end associate
+        end do
+        call net%add_support('left', left, 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
+        call net%add_support('right', right, 'xyz', &
+            [fabric%strain * nx * period(1), 0.0_wp, 0.0_wp])
+        if (fabric%sides == 'rollers' .and. size(sides) > 0) &
+            call net%add_support('sides', sides, 'yz', [0.0_wp, 0.0_wp, 0.0_wp])
+    contains
+        logical function inside(i, j)
+            integer, intent(in) :: i, j
+            inside = i >= 0 .and. i < nx .and. j >= 0 .and. j < ny
+        end function inside
+
+        !> Node k of copy (i, j), made on first use.
+        integer function node_of(k, i, j) result(found)
+            integer, intent(in) :: k, i, j
+            if (id(k, i, j) == 0) id(k, i, j) = net%add_node(unit%position(:, k) &
+                + [(i - moved(1, k)) * period(1), (j - moved(2, k)) * period(2), 0.0_wp])
+            found = id(k, i, j)
+        end function node_of
+
+        !> Copies between a gap-holder's follower and its leader, once both yarns are
+        !> moved into the window.
+        function lattice_part(link) result(copies)
+            type(link_config_type), intent(in) :: link
+            integer :: copies(2)
+            copies = nint(link%period(1:2) / period) - moved(:, link%follower) &
+                + moved(:, link%leader)
+        end function lattice_part
+
+        !> The sample's window starts where the yarns along x start (x) and where those
+        !> along y start (y); every yarn of the cell is moved by whole periods so that
+        !> its middle lies in the window's first cell (moved(:, node) for its nodes), so
+        !> the sample's edges are the cell's yarn ends.
+        subroutine get_window_shifts(error)
+            type(error_type), allocatable, intent(out) :: error
+            real(wp) :: origin(2), middle(3), span(3)
+            integer :: yy, d
+            origin = huge(1.0_wp)
+            do yy = 1, size(unit%yarns)
+                associate(list => unit%yarns(yy)%nodes)
+                    span = unit%position(:, list(size(list))) - unit%position(:, list(1))
+                    do d = 1, 2
+                        if (abs(span(d)) > 0.5_wp * period(d)) origin(d) = min(origin(d), &
+                            min(unit%position(d, list(1)), unit%position(d, list(size(list)))))
+                    end do
+                end associate
+            end do
+            do d = 1, 2
+                if (origin(d) == huge(1.0_wp)) then
+                    call fatal_error(error, 'no yarn runs along ' // merge('x', 'y', d == 1) &
+                        // ' through the cell: cannot clamp a sample of it')
+                    return
+                end if
+            end do
+            allocate(moved(2, n), source=0)
+            do yy = 1, size(unit%yarns)
+                associate(list => unit%yarns(yy)%nodes)
+                    middle = 0.5_wp * (unit%position(:, list(1)) &
+                        + unit%position(:, list(size(list))))
+                    do d = 1, 2
+                        moved(d, list) = floor((middle(d) - origin(d)) / period(d) &
+                            + lattice_tolerance)
+                    end do
+                end associate
+            end do
+        end subroutine get_window_shifts
+    end subroutine tile_sample
 
     !> The centre line's point at arc length s of the first period.
     pure function point_at(yarn, s) result(x)

@@ -33,6 +33,9 @@ module yarnfort_input_config
         !> to a periodic image, TexGen import); it follows the macroscopic strain
         !> (p_disp * strain * period), the rest is the gap.
         real(wp) :: period(3) = 0.0_wp
+        !> Gap link only: the two nodes are sewn together, not one contact (no passage
+        !> at either for the other's yarn; the clamped knit's edge threads).
+        logical :: bonded = .false.
     end type link_config_type
 
     !> The whole input.

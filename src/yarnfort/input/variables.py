@@ -217,12 +217,14 @@ GROUPS = [
             choices=['knit', 'plain', 'twill', 'texgen'],
             checked_by='fabric', default_doc='required',
             doc="`'knit'` (weft-knitted single jersey, optional inlay), `'plain'` (plain weave), "
-                "`'twill'` (2/2 twill) or `'texgen'` (a periodic cell from a TexGen model file, "
+                "`'twill'` (2/2 twill) or `'texgen'` (a periodic cell, or a clamped sample of "
+                "copies of it, from a TexGen model file, "
                 '`texgen_file`).'),
         Var('cells', 'integer', [4, 4], shape=2, range='>= 1', checked_by='fabric',
             doc='Repeats along x and y: wales x courses (knit); weft yarns (crossings along x) x '
                 'warp yarns (woven). A periodic plain weave needs even counts, a periodic twill '
-                'multiples of 4.'),
+                'multiples of 4. TexGen: copies of the cell in a clamped sample (not used for '
+                'a periodic cell).'),
         Var('spacing', 'real', [-1.0, -1.0], shape=2, unit='m', range='> 0', checked_by='fabric',
             default_doc='required',
             doc='Repeat spacing along x and y: wale and course spacing (knit); weft and warp '
@@ -232,7 +234,8 @@ GROUPS = [
             doc="`'periodic'`: a unit cell whose edge nodes are tied to the opposite edge (paper "
                 'eq. 53), stretched by the macroscopic strain below; one node (`anchor`) is held '
                 "against rigid translation. `'clamped'`: a finite sample, yarn ends at x = 0 "
-                'held (`left`), those at the right edge pulled (`right`).'),
+                'held (`left`), those at the right edge pulled (`right`); for `texgen`, '
+                '`cells` copies of the cell.'),
         Var('strain', 'real', 1.0, unit='1', range='[-0.9, 100]', checked_by='fabric',
             doc='Engineering strain along x at p_disp = 1 (`1.0` stretches to twice the length). '
                 "Periodic: of the cell's x period; clamped: of the sample's length."),
@@ -250,12 +253,9 @@ GROUPS = [
             doc="Clamped: `'free'` side edges or `'rollers'`. Woven: rollers hold the weft ends "
                 'in y and z (a selvedge); free weft ends of pre-stressed weft yarns cannot carry '
                 'their tension, so woven strips need rollers. Knit: rollers hold the contacts of '
-                'the first and last course in y. With free sides the feet of the first course '
-                'and the heads of the last touch one yarn only: a yarn bent there at a free '
-                'node is in equilibrium only slack, so the edge loops go slack, Newton meets '
-                'singular matrices and the run stalls or stops with an error (clamped 8 x 2: '
-                'stops at strain 0.018; 4 x 4: 32 Newton iterations a step). With rollers '
-                'clamped knits take 3-4 a step, as periodic cells do.'),
+                'the first and last course in y. With free sides a cast-on and a bind-off '
+                'thread close the first and the last course (`edge_material`; see *Clamped '
+                'knit edges* below).'),
         Var('elements_per_segment', 'integer', 1, range='>= 1', checked_by='fabric',
             doc='Elements per yarn segment between generated nodes. A string under tension is '
                 'straight between contacts, so 1 is exact: `verification/fabrics` finds 2, 4 and '
@@ -326,6 +326,11 @@ GROUPS = [
                 'between them, and each loop contact has a node on either yarn joined by a '
                 'gap-holder of this length (the distance between the yarn axes: the yarn '
                 'thickness). See *Three-dimensional knit* below.'),
+        Var('edge_material', 'character', '', length='name_length', checked_by='fabric',
+            default_doc='`knit_material`',
+            doc="Knit, clamped with `sides = 'free'`: yarn type of the cast-on and bind-off "
+                'threads that close the first and the last course (see *Clamped knit edges* '
+                'below).'),
     ]),
     Group('nodes', 'singleton',
           'Node coordinates (node ids 1..n in list order).', [

@@ -577,12 +577,14 @@ contains
         call get_contact_node_sets(config, set_of, set_names, n_obstacles)
         ! Visits of each original node by the yarns, listed per node (CSR). Nodes joined
         ! by links (gap-holders, periodic images) count as one contact: visits are
-        ! counted at the root of each node's chain of links.
+        ! counted at the root of each node's chain of links. Bonded gap links do not
+        ! join contacts (their nodes are sewn together).
         n_nodes = size(config%node_positions, 2)
         allocate(root(n_nodes))
         root = [(node, node = 1, n_nodes)]
         if (allocated(config%links)) then
             do k = 1, size(config%links)
+                if (config%links(k)%bonded) cycle
                 root(config%links(k)%follower) = config%links(k)%leader
             end do
         end if
