@@ -42,16 +42,19 @@ end module bench_friction_counter
 !> Benchmark of a load/unload cycle with sliding on a generated crimped woven net.
 !>     bench_friction <crossings per side> <monolithic|staggered> [elements per segment
 !>                    [linear solver]] [--skewed] [--steps N] [--no-line-search]
+!>                    [--no-factor-times]
 !> --skewed: every crossing node moved by a small fixed pseudo-random offset (up to 2 %
 !> of the spacing in x and y, 0.01 in z), so that no element is aligned with an axis
 !> (`zeros` in the `factors:` line: the fractions of exact zeros among the stored
 !> entries of the friction Jacobian, in all and in its position block, flow rows and
 !> flow columns, and of the elastic Jacobian). --steps N: only the first N load steps
 !> of 0.05 (N <= 20: loading only; for the largest nets). --no-line-search: Newton
-!> without KINSOL's line search.
+!> without KINSOL's line search. --no-factor-times: the `factors:` line without the
+!> timed factorisations (-1; they take longer than the run itself above 1e5 unknowns).
 !> Prints, for the whole cycle: unknowns, passages, load steps, Newton iterations and
 !> sparse factorisations per step, time per step, and the split of time between
-!> assembly, factorisation, solves and the rest; peak resident memory.
+!> assembly, factorisation, solves and the rest; peak resident memory; process CPU time
+!> per step (the cycle alone).
 !> Then a second line, `factors:` (both schemes: the staggered one finishes its steps
 !> with monolithic solves), on the Jacobians at the final
 !> state (bench_floor, CPU ms per factorisation + solve, nonzeros of L + U): the friction
@@ -81,20 +84,21 @@ program bench_friction
     type(friction_stepper_type) :: stepper
     type(counter_type) :: counter
     type(error_type), allocatable :: error
-    real(wp) :: total, start, times(3, 5)
+    real(wp) :: total, start, times(3, 5), cpu_start, cpu_total
     integer :: side, per_segment, factorisations(3), n_positional, k, max_steps
     character(len=32) :: argument, scheme, positional(4)
-    logical :: skewed, line_search
+    logical :: skewed, line_search, time_factors
 
     call get_command_argument(1, argument)
     if (trim(argument) == '--header') then
         write(output_unit, '(a)') '    scheme  unknowns  passages  steps  newton/step' // &
             '  factor/step  ms/step  assembly_%  factor_%  solve_%  other_%  max_slipping' // &
-            '  peak_MiB'
+            '  peak_MiB  cpu_ms/step'
         stop
     end if
     skewed = .false.
     line_search = .true.
+    time_factors = .true.
     max_steps = 0
     n_positional = 0
     k = 0
@@ -106,6 +110,8 @@ program bench_friction
             skewed = .true.
         case ('--no-line-search')
             line_search = .false.
+        case ('--no-factor-times')
+            time_factors = .false.
         case ('--steps')
             k = k + 1
             call get_command_argument(k, argument)
@@ -139,15 +145,20 @@ program bench_friction
         config%path%time = [0.0_wp, 0.05_wp * max_steps]
         config%path%p_force = [0.0_wp, 0.0_wp]
         config%path%p_disp = [0.0_wp, 0.05_wp * max_steps]
+        config%solver%initial_step = 1.0_wp / max_steps
+        config%solver%max_step = 1.0_wp / max_steps
     end if
     config%solver%line_search = line_search
     call new_scene(scene, config, error)
     if (allocated(error)) call fail('bench_friction', error)
     call new_friction_stepper(stepper, scene, get_linear_solver_name(scene), error)
     if (allocated(error)) call fail('bench_friction', error)
+    call cpu_time(cpu_start)
     start = wall_time()
     call run_continuation(scene, stepper, counter, error)
     total = wall_time() - start
+    call cpu_time(cpu_total)
+    cpu_total = cpu_total - cpu_start
     if (allocated(error)) call fail('bench_friction', error)
     times = 0.0_wp
     factorisations = 0
@@ -159,13 +170,14 @@ program bench_friction
         times(3, 4), times(3, 5), factorisations(3))
     associate(assembly => sum(times(:, 1:2)), factor => sum(times(:, 3:4)), &
             solve => sum(times(:, 5)))
-        write(output_unit, '(a10, i10, i10, i7, f13.2, f13.2, f9.2, 4f10.1, i14, f10.1)') &
+        write(output_unit, '(a10, i10, i10, i7, f13.2, f13.2, f9.2, 4f10.1, i14, f10.1, &
+            & f13.2)') &
             trim(scheme), scene%dofs%n_unknowns, scene%passages%size(), counter%steps, &
             real(counter%newton, wp) / counter%steps, &
             real(sum(factorisations), wp) / counter%steps, 1e3_wp * total / counter%steps, &
             100 * assembly / total, 100 * factor / total, 100 * solve / total, &
             100 * (total - assembly - factor - solve) / total, counter%max_slipping, &
-            peak_memory_mib()
+            peak_memory_mib(), 1e3_wp * cpu_total / counter%steps
     end associate
     if (associated(stepper%full)) call write_factors()
 
@@ -192,8 +204,10 @@ contains
             if (allocated(error)) call fail('bench_friction', error)
             zeros = real(count(values == 0.0_wp), wp) / nnz
             call count_zeros(n, col_ptr, row_index, values, zero_blocks)
-            call measure_floor('klu', n, col_ptr, row_index, values, friction, error)
-            if (allocated(error)) call fail('bench_friction', error)
+            if (time_factors) then
+                call measure_floor('klu', n, col_ptr, row_index, values, friction, error)
+                if (allocated(error)) call fail('bench_friction', error)
+            end if
         end associate
         call new_elastic_problem(problem, scene)
         call scene%passages%get_length0(scene%network%length0, stepper%flow, problem%length0)
@@ -206,8 +220,10 @@ contains
         call problem%evaluate_jacobian(stepper%u, values, error)
         if (allocated(error)) call fail('bench_friction', error)
         zeros_elastic = real(count(values == 0.0_wp), wp) / nnz_elastic
-        call measure_floor('cholmod', n_elastic, col_ptr, row_index, values, elastic, error)
-        if (allocated(error)) call fail('bench_friction', error)
+        if (time_factors) then
+            call measure_floor('cholmod', n_elastic, col_ptr, row_index, values, elastic, error)
+            if (allocated(error)) call fail('bench_friction', error)
+        end if
         write(output_unit, '(a, i0, a, i0, a, 4(es9.2, a, f8.2, a), a, i0, a, i0, a, &
             & es9.2, a, f8.2, a, f8.2, a, 5(f5.1, a))') &
             'factors: friction n ', n, ' nnz ', nnz, &
