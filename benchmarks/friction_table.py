@@ -144,7 +144,7 @@ def main():
           'nonzeros of the factors; exact zeros among the stored entries):')
     print()
     print('| net | scheme | unknowns | friction LU nnz KLU (ms) | friction LU nnz UMFPACK (ms) '
-          '| elastic CHOLMOD ms | wall step / elastic CHOLMOD | zeros friction (positions, '
+          '| elastic CHOLMOD ms | CPU step / elastic CHOLMOD | zeros friction (positions, '
           'flow rows, flow columns) | zeros elastic |')
     print('|---|---|---:|---:|---:|---:|---:|---|---:|')
     for r in rows:
@@ -152,7 +152,7 @@ def main():
             continue
         klu, umf, chol = r['lu_klu'], r['lu_umfpack'], r['cholmod']
         timed = chol and float(chol[0]) > 0
-        ratio = f'{float(r["ms_per_step"]) / float(chol[0]):.0f}' if timed else '-'
+        ratio = f'{float(r["cpu_ms_per_step"]) / float(chol[0]):.0f}' if timed else '-'
         z = r['zeros']
         print(f'| {r["net"]} | {r["scheme"]} | {int(r["unknowns"]):,} '
               f'| {klu[0]} ({klu[1]}) | {umf[0]} ({umf[1]}) | '
@@ -162,22 +162,26 @@ def main():
               f'| {r["net"]} | {r["scheme"]} | {int(r["unknowns"]):,} | - | - | - | - '
               f'| {z[0]} % ({z[1]}, {z[2]}, {z[3]} %) | {z[4]} % |')
     print()
-    print('Exponents (least-squares fit of wall ms / step against unknowns, sizes run over '
-          'the same kind of run):')
+    print('Exponents (least-squares fit of CPU ms / step against unknowns, sizes run over '
+          'the same kind of run; wall ms / step in brackets, which a loaded machine '
+          'blurs):')
     print()
     for net in args.nets:
         for scheme in args.schemes:
             for cycle in (True, False):
-                points = [(int(r['unknowns']), float(r['ms_per_step'])) for r in rows
-                          if r['net'] == net and r['scheme'] == scheme
-                          and r['cycle'] == cycle and 'failed' not in r]
-                if len(points) < 2:
+                runs = [r for r in rows if r['net'] == net and r['scheme'] == scheme
+                        and r['cycle'] == cycle and 'failed' not in r]
+                if len(runs) < 2:
                     continue
-                big = [p for p in points if p[0] >= 5000]
+                cpu = [(int(r['unknowns']), float(r['cpu_ms_per_step'])) for r in runs]
+                wall = [(int(r['unknowns']), float(r['ms_per_step'])) for r in runs]
                 text = f'- {net}, {scheme}, {"cycle" if cycle else "first load steps"}: ' \
-                       f'n^{slope(points):.2f} over {points[0][0]:,}-{points[-1][0]:,}'
-                if len(big) >= 2 and len(big) < len(points):
-                    text += f'; n^{slope(big):.2f} from {big[0][0]:,}'
+                       f'n^{slope(cpu):.2f} (n^{slope(wall):.2f}) over ' \
+                       f'{cpu[0][0]:,}-{cpu[-1][0]:,}'
+                big = [k for k, p in enumerate(cpu) if p[0] >= 5000]
+                if 2 <= len(big) < len(cpu):
+                    text += f'; n^{slope([cpu[k] for k in big]):.2f} ' \
+                            f'(n^{slope([wall[k] for k in big]):.2f}) from {cpu[big[0]][0]:,}'
                 print(text)
     print()
     print('Commands:')
