@@ -75,17 +75,21 @@ contains
     end function cpu_seconds
 
     !> Time `solver_name` and the bare libraries on the CSC matrix (0-based indices).
-    subroutine measure_floor(solver_name, n, col_ptr, row_index, values, floor, error)
+    subroutine measure_floor(solver_name, n, col_ptr, row_index, values, floor, error, &
+            with_klu)
         character(len=*), intent(in) :: solver_name
         integer(ik), intent(in) :: n
         integer(ik), intent(in) :: col_ptr(:), row_index(:)
         real(wp), intent(in) :: values(:)
         type(floor_type), intent(out) :: floor
         type(error_type), allocatable, intent(out) :: error
+        !> Time bare KLU (default true).
+        logical, intent(in), optional :: with_klu
         class(linear_solver_type), allocatable :: solver
         real(wp), allocatable :: rhs(:)
         real(wp) :: start, first
         integer :: k, repetitions
+        logical :: klu
 
         allocate(rhs(n))
         call new_linear_solver(solver, solver_name, error)
@@ -113,9 +117,13 @@ contains
 
         call time_umfpack(.true., floor%umfpack_ms, floor%strategy, floor%umfpack_lu)
         call time_umfpack(.false., floor%umfpack_pattern_ms, floor%strategy_pattern)
-        call time_klu(0, 1, floor%klu_ms, floor%klu_lu)
-        call time_klu(1, 1, floor%klu_colamd_ms, floor%klu_colamd_lu)
-        call time_klu(0, 0, floor%klu_nobtf_ms, floor%klu_nobtf_lu)
+        klu = .true.
+        if (present(with_klu)) klu = with_klu
+        if (klu) then
+            call time_klu(0, 1, floor%klu_ms, floor%klu_lu)
+            call time_klu(1, 1, floor%klu_colamd_ms, floor%klu_colamd_lu)
+            call time_klu(0, 0, floor%klu_nobtf_ms, floor%klu_nobtf_lu)
+        end if
         if (solver_name == 'cholmod' .or. solver_name == 'cholmod+klu') then
             block
                 real(c_double) :: ms, lnz

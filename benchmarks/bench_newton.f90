@@ -13,7 +13,8 @@
 !> Then the floor (bench_floor) on the Jacobian at the solution: ms per factorisation +
 !> solve of this solver in yarnfort (`yf_ms`), of bare UMFPACK analysed with the values
 !> (`umf_ms`, its strategy `st`) and with the pattern only (`umf_pat_ms`, `st`), and of bare
-!> KLU (`klu_ms`); the ratios of yarnfort's to the bare library of the same name
+!> KLU (`klu_ms`, -1 above 3e5 unknowns); the ratios of yarnfort's to the bare library
+!> of the same name
 !> (`x_bare`, '-' for dense) and of a whole yarnfort Newton iteration to the
 !> fastest bare library (`iter_x_floor`), all in process CPU time; bare CHOLMOD
 !> (`chol_ms`) for 'cholmod' and 'cholmod+klu'. `nnz` counts the free rows and columns
@@ -55,6 +56,9 @@ program bench_newton
     logical :: have_umfpack
     integer :: side, setup_calls, n_factor, iterations
     character(len=32) :: argument, solver_name, variant
+    !> Largest order at which the floor times bare KLU (above it one KLU factorisation of
+    !> the cable net takes over a minute, and KLU is never the default there).
+    integer, parameter :: klu_floor_max = 300000
 
     call get_command_argument(1, argument)
     if (trim(argument) == '--header') then
@@ -149,7 +153,7 @@ contains
         call problem%evaluate_jacobian(u, values, error)
         if (allocated(error)) call fail('bench_newton', error)
         call measure_floor(trim(solver_name), int(size(u), ik), col_ptr, row_index, values, &
-            floor, error)
+            floor, error, with_klu=size(u) <= klu_floor_max)
         if (allocated(error)) call fail('bench_newton', error)
         select case (trim(solver_name))
         case ('umfpack')
@@ -165,7 +169,7 @@ contains
         if (bare > 0.0_wp) write(ratio, '(f8.2)') floor%yarnfort_ms / bare
         fastest = minval(pack([floor%umfpack_ms, floor%klu_ms, floor%cholmod_ms], &
             [floor%umfpack_ms, floor%klu_ms, floor%cholmod_ms] > 0.0_wp))
-        write(output_unit, '(f7.2, f8.2, i3, f12.2, i3, f8.2, f9.2, a8, f14.2, f10.4, es24.16)') &
+        write(output_unit, '(f7.2, f8.2, i3, f12.2, i3, f8.2, f9.2, a8, f14.2, f12.6, es24.16)') &
             floor%yarnfort_ms, floor%umfpack_ms, floor%strategy, floor%umfpack_pattern_ms, &
             floor%strategy_pattern, floor%klu_ms, floor%cholmod_ms, trim(ratio), &
             1e3_wp * cpu_total / iterations / fastest, cpu_total, centre_deflection()

@@ -274,7 +274,7 @@ def print_tables(rows):
         best = min(ok.values(), key=lambda r: r['cpu_s']) if ok else None
         cpu = float(yf['cpu_s'])
         w = float(yf['w_centre'])
-        cells = ' | '.join(f'{r["cpu_s"]:.3f}' if r['status'] == 0 else
+        cells = ' | '.join(f'{r["cpu_s"]:.4f}' if r['status'] == 0 else
                            f'failed ({r["status"]})' for r in runs.values())
         if best:
             diff = abs(w - best['w_centre']) / abs(best['w_centre'])
@@ -282,7 +282,7 @@ def print_tables(rows):
                     f'| {yf["peak_rss_MiB"]:.0f} | {best["peak_rss_MiB"]:.0f}')
         else:
             tail = f'- | {w:.12e} | - | {yf["peak_rss_MiB"]:.0f} | -'
-        print(f'| {yf["unknowns"]} | {cpu:.3f} | {cells} | {tail} |')
+        print(f'| {yf["unknowns"]} | {cpu:.4f} | {cells} | {tail} |')
 
 
 if __name__ == '__main__':
