@@ -169,7 +169,7 @@ contains
         if (bare > 0.0_wp) write(ratio, '(f8.2)') floor%yarnfort_ms / bare
         fastest = minval(pack([floor%umfpack_ms, floor%klu_ms, floor%cholmod_ms], &
             [floor%umfpack_ms, floor%klu_ms, floor%cholmod_ms] > 0.0_wp))
-        write(output_unit, '(f7.2, f8.2, i3, f12.2, i3, f8.2, f9.2, a8, f14.2, f12.6, es24.16)') &
+        write(output_unit, '(f10.2, f10.2, i3, f12.2, i3, f10.2, f10.2, a8, f14.2, f13.6, es25.16)') &
             floor%yarnfort_ms, floor%umfpack_ms, floor%strategy, floor%umfpack_pattern_ms, &
             floor%strategy_pattern, floor%klu_ms, floor%cholmod_ms, trim(ratio), &
             1e3_wp * cpu_total / iterations / fastest, cpu_total, centre_deflection()

@@ -175,6 +175,11 @@ def timed(command):
 
 def run_yarnfort(side, header):
     out, peak = timed([str(BENCH), str(side), 'cholmod+klu', '1', 'linear'])
+    print(f'# bench_newton {side} cholmod+klu 1 linear: {out.strip()}', file=sys.stderr,
+          flush=True)
+    if len(out.split()) != len(header):
+        raise RuntimeError(f'bench_newton printed {len(out.split())} fields for '
+                           f'{len(header)} columns: {out}')
     row = dict(zip(header, out.split()))
     row['peak_rss_MiB'] = peak
     return row
@@ -227,6 +232,8 @@ def main():
         for system in args.systems:
             out, peak = timed([str(python), str(pathlib.Path(__file__).resolve()),
                                '--opensees', str(side), system])
+            print(f'# OpenSeesPy {side} {system}: {out.strip().splitlines()[-1]}',
+                  file=sys.stderr, flush=True)
             result = json.loads(out.strip().splitlines()[-1])
             result['peak_rss_MiB'] = peak
             ops_runs[system] = result
