@@ -7,13 +7,16 @@
 !>   umfpack_dl_symbolic given the values (its defaults, no iterative refinement), and
 !>   the same with the Symbolic object of the pattern alone (what yarnfort did before);
 !> - bare KLU: klu_l_refactor + klu_l_solve after klu_l_analyze (its defaults) and
-!>   klu_l_factor, with KLU's AMD ordering (its default) and with COLAMD.
+!>   klu_l_factor, with KLU's AMD ordering (its default) and with COLAMD;
+!> - bare CHOLMOD (only where the solver named is 'cholmod' or 'cholmod+klu', i.e. the
+!>   matrix is symmetric positive definite): cholmod_l_factorize + cholmod_l_solve after
+!>   cholmod_l_analyze, its defaults (bench_cholmod.c).
 !> Also the nonzeros of the factors (L + U) of each.
 !> Times are process CPU times (cpu_time): everything here runs on one thread, and on a
 !> machine shared with other work the CPU time of a run moves far less than its wall time.
 module bench_floor
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr, c_null_ptr, &
-        c_null_funptr, c_associated, c_f_pointer
+        c_null_funptr, c_associated, c_f_pointer, c_int
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
@@ -30,6 +33,21 @@ module bench_floor
 
     public :: floor_type, measure_floor
 
+    interface
+        !> bench_cholmod.c
+        function bench_cholmod_time(n, col_ptr, row_index, values, target_seconds, &
+                max_repetitions, ms, lnz) result(status) bind(C, name='bench_cholmod_time')
+            import :: c_long, c_double, c_int
+            integer(c_long), value :: n
+            integer(c_long), intent(in) :: col_ptr(*), row_index(*)
+            real(c_double), intent(in) :: values(*)
+            real(c_double), value :: target_seconds
+            integer(c_int), value :: max_repetitions
+            real(c_double), intent(out) :: ms, lnz
+            integer(c_int) :: status
+        end function bench_cholmod_time
+    end interface
+
     !> Wall time spent on each measurement (s): repetitions are chosen to fill it.
     real(wp), parameter :: target_seconds = 0.3_wp
     integer, parameter :: max_repetitions = 20
@@ -38,7 +56,9 @@ module bench_floor
     type :: floor_type
         real(wp) :: yarnfort_ms = -1.0_wp
         real(wp) :: umfpack_ms = -1.0_wp, umfpack_pattern_ms = -1.0_wp, klu_ms = -1.0_wp
-        real(wp) :: klu_colamd_ms = -1.0_wp, klu_nobtf_ms = -1.0_wp
+        real(wp) :: klu_colamd_ms = -1.0_wp, klu_nobtf_ms = -1.0_wp, cholmod_ms = -1.0_wp
+        !> Nonzeros of L of bare CHOLMOD (its analysis' count).
+        real(wp) :: cholmod_lnz = 0.0_wp
         !> Nonzeros of L + U: UMFPACK analysed with the values, KLU with AMD and COLAMD.
         real(wp) :: umfpack_lu = 0.0_wp, klu_lu = 0.0_wp, klu_colamd_lu = 0.0_wp
         !> KLU with AMD and without its block triangular form (btf = 0).
@@ -55,17 +75,21 @@ contains
     end function cpu_seconds
 
     !> Time `solver_name` and the bare libraries on the CSC matrix (0-based indices).
-    subroutine measure_floor(solver_name, n, col_ptr, row_index, values, floor, error)
+    subroutine measure_floor(solver_name, n, col_ptr, row_index, values, floor, error, &
+            with_klu)
         character(len=*), intent(in) :: solver_name
         integer(ik), intent(in) :: n
         integer(ik), intent(in) :: col_ptr(:), row_index(:)
         real(wp), intent(in) :: values(:)
         type(floor_type), intent(out) :: floor
         type(error_type), allocatable, intent(out) :: error
+        !> Time bare KLU (default true).
+        logical, intent(in), optional :: with_klu
         class(linear_solver_type), allocatable :: solver
         real(wp), allocatable :: rhs(:)
         real(wp) :: start, first
         integer :: k, repetitions
+        logical :: klu
 
         allocate(rhs(n))
         call new_linear_solver(solver, solver_name, error)
@@ -93,9 +117,24 @@ contains
 
         call time_umfpack(.true., floor%umfpack_ms, floor%strategy, floor%umfpack_lu)
         call time_umfpack(.false., floor%umfpack_pattern_ms, floor%strategy_pattern)
-        call time_klu(0, 1, floor%klu_ms, floor%klu_lu)
-        call time_klu(1, 1, floor%klu_colamd_ms, floor%klu_colamd_lu)
-        call time_klu(0, 0, floor%klu_nobtf_ms, floor%klu_nobtf_lu)
+        klu = .true.
+        if (present(with_klu)) klu = with_klu
+        if (klu) then
+            call time_klu(0, 1, floor%klu_ms, floor%klu_lu)
+            call time_klu(1, 1, floor%klu_colamd_ms, floor%klu_colamd_lu)
+            call time_klu(0, 0, floor%klu_nobtf_ms, floor%klu_nobtf_lu)
+        end if
+        if (solver_name == 'cholmod' .or. solver_name == 'cholmod+klu') then
+            block
+                real(c_double) :: ms, lnz
+                if (bench_cholmod_time(int(n, c_long), col_ptr, row_index, values, &
+                        real(target_seconds, c_double), int(max_repetitions, c_int), ms, &
+                        lnz) == 0) then
+                    floor%cholmod_ms = ms
+                    floor%cholmod_lnz = lnz
+                end if
+            end block
+        end if
 
     contains
 

@@ -41,10 +41,20 @@ end module bench_friction_counter
 
 !> Benchmark of a load/unload cycle with sliding on a generated crimped woven net.
 !>     bench_friction <crossings per side> <monolithic|staggered> [elements per segment
-!>                    [linear solver]]
+!>                    [linear solver]] [--skewed] [--steps N] [--no-line-search]
+!>                    [--no-factor-times]
+!> --skewed: every crossing node moved by a small fixed pseudo-random offset (up to 2 %
+!> of the spacing in x and y, 0.01 in z), so that no element is aligned with an axis
+!> (`zeros` in the `factors:` line: the fractions of exact zeros among the stored
+!> entries of the friction Jacobian, in all and in its position block, flow rows and
+!> flow columns, and of the elastic Jacobian). --steps N: only the first N load steps
+!> of 0.05 (N <= 20: loading only; for the largest nets). --no-line-search: Newton
+!> without KINSOL's line search. --no-factor-times: the `factors:` line without the
+!> timed factorisations (-1; they take longer than the run itself above 1e5 unknowns).
 !> Prints, for the whole cycle: unknowns, passages, load steps, Newton iterations and
 !> sparse factorisations per step, time per step, and the split of time between
-!> assembly, factorisation, solves and the rest; peak resident memory.
+!> assembly, factorisation, solves and the rest; peak resident memory; process CPU time
+!> per step (the cycle alone).
 !> Then a second line, `factors:` (both schemes: the staggered one finishes its steps
 !> with monolithic solves), on the Jacobians at the final
 !> state (bench_floor, CPU ms per factorisation + solve, nonzeros of L + U): the friction
@@ -84,25 +94,70 @@ program bench_friction
     type(counter_type) :: counter
     type(error_type), allocatable :: error
     real(wp) :: total, start, times(3, 5), cpu_start, cpu_total
-    integer :: side, per_segment, factorisations(3)
-    character(len=32) :: argument, scheme
+    integer :: side, per_segment, factorisations(3), n_positional, k, max_steps
+    character(len=32) :: argument, scheme, positional(4)
+    logical :: skewed, line_search, time_factors
 
     call get_command_argument(1, argument)
     if (trim(argument) == '--header') then
         write(output_unit, '(a)') '    scheme  unknowns  passages  steps  newton/step' // &
             '  factor/step  ms/step  assembly_%  factor_%  solve_%  other_%  max_slipping' // &
-            '  peak_MiB'
+            '  peak_MiB  cpu_ms/step'
         stop
     end if
-    read(argument, *) side
-    call get_command_argument(2, scheme)
-    per_segment = 2
-    if (command_argument_count() >= 3) then
-        call get_command_argument(3, argument)
-        read(argument, *) per_segment
+    skewed = .false.
+    line_search = .true.
+    time_factors = .true.
+    max_steps = 0
+    n_positional = 0
+    k = 0
+    do while (k < command_argument_count())
+        k = k + 1
+        call get_command_argument(k, argument)
+        select case (trim(argument))
+        case ('--skewed')
+            skewed = .true.
+        case ('--no-line-search')
+            line_search = .false.
+        case ('--no-factor-times')
+            time_factors = .false.
+        case ('--steps')
+            k = k + 1
+            call get_command_argument(k, argument)
+            read(argument, *) max_steps
+            if (max_steps < 1 .or. max_steps > 20) then
+                write(error_unit, '(a)') 'bench_friction: --steps must be 1 to 20'
+                error stop 2
+            end if
+        case default
+            if (n_positional == size(positional)) then
+                write(error_unit, '(a)') "bench_friction: unexpected argument '" // &
+                    trim(argument) // "'"
+                error stop 2
+            end if
+            n_positional = n_positional + 1
+            positional(n_positional) = argument
+        end select
+    end do
+    if (n_positional < 2) then
+        write(error_unit, '(a)') 'bench_friction: need <crossings per side> <scheme>'
+        error stop 2
     end if
+    read(positional(1), *) side
+    scheme = positional(2)
+    per_segment = 2
+    if (n_positional >= 3) read(positional(3), *) per_segment
     call make_woven_net(config, side, per_segment, scheme)
-    if (command_argument_count() >= 4) call get_command_argument(4, config%solver%linear_solver)
+    if (n_positional >= 4) config%solver%linear_solver = positional(4)
+    if (skewed) call skew_net(config, side)
+    if (max_steps > 0) then
+        config%path%time = [0.0_wp, 0.05_wp * max_steps]
+        config%path%p_force = [0.0_wp, 0.0_wp]
+        config%path%p_disp = [0.0_wp, 0.05_wp * max_steps]
+        config%solver%initial_step = 1.0_wp / max_steps
+        config%solver%max_step = 1.0_wp / max_steps
+    end if
+    config%solver%line_search = line_search
     call new_scene(scene, config, error)
     if (allocated(error)) call fail('bench_friction', error)
     call new_friction_stepper(stepper, scene, get_linear_solver_name(scene), error)
@@ -124,13 +179,14 @@ program bench_friction
         times(3, 4), times(3, 5), factorisations(3))
     associate(assembly => sum(times(:, 1:2)), factor => sum(times(:, 3:4)), &
             solve => sum(times(:, 5)))
-        write(output_unit, '(a10, i10, i10, i7, f13.2, f13.2, f9.2, 4f10.1, i14, f10.1)') &
+        write(output_unit, '(a10, i10, i10, i7, f13.2, f13.2, f9.2, 4f10.1, i14, f10.1, &
+            & f13.2)') &
             trim(scheme), scene%dofs%n_unknowns, scene%passages%size(), counter%steps, &
             real(counter%newton, wp) / counter%steps, &
             real(sum(factorisations), wp) / counter%steps, 1e3_wp * total / counter%steps, &
             100 * assembly / total, 100 * factor / total, 100 * solve / total, &
             100 * (total - assembly - factor - solve) / total, counter%max_slipping, &
-            peak_memory_mib()
+            peak_memory_mib(), 1e3_wp * cpu_total / counter%steps
     end associate
     if (associated(stepper%full)) call write_factors()
     if (associated(stepper%full)) call write_iterations()
@@ -234,6 +290,7 @@ contains
         integer(ik), allocatable :: col_ptr(:), row_index(:)
         real(wp), allocatable :: values(:)
         integer(ik) :: n, nnz, n_elastic, nnz_elastic
+        real(wp) :: zeros, zeros_elastic, zero_blocks(3)
 
         associate(full => stepper%full)
             n = full%get_size()
@@ -245,8 +302,12 @@ contains
             if (allocated(error)) call fail('bench_friction', error)
             call full%evaluate_jacobian([stepper%u, stepper%flow], values, error)
             if (allocated(error)) call fail('bench_friction', error)
-            call measure_floor('klu', n, col_ptr, row_index, values, friction, error)
-            if (allocated(error)) call fail('bench_friction', error)
+            zeros = real(count(values == 0.0_wp), wp) / nnz
+            call count_zeros(n, col_ptr, row_index, values, zero_blocks)
+            if (time_factors) then
+                call measure_floor('klu', n, col_ptr, row_index, values, friction, error)
+                if (allocated(error)) call fail('bench_friction', error)
+            end if
         end associate
         call new_elastic_problem(problem, scene)
         call scene%passages%get_length0(scene%network%length0, stepper%flow, problem%length0)
@@ -258,18 +319,84 @@ contains
         call problem%copy_pattern(col_ptr, row_index)
         call problem%evaluate_jacobian(stepper%u, values, error)
         if (allocated(error)) call fail('bench_friction', error)
-        call measure_floor('cholmod', n_elastic, col_ptr, row_index, values, elastic, error)
-        if (allocated(error)) call fail('bench_friction', error)
+        zeros_elastic = real(count(values == 0.0_wp), wp) / nnz_elastic
+        if (time_factors) then
+            call measure_floor('cholmod', n_elastic, col_ptr, row_index, values, elastic, error)
+            if (allocated(error)) call fail('bench_friction', error)
+        end if
         write(output_unit, '(a, i0, a, i0, a, 4(es9.2, a, f8.2, a), a, i0, a, i0, a, &
-            & es9.2, a, f8.2, a, f8.2, a)') &
+            & es9.2, a, f8.2, a, f8.2, a, 5(f5.1, a))') &
             'factors: friction n ', n, ' nnz ', nnz, &
             ' LU: klu-amd ', friction%klu_lu, ' (', friction%klu_ms, ' ms)  klu-colamd ', &
             friction%klu_colamd_lu, ' (', friction%klu_colamd_ms, ' ms)  klu-amd-nobtf ', &
             friction%klu_nobtf_lu, ' (', friction%klu_nobtf_ms, ' ms)  umfpack ', &
             friction%umfpack_lu, ' (', friction%umfpack_ms, ' ms)', &
             ' | elastic n ', n_elastic, ' nnz ', nnz_elastic, ' LU: klu-amd ', &
-            elastic%klu_lu, ' (', elastic%klu_ms, ' ms)  cholmod (', elastic%yarnfort_ms, ' ms)'
+            elastic%klu_lu, ' (', elastic%klu_ms, ' ms)  cholmod (', elastic%yarnfort_ms, &
+            ' ms) | zeros: friction ', 100 * zeros, ' % (positions ', 100 * zero_blocks(1), &
+            ' %, flow rows ', 100 * zero_blocks(2), ' %, flow columns ', 100 * zero_blocks(3), &
+            ' %) elastic ', 100 * zeros_elastic, ' %'
     end subroutine write_factors
+
+    !> Fractions of exact zeros among the stored entries of the friction Jacobian: in the
+    !> position block, the flow rows and the flow columns (rows and columns past
+    !> scene%dofs%n_unknowns are the flows').
+    subroutine count_zeros(n, col_ptr, row_index, values, fractions)
+        integer(ik), intent(in) :: n, col_ptr(:), row_index(:)
+        real(wp), intent(in) :: values(:)
+        real(wp), intent(out) :: fractions(3)
+        integer :: column, k, n_positions, block_index
+        integer :: zeros(3), stored(3)
+        logical :: flow_row, flow_column
+
+        n_positions = scene%dofs%n_unknowns
+        zeros = 0
+        stored = 0
+        do column = 1, int(n)
+            flow_column = column > n_positions
+            do k = int(col_ptr(column)) + 1, int(col_ptr(column + 1))
+                flow_row = row_index(k) + 1 > n_positions
+                if (flow_row .and. flow_column) cycle
+                block_index = 1
+                if (flow_row) block_index = 2
+                if (flow_column) block_index = 3
+                stored(block_index) = stored(block_index) + 1
+                if (values(k) == 0.0_wp) zeros(block_index) = zeros(block_index) + 1
+            end do
+        end do
+        fractions = real(zeros, wp) / max(1, stored)
+    end subroutine count_zeros
+
+    !> --skewed: move every crossing node by a fixed pseudo-random offset (program notes);
+    !> the boundary nodes stay.
+    subroutine skew_net(config, side)
+        type(config_type), intent(inout) :: config
+        integer, intent(in) :: side
+        integer, allocatable :: id(:, :)
+        integer :: i, j, n
+
+        call number_grid_nodes(side, id, n)
+        do j = 1, side
+            do i = 1, side
+                associate(x => config%node_positions(:, id(i, j)))
+                    x(1) = x(1) + 0.02_wp * offset(i, j, 1)
+                    x(2) = x(2) + 0.02_wp * offset(i, j, 2)
+                    x(3) = x(3) + 0.01_wp * offset(i, j, 3)
+                end associate
+            end do
+        end do
+    end subroutine skew_net
+
+    !> A fixed pseudo-random number in [-1, 1) from (i, j, c) (integer hash: the same
+    !> with every compiler).
+    pure real(wp) function offset(i, j, c)
+        integer, intent(in) :: i, j, c
+        integer(ik) :: h
+        h = modulo(int(i, ik) * 73856093_ik + int(j, ik) * 19349663_ik + &
+            int(c, ik) * 83492791_ik, 1000003_ik)
+        h = modulo(h * h + 12345_ik, 1000003_ik)
+        offset = 2.0_wp * real(h, wp) / 1000003.0_wp - 1.0_wp
+    end function offset
 
     !> side x side crossings of warp (along x) and weft (along y) yarns at unit
     !> spacing; crossing (i, j) sits at z = +-h in a checkerboard (crimp), so both yarns
@@ -354,7 +481,6 @@ contains
         config%solver%max_step = 0.05_wp
         config%solver%max_iterations = 100
         config%solver%max_friction_iterations = 1000
-        if (command_argument_count() >= 5) config%solver%line_search = .false.
     end subroutine make_woven_net
 
 

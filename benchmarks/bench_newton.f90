@@ -13,10 +13,19 @@
 !> Then the floor (bench_floor) on the Jacobian at the solution: ms per factorisation +
 !> solve of this solver in yarnfort (`yf_ms`), of bare UMFPACK analysed with the values
 !> (`umf_ms`, its strategy `st`) and with the pattern only (`umf_pat_ms`, `st`), and of bare
-!> KLU (`klu_ms`); the ratios of yarnfort's to the bare library of the same name
-!> (`x_bare`, '-' for cholmod and dense) and of a whole yarnfort Newton iteration to the
-!> faster bare library (`iter_x_floor`), all in process CPU time. `nnz` counts the free
-!> rows and columns only.
+!> KLU (`klu_ms`, -1 above 3e5 unknowns); the ratios of yarnfort's to the bare library
+!> of the same name
+!> (`x_bare`, '-' for dense) and of a whole yarnfort Newton iteration to the
+!> fastest bare library (`iter_x_floor`), all in process CPU time; bare CHOLMOD
+!> (`chol_ms`) for 'cholmod' and 'cholmod+klu'. `nnz` counts the free rows and columns
+!> only. Last, the process CPU time of the solve (`cpu_s`) and the displacement along z
+!> of the interior node nearest the centre (`w_centre`, m; compare.py checks it against
+!> OpenSeesPy).
+!> The optional 4th argument `linear` gives the net of benchmarks/compare.py: linear
+!> strings (EA = 10 N, corotTruss with an elastic material in OpenSees) and a first
+!> guess with the interior nodes at the homogeneous pre-stretch of the supports (both
+!> codes start there: at the flat stress-free net the transverse stiffness of a truss
+!> model is zero and OpenSees' first factorisation fails).
 program bench_newton
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use yarnfort_kinds, only: wp, ik
@@ -46,15 +55,18 @@ program bench_newton
     type(umfpack_memory_type) :: umfpack_memory
     logical :: have_umfpack
     integer :: side, setup_calls, n_factor, iterations
-    character(len=32) :: argument, solver_name
+    character(len=32) :: argument, solver_name, variant
+    !> Largest order at which the floor times bare KLU (above it one KLU factorisation of
+    !> the cable net takes over a minute, and KLU is never the default there).
+    integer, parameter :: klu_floor_max = 300000
 
     call get_command_argument(1, argument)
     if (trim(argument) == '--header') then
         write(output_unit, '(a)') 'solver  setup  unknowns       nnz  iters  facts' // &
             '  residual_ms  jacobian_ms  factor_ms  solve_ms  other_ms  other_%' // &
             '  analyse_ms  total_s  peak_MiB  grow_B/dof  umf_LU_B/dof  umf_peak_B/dof' // &
-            '  x_LU  x_peak  yf_ms  umf_ms st  umf_pat_ms st  klu_ms  x_bare' // &
-            '  iter_x_floor'
+            '  x_LU  x_peak  yf_ms  umf_ms st  umf_pat_ms st  klu_ms  chol_ms  x_bare' // &
+            '  iter_x_floor  cpu_s  w_centre'
         stop
     end if
     read(argument, *) side
@@ -64,9 +76,16 @@ program bench_newton
         call get_command_argument(3, argument)
         read(argument, *) setup_calls
     end if
+    variant = 'neo_hookean'
+    if (command_argument_count() >= 4) call get_command_argument(4, variant)
+    if (variant /= 'neo_hookean' .and. variant /= 'linear') then
+        write(error_unit, '(a)') "bench_newton: 4th argument '" // trim(variant) // &
+            "' is neither 'neo_hookean' nor 'linear'"
+        error stop 2
+    end if
 
     baseline_mib = peak_memory_mib()
-    call make_cable_net(config, side, setup_calls, solver_name)
+    call make_cable_net(config, side, setup_calls, solver_name, variant)
     call new_scene(scene, config, error)
     if (allocated(error)) call fail('bench_newton', error)
     call new_linear_solver(linear, trim(solver_name), error)
@@ -77,6 +96,7 @@ program bench_newton
     if (allocated(error)) call fail('bench_newton', error)
     allocate(u(scene%dofs%n_unknowns))
     call scene%dofs%restrict(scene%network%position, u)
+    if (variant == 'linear') call stretch_first_guess()
 
     call cpu_time(cpu_start)
     start = wall_time()
@@ -133,33 +153,58 @@ contains
         call problem%evaluate_jacobian(u, values, error)
         if (allocated(error)) call fail('bench_newton', error)
         call measure_floor(trim(solver_name), int(size(u), ik), col_ptr, row_index, values, &
-            floor, error)
+            floor, error, with_klu=size(u) <= klu_floor_max)
         if (allocated(error)) call fail('bench_newton', error)
         select case (trim(solver_name))
         case ('umfpack')
             bare = floor%umfpack_ms
         case ('klu')
             bare = floor%klu_ms
+        case ('cholmod', 'cholmod+klu')
+            bare = floor%cholmod_ms
         case default
             bare = -1.0_wp
         end select
         ratio = '-'
         if (bare > 0.0_wp) write(ratio, '(f8.2)') floor%yarnfort_ms / bare
-        fastest = minval(pack([floor%umfpack_ms, floor%klu_ms], &
-            [floor%umfpack_ms, floor%klu_ms] > 0.0_wp))
-        write(output_unit, '(f7.2, f8.2, i3, f12.2, i3, f8.2, a8, f14.2)') floor%yarnfort_ms, &
-            floor%umfpack_ms, floor%strategy, floor%umfpack_pattern_ms, &
-            floor%strategy_pattern, floor%klu_ms, trim(ratio), &
-            1e3_wp * cpu_total / iterations / fastest
+        fastest = minval(pack([floor%umfpack_ms, floor%klu_ms, floor%cholmod_ms], &
+            [floor%umfpack_ms, floor%klu_ms, floor%cholmod_ms] > 0.0_wp))
+        write(output_unit, '(f10.2, f10.2, i3, f12.2, i3, f10.2, f10.2, a8, f14.2, f13.6, es25.16)') &
+            floor%yarnfort_ms, floor%umfpack_ms, floor%strategy, floor%umfpack_pattern_ms, &
+            floor%strategy_pattern, floor%klu_ms, floor%cholmod_ms, trim(ratio), &
+            1e3_wp * cpu_total / iterations / fastest, cpu_total, centre_deflection()
     end subroutine write_floor
+
+    !> First guess of the `linear` variant: every interior node where the supports'
+    !> pre-stretch (1.04 along x and y, about the net's centre) takes it, in the plane.
+    subroutine stretch_first_guess()
+        real(wp), allocatable :: x(:, :)
+        real(wp) :: centre
+        x = scene%network%position
+        centre = 0.5_wp * (side + 1)
+        x(1:2, :) = centre + 1.04_wp * (x(1:2, :) - centre)
+        call scene%dofs%restrict(x, u)
+    end subroutine stretch_first_guess
+
+    !> z displacement at the solution of interior node (c, c), c = (side + 1) / 2.
+    real(wp) function centre_deflection()
+        real(wp), allocatable :: x(:, :)
+        integer, allocatable :: id(:, :)
+        integer :: n, c
+        allocate(x(3, scene%network%n_nodes()))
+        call scene%dofs%expand(u, problem%factors, x)
+        call number_grid_nodes(side, id, n)
+        c = (side + 1) / 2
+        centre_deflection = x(3, id(c, c)) - scene%network%position(3, id(c, c))
+    end function centre_deflection
 
     !> side x side interior nodes, unit spacing, cables along x and y ending on boundary
     !> nodes that are pulled outward by 2 % (pretension); a transverse force on every
     !> interior node. Neo-Hookean cables. Everything ramps in one step.
-    subroutine make_cable_net(config, side, setup_calls, solver_name)
+    subroutine make_cable_net(config, side, setup_calls, solver_name, variant)
         type(config_type), intent(out) :: config
         integer, intent(in) :: side, setup_calls
-        character(len=*), intent(in) :: solver_name
+        character(len=*), intent(in) :: solver_name, variant
         integer :: i, j, n, y
         integer, allocatable :: id(:, :)
 
@@ -173,9 +218,14 @@ contains
         end do
         allocate(config%materials(1))
         config%materials(1)%name = 'cable'
-        config%materials(1)%law = 'neo_hookean'
-        config%materials(1)%modulus = 2.0e6_wp
-        config%materials(1)%area = 5.0e-6_wp
+        if (variant == 'linear') then
+            config%materials(1)%law = 'linear'
+            config%materials(1)%stiffness = 2.0e6_wp * 5.0e-6_wp
+        else
+            config%materials(1)%law = 'neo_hookean'
+            config%materials(1)%modulus = 2.0e6_wp
+            config%materials(1)%area = 5.0e-6_wp
+        end if
         allocate(config%yarns(2 * side))
         y = 0
         do j = 1, side
