@@ -189,7 +189,11 @@ program bench_friction
             peak_memory_mib(), 1e3_wp * cpu_total / counter%steps
     end associate
     if (associated(stepper%full)) call write_factors()
-    if (associated(stepper%full)) call write_iterations()
+    ! Only where the run used its monolithic solver (a staggered run may never need its
+    ! monolithic finish; its friction Jacobian was then never analysed).
+    if (associated(stepper%full)) then
+        if (stepper%newton_full%adapter%analysed) call write_iterations()
+    end if
 
 contains
 
