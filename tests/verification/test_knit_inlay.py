@@ -26,6 +26,8 @@ from yarnfort.results import read_contacts
 KNIT = "inputs/knit.nml"
 #: Identities computed in floating point (a tension against itself, a closed form).
 ROUND_OFF = 1e-12
+#: `&solver residual_tolerance` by default (inputs/REFERENCE.md).
+DEFAULT_RESIDUAL_TOLERANCE = 1e-10
 #: knit.nml's knit-knit law (kmu, kbeta) and knit-inlay parameters set apart from it.
 KMU, KBETA = 0.3999, 0.015
 IKMU, IKBETA = 0.3333, 0.05
@@ -111,3 +113,29 @@ def test_free_sided_sample_inlay_crossings_stick(run_yarnfort, tmp_path):
     assert np.any(inlay)
     assert set(contacts["mode"][inlay]) == {"stick"}
     assert np.any(contacts["mode"][~inlay] != "stick")  # the knit-knit ones do slip
+
+
+def test_three_dimensional_cell_inlay_crossings_stick(run_yarnfort, tmp_path):
+    """The periodic cell in depth (`knit_depth`): the legs now slope through the inlay's
+    depth, but the cell's symmetry still keeps the inlay at right angles to the legs in
+    the x-y plane, so the inlay passages carry equal tensions and ikbeta changes the
+    curve by nothing (measured: 0.0 N/m; the knit-knit passages slip)."""
+    depth = {**ONE_CYCLE, "fabric.knit_depth": 0.2e-3}
+    curves = []
+    for beta in (KBETA, IKBETA):
+        curve, contacts = run(run_yarnfort, {**depth, "contact[1].adhesion": beta},
+                              tmp_path / f"beta{beta}")
+        inlay = np.isin(contacts["passage"], inlay_passages(contacts, 2))
+        t_min, t_max = contacts["tension_min"][inlay], contacts["tension_max"][inlay]
+        assert np.any(inlay)
+        # Equal here by equilibrium, not by an identity: to the solve's default
+        # residual tolerance relative to the forces at the node (measured 5.9e-12).
+        assert np.max(np.abs(t_max - t_min) / t_max) < DEFAULT_RESIDUAL_TOLERANCE
+        assert set(contacts["mode"][inlay]) == {"stick"}
+        assert np.any(contacts["mode"][~inlay] != "stick")
+        curves.append(curve)
+    nominal, sticky = curves
+    assert np.array_equal(nominal["time"], sticky["time"])
+    peak = np.max(np.abs(nominal["force_per_width"]))
+    assert np.max(np.abs(sticky["force_per_width"] - nominal["force_per_width"])) \
+        <= ROUND_OFF * peak
