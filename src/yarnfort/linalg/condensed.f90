@@ -13,22 +13,21 @@ module yarnfort_linalg_condensed
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size
+    use yarnfort_linalg_direct, only: direct_solver_type
     implicit none
     private
 
     public :: condensed_solver_type
 
-    !> Eliminates trivial rows, then calls `inner` on the rest.
-    type, extends(linear_solver_type) :: condensed_solver_type
+    !> Eliminates trivial rows, then calls `inner` on the rest. The pattern, the call
+    !> order and the array sizes are checked by direct_solver_type.
+    type, extends(direct_solver_type) :: condensed_solver_type
         !> The solver of the reduced system (owned).
         class(linear_solver_type), allocatable :: inner
         !> Only unknowns first_candidate..n may be eliminated (1-based): the owner knows
         !> which rows can be trivial (the flows); a coordinate row that happens to hold
         !> only its diagonal for one matrix would make the reduced pattern flicker.
         integer(ik) :: first_candidate = 1
-        integer(ik) :: n = 0
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
         !> Reduced index of each unknown (1-based), 0 for an eliminated one; the reduced
         !> pattern and, for each of its entries, the entry of the full matrix.
         integer(ik), allocatable :: reduced(:)
@@ -43,59 +42,43 @@ module yarnfort_linalg_condensed
         !> The last values of the candidate columns (entries col_ptr(first_candidate) + 1
         !> onwards: `solve` moves the eliminated columns to the right-hand side).
         real(wp), allocatable :: values(:)
-        logical :: analysed = .false., inner_analysed = .false., factored = .false.
+        logical :: inner_analysed = .false.
         !> Analyses of the reduced system so far (each set of eliminated unknowns).
         integer :: n_reductions = 0
     contains
-        procedure :: analyse
-        procedure :: factor
-        procedure :: solve
+        procedure :: analyse_pattern
+        procedure :: factor_values
+        procedure :: solve_rhs
         procedure :: destroy
         procedure :: get_name
     end type condensed_solver_type
 
 contains
 
-    subroutine analyse(self, n, col_ptr, row_index, error)
+    !> The candidates' entries of the kept pattern (direct_solver_type checked and kept it).
+    subroutine analyse_pattern(self, error)
         class(condensed_solver_type), intent(inout) :: self
-        integer(ik), intent(in) :: n
-        integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
 
-        call self%destroy()
         if (.not. allocated(self%inner)) then
             call fatal_error(error, self%get_name() // ': no solver for the reduced system')
             return
         end if
-        call check_csc_pattern(self%get_name(), n, col_ptr, row_index, error)
-        if (allocated(error)) return
-        self%n = n
-        self%col_ptr = col_ptr
-        self%row_index = row_index(1:col_ptr(n + 1))
-        allocate(self%reduced(n), source=0_ik)
+        allocate(self%reduced(self%n), source=0_ik)
         self%n_reductions = 0
-        allocate(self%pivot(n), source=0.0_wp)
+        allocate(self%pivot(self%n), source=0.0_wp)
         call find_candidate_entries(self)
-        self%analysed = .true.
-    end subroutine analyse
+    end subroutine analyse_pattern
 
     !> Find the trivial rows of these values, reduce (analysing the reduced pattern
     !> again if the set changed) and factor the reduced matrix.
-    subroutine factor(self, values, error)
+    subroutine factor_values(self, values, error)
         class(condensed_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         logical, allocatable :: trivial(:)
         integer(ik) :: j, k, i, m
 
-        self%factored = .false.
-        if (.not. self%analysed) then
-            call fatal_error(error, self%get_name() // ': factor called before analyse')
-            return
-        end if
-        call check_array_size(self%get_name(), 'values', size(values, kind=ik), &
-            int(size(self%row_index), ik), error, at_least=.true.)
-        if (allocated(error)) return
         ! A candidate row is trivial when its only nonzero value is a nonzero diagonal.
         self%pivot = 0.0_wp
         do j = self%first_candidate, self%n
@@ -120,7 +103,6 @@ contains
             call self%inner%factor(values(self%source), error)
             if (allocated(error)) return
         end if
-        self%factored = .true.
     contains
         !> The reduced pattern: the stored entries whose row and column both stay.
         subroutine reduce(trivial)
@@ -161,24 +143,17 @@ contains
             self%inner_analysed = .false.
             self%n_reductions = self%n_reductions + 1
         end subroutine reduce
-    end subroutine factor
+    end subroutine factor_values
 
     !> Eliminated unknowns from their rows, their columns moved to the right-hand side,
     !> then the reduced system.
-    subroutine solve(self, rhs, error)
+    subroutine solve_rhs(self, rhs, error)
         class(condensed_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: part(:)
         integer(ik) :: j, k, i, offset
 
-        if (.not. self%factored) then
-            call fatal_error(error, self%get_name() &
-                // ': solve called without a valid factorisation')
-            return
-        end if
-        call check_array_size(self%get_name(), 'rhs', size(rhs, kind=ik), self%n, error)
-        if (allocated(error)) return
         offset = self%col_ptr(self%first_candidate)
         do j = self%first_candidate, self%n
             if (self%reduced(j) /= 0) cycle
@@ -198,7 +173,7 @@ contains
         do j = 1, self%n
             if (self%reduced(j) /= 0) rhs(j) = part(self%reduced(j))
         end do
-    end subroutine solve
+    end subroutine solve_rhs
 
     !> The diagonal entries of the candidate columns and the off-diagonal entries of the
     !> candidate rows (first_candidate clipped to 1..n + 1).
@@ -239,12 +214,8 @@ contains
 
         if (allocated(self%inner)) call self%inner%destroy()
         self%inner_analysed = .false.
-        self%analysed = .false.
-        self%factored = .false.
-        self%n = 0
+        call self%forget_pattern()
         self%n_reduced = 0
-        if (allocated(self%col_ptr)) deallocate(self%col_ptr)
-        if (allocated(self%row_index)) deallocate(self%row_index)
         if (allocated(self%reduced)) deallocate(self%reduced)
         if (allocated(self%reduced_col_ptr)) deallocate(self%reduced_col_ptr)
         if (allocated(self%reduced_row_index)) deallocate(self%reduced_row_index)
