@@ -163,13 +163,9 @@ def plot_states() -> None:
     matplotlib.use("Agg")
     from yarnfort.plots import plot_states as draw_states, save_figure
 
-    folder = OUT / "knit3d_states"
-    text = patched_scene("inputs/knit3d.nml", {
-        "path.time": [0.0, 1.0], "path.p_disp": [0.0, 1.0], "solver.max_step": 0.05,
-        "solver.initial_step": 0.05, "output.vtk_every": 1}, folder)
-    proc = subprocess.run([str(EXE)], input=text, capture_output=True, text=True, cwd=TOP)
-    if proc.returncode != 0:
-        raise SystemExit(proc.stderr)
+    folder = run("inputs/knit3d.nml", {"path.time": [0.0, 1.0], "path.p_disp": [0.0, 1.0],
+                                       "solver.initial_step": 0.05}, "knit3d_states",
+                 vtk_every=1)
     figure = draw_states(folder, (0.0, 0.5, 1.0), images=(3, 3), projections=("xy", "3d"),
                          depth_scale=6.0, title="3D knit (knit_depth 0.2 mm), 3 x 3 periodic"
                          " cells: front (x-y) and perspective (depth x 6); computed,"
