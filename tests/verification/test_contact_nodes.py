@@ -24,7 +24,7 @@ from scenes import group
 from test_defaults import (FIRST_LOAD, FORCE_RTOL, POSITION_RTOL, PULL, RING_A, RING_B,
                            RING_LOAD, RING_MU, RING_SIZE, RING_STIFFNESS, YARN_EA,
                            CAPSTAN_PATH, FRICTION_START, admissible_splits, capstan_net,
-                           check_capstan, defaults_namelist, frictionless_ring, run_capstan,
+                           check_capstan, defaults_namelist, frictionless_ring_path, run_capstan,
                            statics_at, stuck_ring)
 from test_friction import LAWS, critical, run_scene
 from yarnfort.results import read_contacts
@@ -178,11 +178,7 @@ def test_frictionless_ring_with_defaults(run_yarnfort, tmp_path, first_load):
     length0 = np.linalg.norm(RING_A - start) + np.linalg.norm(RING_B - start)
     _, curve, states = run_scene(run_yarnfort, tmp_path, "ring",
                                  ring_scene(start, stiffness, 0.0, first_load))
-    rings, tensions = [], []
-    for p in curve["p_force"]:
-        ring, t, _ = frictionless_ring(length0, stiffness, p * RING_LOAD)
-        rings.append(ring)
-        tensions.append(np.array([t, t]))
+    rings, tensions = frictionless_ring_path(length0, stiffness, curve["p_force"])
     errors = ring_errors(curve, states, rings, tensions)
     print(f"frictionless &ring (from {first_load} P): {len(states)} steps, errors "
           f"{', '.join(f'{n} {v:.1e}' for n, v in errors.items())}")

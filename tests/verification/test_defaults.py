@@ -478,6 +478,17 @@ def frictionless_ring(length0: float, stiffness: float, load: float):
     return ring, load / (2.0 * np.cos(theta)), length
 
 
+
+def frictionless_ring_path(length0: float, stiffness: float, p_force):
+    """frictionless_ring at each load factor of a run: the ring positions and the two
+    (equal) tensions per step."""
+    rings, tensions = [], []
+    for p in p_force:
+        ring, t, _ = frictionless_ring(length0, stiffness, p * RING_LOAD)
+        rings.append(ring)
+        tensions.append(np.array([t, t]))
+    return rings, tensions
+
 def lower_intersection(l1: float, l2: float) -> np.ndarray:
     """The lower intersection of the circles of radius l1 about A and l2 about B."""
     e = RING_B - RING_A
@@ -642,11 +653,7 @@ def test_frictionless_ring_with_defaults(run_yarnfort, tmp_path, yarn, first_loa
     length0 = np.linalg.norm(RING_A - start) + np.linalg.norm(RING_B - start)
     curve, states = run_ring(run_yarnfort, tmp_path, "ring", start, stiffness, 0.0,
                              first_load=first_load)
-    rings, tensions = [], []
-    for p in curve["p_force"]:
-        ring, t, _ = frictionless_ring(length0, stiffness, p * RING_LOAD)
-        rings.append(ring)
-        tensions.append(np.array([t, t]))
+    rings, tensions = frictionless_ring_path(length0, stiffness, curve["p_force"])
     errors = ring_errors(curve, states, rings, tensions)
     print(f"frictionless ring ({yarn}, from {first_load} P): {len(states)} steps, errors "
           f"{', '.join(f'{n} {v:.1e}' for n, v in errors.items())}; "
