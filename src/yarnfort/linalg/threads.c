@@ -10,6 +10,16 @@
  *   user set OPENBLAS_NUM_THREADS.
  * The OpenMP and OpenBLAS entry points are looked up in the running process (dlsym), so
  * nothing here needs them at link time and a reference BLAS is left alone.
+ *
+ * OpenBLAS (pthreads build) starts its worker threads when it is loaded, one per core
+ * but the caller's, and each spins (sched_yield) for 2^28 TSC cycles, about 0.1 s, before
+ * it sleeps; openblas_set_num_threads starts them again if they were stopped. On this
+ * 2-core machine that burnt a second core at the start of every process (0.04-0.1 s CPU,
+ * whatever the number of threads). Unless the user set OPENBLAS_NUM_THREADS, the workers
+ * are stopped when this library is loaded (a constructor: it runs after those of the
+ * libraries it depends on) and again right after the policy sets one thread, with
+ * OpenBLAS's own blas_thread_shutdown_ (the call its fork handler makes). OpenBLAS starts
+ * them again at its first multithreaded call, which with one thread never comes.
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -23,6 +33,26 @@ typedef void (*set_int_function)(int);
 
 static int applied = -1;
 
+/* The user's OPENBLAS_NUM_THREADS decides OpenBLAS's threads. */
+static int blas_left_to_user(void)
+{
+    return getenv("OPENBLAS_NUM_THREADS") != NULL;
+}
+
+/* Stop OpenBLAS's worker threads if OpenBLAS is loaded. */
+static void stop_blas_workers(void)
+{
+    typedef int (*shutdown_function)(void);
+    shutdown_function shutdown;
+    shutdown = (shutdown_function) dlsym(RTLD_DEFAULT, "blas_thread_shutdown_");
+    if (shutdown) shutdown();
+}
+
+__attribute__((constructor)) static void stop_blas_workers_at_load(void)
+{
+    if (!blas_left_to_user()) stop_blas_workers();
+}
+
 int yarnfort_apply_thread_policy(int library_openmp, int blas_threads)
 {
     set_int_function set;
@@ -35,10 +65,11 @@ int yarnfort_apply_thread_policy(int library_openmp, int blas_threads)
             applied |= YARNFORT_THREADS_OPENMP;
         }
     }
-    if (blas_threads > 0 && !getenv("OPENBLAS_NUM_THREADS")) {
+    if (blas_threads > 0 && !blas_left_to_user()) {
         set = (set_int_function) dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
         if (set) {
             set(blas_threads);
+            if (blas_threads == 1) stop_blas_workers();
             applied |= YARNFORT_THREADS_OPENBLAS;
         }
     }
