@@ -43,6 +43,9 @@ end module bench_friction_counter
 !>     bench_friction <crossings per side> <monolithic|staggered> [elements per segment
 !>                    [linear solver]] [--skewed] [--steps N] [--no-line-search]
 !>                    [--no-factor-times]
+!>     bench_friction --input <file.nml> <monolithic|staggered> [--steps N] ...
+!> --input: the scene of a namelist input (e.g. benchmarks/knit40.nml; relative file
+!> names in it are read from the working directory) instead of the woven net.
 !> --skewed: every crossing node moved by a small fixed pseudo-random offset (up to 2 %
 !> of the spacing in x and y, 0.01 in z), so that no element is aligned with an axis
 !> (`zeros` in the `factors:` line: the fractions of exact zeros among the stored
@@ -61,8 +64,9 @@ end module bench_friction_counter
 !> Jacobian (final active set) with KLU's AMD and COLAMD orderings and UMFPACK, and the
 !> elastic Jacobian of the same net and state with KLU and yarnfort's CHOLMOD.
 !> Then, when the monolithic solver eliminates stick flows, a line `reduced:` (the
-!> reduced system at the final state, as the `factors:` line, and the reductions per
-!> step), and a line `iteration:`: one Newton iteration of each problem at the final
+!> reduced system at the final state, as the `factors:` line, the reductions per step,
+!> and KLU's predicted flops per factor nonzero with the solver they chose:
+!> yarnfort_linalg_lu_choice), and a line `iteration:`: one Newton iteration of each problem at the final
 !> state with the solvers yarnfort uses, and the cycle's CPU time per step against the
 !> elastic one (write_iterations).
 program bench_friction
@@ -86,6 +90,8 @@ program bench_friction
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
     use yarnfort_linalg_condensed, only: condensed_solver_type
+    use yarnfort_linalg_lu_choice, only: lu_choice_solver_type
+    use yarnfort_input_namelist, only: read_config_from_file, check_config
     implicit none
 
     type(config_type) :: config
@@ -96,6 +102,7 @@ program bench_friction
     real(wp) :: total, start, times(3, 5), cpu_start, cpu_total
     integer :: side, per_segment, factorisations(3), n_positional, k, max_steps
     character(len=32) :: argument, scheme, positional(4)
+    character(len=:), allocatable :: input_file
     logical :: skewed, line_search, time_factors
 
     call get_command_argument(1, argument)
@@ -121,6 +128,11 @@ program bench_friction
             line_search = .false.
         case ('--no-factor-times')
             time_factors = .false.
+        case ('--input')
+            k = k + 1
+            allocate(character(len=4096) :: input_file)
+            call get_command_argument(k, input_file)
+            input_file = trim(input_file)
         case ('--steps')
             k = k + 1
             call get_command_argument(k, argument)
@@ -139,17 +151,30 @@ program bench_friction
             positional(n_positional) = argument
         end select
     end do
-    if (n_positional < 2) then
-        write(error_unit, '(a)') 'bench_friction: need <crossings per side> <scheme>'
-        error stop 2
+    if (allocated(input_file)) then
+        if (n_positional /= 1) then
+            write(error_unit, '(a)') 'bench_friction: need --input <file> <scheme>'
+            error stop 2
+        end if
+        call read_config_from_file(input_file, config, error, from_working_directory=.true.)
+        if (allocated(error)) call fail('bench_friction', error)
+        call check_config(config, error)
+        if (allocated(error)) call fail('bench_friction', error)
+        scheme = positional(1)
+        config%solver%scheme = scheme
+    else
+        if (n_positional < 2) then
+            write(error_unit, '(a)') 'bench_friction: need <crossings per side> <scheme>'
+            error stop 2
+        end if
+        read(positional(1), *) side
+        scheme = positional(2)
+        per_segment = 2
+        if (n_positional >= 3) read(positional(3), *) per_segment
+        call make_woven_net(config, side, per_segment, scheme)
+        if (n_positional >= 4) config%solver%linear_solver = positional(4)
+        if (skewed) call skew_net(config, side)
     end if
-    read(positional(1), *) side
-    scheme = positional(2)
-    per_segment = 2
-    if (n_positional >= 3) read(positional(3), *) per_segment
-    call make_woven_net(config, side, per_segment, scheme)
-    if (n_positional >= 4) config%solver%linear_solver = positional(4)
-    if (skewed) call skew_net(config, side)
     if (max_steps > 0) then
         config%path%time = [0.0_wp, 0.05_wp * max_steps]
         config%path%p_force = [0.0_wp, 0.0_wp]
@@ -225,11 +250,23 @@ contains
             call measure_floor('klu', linear%n_reduced, linear%reduced_col_ptr, &
                 linear%reduced_row_index, values(linear%source), reduced, error)
             if (allocated(error)) call fail('bench_friction', error)
-            write(output_unit, '(a, i0, a, i0, a, f8.2, a, 2(es9.2, a, f8.2, a))') &
+            write(output_unit, '(a, i0, a, i0, a, f8.2, a, 2(es9.2, a, f8.2, a), a)', &
+                advance='no') &
                 'reduced: n ', linear%n_reduced, ' nnz ', size(linear%source), &
                 ' reductions/step ', real(linear%n_reductions, wp) / counter%steps, &
                 ' LU: klu-amd ', reduced%klu_lu, ' (', reduced%klu_ms, ' ms)  umfpack ', &
-                reduced%umfpack_lu, ' (', reduced%umfpack_ms, ' ms)'
+                reduced%umfpack_lu, ' (', reduced%umfpack_ms, ' ms)', ' |'
+            select type (choice => linear%inner)
+            type is (lu_choice_solver_type)
+                write(output_unit, '(a, es9.2, a, es9.2, a, f8.1, a)', advance='no') &
+                    ' predicted flops ', choice%predicted_flops, ' LU ', &
+                    choice%predicted_nonzeros, ' flops/nonzero ', &
+                    choice%predicted_flops / max(1.0_wp, choice%predicted_nonzeros), &
+                    ' -> ' // choice%get_name()
+            class default
+                write(output_unit, '(a)', advance='no') ' ' // choice%get_name()
+            end select
+            write(output_unit, '(a)') ''
         end select
         call new_elastic_problem(problem, scene)
         call scene%passages%get_length0(scene%network%length0, stepper%flow, problem%length0)

@@ -21,7 +21,8 @@ module yarnfort_contact_friction_stepper
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
+    use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
+        chosen_lu_name
     use yarnfort_linalg_condensed, only: condensed_solver_type
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
@@ -50,15 +51,6 @@ module yarnfort_contact_friction_stepper
     !> contact nodes are free) and needed hundreds of rounds per step on inputs/belt.nml;
     !> the monolithic finish converges quadratically to the same fixed point.
     integer, parameter :: finish_after_rounds = 3
-
-    !> Largest order of the monolithic friction Jacobian whose reduced system (stick
-    !> flows eliminated: yarnfort_linalg_condensed) KLU factors; UMFPACK above. The
-    !> reduced system is the elastic tangent bordered by the slipping flows. Measured
-    !> (benchmarks/results-friction-factor.md, woven nets, final active set, CPU ms per
-    !> refactorisation of the reduced system): KLU 0.16 / 1.4 / 7.0 ms against UMFPACK
-    !> 3.8 / 16 / 86 ms at 2.4e3 / 1.1e4 / 3.3e4 unknowns; design.md section 5 has
-    !> UMFPACK ahead of KLU on elastic tangents only at 1e6 (1.49 s against 3.95 s).
-    integer, parameter :: condensed_klu_max_order = 300000
 
     !> Round-off of a reference length locked at its minimum, relative to its initial
     !> length (the lock sets L0 = initial length - flow to the minimum).
@@ -100,8 +92,8 @@ contains
     !> Set up the chosen scheme; `linear_name` is the linear solver for the elastic
     !> solves. The sliding systems are unsymmetric: when `linear_name` is a Cholesky
     !> solver, the flows-only one uses the measured default for unsymmetric systems and
-    !> the monolithic one KLU or UMFPACK by condensed_klu_max_order, else both use
-    !> `linear_name`. The monolithic one first eliminates its stick flows
+    !> the monolithic one KLU or UMFPACK, chosen per reduced pattern (chosen_lu_name),
+    !> else both use `linear_name`. The monolithic one first eliminates its stick flows
     !> (yarnfort_linalg_condensed).
     subroutine new_friction_stepper(self, scene, linear_name, error)
         type(friction_stepper_type), intent(out) :: self
@@ -121,8 +113,7 @@ contains
         full_name = linear_name
         if (linear_name == 'cholmod' .or. linear_name == 'cholmod+klu') then
             general_name = default_linear_solver_name(int(n_p, 8), .false.)
-            full_name = 'umfpack'
-            if (scene%dofs%n_unknowns + n_p <= condensed_klu_max_order) full_name = 'klu'
+            full_name = chosen_lu_name
         end if
         if (self%staggered) then
             allocate(self%elastic, self%sliding)

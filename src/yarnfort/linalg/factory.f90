@@ -10,17 +10,23 @@ module yarnfort_linalg_factory
     use yarnfort_linalg_cholmod, only: cholmod_solver_type
     use yarnfort_linalg_dense, only: dense_solver_type
     use yarnfort_linalg_fallback, only: fallback_solver_type
+    use yarnfort_linalg_lu_choice, only: lu_choice_solver_type
     use yarnfort_linalg_threads, only: apply_thread_policy
     use yarnfort_text, only: to_lower
     implicit none
     private
 
     public :: new_linear_solver, default_linear_solver_name
-    public :: linear_solver_names, klu_max_order
+    public :: linear_solver_names, klu_max_order, chosen_lu_name
 
-    !> Names accepted by `new_linear_solver`.
+    !> Names accepted by `new_linear_solver` (with chosen_lu_name).
     character(len=*), parameter :: linear_solver_names = &
         "'umfpack', 'klu', 'cholmod', 'cholmod+klu', 'dense'"
+
+    !> Name of KLU or UMFPACK chosen per pattern from KLU's predicted cost
+    !> (yarnfort_linalg_lu_choice): the friction stepper's solver of the reduced systems,
+    !> not one of the names offered to users (&solver linear_solver).
+    character(len=*), parameter :: chosen_lu_name = 'klu|umfpack'
 
     !> Largest order for which KLU is the default for unsymmetric or indefinite
     !> systems. Measured on cable-net tangents (benchmarks/bench_newton's floor columns,
@@ -65,6 +71,8 @@ contains
             allocate(cholmod_solver_type :: solver)
         case ('dense')
             allocate(dense_solver_type :: solver)
+        case (chosen_lu_name)
+            allocate(lu_choice_solver_type :: solver)
         case ('cholmod+klu')
             block
                 type(fallback_solver_type), allocatable :: fallback

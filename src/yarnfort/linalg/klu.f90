@@ -15,8 +15,7 @@ module yarnfort_linalg_klu
     use yarnfort_linalg_klu_binding, only: klu_l_common, klu_ok, klu_singular, &
         klu_out_of_memory, klu_invalid, klu_too_large, klu_l_defaults, klu_l_analyze, &
         klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_rcond, klu_l_free_symbolic, &
-        klu_l_numeric_sizes, &
-        klu_l_free_numeric
+        klu_l_numeric_sizes, klu_l_symbolic_estimates, klu_l_free_numeric
     implicit none
     private
 
@@ -53,6 +52,8 @@ module yarnfort_linalg_klu
         procedure :: solve_rhs
         procedure :: destroy
         procedure :: get_name
+        !> AMD's prediction of the factorisation's cost (yarnfort_linalg_lu_choice).
+        procedure :: get_prediction
         final :: finalize
     end type klu_solver_type
 
@@ -173,6 +174,22 @@ contains
         self%symbolic_colamd = c_null_ptr
         call self%forget_pattern()
     end subroutine destroy
+
+    !> Flops of a factorisation and nonzeros of L + U that the AMD ordering of the last
+    !> analysis predicts without pivoting (KLU's factors of the friction Jacobians never
+    !> pivot off the diagonal: benchmarks/results-friction-factor.md); 0 before analyse.
+    subroutine get_prediction(self, flops, factor_nonzeros)
+        class(klu_solver_type), intent(in) :: self
+        real(wp), intent(out) :: flops, factor_nonzeros
+        type(klu_l_symbolic_estimates), pointer :: estimates
+
+        flops = 0.0_wp
+        factor_nonzeros = 0.0_wp
+        if (.not. c_associated(self%symbolic)) return
+        call c_f_pointer(self%symbolic, estimates)
+        flops = estimates%est_flops
+        factor_nonzeros = estimates%lnz + estimates%unz
+    end subroutine get_prediction
 
     pure function get_name(self) result(name)
         class(klu_solver_type), intent(in) :: self

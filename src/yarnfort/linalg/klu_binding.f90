@@ -8,7 +8,7 @@ module yarnfort_linalg_klu_binding
     implicit none
     private
 
-    public :: klu_l_common, klu_l_numeric_sizes
+    public :: klu_l_common, klu_l_numeric_sizes, klu_l_symbolic_estimates
     public :: klu_ok, klu_singular, klu_out_of_memory, klu_invalid, klu_too_large
     public :: klu_l_defaults, klu_l_analyze, klu_l_factor, klu_l_refactor, klu_l_solve
     public :: klu_l_rcond, klu_l_free_symbolic, klu_l_free_numeric
@@ -35,6 +35,14 @@ module yarnfort_linalg_klu_binding
     type, bind(C) :: klu_l_numeric_sizes
         integer(c_long) :: n, nblocks, lnz, unz
     end type klu_l_numeric_sizes
+
+    !> The leading members of `klu_l_symbolic` (klu.h): AMD's predictions for the ordering
+    !> it found (filled for AMD only), summed over the diagonal blocks of the block
+    !> triangular form: symmetry of the largest block, flop count of the factorisation
+    !> and nonzeros of L and U (diagonals included), pivoting on the diagonal.
+    type, bind(C) :: klu_l_symbolic_estimates
+        real(c_double) :: symmetry, est_flops, lnz, unz
+    end type klu_l_symbolic_estimates
 
     interface
         !> Set default parameters; returns TRUE (1) on success.

@@ -1,0 +1,196 @@
+! SPDX-License-Identifier: MIT
+!> Unit tests of the choice between KLU and UMFPACK (yarnfort_linalg_lu_choice): the rule
+!> on KLU's predicted cost, the solver it picks for a chain and for a dense block, the
+!> same pick for the same pattern, and right solutions either way.
+module test_lu_choice
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type
+    use yarnfort_testing, only: unittest_type, new_unittest, check
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_lu_choice, only: lu_choice_solver_type, prefers_umfpack, &
+        umfpack_min_flops_per_nonzero
+    use yarnfort_linalg_factory, only: new_linear_solver, chosen_lu_name
+    implicit none
+    private
+
+    public :: collect_lu_choice
+
+    !> Relative error of x accepted from a backward-stable solve of these diagonally
+    !> dominant systems (condition numbers of a few units).
+    real(wp), parameter :: solution_tol = 1.0e5_wp * epsilon(1.0_wp)
+
+contains
+
+    subroutine collect_lu_choice(testsuite)
+        type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+        testsuite = [ &
+            new_unittest('the rule: flops per factor nonzero', test_rule), &
+            new_unittest('a chain goes to KLU', test_chain), &
+            new_unittest('a dense block goes to UMFPACK', test_dense), &
+            new_unittest('the same pattern, the same choice', test_same_pattern), &
+            new_unittest('calls out of order are errors', test_out_of_order) &
+            ]
+    end subroutine collect_lu_choice
+
+    subroutine test_rule(error)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), parameter :: nonzeros = 1.0e5_wp
+
+        call check(error, prefers_umfpack(umfpack_min_flops_per_nonzero * nonzeros, &
+            nonzeros), 'at the threshold the rule should pick UMFPACK')
+        if (allocated(error)) return
+        call check(error, .not. prefers_umfpack(0.99_wp * umfpack_min_flops_per_nonzero &
+            * nonzeros, nonzeros), 'below the threshold the rule should pick KLU')
+    end subroutine test_rule
+
+    !> An unsymmetric, diagonally dominant matrix of order n in CSC form: a tridiagonal
+    !> chain, or (dense) every entry stored.
+    subroutine test_matrix(n, dense, col_ptr, row_index, values)
+        integer, intent(in) :: n
+        logical, intent(in) :: dense
+        integer(ik), allocatable, intent(out) :: col_ptr(:), row_index(:)
+        real(wp), allocatable, intent(out) :: values(:)
+        integer :: i, j, k
+
+        allocate(col_ptr(n + 1), row_index(n * n), values(n * n))
+        col_ptr(1) = 0
+        k = 0
+        do j = 1, n
+            do i = 1, n
+                if (.not. dense .and. abs(i - j) > 1) cycle
+                k = k + 1
+                row_index(k) = i - 1
+                if (i == j) then
+                    values(k) = 4.0_wp + mod(j, 3)
+                else
+                    values(k) = (0.5_wp + 0.25_wp * mod(i + 2 * j, 3)) / max(1, n / 2) &
+                        * merge(1.0_wp, -1.0_wp, i < j)
+                end if
+            end do
+            col_ptr(j + 1) = k
+        end do
+        row_index = row_index(1:k)
+        values = values(1:k)
+    end subroutine test_matrix
+
+    !> A x for CSC a.
+    function multiply(n, col_ptr, row_index, values, x) result(y)
+        integer, intent(in) :: n
+        integer(ik), intent(in) :: col_ptr(:), row_index(:)
+        real(wp), intent(in) :: values(:), x(:)
+        real(wp) :: y(n)
+        integer :: j
+        integer(ik) :: k
+
+        y = 0.0_wp
+        do j = 1, n
+            do k = col_ptr(j) + 1, col_ptr(j + 1)
+                y(row_index(k) + 1) = y(row_index(k) + 1) + values(k) * x(j)
+            end do
+        end do
+    end function multiply
+
+    !> Analyse, factor and solve the test matrix; `name` is the solver chosen.
+    subroutine choose_and_solve(n, dense, name, error)
+        integer, intent(in) :: n
+        logical, intent(in) :: dense
+        character(len=:), allocatable, intent(out) :: name
+        type(error_type), allocatable, intent(out) :: error
+        class(linear_solver_type), allocatable :: solver
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        real(wp), allocatable :: values(:), x(:), rhs(:)
+        integer :: i
+
+        call new_linear_solver(solver, chosen_lu_name, error)
+        if (allocated(error)) return
+        call test_matrix(n, dense, col_ptr, row_index, values)
+        call solver%analyse(int(n, ik), col_ptr, row_index, error)
+        if (allocated(error)) return
+        name = solver%get_name()
+        call solver%factor(values, error)
+        if (allocated(error)) return
+        x = [(real(mod(i, 7) - 3, wp), i = 1, n)]
+        rhs = multiply(n, col_ptr, row_index, values, x)
+        call solver%solve(rhs, error)
+        if (allocated(error)) return
+        call check(error, maxval(abs(rhs - x)) <= solution_tol * maxval(abs(x)), &
+            name // ': solution differs from the known x')
+    end subroutine choose_and_solve
+
+    !> A chain fills nothing: about 2 flops per factor nonzero.
+    subroutine test_chain(error)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: name
+
+        call choose_and_solve(300, .false., name, error)
+        if (allocated(error)) return
+        call check(error, name == 'klu', 'a chain should go to klu, not ' // name)
+    end subroutine test_chain
+
+    !> A dense block of order n: about 2 n^3 / 3 flops on n^2 nonzeros, so n = 300 is
+    !> twice the threshold.
+    subroutine test_dense(error)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: name
+
+        call choose_and_solve(300, .true., name, error)
+        if (allocated(error)) return
+        call check(error, name == 'umfpack', 'a dense block should go to umfpack, not ' &
+            // name)
+    end subroutine test_dense
+
+    !> Analysing the same pattern again gives the same solver and prediction.
+    subroutine test_same_pattern(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(lu_choice_solver_type) :: solver
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        real(wp), allocatable :: values(:)
+        character(len=:), allocatable :: first
+        real(wp) :: flops
+        integer :: k
+
+        call test_matrix(120, .true., col_ptr, row_index, values)
+        do k = 1, 3
+            call solver%analyse(120_ik, col_ptr, row_index, error)
+            if (allocated(error)) return
+            if (k == 1) then
+                first = solver%get_name()
+                flops = solver%predicted_flops
+                call check(error, flops > 0.0_wp, 'no predicted flops after analyse')
+                if (allocated(error)) return
+            else
+                call check(error, solver%get_name() == first .and. &
+                    solver%predicted_flops == flops, 'a second analysis chose differently')
+                if (allocated(error)) return
+            end if
+        end do
+        call solver%destroy()
+    end subroutine test_same_pattern
+
+    subroutine test_out_of_order(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(lu_choice_solver_type) :: solver
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        real(wp), allocatable :: values(:)
+        real(wp) :: rhs(10)
+        logical :: failed
+
+        rhs = 1.0_wp
+        call test_matrix(10, .false., col_ptr, row_index, values)
+        call solver%factor(values, error)
+        failed = allocated(error)
+        call check(error, failed, 'factor before analyse should fail')
+        if (allocated(error)) return
+        call solver%solve(rhs, error)
+        failed = allocated(error)
+        call check(error, failed, 'solve before factor should fail')
+        if (allocated(error)) return
+        call solver%analyse(10_ik, col_ptr, row_index, error)
+        if (allocated(error)) return
+        call solver%solve(rhs, error)
+        failed = allocated(error)
+        call check(error, failed, 'solve after analyse only should fail')
+    end subroutine test_out_of_order
+
+end module test_lu_choice
