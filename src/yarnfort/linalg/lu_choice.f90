@@ -18,6 +18,13 @@ module yarnfort_linalg_lu_choice
     public :: lu_choice_solver_type, prefers_umfpack, umfpack_min_flops_per_nonzero
 
     !> UMFPACK is chosen when KLU's predicted flops per nonzero of L + U reach this.
+    !> Measured on the reduced friction systems (benchmarks/results-lu-choice.md, CPU
+    !> time of UMFPACK's numeric factorisation over KLU's refactorisation, same matrix):
+    !> 6-9 at 6-11 flops per nonzero (woven nets, 1e3-1e4 unknowns), 2.0 at 32 (woven,
+    !> 1e5), 0.85-1.9 at 62-80 (knit, 20 x 20 loops), 0.37-0.73 at 119-165 (knit,
+    !> 40 x 40), 0.4-1.0 at 127 (woven, 1e6). Whole runs cross near 80-90, where the two
+    !> are within 10 %; the threshold sits above that because UMFPACK also costs memory
+    !> and system time (a new Numeric object, freshly mapped, at every factorisation).
     real(wp), parameter :: umfpack_min_flops_per_nonzero = 100.0_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks
