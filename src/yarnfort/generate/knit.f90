@@ -170,19 +170,17 @@ contains
         integer, intent(in) :: ends(2), foot_left(:), foot_right(:), head_left(:)
         integer, intent(in) :: head_right(:), leg_left(:), leg_right(:)
         logical, intent(in) :: inlaid
-        integer, allocatable :: course(:)
         integer :: i
 
-        course = [ends(1)]
-        do i = 1, size(foot_left)
-            course = [course, foot_left(i)]
-            if (inlaid) course = [course, leg_left(i)]
-            course = [course, head_left(i), head_right(i)]
-            if (inlaid) course = [course, leg_right(i)]
-            course = [course, foot_right(i)]
-        end do
-        course = [course, ends(2)]
-        call net%add_yarn(fabric%knit_material, course, fabric%elements_per_segment)
+        if (inlaid) then
+            call net%add_yarn(fabric%knit_material, [ends(1), (foot_left(i), leg_left(i), &
+                head_left(i), head_right(i), leg_right(i), foot_right(i), &
+                i = 1, size(foot_left)), ends(2)], fabric%elements_per_segment)
+        else
+            call net%add_yarn(fabric%knit_material, [ends(1), (foot_left(i), head_left(i), &
+                head_right(i), foot_right(i), i = 1, size(foot_left)), ends(2)], &
+                fabric%elements_per_segment)
+        end if
     end subroutine add_course
 
     !> The inlay yarn of a course, from `ends(1)` through its crossings of the loops'
@@ -191,15 +189,10 @@ contains
         type(fabric_config_type), intent(in) :: fabric
         type(net_builder_type), intent(inout) :: net
         integer, intent(in) :: ends(2), left(:), right(:)
-        integer, allocatable :: inlay(:)
         integer :: i
 
-        inlay = [ends(1)]
-        do i = 1, size(left)
-            inlay = [inlay, left(i), right(i)]
-        end do
-        inlay = [inlay, ends(2)]
-        call net%add_yarn(fabric%inlay_material, inlay, fabric%elements_per_segment)
+        call net%add_yarn(fabric%inlay_material, [ends(1), (left(i), right(i), &
+            i = 1, size(left)), ends(2)], fabric%elements_per_segment)
     end subroutine add_inlay
 
     !> A clamped knit: the course (and inlay) ends `left` held, those at the right edge

@@ -24,10 +24,11 @@
 module yarnfort_output_vtk
     use, intrinsic :: iso_fortran_env, only: int8, int32, int64
     use yarnfort_kinds, only: wp
-    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_error, only: error_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
-    use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked
+    use yarnfort_output_filesystem, only: rename_file, remove_file, open_new_file, &
+        close_new_file
     use yarnfort_text, only: format_integer
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
     implicit none
@@ -268,27 +269,17 @@ contains
         if (present(atomic)) through_temporary = atomic
         target = path
         if (through_temporary) target = path // '.tmp'
-        message = ''
-        open(newunit=unit, file=target, access='stream', form='unformatted', &
-            status='replace', action='write', iostat=status, iomsg=message)
-        if (status == 0) then
-            write(unit, iostat=status, iomsg=message) text
-            if (status == 0) then
-                call close_checked(unit, target, error)
-            else
-                close(unit)
-            end if
-        end if
-        if (status /= 0) call fatal_error(error, "cannot write '" // target // "': " &
-            // trim(message))
+        call open_new_file(unit, target, error, stream=.true.)
         if (allocated(error)) then
             call remove_file(target, ignored)
             return
         end if
-        if (through_temporary) then
-            call rename_file(target, path, error)
-            if (allocated(error)) call remove_file(target, ignored)
-        end if
+        message = ''
+        write(unit, iostat=status, iomsg=message) text
+        call close_new_file(unit, target, error, status, message)
+        if (allocated(error) .or. .not. through_temporary) return
+        call rename_file(target, path, error)
+        if (allocated(error)) call remove_file(target, ignored)
     end subroutine write_text_file
 
     subroutine add_text(vtu, text)
