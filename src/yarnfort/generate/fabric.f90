@@ -72,12 +72,9 @@ contains
                 call require_range(error, 'lateral_strain', fabric%lateral_strain, -0.9_wp, &
                     100.0_wp)
                 if (allocated(error)) return
-                if (fabric%elements_per_segment < 1 .or. fabric%elements_per_segment > 1000) then
-                    write(buffer, '(a, "elements_per_segment = ", i0, " must lie in [1, ", &
-                        & "1000]")') label, fabric%elements_per_segment
-                    call fatal_error(error, trim(buffer))
-                    return
-                end if
+                call require_count(error, 'elements_per_segment', fabric%elements_per_segment, &
+                    1, 1000)
+                if (allocated(error)) return
                 call forbid_depth(error)
                 if (allocated(error)) return
                 call check_texgen(error)
@@ -104,12 +101,8 @@ contains
                 call fatal_error(error, trim(buffer))
                 return
             end if
-            if (fabric%elements_per_segment < 1) then
-                write(buffer, '(a, "elements_per_segment = ", i0, " must be at least 1")') &
-                    label, fabric%elements_per_segment
-                call fatal_error(error, trim(buffer))
-                return
-            end if
+            call require_count(error, 'elements_per_segment', fabric%elements_per_segment, 1)
+            if (allocated(error)) return
 
             call forbid_name(error, 'texgen_file', fabric%texgen_file)
             if (allocated(error)) return
@@ -141,12 +134,8 @@ contains
                     call require_range(error, 'inlay_offset', fabric%inlay_offset, 0.05_wp, &
                         0.95_wp)
                     if (allocated(error)) return
-                    if (fabric%inlay_every < 1) then
-                        write(buffer, '(a, "inlay_every = ", i0, " must be at least 1")') &
-                            label, fabric%inlay_every
-                        call fatal_error(error, trim(buffer))
-                        return
-                    end if
+                    call require_count(error, 'inlay_every', fabric%inlay_every, 1)
+                    if (allocated(error)) return
                 end if
                 call forbid_woven_materials(error)
                 if (allocated(error)) return
@@ -198,6 +187,24 @@ contains
                 label, variable, value, low, high
             call fatal_error(error, trim(buffer))
         end subroutine require_range
+
+        !> An integer in [low, high], or at least `low` without `high`.
+        subroutine require_count(error, variable, value, low, high)
+            type(error_type), allocatable, intent(out) :: error
+            character(len=*), intent(in) :: variable
+            integer, intent(in) :: value, low
+            integer, intent(in), optional :: high
+            if (present(high)) then
+                if (value >= low .and. value <= high) return
+                write(buffer, '(a, a, " = ", i0, " must lie in [", i0, ", ", i0, "]")') &
+                    label, variable, value, low, high
+            else
+                if (value >= low) return
+                write(buffer, '(a, a, " = ", i0, " must be at least ", i0)') label, variable, &
+                    value, low
+            end if
+            call fatal_error(error, trim(buffer))
+        end subroutine require_count
 
         subroutine require_material(error, variable, name, required)
             type(error_type), allocatable, intent(out) :: error
@@ -251,12 +258,8 @@ contains
                 call require_range(error, 'texgen_contact_tolerance', &
                     fabric%texgen_contact_tolerance, 0.0_wp, 1.0_wp)
                 if (allocated(error)) return
-                if (fabric%texgen_samples < 2 .or. fabric%texgen_samples > 1000) then
-                    write(buffer, '(a, "texgen_samples = ", i0, " must lie in [2, 1000]")') &
-                        label, fabric%texgen_samples
-                    call fatal_error(error, trim(buffer))
-                    return
-                end if
+                call require_count(error, 'texgen_samples', fabric%texgen_samples, 2, 1000)
+                if (allocated(error)) return
                 call forbid_knit_materials(error)
                 if (allocated(error)) return
                 call forbid_woven_materials(error)

@@ -455,18 +455,15 @@ contains
         end if
         if (allocated(config%materials)) then
             do m = 1, size(config%materials)
-                if (len_trim(config%materials(m)%table_file) > 0) call add_file( &
-                    resolve_path(config%materials(m)%table_file, config%input_folder))
+                call add_named_file(config%materials(m)%table_file)
             end do
         end if
         if (allocated(config%contacts)) then
             do m = 1, size(config%contacts)
-                if (len_trim(config%contacts(m)%rate_table) > 0) call add_file( &
-                    resolve_path(config%contacts(m)%rate_table, config%input_folder))
+                call add_named_file(config%contacts(m)%rate_table)
             end do
         end if
-        if (len_trim(config%geometry%file) > 0) &
-            call add_file(resolve_path(config%geometry%file, config%input_folder))
+        call add_named_file(config%geometry%file)
         call add_bytes(transfer(scene%network%position, [0_int8]))
         call add_bytes(transfer(scene%network%element_nodes, [0_int8]))
         call add_bytes(transfer(scene%network%length0, [0_int8]))
@@ -482,10 +479,12 @@ contains
             call add_hash_bytes(state, bytes)
         end subroutine add_bytes
 
-        subroutine add_file(path)
-            character(len=*), intent(in) :: path
-            call add_file_bytes(state, path)
-        end subroutine add_file
+        !> The content of a file the input names (nothing for a blank name).
+        subroutine add_named_file(name)
+            character(len=*), intent(in) :: name
+            if (len_trim(name) > 0) &
+                call add_file_bytes(state, resolve_path(name, config%input_folder))
+        end subroutine add_named_file
     end function get_input_hash
 
     !> Add `bytes` to the two 32-bit FNV-1a-like hashes of `state`.
