@@ -11,7 +11,7 @@ module yarnfort_input_channel_checks
     use yarnfort_input_config, only: config_type, path_config_type, name_length
     use yarnfort_input_fields, only: check_name, quoted_list
     use yarnfort_input_network_checks, only: check_defined
-    use yarnfort_text, only: format_integer
+    use yarnfort_text, only: format_integer, parse_integer
     implicit none
     private
 
@@ -120,63 +120,51 @@ contains
             end if
             ! A config built in code (tests, benchmarks) may leave factors unallocated.
             if (.not. given) then
-                if (n_factors(path) > 0) then
-                    call fatal_error(error, '&path: factors is given but channels is not ' &
-                        // '(factors are the columns of the channels that channels names; ' &
-                        // 'without channels give p_force and p_disp)')
-                    return
-                end if
-            else
-                if (len_trim(config%fabric%kind) > 0) then
-                    call fatal_error(error, '&path: channels is given with &fabric (a ' &
-                        // "generated fabric is driven by the channels 'p_force' and " &
-                        // "'p_disp': give p_force and p_disp instead)")
-                    return
-                end if
-                if (any(path%p_force /= 0.0_wp) .or. any(path%p_disp /= 0.0_wp)) then
-                    call fatal_error(error, '&path: p_force or p_disp is set together with ' &
-                        // 'channels (with channels every factor comes from factors: give ' &
-                        // "'p_force' / 'p_disp' as channel names if you want them)")
-                    return
-                end if
-                if (n_factors(path) /= n * n_knots) then
-                    call fatal_error(error, '&path: factors has ' &
-                        // format_integer(n_factors(path)) // ' values but the ' &
-                        // format_integer(n) // ' channels (' // quoted_list(path%channels(:n)) &
-                        // ') at ' // format_integer(n_knots) // ' knots need ' &
-                        // format_integer(n * n_knots) // ' (one row per knot, one value per ' &
-                        // 'channel)')
-                    return
-                end if
-                do k = 1, n
-                    call check_name(error, '&path channels(' // format_integer(k) // ')', &
-                        path%channels(k))
-                    if (allocated(error)) return
-                    j = findloc(path%channels(:k - 1), path%channels(k), dim=1)
-                    if (j > 0) then
-                        call fatal_error(error, "&path: channel '" // trim(path%channels(k)) &
-                            // "' is named twice (channels(" // format_integer(j) &
-                            // ') and channels(' // format_integer(k) // '))')
-                        return
-                    end if
-                    if (any(fixed_curve_columns == path%channels(k))) then
-                        call fatal_error(error, '&path: channels(' // format_integer(k) &
-                            // ") = '" // trim(path%channels(k)) // "' is the name of " &
-                            // 'another column of curve.csv (' &
-                            // quoted_list(fixed_curve_columns) // '): choose another name')
-                        return
-                    end if
-                end do
+                if (n_factors(path) > 0) call fatal_error(error, '&path: factors is given ' &
+                    // 'but channels is not (factors are the columns of the channels that ' &
+                    // 'channels names; without channels give p_force and p_disp)')
+            else if (len_trim(config%fabric%kind) > 0) then
+                call fatal_error(error, '&path: channels is given with &fabric (a generated ' &
+                    // "fabric is driven by the channels 'p_force' and 'p_disp': give " &
+                    // 'p_force and p_disp instead)')
+            else if (any(path%p_force /= 0.0_wp) .or. any(path%p_disp /= 0.0_wp)) then
+                call fatal_error(error, '&path: p_force or p_disp is set together with ' &
+                    // 'channels (with channels every factor comes from factors: give ' &
+                    // "'p_force' / 'p_disp' as channel names if you want them)")
+            else if (n_factors(path) /= n * n_knots) then
+                call fatal_error(error, '&path: factors has ' // format_integer(n_factors(path)) &
+                    // ' values but the ' // format_integer(n) // ' channels (' &
+                    // quoted_list(path%channels(:n)) // ') at ' // format_integer(n_knots) &
+                    // ' knots need ' // format_integer(n * n_knots) // ' (one row per ' &
+                    // 'knot, one value per channel)')
             end if
+            if (allocated(error)) return
+            do k = 1, n
+                call check_name(error, '&path channels(' // format_integer(k) // ')', &
+                    path%channels(k))
+                if (allocated(error)) return
+                j = findloc(path%channels(:k - 1), path%channels(k), dim=1)
+                if (j > 0) then
+                    call fatal_error(error, "&path: channel '" // trim(path%channels(k)) &
+                        // "' is named twice (channels(" // format_integer(j) &
+                        // ') and channels(' // format_integer(k) // '))')
+                    return
+                end if
+                if (any(fixed_curve_columns == path%channels(k))) then
+                    call fatal_error(error, '&path: channels(' // format_integer(k) // ") = '" &
+                        // trim(path%channels(k)) // "' is the name of another column of " &
+                        // 'curve.csv (' // quoted_list(fixed_curve_columns) // '): choose ' &
+                        // 'another name')
+                    return
+                end if
+            end do
         end associate
         names = get_channel_names(config%path)
         if (allocated(config%loads)) then
             do k = 1, size(config%loads)
-                associate(load => config%loads(k))
-                    call check_one('&load #' // format_integer(k), load%channel, &
-                        default_force_channel, any(load%force /= 0.0_wp), 'force')
-                    if (allocated(error)) return
-                end associate
+                call check_one('&load #' // format_integer(k), config%loads(k)%channel, &
+                    default_force_channel, any(config%loads(k)%force /= 0.0_wp), 'force')
+                if (allocated(error)) return
             end do
         end if
         if (allocated(config%supports)) then
@@ -261,18 +249,15 @@ contains
         !> k if `text` is load_column_prefix(k) of an existing &load, else 0.
         integer function load_number(text)
             character(len=*), intent(in) :: text
-            integer :: status
+            logical :: ok
 
             load_number = 0
-            if (len(text) < 6) return
-            if (text(:5) /= 'load_') return
-            if (verify(text(6:), '0123456789') /= 0) return
-            read(text(6:), *, iostat=status) load_number
-            if (status /= 0) load_number = 0
-            if (load_number < 1 .or. load_number > n_loads) then
+            if (index(text, 'load_') /= 1) return
+            call parse_integer(text(6:), load_number, ok)
+            if (.not. ok .or. load_number < 1 .or. load_number > n_loads) then
                 load_number = 0
             else if (load_column_prefix(load_number) /= text) then
-                load_number = 0          ! 'load_01' is no column name
+                load_number = 0          ! 'load_01' or 'load_+1' is no column name
             end if
         end function load_number
     end subroutine check_curve_columns

@@ -86,18 +86,14 @@ contains
     pure integer function find_node_contact(config, name, material) result(contact)
         type(config_type), intent(in) :: config
         character(len=*), intent(in) :: name, material
-        integer :: c
 
         contact = 0
         if (.not. allocated(config%contacts)) return
-        do c = 1, size(config%contacts)
-            if (config%contacts(c)%at /= name) cycle
-            if (config%contacts(c)%materials(1) == material) then
-                contact = c
-                return
-            end if
-            if (len_trim(config%contacts(c)%materials(1)) == 0) contact = c
-        end do
+        associate(at => config%contacts%at, first => config%contacts%materials(1))
+            contact = findloc(at == name .and. first == material, .true., dim=1)
+            if (contact == 0) contact = findloc(at == name .and. first == '', .true., dim=1, &
+                back=.true.)
+        end associate
     end function find_node_contact
 
     !> &obstacle and &ring groups: named (one word, unique among obstacles, rings and

@@ -49,9 +49,9 @@ contains
         if (bad(2) == 0) return
         associate(k => bad(1), n => bad(2))
             if (len_trim(config%geometry%file) > 0) then
-                call fatal_error(error, "&geometry: file '" // trim(config%geometry%file) &
-                    // "': node " // format_integer(n) // ' ' // axis(k) // ' = ' &
-                    // format_real(config%node_positions(k, n)) // ' is not finite')
+                call fatal_error(error, node_source(config) // ': node ' // format_integer(n) &
+                    // ' ' // axis(k) // ' = ' // format_real(config%node_positions(k, n)) &
+                    // ' is not finite')
             else
                 call fatal_error(error, '&nodes: xyz(' // format_integer(3 * (n - 1) + k) &
                     // ') = ' // format_real(config%node_positions(k, n)) // ' (node ' &
@@ -339,7 +339,9 @@ contains
         type(config_type), intent(in) :: config
         integer, allocatable, intent(out) :: owner(:, :)
         type(error_type), allocatable, intent(out) :: error
-        integer :: s, k, i
+        integer :: s, k, i, node
+        !> The components that the support prescribes.
+        logical :: fixed(3)
         character(len=:), allocatable :: label
         character(len=24), allocatable :: labels(:)
 
@@ -356,8 +358,8 @@ contains
                 if (allocated(error)) return
                 call check_support_variables(support, label, error)
                 if (allocated(error)) return
-                k = findloc(support%displacement /= 0.0_wp .and. index(support%fix, axis) == 0, &
-                    .true., dim=1)
+                fixed = index(support%fix, axis) > 0
+                k = findloc(support%displacement /= 0.0_wp .and. .not. fixed, .true., dim=1)
                 if (k > 0) then
                     call fatal_error(error, label // ': displacement(' // format_integer(k) &
                         // ') = ' // format_real(support%displacement(k)) // ' but ' &
@@ -368,19 +370,15 @@ contains
                 call check_node_list(error, label, support%nodes, size(owner, 2))
                 if (allocated(error)) return
                 do i = 1, size(support%nodes)
-                    associate(owners => owner(:, support%nodes(i)))
-                        do k = 1, 3
-                            if (index(support%fix, axis(k)) == 0) cycle
-                            if (owners(k) /= 0) then
-                                call fatal_error(error, label // ': node ' &
-                                    // format_integer(support%nodes(i)) // ' ' // axis(k) &
-                                    // " is already prescribed by &support '" &
-                                    // trim(config%supports(owners(k))%name) // "'")
-                                return
-                            end if
-                            owners(k) = s
-                        end do
-                    end associate
+                    node = support%nodes(i)
+                    k = findloc(fixed .and. owner(:, node) /= 0, .true., dim=1)
+                    if (k > 0) then
+                        call fatal_error(error, label // ': node ' // format_integer(node) &
+                            // ' ' // axis(k) // " is already prescribed by &support '" &
+                            // trim(config%supports(owner(k, node))%name) // "'")
+                        return
+                    end if
+                    where (fixed) owner(:, node) = s
                 end do
             end associate
         end do
