@@ -133,16 +133,15 @@ contains
                 end if
                 call check_node_list(error, set_label(set), set%nodes, n_nodes)
                 if (allocated(error)) return
-                do i = 1, size(set%nodes)
-                    if (set_of(set%nodes(i)) /= 0) then
-                        call fatal_error(error, set_label(set) // ': node ' &
-                            // format_integer(set%nodes(i)) // ' is already a node of ' &
-                            // set_label(sets(set_of(set%nodes(i)))) &
-                            // ' (a node is one obstacle or one ring)')
-                        return
-                    end if
-                    set_of(set%nodes(i)) = s
-                end do
+                i = findloc(set_of(set%nodes) /= 0, .true., dim=1)
+                if (i > 0) then
+                    call fatal_error(error, set_label(set) // ': node ' &
+                        // format_integer(set%nodes(i)) // ' is already a node of ' &
+                        // set_label(sets(set_of(set%nodes(i)))) &
+                        // ' (a node is one obstacle or one ring)')
+                    return
+                end if
+                set_of(set%nodes) = s
             end associate
         end do
         ! Every yarn passes through the contact nodes it lists; every one has a yarn.

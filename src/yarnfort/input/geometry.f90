@@ -70,11 +70,9 @@ contains
                 line_number = line_number + 1
                 if (index(line, '#') > 0) line = line(:index(line, '#') - 1)
                 line = trim(line)
-                if (len(line) > 0) then
-                    if (line(len(line):len(line)) == '&') then
-                        record = record // ' ' // line(:len(line) - 1)
-                        cycle
-                    end if
+                if (len(line) > 0 .and. index(line, '&', back=.true.) == len(line)) then
+                    record = record // ' ' // line(:len(line) - 1)
+                    cycle
                 end if
                 record = record // ' ' // line
                 exit
