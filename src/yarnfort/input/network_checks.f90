@@ -81,6 +81,8 @@ contains
         !> Elements and new nodes of the yarns so far (elements_per_segment may be large).
         integer(int64) :: n_elements, n_new_nodes
         logical, allocatable :: used(:)
+        !> The yarn with its unset per-element lists empty.
+        type(yarn_config_type) :: listed
         real(wp) :: scale
         character(len=:), allocatable :: label
         character(len=80) :: counts
@@ -108,7 +110,8 @@ contains
                     config%materials%name, 'defined by any &material', 'defined')
                 if (allocated(error)) return
                 ! Yarns of a geometry file or a generator may leave the lists unset.
-                call check_yarn_variables(with_lists(yarn), label, error)
+                listed = with_lists(yarn)
+                call check_yarn_variables(listed, label, error)
                 if (allocated(error)) return
                 if (size(yarn%nodes) < 2) then
                     call fatal_error(error, label // ': nodes has ' &
@@ -116,7 +119,7 @@ contains
                         // ' node id(s); a yarn needs at least 2')
                     return
                 end if
-                call check_element_lengths(config, y, label, error)
+                call check_element_lengths(config, listed, label, error)
                 if (allocated(error)) return
                 n_elements = n_elements + (size(yarn%nodes) - 1) &
                     * int(yarn%elements_per_segment, int64)
@@ -177,60 +180,53 @@ contains
         if (.not. allocated(copy%stretch)) allocate(copy%stretch(0))
     end function with_lists
 
-    !> Per-element reference lengths of yarn y (`length0` or `stretch`): one value per
-    !> element, not both, and not on a yarn whose material has a prestress (which would
-    !> set the same lengths another way). Their ranges (> 0) are checked with the group.
-    subroutine check_element_lengths(config, y, label, error)
+    !> Per-element reference lengths of a yarn (`length0` or `stretch`, both allocated):
+    !> one value per element, not both, and not on a yarn whose material has a prestress
+    !> (which would set the same lengths another way). Their ranges (> 0) are checked
+    !> with the group.
+    subroutine check_element_lengths(config, yarn, label, error)
         type(config_type), intent(in) :: config
-        integer, intent(in) :: y
+        type(yarn_config_type), intent(in) :: yarn
         character(len=*), intent(in) :: label
         type(error_type), allocatable, intent(out) :: error
         integer(int64) :: n_elements
         integer :: n_values
         character(len=:), allocatable :: name
 
-        associate(yarn => config%yarns(y))
-            if (is_given(yarn%length0) .and. is_given(yarn%stretch)) then
-                call fatal_error(error, label // ': length0 and stretch are both given ' &
-                    // '(each sets the reference lengths of the elements: give one)')
-                return
+        if (size(yarn%length0) > 0 .and. size(yarn%stretch) > 0) then
+            call fatal_error(error, label // ': length0 and stretch are both given ' &
+                // '(each sets the reference lengths of the elements: give one)')
+            return
+        end if
+        if (size(yarn%length0) > 0) then
+            name = 'length0'
+            n_values = size(yarn%length0)
+        else if (size(yarn%stretch) > 0) then
+            name = 'stretch'
+            n_values = size(yarn%stretch)
+        else
+            return
+        end if
+        n_elements = (size(yarn%nodes) - 1) * int(yarn%elements_per_segment, int64)
+        if (n_values /= n_elements) then
+            call fatal_error(error, label // ': ' // name // ' has ' &
+                // format_integer(n_values) // ' values but the yarn has ' &
+                // format_integer(int(n_elements)) // ' elements (' &
+                // format_integer(size(yarn%nodes) - 1) // ' segments of ' &
+                // format_integer(yarn%elements_per_segment) &
+                // '): give one value per element, in order along the yarn')
+            return
+        end if
+        ! The material is defined (checked before).
+        associate(material => config%materials(findloc(config%materials%name, &
+                yarn%material, dim=1)))
+            if (material%prestress > 0.0_wp) then
+                call fatal_error(error, label // ': ' // name // " is given, but its " &
+                    // "material '" // trim(yarn%material) // "' has prestress = " &
+                    // format_real(material%prestress) // ' (both set the ' &
+                    // 'reference lengths: give one)')
             end if
-            if (is_given(yarn%length0)) then
-                name = 'length0'
-                n_values = size(yarn%length0)
-            else if (is_given(yarn%stretch)) then
-                name = 'stretch'
-                n_values = size(yarn%stretch)
-            else
-                return
-            end if
-            n_elements = (size(yarn%nodes) - 1) * int(yarn%elements_per_segment, int64)
-            if (n_values /= n_elements) then
-                call fatal_error(error, label // ': ' // name // ' has ' &
-                    // format_integer(n_values) // ' values but the yarn has ' &
-                    // format_integer(int(n_elements)) // ' elements (' &
-                    // format_integer(size(yarn%nodes) - 1) // ' segments of ' &
-                    // format_integer(yarn%elements_per_segment) &
-                    // '): give one value per element, in order along the yarn')
-                return
-            end if
-            ! The material is defined (checked before).
-            associate(material => config%materials(findloc(config%materials%name, &
-                    yarn%material, dim=1)))
-                if (material%prestress > 0.0_wp) then
-                    call fatal_error(error, label // ': ' // name // " is given, but its " &
-                        // "material '" // trim(yarn%material) // "' has prestress = " &
-                        // format_real(material%prestress) // ' (both set the ' &
-                        // 'reference lengths: give one)')
-                end if
-            end associate
         end associate
-    contains
-        pure logical function is_given(values)
-            real(wp), allocatable, intent(in) :: values(:)
-            is_given = allocated(values)
-            if (is_given) is_given = size(values) > 0
-        end function is_given
     end subroutine check_element_lengths
 
     !> No two segments, of one yarn or of two, join the same two nodes: their elements
