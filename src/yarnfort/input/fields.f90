@@ -15,7 +15,7 @@ module yarnfort_input_fields
     private
 
     public :: max_list, max_coordinates, indent
-    public :: post_read_error, group_label, take_scalar, take_array, list_length
+    public :: group_label, take_scalar, take_array, list_length
     public :: check_range, check_choice, check_law_parameter
     public :: suggestion, quoted_list, check_name, check_item_name, put, put_list
 
@@ -31,24 +31,6 @@ module yarnfort_input_fields
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
 
 contains
-
-    !> An error of a group found after reading it, with the group's line.
-    subroutine post_read_error(error, scan, name, occurrence, text)
-        type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: occurrence
-        character(len=*), intent(in) :: text
-        integer :: g
-
-        g = scan%find_group(name, max(occurrence, 1))
-        if (g == 0) then
-            call fatal_error(error, group_label(name, occurrence) // ': ' // text)
-        else
-            call fatal_error(error, group_label(name, occurrence) // ': ' // text &
-                // ' (group on line ' // format_integer(scan%groups(g)%first_line) // ')')
-        end if
-    end subroutine post_read_error
 
     !> Scalar variable `name` of group `label` (real(wp), integer, logical or character,
     !> folded to lower case if `lower`, leading blanks dropped if `adjust`) from its

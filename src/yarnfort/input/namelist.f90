@@ -17,8 +17,7 @@ module yarnfort_input_namelist
         read_fabric_groups, read_nodes_groups, read_geometry_groups, read_yarn_groups, &
         read_support_groups, read_load_groups, read_path_groups, read_output_groups, &
         read_obstacle_groups, read_ring_groups, apply_solver_preset
-    use yarnfort_input_fields, only: max_list, max_coordinates, &
-        post_read_error
+    use yarnfort_input_fields, only: max_list, max_coordinates
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
     use yarnfort_input_geometry, only: read_geometry_file
     use yarnfort_text, only: format_integer, folder_of, resolve_path, open_to_read
@@ -84,16 +83,16 @@ contains
         if (allocated(error)) return
 
         if (len_trim(config%geometry%file) > 0) then
-            if (scan%count_group('nodes') > 0) then
-                call fatal_error(error, '&nodes: not allowed together with &geometry file = ' &
-                    // "'" // trim(config%geometry%file) // "' (the file gives the nodes)")
-                return
-            end if
-            if (scan%count_group('yarn') > 0) then
-                call fatal_error(error, '&yarn: not allowed together with &geometry file = ' &
-                    // "'" // trim(config%geometry%file) // "' (the file gives the yarns)")
-                return
-            end if
+            do k = 1, 2
+                name = trim(merge('nodes', 'yarn ', k == 1))
+                if (scan%count_group(name) > 0) then
+                    call fatal_error(error, '&' // name // ': not allowed together with ' &
+                        // "&geometry file = '" // trim(config%geometry%file) &
+                        // "' (the file gives the " // trim(merge('nodes', 'yarns', k == 1)) &
+                        // ')')
+                    return
+                end if
+            end do
             call read_geometry_file(resolve_path(config%geometry%file, config%input_folder), &
                 config%node_positions, config%yarns, error)
             if (allocated(error)) return
@@ -135,8 +134,7 @@ contains
         call read_fabric_groups(scan, config%fabric, error)
         if (allocated(error)) return
         if (scan%count_group('fabric') > 0 .and. len_trim(config%fabric%kind) == 0) then
-            call post_read_error(error, scan, 'fabric', 0, &
-                "kind is required (knit, plain or twill)")
+            call post_read_error(error, scan, 'fabric', 'kind is required (knit, plain or twill)')
             return
         end if
         if (.not. allocated(config%fabric%gap_factor)) allocate(config%fabric%gap_factor(0))
@@ -147,7 +145,7 @@ contains
         if (allocated(nodes%xyz)) then
             n = size(nodes%xyz)
             if (mod(n, 3) /= 0) then
-                call post_read_error(error, scan, 'nodes', 0, 'xyz has ' // format_integer(n) &
+                call post_read_error(error, scan, 'nodes', 'xyz has ' // format_integer(n) &
                     // ' values, not a multiple of 3 (x, y, z of each node)')
                 return
             end if
@@ -175,6 +173,16 @@ contains
         if (allocated(error)) return
         call read_ring_groups(scan, config%rings, error)
     end subroutine read_groups
+
+    !> An error of singleton group `name` found after reading it, with the group's line.
+    subroutine post_read_error(error, scan, name, text)
+        type(error_type), allocatable, intent(out) :: error
+        type(namelist_scan_type), intent(in) :: scan
+        character(len=*), intent(in) :: name, text
+
+        call fatal_error(error, '&' // name // ': ' // text // ' (group on line ' &
+            // format_integer(scan%groups(scan%find_group(name, 1))%first_line) // ')')
+    end subroutine post_read_error
 
     !> Read the namelist input from the file `path`; relative file names in it are
     !> resolved against the folder of `path`, or with `from_working_directory` against
