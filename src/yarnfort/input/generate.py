@@ -60,11 +60,9 @@ def fortran_default(var: Var) -> str:
     return fortran_value(var, var.default)
 
 
-def declaration(var: Var, buffer: bool = False) -> str:
-    if var.type == "character":
-        kind = "character(len=buffer_length)" if buffer else f"character(len={var.length})"
-    else:
-        kind = {"real": "real(wp)", "integer": "integer", "logical": "logical"}[var.type]
+def declaration(var: Var) -> str:
+    kind = {"real": "real(wp)", "integer": "integer", "logical": "logical",
+            "character": f"character(len={var.length})"}[var.type]
     if var.is_list:
         return f"{kind}, allocatable :: {var.name}(:)"
     shape = f"({var.size})" if var.size else ""
@@ -424,17 +422,13 @@ def fortran_module() -> str:
 
 
 # ---------------------------------------------------------------- REFERENCE.md tables
-def markdown_real(value: float) -> str:
-    return fortran_real(value)[:-3]
-
-
 def default_text(var: Var) -> str:
     if var.default_doc is not None:
         return var.default_doc
     if var.is_list:
         return "none"
     values = var.default if isinstance(var.default, list) else [var.default]
-    text = ", ".join(markdown_real(v) if var.type == "real" else
+    text = ", ".join(fortran_real(v)[:-3] if var.type == "real" else
                      fortran_value(var, v) for v in values)  # type: ignore[arg-type]
     return f"`{text}`"
 

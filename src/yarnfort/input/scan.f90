@@ -115,7 +115,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         logical :: in_group, after_comma
         character(len=1) :: c
-        character(len=:), allocatable :: name
+        character(len=:), allocatable :: name, hint
         integer :: iline, i, j, k, depth, n_tokens
 
         allocate(scan%groups(16), scan%tokens(64))
@@ -140,8 +140,15 @@ contains
                             else if (name == 'end') then
                                 call fail(': ' // c // 'end outside a group')
                             else if (.not. any(known_groups == name)) then
-                                call unknown_group_error(error, text(i + 1:j - 1), iline, &
-                                    known_groups)
+                                hint = closest_name(text(i + 1:j - 1), known_groups)
+                                if (len(hint) > 0) then
+                                    hint = ' (did you mean &' // hint // '?)'
+                                else
+                                    hint = ' (known groups: ' // join_names(known_groups, '&') &
+                                        // ')'
+                                end if
+                                call fatal_error(error, 'unknown group &' // text(i + 1:j - 1) &
+                                    // ' on line ' // format_integer(iline) // hint)
                             end if
                             if (allocated(error)) return
                             call start_group()
@@ -320,23 +327,6 @@ contains
         end do
         name = to_lower(text(first:next - 1))
     end subroutine read_name
-
-    subroutine unknown_group_error(error, name, line, known_groups)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: line
-        character(len=*), intent(in) :: known_groups(:)
-        character(len=:), allocatable :: guess, hint
-
-        guess = closest_name(name, known_groups)
-        if (len(guess) > 0) then
-            hint = ' (did you mean &' // guess // '?)'
-        else
-            hint = ' (known groups: ' // join_names(known_groups, '&') // ')'
-        end if
-        call fatal_error(error, 'unknown group &' // name // ' on line ' &
-            // format_integer(line) // hint)
-    end subroutine unknown_group_error
 
     !> A variable name in lower case without blanks (subscript kept).
     pure function normalized_name(text) result(name)
