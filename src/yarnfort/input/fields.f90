@@ -15,7 +15,7 @@ module yarnfort_input_fields
     private
 
     public :: max_list, max_coordinates, indent
-    public :: group_label, take_scalar, take_array, list_length
+    public :: group_label, take_scalar, take_array, list_length, is_assigned
     public :: check_range, check_choice, check_law_parameter
     public :: suggestion, quoted_list, check_name, check_item_name, put, put_list
 
@@ -117,6 +117,18 @@ contains
         if (j > 0) call fatal_error(error, label // ': ' // name // '(' // format_integer(j) &
             // ') has no value, but later entries have (an empty entry between commas?)')
     end subroutine list_length
+
+    !> Whether an assignment among `sets` sets variable `name` (any of its entries).
+    pure logical function is_assigned(sets, name)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: name
+        integer :: k
+
+        is_assigned = .false.
+        do k = 1, size(sets)
+            if (sets(k)%name == name) is_assigned = .true.
+        end do
+    end function is_assigned
 
     !> For each entry of array `name` (at most `most`) up to the last one its assignments
     !> reach, the assignment that sets it (negative for a null value, 0 for none); an

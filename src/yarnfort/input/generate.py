@@ -192,8 +192,9 @@ def check_routine(group: Group) -> list[str]:
         if var.laws:
             continue
         if var.choices:
+            required = ".true." if var.selects else ".false."
             body.append((0, f"call check_choice(error, label, '{var.name}', value%{var.name}, "
-                            f"{choices_name(group, var)}, {'.true.' if var.selects else '.false.'})"))
+                            f"{choices_name(group, var)}, {required})"))
         if var.selects and law_bound:
             body += law_block(var, law_bound)
         elif var.type in ("real", "integer"):
@@ -219,7 +220,7 @@ def check_routine(group: Group) -> list[str]:
             {steps}
         end subroutine check_{name}_variables
         """, name=group.name, type=group.type_name, steps=steps,
-        loops=["integer :: i"] if any(line.startswith("do i") for _, line in body) else [])
+        loops=["integer :: i"] if any(line.startswith("do i") for _, line in body) else []) + [""]
 
 
 def read_routine(group: Group) -> list[str]:
@@ -253,7 +254,9 @@ def read_routine(group: Group) -> list[str]:
             {takes}
         end subroutine read_{name}
 
-        """, name=group.name, type=group.type_name, takes=takes[:-1])
+        """, name=group.name, type=group.type_name,
+        takes=takes + [f"call apply_{group.name}_preset(sets, value)"] if preset_routine(group)
+        else takes[:-1]) + [""]
     if group.kind == "singleton":
         return one + fill("""
             !> The &{name} group into `value` if there is one (`value` is unchanged otherwise).
@@ -288,15 +291,15 @@ def preset_routine(group: Group) -> list[str]:
         return []
     cases = []
     for name in next(v for v in group.variables if v.name == "preset").choices or []:
-        settings = [(1, f"if (.not. scan%is_set('{group.name}', 1, '{v.name}')) "
+        settings = [(1, f"if (.not. is_assigned(sets, '{v.name}')) "
                         f"value%{v.name} = {fortran_value(v, v.presets[name])}")
                     for v in preset if name in v.presets]  # type: ignore[operator]
         cases += [f"case ('{name}')", *settings] if settings else []
     return fill("""
         !> The values the preset named by `value%preset` gives the variables of &{name}
         !> that the input does not set (none for another name).
-        subroutine apply_{name}_preset(scan, value)
-            type(namelist_scan_type), intent(in) :: scan
+        subroutine apply_{name}_preset(sets, value)
+            type(assignment_type), intent(in) :: sets(:)
             type({type}), intent(inout) :: value
 
             select case (trim(value%preset))
@@ -372,7 +375,6 @@ def fortran_module() -> str:
         publics += [f"read_{group.name}_groups", f"write_{group.name}"]
         publics += [f"write_{group.name}_groups"] if group.kind == "repeatable" else []
         publics += [f"check_{group.name}_variables"] if check_routine(group) else []
-        publics += [f"apply_{group.name}_preset"] if preset_routine(group) else []
         names.append(string_array(f"{group.name}_variables", [v.name for v in group.variables]))
         for var in (v for v in group.variables if v.choices):
             names += [f"!> Values of &{group.name} {var.name}."]
@@ -389,7 +391,7 @@ def fortran_module() -> str:
             use yarnfort_error, only: error_type
             use yarnfort_text, only: format_integer, format_real, quote_string
             use yarnfort_input_scan, only: namelist_scan_type, assignment_type, get_assignments
-            use yarnfort_input_fields, only: max_list, max_coordinates, group_label, take_scalar, take_array, list_length, check_range, check_choice, check_law_parameter, put, put_list, indent
+            use yarnfort_input_fields, only: {fields}
             implicit none
             private
 
@@ -407,11 +409,13 @@ def fortran_module() -> str:
             {help}
 
         """, at="", publics=", ".join(publics), choices=", ".join(choices),
+        fields="max_list, max_coordinates, group_label, take_scalar, take_array, list_length, "
+        "is_assigned, check_range, check_choice, check_law_parameter, put, put_list, indent",
         lengths=[f"integer, parameter :: {k} = {v}" for k, v in LENGTHS.items()],
         group_names=[string_array("group_names", [g.name for g in GROUPS])],
         singleton_names=[string_array("singleton_names",
                                       [g.name for g in GROUPS if g.kind == "singleton"])],
-        names=names, help=[string_array("help_lines", help_lines())])
+        names=names, help=[string_array("help_lines", help_lines())]) + [""]
     for group in GROUPS:
         out += type_definition(group)
     out += ["contains", ""]

@@ -16,7 +16,7 @@ module yarnfort_input_namelist
         read_control_groups, read_solver_groups, read_material_groups, read_contact_groups, &
         read_fabric_groups, read_nodes_groups, read_geometry_groups, read_yarn_groups, &
         read_support_groups, read_load_groups, read_path_groups, read_output_groups, &
-        read_obstacle_groups, read_ring_groups, apply_solver_preset
+        read_obstacle_groups, read_ring_groups
     use yarnfort_input_fields, only: max_list, max_coordinates
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
     use yarnfort_input_geometry, only: read_geometry_file
@@ -113,7 +113,7 @@ contains
     end subroutine read_config
 
     !> Each group, in a fixed order, with what is not one variable's business: the
-    !> fabric kind and the node triplets; then the solver preset and the defaults of lists.
+    !> fabric kind and the node triplets; then the defaults of lists.
     subroutine read_groups(scan, config, error)
         type(namelist_scan_type), intent(in) :: scan
         type(config_type), intent(inout) :: config
@@ -152,8 +152,6 @@ contains
         if (.not. allocated(error)) call read_obstacle_groups(scan, config%obstacles, error)
         if (.not. allocated(error)) call read_ring_groups(scan, config%rings, error)
         if (allocated(error)) return
-        ! An unknown preset leaves the plain defaults here; check_config rejects its name.
-        call apply_solver_preset(scan, config%solver)
         if (.not. allocated(config%fabric%gap_factor)) allocate(config%fabric%gap_factor(0))
         if (.not. allocated(config%fabric%gap_factor_p_disp)) &
             allocate(config%fabric%gap_factor_p_disp(0))

@@ -47,8 +47,6 @@ module yarnfort_input_scan
         procedure :: find_group
         !> Text of a token.
         procedure :: token_text
-        !> Whether a group sets a variable (any of its entries).
-        procedure :: is_set
     end type namelist_scan_type
 
     !> One assignment `name = values` or `name(first) = values` of a group occurrence.
@@ -377,23 +375,6 @@ contains
             end if
         end do
     end function find_group
-
-    !> Whether the `occurrence`-th group `name` has an assignment to `variable` (whole
-    !> or subscripted).
-    pure logical function is_set(self, name, occurrence, variable)
-        class(namelist_scan_type), intent(in) :: self
-        character(len=*), intent(in) :: name, variable
-        integer, intent(in) :: occurrence
-        integer :: g, k
-
-        is_set = .false.
-        g = self%find_group(name, occurrence)
-        if (g == 0) return
-        do k = self%groups(g)%first_token, self%groups(g)%last_token
-            if (.not. self%tokens(k)%is_name) cycle
-            if (base_name(self%token_text(self%tokens(k))) == variable) is_set = .true.
-        end do
-    end function is_set
 
     !> The assignments of the `occurrence`-th group `name` (1 for a singleton), in text
     !> order. An error for a value before the first name, a variable not in `variables`
