@@ -326,14 +326,6 @@ contains
         name = to_lower(text(first:next - 1))
     end subroutine read_name
 
-    !> A variable name in lower case without blanks (subscript kept).
-    pure function normalized_name(text) result(name)
-        character(len=*), intent(in) :: text
-        character(len=:), allocatable :: name
-
-        name = to_lower(remove_characters(text, ' ' // tab))
-    end function normalized_name
-
     !> At most 40 characters of a text for a message.
     pure function shorten(text) result(short)
         character(len=*), intent(in) :: text
@@ -388,7 +380,7 @@ contains
         type(assignment_type), allocatable, intent(out) :: sets(:)
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: text, label, guess
-        integer :: k, n, j, m, g
+        integer :: k, n, j, m, g, paren
         logical :: ok
 
         label = group_label(name, occurrence)
@@ -401,7 +393,6 @@ contains
                 if (tokens(k)%is_name) then
                     n = n + 1
                     sets(n)%line = tokens(k)%line
-                    sets(n)%name = base_name(text)
                     ! Its values: the tokens up to the next name.
                     j = k
                     do while (j < size(tokens))
@@ -410,16 +401,20 @@ contains
                     end do
                     allocate(sets(n)%values(j - k))
                     m = 0
-                    sets(n)%subscripted = index(text, '(') > 0
-                    if (sets(n)%subscripted) then
-                        call read_subscript(normalized_name(text(index(text, '('):)), sets(n), ok)
+                    ! The name in lower case without blanks, then without its subscript.
+                    sets(n)%name = to_lower(remove_characters(text, ' ' // tab))
+                    paren = index(sets(n)%name, '(')
+                    sets(n)%subscripted = paren > 0
+                    if (paren > 0) then
+                        call read_subscript(sets(n)%name(paren:), sets(n), ok)
                         if (.not. ok) then
-                            call fatal_error(error, label // ': ' // normalized_name(text) &
-                                // ' (line ' // format_integer(sets(n)%line) &
-                                // '): a subscript is an integer or a section, as in ' &
-                                // sets(n)%name // '(2) or ' // sets(n)%name // '(2:3)')
+                            call fatal_error(error, label // ': ' // sets(n)%name // ' (line ' &
+                                // format_integer(sets(n)%line) // '): a subscript is an ' &
+                                // 'integer or a section, as in ' // sets(n)%name(:paren - 1) &
+                                // '(2) or ' // sets(n)%name(:paren - 1) // '(2:3)')
                             return
                         end if
+                        sets(n)%name = sets(n)%name(:paren - 1)
                     end if
                     if (.not. any(variables == sets(n)%name)) then
                         guess = closest_name(sets(n)%name, variables)
@@ -487,19 +482,5 @@ contains
         label = '&' // name
         if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
     end function group_label
-
-    !> A variable name without subscript, lower case.
-    pure function base_name(text) result(name)
-        character(len=*), intent(in) :: text
-        character(len=:), allocatable :: name
-        integer :: paren
-
-        paren = index(text, '(')
-        if (paren == 0) then
-            name = to_lower(trim(text))
-        else
-            name = to_lower(trim(text(:paren - 1)))
-        end if
-    end function base_name
 
 end module yarnfort_input_scan
