@@ -204,29 +204,26 @@ contains
     pure subroutine split_words(line, words)
         character(len=*), intent(in) :: line
         type(string_type), allocatable, intent(out) :: words(:)
-        integer :: i, first, n
+        integer :: first, last, n
         type(string_type), allocatable :: grown(:)
 
         allocate(words(8))
         n = 0
-        i = 1
-        do while (i <= len(line))
-            if (line(i:i) == ' ' .or. line(i:i) == tab) then
-                i = i + 1
-                cycle
-            end if
-            first = i
-            do while (i <= len(line))
-                if (line(i:i) == ' ' .or. line(i:i) == tab) exit
-                i = i + 1
-            end do
+        last = 0
+        do
+            ! The next word: from its first character to the one before the next blank.
+            first = verify(line(last + 1:), ' ' // tab)
+            if (first == 0) exit
+            first = last + first
+            last = scan(line(first:), ' ' // tab)
+            last = merge(len(line), first + last - 2, last == 0)
             if (n == size(words)) then
                 allocate(grown(2 * n))
                 grown(:n) = words
                 call move_alloc(grown, words)
             end if
             n = n + 1
-            words(n)%text = line(first:i - 1)
+            words(n)%text = line(first:last)
         end do
         words = words(:n)
     end subroutine split_words
