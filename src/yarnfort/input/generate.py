@@ -109,8 +109,8 @@ def string_array(name: str, values: list[str]) -> str:
 # ---------------------------------------------------------------- the Fortran module
 def fill(template: str, at: str = INDENT, **parts: object) -> list[str]:
     """The lines of a template (dedented, then indented by `at`; '{name}' replaced by
-    parts[name]); a line that is a lone '{name}' of a list part becomes its statements,
-    wrapped, at its indent (an item (depth, text) one indent deeper per depth)."""
+    parts[name]) and a blank line; a line that is a lone '{name}' of a list part becomes its
+    statements, wrapped, at its indent (an item (depth, text) one indent deeper per depth)."""
     out = []
     for line in textwrap.dedent(template).strip("\n").split("\n"):
         key, indent = line.strip()[1:-1], at + line[:len(line) - len(line.lstrip())]
@@ -120,7 +120,7 @@ def fill(template: str, at: str = INDENT, **parts: object) -> list[str]:
                 out += wrap_statement(text, indent + INDENT * depth)
         else:
             out += wrap_statement(line.strip().format(**parts), indent) if line else [""]
-    return out
+    return out + [""]
 
 
 def range_check(var: Var, value: str, variable: str) -> list[str]:
@@ -220,7 +220,7 @@ def check_routine(group: Group) -> list[str]:
             {steps}
         end subroutine check_{name}_variables
         """, name=group.name, type=group.type_name, steps=steps,
-        loops=["integer :: i"] if any(line.startswith("do i") for _, line in body) else []) + [""]
+        loops=["integer :: i"] if any(line.startswith("do i") for _, line in body) else [])
 
 
 def read_routine(group: Group) -> list[str]:
@@ -256,7 +256,7 @@ def read_routine(group: Group) -> list[str]:
 
         """, name=group.name, type=group.type_name,
         takes=takes + [f"call apply_{group.name}_preset(sets, value)"] if preset_routine(group)
-        else takes[:-1]) + [""]
+        else takes[:-1])
     if group.kind == "singleton":
         return one + fill("""
             !> The &{name} group into `value` if there is one (`value` is unchanged otherwise).
@@ -267,7 +267,7 @@ def read_routine(group: Group) -> list[str]:
 
                 if (scan%count_group('{name}') > 0) call read_{name}(scan, 0, value, error)
             end subroutine read_{name}_groups
-            """, name=group.name, type=group.type_name) + [""]
+            """, name=group.name, type=group.type_name)
     return one + fill("""
         !> Every &{name} group, in the order of the text.
         subroutine read_{name}_groups(scan, values, error)
@@ -282,7 +282,7 @@ def read_routine(group: Group) -> list[str]:
                 if (allocated(error)) return
             end do
         end subroutine read_{name}_groups
-        """, name=group.name, type=group.type_name) + [""]
+        """, name=group.name, type=group.type_name)
 
 
 def preset_routine(group: Group) -> list[str]:
@@ -306,7 +306,7 @@ def preset_routine(group: Group) -> list[str]:
             {cases}
             end select
         end subroutine apply_{name}_preset
-        """, name=group.name, type=group.type_name, cases=cases) + [""]
+        """, name=group.name, type=group.type_name, cases=cases)
 
 
 def write_routine(group: Group) -> list[str]:
@@ -332,7 +332,7 @@ def write_routine(group: Group) -> list[str]:
             {puts}
             call put(unit, '/')
         end subroutine write_{name}
-        """, name=group.name, type=group.type_name, puts=puts) + [""]
+        """, name=group.name, type=group.type_name, puts=puts)
     if group.kind == "singleton":
         return out
     return out + fill("""
@@ -347,7 +347,7 @@ def write_routine(group: Group) -> list[str]:
                 call write_{name}(unit, values(k))
             end do
         end subroutine write_{name}_groups
-        """, name=group.name, type=group.type_name) + [""]
+        """, name=group.name, type=group.type_name)
 
 
 def type_definition(group: Group) -> list[str]:
@@ -415,7 +415,7 @@ def fortran_module() -> str:
         group_names=[string_array("group_names", [g.name for g in GROUPS])],
         singleton_names=[string_array("singleton_names",
                                       [g.name for g in GROUPS if g.kind == "singleton"])],
-        names=names, help=[string_array("help_lines", help_lines())]) + [""]
+        names=names, help=[string_array("help_lines", help_lines())])
     for group in GROUPS:
         out += type_definition(group)
     out += ["contains", ""]
