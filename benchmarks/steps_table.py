@@ -18,7 +18,8 @@ program from another commit) one after the other on
   strain 1 (20 steps, as in verification/clamped) and/or one stretch cycle 0 -> 1 -> 0;
 - inputs/knit_clamped.nml as shipped.
 Columns per build: Newton iterations, active-set rounds (Newton solves) and residual
-evaluations per step, passages turned stick -> slip and slip -> stick per step, CPU ms
+evaluations per step (a build with chord steps prints them too: `newton / chord`),
+passages turned stick -> slip and slip -> stick per step, CPU ms
 per step (the continuation alone, process CPU time), and that over the CPU ms of one
 elastic Newton iteration of the same net at the final state. The load average is printed
 before and after. Progress goes to stderr.
@@ -35,7 +36,7 @@ sys.path.insert(0, str(TOP / 'tests' / 'verification'))
 from fabric_scenes import LOADING, ONE_CYCLE, patched_scene  # noqa: E402
 
 TRACE = TOP / 'build' / 'benchmarks' / 'steps_trace'
-SUMMARY = ('unknowns passages steps cuts newton rounds residuals to_slip to_stick '
+SUMMARY = ('unknowns passages steps cuts newton chords rounds residuals to_slip to_stick '
            'cpu_ms elastic_ms ratio').split()
 #: A holding thread pulled taut (verification/clamped/run_study.py).
 THREAD = """
@@ -70,14 +71,18 @@ def run(binary, arguments, timeout):
     if done.returncode != 0 or not lines:
         tail = done.stderr.strip().splitlines()
         return {'failed': tail[-1] if tail else f'exit {done.returncode}'}
-    return dict(zip(SUMMARY, (float(x) for x in lines[-1].split()[1:])))
+    values = [float(x) for x in lines[-1].split()[1:]]
+    if len(values) == len(SUMMARY) - 1:
+        values.insert(SUMMARY.index('chords'), 0.0)   # a build without chord steps
+    return dict(zip(SUMMARY, values))
 
 
 def cells(row):
     if 'failed' in row:
         return ['failed: ' + row['failed'][:40]] + [''] * 6
     steps = row['steps']
-    return [f"{row['newton']:.2f}", f"{row['rounds']:.2f}", f"{row['residuals']:.2f}",
+    newton = f"{row['newton']:.2f}" + (f" / {row['chords']:.2f}" if row['chords'] else '')
+    return [newton, f"{row['rounds']:.2f}", f"{row['residuals']:.2f}",
             f"{row['to_slip']:.2f} / {row['to_stick']:.2f}", f"{row['cpu_ms']:.2f}",
             f"{row['ratio']:.2f}", f"{int(steps)}" + (f" ({int(row['cuts'])} cuts)"
                                                         if row['cuts'] else '')]
@@ -86,6 +91,8 @@ def cells(row):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--before', help='steps_trace built from the commit before')
+    parser.add_argument('--also', nargs='*', default=[], metavar='NAME=PATH',
+                        help='more builds of steps_trace to compare (a variant)')
     parser.add_argument('--sides', type=int, nargs='*', default=[6, 10, 14, 22])
     parser.add_argument('--knits', type=int, nargs='*', default=[4, 8])
     parser.add_argument('--paths', nargs='*', default=['loading', 'cycle'])
@@ -93,6 +100,8 @@ def main():
     args = parser.parse_args()
     builds = [('after', TRACE)] + ([('before', pathlib.Path(args.before))]
                                    if args.before else [])
+    builds += [(name, pathlib.Path(path)) for name, path in
+               (item.split('=', 1) for item in args.also)]
     cases = []
     for side in args.sides:
         for net in ('aligned', 'skewed'):

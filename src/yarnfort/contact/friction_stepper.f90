@@ -223,19 +223,10 @@ contains
             problem%flow_target = self%flow
             unknowns = [self%u, self%flow]
             call predict(self, unknowns, outcome)
-            guessed = .false.
-            select case (outcome)
-            case (predicted_state)
-                ! Stick passages that the predicted state takes past their critical
-                ! tension start the step slipping: a growing slip zone then costs no
-                ! active-set round per step.
-                call predict_modes(problem, unknowns, self%mode_trial, guessed, error)
-                if (allocated(error)) return
-            case (reversed)
-                ! The loading turned: slipping passages start the step in stick.
-                guessed = any(self%mode_trial /= mode_stick)
-                self%mode_trial = mode_stick
-            end select
+            ! The loading turned: slipping passages start the step in stick (measured:
+            ! the last step's slip set first cost a failed or wasted solve, then a round).
+            guessed = outcome == reversed .and. any(self%mode_trial /= mode_stick)
+            if (guessed) self%mode_trial = mode_stick
             allocate(flips(size(self%flow)), source=0)
             allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
                 source=.false.)
@@ -577,42 +568,6 @@ contains
             end if
         end subroutine set_mode
     end subroutine update_active_set
-
-    !> Start modes of a step from its predicted `unknowns`: each stick passage that
-    !> fails the stick test there (and is not at its minimum length) slips. `changed`:
-    !> some did.
-    subroutine predict_modes(problem, unknowns, mode, changed, error)
-        type(friction_problem_type), intent(inout) :: problem
-        real(wp), intent(in) :: unknowns(:)
-        integer, intent(inout) :: mode(:)
-        logical, intent(out) :: changed
-        type(error_type), allocatable, intent(out) :: error
-        integer :: p, direction
-        real(wp) :: floor, measure
-        logical :: at_min_before, at_min_after
-
-        changed = .false.
-        call problem%update_state(unknowns, error)
-        if (allocated(error)) return
-        floor = node_level_floor * problem%get_force_level()
-        associate(scene => problem%scene, passages => problem%scene%passages)
-            do p = 1, size(mode)
-                if (mode(p) /= mode_stick) cycle
-                associate(before => passages%element_before(p), &
-                        after => passages%element_after(p))
-                    at_min_before = problem%length0(before) <= (scene%solver%min_length_ratio &
-                        + length_round_off) * scene%network%length0(before)
-                    at_min_after = problem%length0(after) <= (scene%solver%min_length_ratio &
-                        + length_round_off) * scene%network%length0(after)
-                end associate
-                call get_slip_tendency(problem, p, floor, at_min_before, at_min_after, &
-                    direction, measure)
-                if (direction == mode_stick) cycle
-                mode(p) = direction
-                changed = .true.
-            end do
-        end associate
-    end subroutine predict_modes
 
     !> Stick test of stick passage p at the state held in `problem` (update_state):
     !> `direction` is the way it starts to slip (mode_forward, mode_backward; not a
