@@ -33,20 +33,13 @@ import tempfile
 
 TOP = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(TOP / 'tests' / 'verification'))
+sys.path.insert(0, str(TOP / 'verification' / 'clamped'))
 from fabric_scenes import LOADING, ONE_CYCLE, patched_scene  # noqa: E402
+from run_study import THREAD  # noqa: E402  (the taut edge thread of the clamped study)
 
 TRACE = TOP / 'build' / 'benchmarks' / 'steps_trace'
 SUMMARY = ('unknowns passages steps cuts newton chords rounds residuals to_slip to_stick '
            'cpu_ms elastic_ms ratio').split()
-#: A holding thread pulled taut (verification/clamped/run_study.py).
-THREAD = """
-&material
-    name = 'thread'
-    law = 'table'
-    table_file = 'inputs/data/knit_yarn.csv'
-    prestress = 1.0
-/
-"""
 
 
 def knit_scene(n, kind, path, folder):

@@ -43,9 +43,9 @@ module yarnfort_contact_friction_stepper
         !> evaluations, solves that failed.
         integer :: tries = 0, rounds = 0, iterations = 0, residual_evaluations = 0
         integer :: jacobian_evaluations = 0, failed_solves = 0
-        !> Mode changes by the rounds: stick -> slip, slip -> stick (wrong sign), locks
-        !> at the minimum length.
-        integer :: to_slip = 0, to_stick = 0, locks = 0
+        !> Mode changes by the rounds: stick -> slip, slip -> stick (a flow increment of
+        !> the wrong sign, a lock at the minimum length, chatter damping).
+        integer :: to_slip = 0, to_stick = 0
         !> Scaled residual of the first solve's initial guess (the predictor's quality).
         real(wp) :: start_residual = -1.0_wp
         !> Passages whose mode at the end differs from that at the start of the step.
