@@ -82,7 +82,9 @@ program bench_friction
     use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
     use yarnfort_solver_timer, only: wall_time
     use bench_friction_counter, only: counter_type
-    use bench_common, only: peak_memory_mib, fail, number_grid_nodes
+    use bench_common, only: peak_memory_mib, fail
+    use bench_woven_net, only: make_woven_net, skew_net
+    use bench_iteration, only: time_iteration
     use bench_floor, only: floor_type, measure_floor
     use yarnfort_kinds, only: ik
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
@@ -243,7 +245,7 @@ contains
             if (allocated(error)) call fail('bench_friction', error)
             allocate(values(full%get_nonzeros()), residual(size(u)))
             call time_iteration(full, stepper%newton_full%linear, u, values, residual, &
-                friction_ms)
+                friction_ms, 'bench_friction')
         end associate
         select type (linear => stepper%newton_full%linear)
         type is (condensed_solver_type)
@@ -280,7 +282,8 @@ contains
         if (allocated(error)) call fail('bench_friction', error)
         deallocate(values, residual)
         allocate(values(problem%get_nonzeros()), residual(problem%get_size()))
-        call time_iteration(problem, elastic_solver, stepper%u, values, residual, elastic_ms)
+        call time_iteration(problem, elastic_solver, stepper%u, values, residual, elastic_ms, &
+            'bench_friction')
         write(output_unit, '(a, 2(f9.3, a), f9.3, a, f9.3, a, f9.2, a, f8.2)') &
             'iteration: friction ', sum(friction_ms), ' ms (assembly ', friction_ms(1), &
             ' ms, ' // stepper%newton_full%linear%get_name() // ') | elastic ', &
@@ -288,41 +291,6 @@ contains
             ') | cpu ms/step ', 1e3_wp * cpu_total / counter%steps, ' = elastic x ', &
             1e3_wp * cpu_total / counter%steps / sum(elastic_ms)
     end subroutine write_iterations
-
-    !> CPU ms of residual + Jacobian (times(1)) and factorisation + solve (times(2)),
-    !> the mean of repetitions filling about 0.3 s.
-    subroutine time_iteration(problem, solver, u, values, residual, times)
-        class(nonlinear_problem_type), intent(inout) :: problem
-        class(linear_solver_type), intent(inout) :: solver
-        real(wp), intent(in) :: u(:)
-        real(wp), intent(inout) :: values(:), residual(:)
-        real(wp), intent(out) :: times(2)
-        real(wp) :: t0, t1, t2
-        integer :: repetitions
-
-        times = 0.0_wp
-        repetitions = 0
-        call cpu_time(t0)
-        t2 = t0
-        do while (t2 - t0 < 0.3_wp .or. repetitions < 3)
-            call cpu_time(t1)
-            call problem%evaluate_residual(u, residual, error)
-            if (allocated(error)) call fail('bench_friction', error)
-            call problem%evaluate_jacobian(u, values, error)
-            if (allocated(error)) call fail('bench_friction', error)
-            call cpu_time(t2)
-            times(1) = times(1) + (t2 - t1)
-            call solver%factor(values, error)
-            if (allocated(error)) call fail('bench_friction', error)
-            call solver%solve(residual, error)
-            if (allocated(error)) call fail('bench_friction', error)
-            call cpu_time(t1)
-            times(2) = times(2) + (t1 - t2)
-            t2 = t1
-            repetitions = repetitions + 1
-        end do
-        times = 1e3_wp * times / repetitions
-    end subroutine time_iteration
 
     !> The `factors:` line (program notes).
     subroutine write_factors()
@@ -407,122 +375,5 @@ contains
         end do
         fractions = real(zeros, wp) / max(1, stored)
     end subroutine count_zeros
-
-    !> --skewed: move every crossing node by a fixed pseudo-random offset (program notes);
-    !> the boundary nodes stay.
-    subroutine skew_net(config, side)
-        type(config_type), intent(inout) :: config
-        integer, intent(in) :: side
-        integer, allocatable :: id(:, :)
-        integer :: i, j, n
-
-        call number_grid_nodes(side, id, n)
-        do j = 1, side
-            do i = 1, side
-                associate(x => config%node_positions(:, id(i, j)))
-                    x(1) = x(1) + 0.02_wp * offset(i, j, 1)
-                    x(2) = x(2) + 0.02_wp * offset(i, j, 2)
-                    x(3) = x(3) + 0.01_wp * offset(i, j, 3)
-                end associate
-            end do
-        end do
-    end subroutine skew_net
-
-    !> A fixed pseudo-random number in [-1, 1) from (i, j, c) (integer hash: the same
-    !> with every compiler).
-    pure real(wp) function offset(i, j, c)
-        integer, intent(in) :: i, j, c
-        integer(ik) :: h
-        h = modulo(int(i, ik) * 73856093_ik + int(j, ik) * 19349663_ik + &
-            int(c, ik) * 83492791_ik, 1000003_ik)
-        h = modulo(h * h + 12345_ik, 1000003_ik)
-        offset = 2.0_wp * real(h, wp) / 1000003.0_wp - 1.0_wp
-    end function offset
-
-    !> side x side crossings of warp (along x) and weft (along y) yarns at unit
-    !> spacing; crossing (i, j) sits at z = +-h in a checkerboard (crimp), so both yarns
-    !> bend at every crossing. Yarn ends: west ends fixed, east ends pulled by 20 % in x
-    !> while weft ends are pulled by 5 % in y (held in z); crossings keep their height;
-    !> unload to half and reload.
-    !> Capstan with adhesion at every crossing.
-    subroutine make_woven_net(config, side, per_segment, scheme)
-        type(config_type), intent(out) :: config
-        integer, intent(in) :: side, per_segment
-        character(len=*), intent(in) :: scheme
-        integer :: i, j, n, y
-        integer, allocatable :: id(:, :)
-        real(wp), parameter :: crimp = 0.15_wp
-
-        call number_grid_nodes(side, id, n)
-        allocate(config%node_positions(3, n))
-        do j = 0, side + 1
-            do i = 0, side + 1
-                if (id(i, j) == 0) cycle
-                config%node_positions(:, id(i, j)) = [real(i, wp), real(j, wp), &
-                    crimp * merge(1.0_wp, -1.0_wp, mod(i + j, 2) == 0)]
-                if (i == 0 .or. j == 0 .or. i == side + 1 .or. j == side + 1) &
-                    config%node_positions(3, id(i, j)) = 0.0_wp
-            end do
-        end do
-        allocate(config%materials(2))
-        config%materials(1)%name = 'warp'
-        config%materials(1)%law = 'linear'
-        config%materials(1)%stiffness = 10.0_wp
-        config%materials(2)%name = 'weft'
-        config%materials(2)%law = 'linear'
-        config%materials(2)%stiffness = 5.0_wp
-        allocate(config%yarns(2 * side))
-        y = 0
-        do j = 1, side
-            y = y + 1
-            config%yarns(y)%material = 'warp'
-            config%yarns(y)%nodes = id(0:side + 1, j)
-            config%yarns(y)%elements_per_segment = per_segment
-        end do
-        do i = 1, side
-            y = y + 1
-            config%yarns(y)%material = 'weft'
-            config%yarns(y)%nodes = id(i, 0:side + 1)
-            config%yarns(y)%elements_per_segment = per_segment
-        end do
-        allocate(config%supports(5))
-        config%supports(1)%name = 'west'
-        config%supports(1)%nodes = id(0, 1:side)
-        config%supports(2)%name = 'east'
-        config%supports(2)%nodes = id(side + 1, 1:side)
-        config%supports(2)%displacement = [0.2_wp * (side + 1), 0.0_wp, 0.0_wp]
-        config%supports(3)%name = 'south'
-        config%supports(3)%nodes = id(1:side, 0)
-        config%supports(3)%fix = 'yz'
-        config%supports(3)%displacement = [0.0_wp, -0.025_wp * (side + 1), 0.0_wp]
-        config%supports(4)%name = 'north'
-        config%supports(4)%nodes = id(1:side, side + 1)
-        config%supports(4)%fix = 'yz'
-        config%supports(4)%displacement = [0.0_wp, 0.025_wp * (side + 1), 0.0_wp]
-        ! Shared crossing nodes cannot keep warp over weft by themselves (both yarns
-        ! would pull a crossing flat); holding the crossings' height keeps the crimp.
-        config%supports(5)%name = 'crimp'
-        config%supports(5)%nodes = pack(id(1:side, 1:side), .true.)
-        config%supports(5)%fix = 'z'
-        allocate(config%loads(0))
-        allocate(config%contacts(merge(1, 0, scheme /= "none")))
-        if (size(config%contacts) > 0) then
-        config%contacts(1)%materials = [character(len=64) :: "warp", "weft"]
-        config%contacts(1)%law = 'adhesion'
-        config%contacts(1)%friction_coefficient = 0.3_wp
-        config%contacts(1)%adhesion = 0.01_wp
-        end if
-        ! Biaxial stretch (warp 20 %, weft 5 %), then unload to half and reload: the net
-        ! stays taut while the friction cycle runs.
-        config%path%time = [0.0_wp, 1.0_wp, 2.0_wp, 3.0_wp]
-        config%path%p_force = [0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-        config%path%p_disp = [0.0_wp, 1.0_wp, 0.5_wp, 1.0_wp]
-        config%solver%scheme = scheme
-        config%solver%initial_step = 0.05_wp
-        config%solver%max_step = 0.05_wp
-        config%solver%max_iterations = 100
-        config%solver%max_friction_iterations = 1000
-    end subroutine make_woven_net
-
 
 end program bench_friction

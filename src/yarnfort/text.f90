@@ -122,28 +122,20 @@ contains
         integer, parameter :: max_digits = 17
         character(len=48) :: buffer
         character(len=24) :: form
-        character(len=:), allocatable :: digits, minus
+        character(len=:), allocatable :: digits, minus, suffix
         real(wp) :: back
-        integer :: decimals, first_decimals, stat, exponent, mark
+        integer :: decimals, first_decimals, stat, exponent, mark, point
 
         if (ieee_is_nan(value)) then
             text = 'NaN'
             return
         end if
+        minus = trim(merge('-', ' ', sign(1.0_wp, value) < 0.0_wp))
         if (.not. ieee_is_finite(value)) then
-            if (value > 0.0_wp) then
-                text = 'Infinity'
-            else
-                text = '-Infinity'
-            end if
+            text = minus // 'Infinity'
             return
-        end if
-        if (value == 0.0_wp) then
-            if (sign(1.0_wp, value) < 0.0_wp) then
-                text = '-0.0'
-            else
-                text = '0.0'
-            end if
+        else if (value == 0.0_wp) then
+            text = minus // '0.0'
             return
         end if
         ! Near the overflow threshold a rounded-up candidate would overflow when read
@@ -160,29 +152,22 @@ contains
         buffer = adjustl(buffer)
         mark = index(buffer, 'E')
         read(buffer(mark + 1:), *) exponent
-        minus = ''
-        if (buffer(1:1) == '-') minus = '-'
         digits = remove_characters(buffer(len(minus) + 1:mark - 1), '.')
         do while (len(digits) > 1 .and. digits(len(digits):len(digits)) == '0')
             digits = digits(:len(digits) - 1)
         end do
-        if (exponent >= -4 .and. exponent <= 6) then
-            if (exponent >= 0) then
-                if (len(digits) <= exponent + 1) then
-                    text = minus // digits // repeat('0', exponent + 1 - len(digits)) // '.0'
-                else
-                    text = minus // digits(:exponent + 1) // '.' // digits(exponent + 2:)
-                end if
-            else
-                text = minus // '0.' // repeat('0', -exponent - 1) // digits
-            end if
+        ! The decimal point after digit `point`, with at least one digit after it.
+        point = 1
+        suffix = ''
+        if (exponent < -4 .or. exponent > 6) then
+            suffix = 'e' // format_integer(exponent)
+        else if (exponent < 0) then
+            digits = repeat('0', -exponent) // digits
         else
-            if (len(digits) == 1) then
-                text = minus // digits // '.0e' // format_integer(exponent)
-            else
-                text = minus // digits(1:1) // '.' // digits(2:) // 'e' // format_integer(exponent)
-            end if
+            point = exponent + 1
         end if
+        digits = digits // repeat('0', max(point + 1 - len(digits), 0))
+        text = minus // digits(:point) // '.' // digits(point + 1:) // suffix
     end function format_real
 
     !> `text` without the characters of `set`.
@@ -219,29 +204,26 @@ contains
     pure subroutine split_words(line, words)
         character(len=*), intent(in) :: line
         type(string_type), allocatable, intent(out) :: words(:)
-        integer :: i, first, n
+        integer :: first, last, n
         type(string_type), allocatable :: grown(:)
 
         allocate(words(8))
         n = 0
-        i = 1
-        do while (i <= len(line))
-            if (line(i:i) == ' ' .or. line(i:i) == tab) then
-                i = i + 1
-                cycle
-            end if
-            first = i
-            do while (i <= len(line))
-                if (line(i:i) == ' ' .or. line(i:i) == tab) exit
-                i = i + 1
-            end do
+        last = 0
+        do
+            ! The next word: from its first character to the one before the next blank.
+            first = verify(line(last + 1:), ' ' // tab)
+            if (first == 0) exit
+            first = last + first
+            last = scan(line(first:), ' ' // tab)
+            last = merge(len(line), first + last - 2, last == 0)
             if (n == size(words)) then
                 allocate(grown(2 * n))
                 grown(:n) = words
                 call move_alloc(grown, words)
             end if
             n = n + 1
-            words(n)%text = line(first:i - 1)
+            words(n)%text = line(first:last)
         end do
         words = words(:n)
     end subroutine split_words
@@ -306,9 +288,9 @@ contains
         logical, intent(out) :: ok
         integer, parameter :: max_exact_power = 22
         integer(int64), parameter :: max_exact_mantissa = 2_int64**53
-        integer :: i, digit, exponent, exponent_part, n_digits, exponent_sign
+        integer :: i, digit, exponent, exponent_part, n_digits
         integer(int64) :: mantissa
-        logical :: negative, in_fraction
+        logical :: negative, in_fraction, fits
 
         value = 0.0_wp
         ok = .false.
@@ -340,23 +322,9 @@ contains
         if (n_digits == 0) return
         if (i <= len(word)) then
             if (index('eEdD', word(i:i)) == 0) return
-            i = i + 1
-            exponent_sign = 1
-            if (i <= len(word)) then
-                if (word(i:i) == '+' .or. word(i:i) == '-') then
-                    if (word(i:i) == '-') exponent_sign = -1
-                    i = i + 1
-                end if
-            end if
-            if (i > len(word)) return
-            exponent_part = 0
-            do while (i <= len(word))
-                digit = index('0123456789', word(i:i)) - 1
-                if (digit < 0 .or. exponent_part > 1000) return
-                exponent_part = 10 * exponent_part + digit
-                i = i + 1
-            end do
-            exponent = exponent + exponent_sign * exponent_part
+            call parse_integer(word(i + 1:), exponent_part, fits)
+            if (.not. fits .or. exponent_part < -1000 .or. exponent_part > 1000) return
+            exponent = exponent + exponent_part
         end if
         if (abs(exponent) > max_exact_power) return
         value = real(mantissa, wp)

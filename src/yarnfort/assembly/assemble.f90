@@ -39,10 +39,9 @@ contains
         do e = 1, scene%network%n_elements()
             n1 = scene%network%element_nodes(1, e)
             n2 = scene%network%element_nodes(2, e)
-            call check_length(scene, x, length0, e, error)
+            call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
+                force, error)
             if (allocated(error)) return
-            call get_truss_response(scene%laws(scene%network%element_material(e))%law, &
-                weight, length0(e), x(:, n1), x(:, n2), tension(e), stretch(e), force)
             if (.not. ieee_is_finite(tension(e))) then
                 call overflow(e, stretch(e))
                 return
@@ -111,7 +110,7 @@ contains
         real(wp), intent(inout) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(in), optional :: spring, tangent_spring
-        integer :: e, n1, n2, a, b, slot
+        integer :: e, a, b, slot
         real(wp) :: force(3), block(3, 3), tension, stretch, sign_ab, weight, tangent_weight
 
         weight = 0.0_wp
@@ -120,13 +119,9 @@ contains
         if (present(tangent_spring)) tangent_weight = tangent_spring
 
         do e = 1, scene%network%n_elements()
-            n1 = scene%network%element_nodes(1, e)
-            n2 = scene%network%element_nodes(2, e)
-            call check_length(scene, x, length0, e, error)
+            call get_element_response(scene, x, length0, e, weight, tension, stretch, force, &
+                error, block, tangent_weight)
             if (allocated(error)) return
-            call get_truss_response(scene%laws(scene%network%element_material(e))%law, &
-                weight, length0(e), x(:, n1), x(:, n2), tension, stretch, force, block, &
-                tangent_weight)
             do b = 1, 6
                 do a = 1, 6
                     slot = element_slot(a, b, e)
@@ -138,21 +133,34 @@ contains
         end do
     end subroutine add_element_tangents
 
-    subroutine check_length(scene, x, length0, e, error)
+    !> Element e's response (get_truss_response: tension, stretch, force on node 2 and,
+    !> with `block`, its tangent; `spring`, `tangent_spring` as there) at node positions x,
+    !> after checking that it has not degenerated to a point.
+    subroutine get_element_response(scene, x, length0, e, spring, tension, stretch, force, &
+            error, block, tangent_spring)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:)
         integer, intent(in) :: e
+        real(wp), intent(in) :: spring
+        real(wp), intent(out) :: tension, stretch, force(3)
         type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(out), optional :: block(3, 3)
+        real(wp), intent(in), optional :: tangent_spring
         real(wp) :: length
         character(len=160) :: buffer
 
-        length = norm2(x(:, scene%network%element_nodes(2, e)) &
-            - x(:, scene%network%element_nodes(1, e)))
-        if (.not. (length > degenerate_length_ratio * length0(e))) then
-            write(buffer, '("element ", i0, " (nodes ", i0, ", ", i0, ") has length ", es10.3)') &
-                e, scene%network%element_nodes(:, e), length
-            call fatal_error(error, trim(buffer))
-        end if
-    end subroutine check_length
+        associate(x1 => x(:, scene%network%element_nodes(1, e)), &
+                x2 => x(:, scene%network%element_nodes(2, e)))
+            length = norm2(x2 - x1)
+            if (.not. (length > degenerate_length_ratio * length0(e))) then
+                write(buffer, '("element ", i0, " (nodes ", i0, ", ", i0, ") has length ", &
+                    & es10.3)') e, scene%network%element_nodes(:, e), length
+                call fatal_error(error, trim(buffer))
+                return
+            end if
+            call get_truss_response(scene%laws(scene%network%element_material(e))%law, spring, &
+                length0(e), x1, x2, tension, stretch, force, block, tangent_spring)
+        end associate
+    end subroutine get_element_response
 
 end module yarnfort_assembly_assemble

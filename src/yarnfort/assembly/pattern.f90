@@ -5,6 +5,7 @@ module yarnfort_assembly_pattern
     use yarnfort_kinds, only: wp, ik
     use yarnfort_network_network, only: network_type
     use yarnfort_network_dof_map, only: dof_map_type
+    use yarnfort_sort, only: sort_index
     implicit none
     private
 
@@ -90,7 +91,7 @@ contains
         end do
 
         ! Rows of each column: the unknowns of the cliques touching it, deduplicated
-        ! with a stamp and sorted (short lists: insertion sort).
+        ! with a stamp and sorted (short lists).
         allocate(col_ptr(n + 1))
         allocate(stamp(n), source=0)
         allocate(rows(64))
@@ -114,7 +115,7 @@ contains
                     end if
                 end do
             end do
-            call insertion_sort(rows(1:n_rows))
+            rows(1:n_rows) = rows(sort_index(rows(1:n_rows)))
             if (used + n_rows > capacity) then
                 capacity = max(2 * capacity, used + n_rows)
                 call grow_ik(all_rows, capacity)
@@ -158,21 +159,6 @@ contains
             call move_alloc(tmp, array)
         end subroutine grow_ik
     end subroutine build_clique_pattern
-
-    pure subroutine insertion_sort(values)
-        integer, intent(inout) :: values(:)
-        integer :: i, j, v
-        do i = 2, size(values)
-            v = values(i)
-            j = i - 1
-            do while (j >= 1)
-                if (values(j) <= v) exit
-                values(j + 1) = values(j)
-                j = j - 1
-            end do
-            values(j + 1) = v
-        end do
-    end subroutine insertion_sort
 
     !> Position (1-based) of `row` in the ascending list `rows` (binary search).
     pure integer function find_row(rows, row) result(pos)

@@ -34,7 +34,24 @@ module yarnfort_contact_friction_stepper
     implicit none
     private
 
-    public :: friction_stepper_type, new_friction_stepper
+    public :: friction_stepper_type, new_friction_stepper, step_trace_type
+
+    !> Where a load step's work goes (benchmarks/steps_trace): summed over every try
+    !> since the last accepted step (cut tries included).
+    type :: step_trace_type
+        !> Tries of the step (1 + cuts), active-set rounds (monolithic solves, or the
+        !> staggered scheme's alternations), Newton iterations, residual and Jacobian
+        !> evaluations, solves that failed.
+        integer :: tries = 0, rounds = 0, iterations = 0, residual_evaluations = 0
+        integer :: jacobian_evaluations = 0, failed_solves = 0
+        !> Mode changes by the rounds: stick -> slip, slip -> stick (a flow increment of
+        !> the wrong sign, a lock at the minimum length, chatter damping).
+        integer :: to_slip = 0, to_stick = 0
+        !> Scaled residual of the first solve's initial guess (the predictor's quality).
+        real(wp) :: start_residual = -1.0_wp
+        !> Passages whose mode at the end differs from that at the start of the step.
+        integer :: mode_changes = 0
+    end type step_trace_type
 
     !> Bounds of the staggered scheme's Aitken relaxation factor.
     real(wp), parameter :: min_relaxation = 0.1_wp, max_relaxation = 100.0_wp
@@ -51,6 +68,9 @@ module yarnfort_contact_friction_stepper
     !> contact nodes are free) and needed hundreds of rounds per step on inputs/belt.nml;
     !> the monolithic finish converges quadratically to the same fixed point.
     integer, parameter :: finish_after_rounds = 3
+
+    !> Outcomes of the predictor (predict).
+    integer, parameter :: predicted_state = 1, reversed = -1
 
     !> Round-off of a reference length locked at its minimum, relative to its initial
     !> length (the lock sets L0 = initial length - flow to the minimum).
@@ -76,8 +96,8 @@ module yarnfort_contact_friction_stepper
         logical :: have_old = .false.
         !> Passages held in stick by chatter damping in the last step.
         integer :: n_damped = 0
-        !> Factorisations so far (for benchmarks).
-        integer :: n_solves = 0
+        !> The current step's trace (since the last accept) and the last accepted one's.
+        type(step_trace_type) :: trace, last_trace
     contains
         procedure :: try_step
         procedure :: accept
@@ -165,6 +185,7 @@ contains
         integer, intent(out) :: iterations
         type(error_type), allocatable, intent(out) :: error
 
+        self%trace%tries = self%trace%tries + 1
         self%factors_trial = factors
         self%u_trial = self%u
         self%flow_trial = self%flow
@@ -184,15 +205,19 @@ contains
         real(wp), allocatable :: unknowns(:), good_unknowns(:)
         integer, allocatable :: flips(:), good_mode(:), good_flips(:)
         logical, allocatable :: locked_forward(:), locked_backward(:)
-        integer :: round, n_x, changed, cap, new_slips
-        logical :: have_good
+        integer :: round, n_x, changed, cap, new_slips, outcome
+        logical :: have_good, guessed
 
         associate(problem => self%full, scene => self%scene)
             n_x = scene%dofs%n_unknowns
             problem%factors = self%factors_trial
             problem%flow_target = self%flow
             unknowns = [self%u, self%flow]
-            call predict(self, unknowns)
+            call predict(self, unknowns, outcome)
+            ! The loading turned: slipping passages start the step in stick (measured:
+            ! the last step's slip set first cost a failed or wasted solve, then a round).
+            guessed = outcome == reversed .and. any(self%mode_trial /= mode_stick)
+            if (guessed) self%mode_trial = mode_stick
             allocate(flips(size(self%flow)), source=0)
             allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
                 source=.false.)
@@ -212,6 +237,7 @@ contains
                 self%newton_full%quick = .not. have_good .and. any(self%mode_trial /= mode_stick)
                 call self%newton_full%solve(unknowns, stats, error)
                 iterations = iterations + stats%iterations
+                call record_solve(self%trace, stats, allocated(error))
                 if (allocated(error)) then
                     ! A fixed active set may have no solution nearby. Go back to the last
                     ! solved state and let fewer passages start slipping at once (half as
@@ -229,6 +255,15 @@ contains
                         call update_active_set(problem, unknowns(n_x + 1:), self%flow, &
                             self%mode_trial, flips, locked_forward, locked_backward, changed, &
                             cap, new_slips)
+                        cycle
+                    end if
+                    if (guessed) then
+                        ! The guessed start failed: the last step's active set instead.
+                        guessed = .false.
+                        deallocate(error)
+                        self%mode_trial = self%mode
+                        unknowns = [self%u, self%flow]
+                        call predict(self, unknowns, outcome)
                         cycle
                     end if
                     if (all(self%mode_trial == mode_stick)) return
@@ -249,6 +284,7 @@ contains
                 good_flips = flips
                 call update_active_set(problem, unknowns(n_x + 1:), self%flow, self%mode_trial, &
                     flips, locked_forward, locked_backward, changed, cap, new_slips)
+                call record_changes(self%trace, good_mode, self%mode_trial)
                 if (changed == 0) then
                     self%u_trial = unknowns(1:n_x)
                     self%flow_trial = unknowns(n_x + 1:)
@@ -294,6 +330,7 @@ contains
                 if (scene%dofs%n_unknowns > 0) then
                     call self%newton_elastic%solve(self%u_trial, stats, error)
                     iterations = iterations + stats%iterations
+                    call record_solve(self%trace, stats, allocated(error))
                     if (allocated(error)) return
                 end if
                 ! (2) Sliding step: positions frozen; its own active set settles first.
@@ -303,6 +340,7 @@ contains
                     sliding%mode = self%mode_trial
                     call self%newton_sliding%solve(self%flow_trial, stats, error)
                     iterations = iterations + stats%iterations
+                    call record_solve(self%trace, stats, allocated(error))
                     if (allocated(error)) return
                     call sliding%update_state(self%flow_trial, error)
                     if (allocated(error)) return
@@ -409,6 +447,7 @@ contains
             unknowns = [self%u_trial, self%flow_trial]
             call self%newton_full%solve(unknowns, stats, solve_error)
             iterations = iterations + stats%iterations
+            call record_solve(self%trace, stats, allocated(solve_error))
             if (allocated(solve_error)) return
             solved = .true.
             call full%update_state(unknowns, error)
@@ -437,17 +476,12 @@ contains
         integer, intent(in) :: max_new_slips
         !> How many did.
         integer, intent(out) :: new_slips
-        integer :: p, new_mode, before, after, n_candidates, k
-        real(wp) :: t_before, t_after, angle, critical, d1, d2, tol, min_before, min_after
-        real(wp) :: increment, floor, band, noise_before, noise_after
+        integer :: p, new_mode, before, after, n_candidates, k, direction_p
+        real(wp) :: min_before, min_after, increment, floor, measure
         integer, allocatable :: candidate(:), direction(:)
         real(wp), allocatable :: violation(:)
 
         associate(scene => problem%scene, passages => problem%scene%passages)
-            tol = scene%solver%friction_tolerance
-            ! The dead band of the stick test is the uncertainty of the passage's own
-            ! tensions at convergence: the residual tolerance times their level (floored,
-            ! like the nodes', by the scene's largest force) plus their rounding.
             floor = node_level_floor * problem%get_force_level()
             changed = 0
             new_slips = 0
@@ -470,27 +504,9 @@ contains
                     if (problem%length0(after) <= min_after &
                             + length_round_off * scene%network%length0(after)) &
                         locked_backward(p) = .true.
-                    call problem%get_passage_state(p, t_before, t_after, angle)
-                    noise_before = problem%get_element_noise(before)
-                    noise_after = problem%get_element_noise(after)
-                    associate(law => scene%friction(passages%law(p))%law)
-                        call law%get_critical_tension(t_before, angle, critical, d1, d2)
-                        band = dead_band_factor * (scene%solver%residual_tolerance &
-                            * max(t_before, t_after, floor) + noise_after + abs(d1) * noise_before)
-                        if (t_after > critical * (1 + tol) + band .and. &
-                                .not. locked_forward(p)) then
-                            call add_candidate(mode_forward, (t_after - critical) &
-                                / max(critical + band, tiny(1.0_wp)))
-                        else
-                            call law%get_critical_tension(t_after, angle, critical, d1, d2)
-                            band = dead_band_factor * (scene%solver%residual_tolerance &
-                                * max(t_before, t_after, floor) + noise_before &
-                                + abs(d1) * noise_after)
-                            if (t_before > critical * (1 + tol) + band .and. &
-                                    .not. locked_backward(p)) call add_candidate( &
-                                mode_backward, (t_before - critical) / max(critical + band, tiny(1.0_wp)))
-                        end if
-                    end associate
+                    call get_slip_tendency(problem, p, floor, locked_forward(p), &
+                        locked_backward(p), direction_p, measure)
+                    if (direction_p /= mode_stick) call add_candidate(direction_p, measure)
                 case (mode_forward)
                     if (increment < 0.0_wp) new_mode = mode_stick
                     ! Forward flow shortens the element before the node.
@@ -544,6 +560,52 @@ contains
         end subroutine set_mode
     end subroutine update_active_set
 
+    !> Stick test of stick passage p at the state held in `problem` (update_state):
+    !> `direction` is the way it starts to slip (mode_forward, mode_backward; not a
+    !> locked one) and `measure` the relative excess of its high tension over the
+    !> critical one, or `direction` is mode_stick. `floor`: node_level_floor times the
+    !> scene's largest force.
+    subroutine get_slip_tendency(problem, p, floor, locked_forward, locked_backward, &
+            direction, measure)
+        type(friction_problem_type), intent(in) :: problem
+        integer, intent(in) :: p
+        real(wp), intent(in) :: floor
+        logical, intent(in) :: locked_forward, locked_backward
+        integer, intent(out) :: direction
+        real(wp), intent(out) :: measure
+        real(wp) :: t_before, t_after, angle, critical, d1, d2, tol, band
+        real(wp) :: noise_before, noise_after
+
+        direction = mode_stick
+        measure = 0.0_wp
+        associate(scene => problem%scene, passages => problem%scene%passages)
+            tol = scene%solver%friction_tolerance
+            call problem%get_passage_state(p, t_before, t_after, angle)
+            noise_before = problem%get_element_noise(passages%element_before(p))
+            noise_after = problem%get_element_noise(passages%element_after(p))
+            ! The dead band of the stick test is the uncertainty of the passage's own
+            ! tensions at convergence: the residual tolerance times their level (floored,
+            ! like the nodes', by the scene's largest force) plus their rounding.
+            associate(law => scene%friction(passages%law(p))%law)
+                call law%get_critical_tension(t_before, angle, critical, d1, d2)
+                band = dead_band_factor * (scene%solver%residual_tolerance &
+                    * max(t_before, t_after, floor) + noise_after + abs(d1) * noise_before)
+                if (t_after > critical * (1 + tol) + band .and. .not. locked_forward) then
+                    direction = mode_forward
+                    measure = (t_after - critical) / max(critical + band, tiny(1.0_wp))
+                    return
+                end if
+                call law%get_critical_tension(t_after, angle, critical, d1, d2)
+                band = dead_band_factor * (scene%solver%residual_tolerance &
+                    * max(t_before, t_after, floor) + noise_before + abs(d1) * noise_after)
+                if (t_before > critical * (1 + tol) + band .and. .not. locked_backward) then
+                    direction = mode_backward
+                    measure = (t_before - critical) / max(critical + band, tiny(1.0_wp))
+                end if
+            end associate
+        end associate
+    end subroutine get_slip_tendency
+
     subroutine not_settled(error, rounds, flips)
         type(error_type), allocatable, intent(out) :: error
         integer, intent(in) :: rounds, flips(:)
@@ -558,26 +620,58 @@ contains
     !> of slipping passages along the last accepted increment, scaled by the ratio of
     !> load increments (of the sum of the channels' factors), while the loading keeps its
     !> direction.
-    subroutine predict(self, unknowns)
+    !> `outcome`: predicted_state, else reversed when the loading turned, else 0.
+    subroutine predict(self, unknowns, outcome)
         type(friction_stepper_type), intent(in) :: self
         real(wp), intent(inout) :: unknowns(:)
+        integer, intent(out) :: outcome
         real(wp) :: ratio, load, load_now
         integer :: n_x
 
+        outcome = 0
         if (.not. self%have_old) return
         load = sum(self%factors_trial)
         load_now = sum(self%factors)
         if (load_now == self%load_old) return
         ratio = (load - load_now) / (load_now - self%load_old)
+        if (ratio < 0.0_wp) outcome = reversed
         if (.not. (ratio > 0.0_wp .and. ratio <= 2.0_wp)) return
+        outcome = predicted_state
         n_x = size(self%u)
         unknowns(1:n_x) = self%u + ratio * (self%u - self%u_old)
         where (self%mode /= mode_stick) unknowns(n_x + 1:) = self%flow &
             + ratio * (self%flow - self%flow_old)
     end subroutine predict
 
+    !> Add a Newton solve to a step's trace (the first one's initial residual too).
+    subroutine record_solve(trace, stats, failed)
+        type(step_trace_type), intent(inout) :: trace
+        type(newton_stats_type), intent(in) :: stats
+        logical, intent(in) :: failed
+        if (trace%rounds == 0 .and. allocated(stats%residual_history)) then
+            if (size(stats%residual_history) > 0) &
+                trace%start_residual = stats%residual_history(1)
+        end if
+        trace%rounds = trace%rounds + 1
+        trace%iterations = trace%iterations + stats%iterations
+        trace%residual_evaluations = trace%residual_evaluations + stats%residual_evaluations
+        trace%jacobian_evaluations = trace%jacobian_evaluations + stats%jacobian_evaluations
+        if (failed) trace%failed_solves = trace%failed_solves + 1
+    end subroutine record_solve
+
+    !> Add an active-set update from mode `before` to mode `after` to a step's trace.
+    pure subroutine record_changes(trace, before, after)
+        type(step_trace_type), intent(inout) :: trace
+        integer, intent(in) :: before(:), after(:)
+        trace%to_slip = trace%to_slip + count(before == mode_stick .and. after /= mode_stick)
+        trace%to_stick = trace%to_stick + count(before /= mode_stick .and. after == mode_stick)
+    end subroutine record_changes
+
     subroutine accept(self)
         class(friction_stepper_type), intent(inout) :: self
+        self%last_trace = self%trace
+        self%last_trace%mode_changes = count(self%mode_trial /= self%mode)
+        self%trace = step_trace_type()
         self%u_old = self%u
         self%flow_old = self%flow
         self%load_old = sum(self%factors)

@@ -10,7 +10,7 @@ module yarnfort_generate_fabric
     use yarnfort_generate_knit, only: generate_knit
     use yarnfort_generate_woven, only: generate_woven
     use yarnfort_generate_texgen, only: generate_texgen
-    use yarnfort_text, only: resolve_path
+    use yarnfort_text, only: resolve_path, join_names
     implicit none
     private
 
@@ -57,51 +57,31 @@ contains
         integer :: k
 
         associate(fabric => config%fabric)
-            select case (trim(fabric%kind))
-            case ('knit', 'plain', 'twill', 'texgen')
-            case default
-                call fatal_error(error, label // "kind = '" // trim(fabric%kind) &
-                    // "' is unknown (use knit, plain, twill or texgen)")
-                return
-            end select
-            select case (trim(fabric%boundary))
-            case ('periodic', 'clamped')
-            case default
-                call fatal_error(error, label // "boundary = '" // trim(fabric%boundary) &
-                    // "' is unknown (use periodic or clamped)")
-                return
-            end select
-            select case (trim(fabric%sides))
-            case ('free', 'rollers')
-            case default
-                call fatal_error(error, label // "sides = '" // trim(fabric%sides) &
-                    // "' is unknown (use free or rollers)")
-                return
-            end select
+            call require_choice(error, 'kind', fabric%kind, [character(len=6) :: 'knit', &
+                'plain', 'twill', 'texgen'])
+            if (allocated(error)) return
+            call require_choice(error, 'boundary', fabric%boundary, [character(len=8) :: &
+                'periodic', 'clamped'])
+            if (allocated(error)) return
+            call require_choice(error, 'sides', fabric%sides, [character(len=7) :: 'free', &
+                'rollers'])
+            if (allocated(error)) return
             if (fabric%kind == 'texgen') then
                 call require_range(error, 'strain', fabric%strain, -0.9_wp, 100.0_wp)
                 if (allocated(error)) return
                 call require_range(error, 'lateral_strain', fabric%lateral_strain, -0.9_wp, &
                     100.0_wp)
                 if (allocated(error)) return
-                if (fabric%elements_per_segment < 1 .or. fabric%elements_per_segment > 1000) then
-                    write(buffer, '(a, "elements_per_segment = ", i0, " must lie in [1, ", &
-                        & "1000]")') label, fabric%elements_per_segment
-                    call fatal_error(error, trim(buffer))
-                    return
-                end if
+                call require_count(error, 'elements_per_segment', fabric%elements_per_segment, &
+                    1, 1000)
+                if (allocated(error)) return
                 call forbid_depth(error)
                 if (allocated(error)) return
                 call check_texgen(error)
                 return
             end if
-            if (any(fabric%cells < 1) .or. &
-                    real(fabric%cells(1), wp) * fabric%cells(2) > max_generated_cells) then
-                write(buffer, '(a, "cells = ", i0, ", ", i0, " must be at least 1 and at most ", &
-                    & i0, " in all")') label, fabric%cells, max_generated_cells
-                call fatal_error(error, trim(buffer))
-                return
-            end if
+            call check_cells(error)
+            if (allocated(error)) return
             if (.not. all(fabric%spacing > 0.0_wp .and. fabric%spacing < huge(1.0_wp))) then
                 write(buffer, '(a, "spacing = ", g0, ", ", g0, " must be two positive lengths (m)")') &
                     label, fabric%spacing
@@ -121,12 +101,8 @@ contains
                 call fatal_error(error, trim(buffer))
                 return
             end if
-            if (fabric%elements_per_segment < 1) then
-                write(buffer, '(a, "elements_per_segment = ", i0, " must be at least 1")') &
-                    label, fabric%elements_per_segment
-                call fatal_error(error, trim(buffer))
-                return
-            end if
+            call require_count(error, 'elements_per_segment', fabric%elements_per_segment, 1)
+            if (allocated(error)) return
 
             call forbid_name(error, 'texgen_file', fabric%texgen_file)
             if (allocated(error)) return
@@ -158,16 +134,10 @@ contains
                     call require_range(error, 'inlay_offset', fabric%inlay_offset, 0.05_wp, &
                         0.95_wp)
                     if (allocated(error)) return
-                    if (fabric%inlay_every < 1) then
-                        write(buffer, '(a, "inlay_every = ", i0, " must be at least 1")') &
-                            label, fabric%inlay_every
-                        call fatal_error(error, trim(buffer))
-                        return
-                    end if
+                    call require_count(error, 'inlay_every', fabric%inlay_every, 1)
+                    if (allocated(error)) return
                 end if
-                call forbid_name(error, 'warp_material', fabric%warp_material)
-                if (allocated(error)) return
-                call forbid_name(error, 'weft_material', fabric%weft_material)
+                call forbid_woven_materials(error)
                 if (allocated(error)) return
                 if (len_trim(fabric%inlay_material) > 0) then
                     call check_gap(error)
@@ -180,35 +150,24 @@ contains
                     ! The loop contacts' gap-holders take the gap factor.
                     call check_gap_table(error, below_spacing=.false.)
                     if (allocated(error)) return
-                    if (any(fabric%gap_factor * fabric%knit_depth >= minval(fabric%spacing))) then
-                        call fatal_error(error, label // 'gap_factor must keep knit_depth * ' &
-                            // 'factor below the spacing')
-                        return
-                    end if
                 else if (size(fabric%gap_factor) > 0) then
                     call fatal_error(error, label // 'gap and gap_factor apply to woven ' &
                         // 'fabrics, to the inlay of a knit and to a three-dimensional knit ' &
                         // '(knit_depth > 0); this planar knit has no inlay_material')
                     return
                 end if
-                if (fabric%knit_depth > 0.0_wp .and. size(fabric%gap_factor) > 0 .and. &
-                        len_trim(fabric%inlay_material) > 0) then
-                    if (any(fabric%gap_factor * fabric%knit_depth >= minval(fabric%spacing))) then
-                        call fatal_error(error, label // 'gap_factor must keep knit_depth * ' &
-                            // 'factor below the spacing')
-                        return
-                    end if
+                if (fabric%knit_depth > 0.0_wp .and. any(fabric%gap_factor * fabric%knit_depth &
+                        >= minval(fabric%spacing))) then
+                    call fatal_error(error, label // 'gap_factor must keep knit_depth * ' &
+                        // 'factor below the spacing')
+                    return
                 end if
             else
                 call require_material(error, 'warp_material', fabric%warp_material, .true.)
                 if (allocated(error)) return
                 call require_material(error, 'weft_material', fabric%weft_material, .true.)
                 if (allocated(error)) return
-                call forbid_name(error, 'knit_material', fabric%knit_material)
-                if (allocated(error)) return
-                call forbid_name(error, 'inlay_material', fabric%inlay_material)
-                if (allocated(error)) return
-                call forbid_name(error, 'edge_material', fabric%edge_material)
+                call forbid_knit_materials(error)
                 if (allocated(error)) return
                 call forbid_depth(error)
                 if (allocated(error)) return
@@ -228,6 +187,24 @@ contains
                 label, variable, value, low, high
             call fatal_error(error, trim(buffer))
         end subroutine require_range
+
+        !> An integer in [low, high], or at least `low` without `high`.
+        subroutine require_count(error, variable, value, low, high)
+            type(error_type), allocatable, intent(out) :: error
+            character(len=*), intent(in) :: variable
+            integer, intent(in) :: value, low
+            integer, intent(in), optional :: high
+            if (present(high)) then
+                if (value >= low .and. value <= high) return
+                write(buffer, '(a, a, " = ", i0, " must lie in [", i0, ", ", i0, "]")') &
+                    label, variable, value, low, high
+            else
+                if (value >= low) return
+                write(buffer, '(a, a, " = ", i0, " must be at least ", i0)') label, variable, &
+                    value, low
+            end if
+            call fatal_error(error, trim(buffer))
+        end subroutine require_count
 
         subroutine require_material(error, variable, name, required)
             type(error_type), allocatable, intent(out) :: error
@@ -255,13 +232,8 @@ contains
                     call fatal_error(error, label // "texgen_file is required for kind = 'texgen'")
                     return
                 end if
-                if (fabric%boundary == 'clamped' .and. (any(fabric%cells < 1) .or. &
-                        real(fabric%cells(1), wp) * fabric%cells(2) > max_generated_cells)) then
-                    write(buffer, '(a, "cells = ", i0, ", ", i0, " must be at least 1 and ", &
-                        & "at most ", i0, " in all")') label, fabric%cells, max_generated_cells
-                    call fatal_error(error, trim(buffer))
-                    return
-                end if
+                if (fabric%boundary == 'clamped') call check_cells(error)
+                if (allocated(error)) return
                 given = 0
                 do m = 1, size(fabric%texgen_materials)
                     if (len_trim(fabric%texgen_materials(m)) == 0) cycle
@@ -286,21 +258,11 @@ contains
                 call require_range(error, 'texgen_contact_tolerance', &
                     fabric%texgen_contact_tolerance, 0.0_wp, 1.0_wp)
                 if (allocated(error)) return
-                if (fabric%texgen_samples < 2 .or. fabric%texgen_samples > 1000) then
-                    write(buffer, '(a, "texgen_samples = ", i0, " must lie in [2, 1000]")') &
-                        label, fabric%texgen_samples
-                    call fatal_error(error, trim(buffer))
-                    return
-                end if
-                call forbid_name(error, 'knit_material', fabric%knit_material)
+                call require_count(error, 'texgen_samples', fabric%texgen_samples, 2, 1000)
                 if (allocated(error)) return
-                call forbid_name(error, 'inlay_material', fabric%inlay_material)
+                call forbid_knit_materials(error)
                 if (allocated(error)) return
-                call forbid_name(error, 'edge_material', fabric%edge_material)
-                if (allocated(error)) return
-                call forbid_name(error, 'warp_material', fabric%warp_material)
-                if (allocated(error)) return
-                call forbid_name(error, 'weft_material', fabric%weft_material)
+                call forbid_woven_materials(error)
                 if (allocated(error)) return
                 if (fabric%gap /= -1.0_wp) then
                     call fatal_error(error, label // "gap does not apply to kind = 'texgen' " &
@@ -327,6 +289,48 @@ contains
             call fatal_error(error, label // variable // " does not apply to kind = '" &
                 // trim(config%fabric%kind) // "'")
         end subroutine forbid_name
+
+        !> None of the knit's materials (outside kind = 'knit').
+        subroutine forbid_knit_materials(error)
+            type(error_type), allocatable, intent(out) :: error
+            call forbid_name(error, 'knit_material', config%fabric%knit_material)
+            if (allocated(error)) return
+            call forbid_name(error, 'inlay_material', config%fabric%inlay_material)
+            if (allocated(error)) return
+            call forbid_name(error, 'edge_material', config%fabric%edge_material)
+        end subroutine forbid_knit_materials
+
+        !> None of the weave's materials (outside the woven kinds).
+        subroutine forbid_woven_materials(error)
+            type(error_type), allocatable, intent(out) :: error
+            call forbid_name(error, 'warp_material', config%fabric%warp_material)
+            if (allocated(error)) return
+            call forbid_name(error, 'weft_material', config%fabric%weft_material)
+        end subroutine forbid_woven_materials
+
+        !> `value` must be one of `choices` (named in the message as "a, b or c").
+        subroutine require_choice(error, variable, value, choices)
+            type(error_type), allocatable, intent(out) :: error
+            character(len=*), intent(in) :: variable, value, choices(:)
+            integer :: n
+            if (any(choices == value)) return
+            n = size(choices)
+            call fatal_error(error, label // variable // " = '" // trim(value) &
+                // "' is unknown (use " // join_names(choices(:n - 1), '') // ' or ' &
+                // trim(choices(n)) // ')')
+        end subroutine require_choice
+
+        !> At least one cell each way, and not too many in all.
+        subroutine check_cells(error)
+            type(error_type), allocatable, intent(out) :: error
+            associate(cells => config%fabric%cells)
+                if (all(cells >= 1) .and. real(cells(1), wp) * cells(2) <= max_generated_cells) &
+                    return
+                write(buffer, '(a, "cells = ", i0, ", ", i0, " must be at least 1 and at most ", &
+                    & i0, " in all")') label, cells, max_generated_cells
+            end associate
+            call fatal_error(error, trim(buffer))
+        end subroutine check_cells
 
         subroutine check_gap(error)
             type(error_type), allocatable, intent(out) :: error

@@ -52,14 +52,13 @@ contains
         type(net_builder_type), intent(inout) :: net
         real(wp), intent(out) :: width
         integer, intent(out) :: pulled
-        integer :: nw, nc, i, j, k
+        integer :: nw, nc, i, j
         real(wp) :: w, c, a, y_inlay, strain(3)
         integer, allocatable :: sinker(:, :), left(:, :), right(:, :)
         integer, allocatable :: leg_left(:, :), leg_right(:, :), inlay_left(:, :)
         integer, allocatable :: inlay_right(:, :), inlay_end(:, :)
-        integer, allocatable :: course(:), inlay(:)
         real(wp) :: half_gap
-        logical :: periodic, has_inlay
+        logical :: periodic
         logical, allocatable :: inlaid(:)
 
         if (fabric%knit_depth > 0.0_wp) then
@@ -72,16 +71,8 @@ contains
         c = fabric%spacing(2)
         a = 0.5_wp * (1.0_wp - fabric%head_width) * w
         periodic = fabric%boundary == 'periodic'
-        has_inlay = len_trim(fabric%inlay_material) > 0
         strain = [fabric%strain, fabric%lateral_strain, 0.0_wp]
-
-        allocate(inlaid(0:nc - 1))
-        inlaid = .false.
-        if (has_inlay) then
-            do j = 0, nc - 1
-                inlaid(j) = mod(j, fabric%inlay_every) == 0
-            end do
-        end if
+        call get_inlaid_courses(fabric, inlaid)
 
         ! sinker(i, j): middle of the sinker before wale i of course j (yarn ends at i = 0
         ! and i = nw; inner ones only where an inlay crosses).
@@ -103,14 +94,10 @@ contains
             if (.not. inlaid(j)) cycle
             y_inlay = (j + fabric%inlay_offset) * c
             do i = 0, nw - 1
-                leg_left(i, j) = net%add_node([i * w + a, y_inlay, -half_gap])
-                inlay_left(i, j) = net%add_node([i * w + a, y_inlay, half_gap])
-                call net%add_link(inlay_left(i, j), leg_left(i, j), [0.0_wp, 0.0_wp, 0.0_wp], &
-                    .true.)
-                leg_right(i, j) = net%add_node([(i + 1) * w - a, y_inlay, half_gap])
-                inlay_right(i, j) = net%add_node([(i + 1) * w - a, y_inlay, -half_gap])
-                call net%add_link(inlay_right(i, j), leg_right(i, j), &
-                    [0.0_wp, 0.0_wp, 0.0_wp], .true.)
+                call add_crossing(net, [i * w + a, y_inlay, 0.0_wp], half_gap, leg_left(i, j), &
+                    inlay_left(i, j))
+                call add_crossing(net, [(i + 1) * w - a, y_inlay, 0.0_wp], -half_gap, &
+                    leg_right(i, j), inlay_right(i, j))
             end do
             ! Inlay ends half way between a right and a left crossing (z = 0).
             inlay_end(1, j) = net%add_node([0.0_wp, y_inlay, 0.0_wp])
@@ -118,27 +105,11 @@ contains
         end do
 
         do j = 0, nc - 1
-            allocate(course(0))
-            do i = 0, nw - 1
-                if (i == 0) course = [course, sinker(i, j)]
-                course = [course, left(i, j - 1)]
-                if (inlaid(j)) course = [course, leg_left(i, j)]
-                course = [course, left(i, j), right(i, j)]
-                if (inlaid(j)) course = [course, leg_right(i, j)]
-                course = [course, right(i, j - 1)]
-            end do
-            course = [course, sinker(nw, j)]
-            call net%add_yarn(fabric%knit_material, course, fabric%elements_per_segment)
-            deallocate(course)
-            if (.not. inlaid(j)) cycle
-            allocate(inlay(0))
-            inlay = [inlay_end(1, j)]
-            do i = 0, nw - 1
-                inlay = [inlay, inlay_left(i, j), inlay_right(i, j)]
-            end do
-            inlay = [inlay, inlay_end(2, j)]
-            call net%add_yarn(fabric%inlay_material, inlay, fabric%elements_per_segment)
-            deallocate(inlay)
+            call add_course(fabric, net, [sinker(0, j), sinker(nw, j)], left(:, j - 1), &
+                right(:, j - 1), left(:, j), right(:, j), leg_left(:, j), leg_right(:, j), &
+                inlaid(j))
+            if (inlaid(j)) call add_inlay(fabric, net, inlay_end(:, j), inlay_left(:, j), &
+                inlay_right(:, j))
         end do
 
         width = nc * c
@@ -156,20 +127,92 @@ contains
             ! Rigid-body translation: hold one contact.
             call net%add_support('anchor', [left(0, 0)], 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
         else
-            call net%add_support('left', [sinker(0, :), pack(inlay_end(1, :), inlaid)], 'xyz', &
-                [0.0_wp, 0.0_wp, 0.0_wp])
-            call net%add_support('right', [sinker(nw, :), pack(inlay_end(2, :), inlaid)], 'xyz', &
-                [fabric%strain * nw * w, 0.0_wp, 0.0_wp])
+            call clamp_knit(fabric, net, [sinker(0, :), pack(inlay_end(1, :), inlaid)], &
+                [sinker(nw, :), pack(inlay_end(2, :), inlaid)], reshape([left(:, -1), &
+                right(:, -1)], [nw, 2]), reshape([left(:, nc - 1), right(:, nc - 1)], [nw, 2]))
             pulled = 2
-            if (fabric%sides == 'rollers') then
-                call net%add_support('sides', [left(:, -1), right(:, -1), left(:, nc - 1), &
-                    right(:, nc - 1)], 'y', [0.0_wp, 0.0_wp, 0.0_wp])
-            else
-                call add_edge_threads(fabric, net, reshape([left(:, -1), right(:, -1)], &
-                    [nw, 2]), reshape([left(:, nc - 1), right(:, nc - 1)], [nw, 2]))
-            end if
         end if
     end subroutine generate_knit
+
+    !> The courses (0-based) that hold an inlay: every inlay_every-th from course 0, when
+    !> the knit has an inlay_material.
+    subroutine get_inlaid_courses(fabric, inlaid)
+        type(fabric_config_type), intent(in) :: fabric
+        logical, allocatable, intent(out) :: inlaid(:)
+        integer :: j
+
+        allocate(inlaid(0:fabric%cells(2) - 1), source=.false.)
+        if (len_trim(fabric%inlay_material) == 0) return
+        do j = 0, fabric%cells(2) - 1
+            inlaid(j) = mod(j, fabric%inlay_every) == 0
+        end do
+    end subroutine get_inlaid_courses
+
+    !> An inlay crossing a leg at `x`: a node of each yarn, the inlay's `offset` in z from
+    !> x and the leg's at -offset, joined by a gap-holder.
+    subroutine add_crossing(net, x, offset, leg, inlay)
+        type(net_builder_type), intent(inout) :: net
+        real(wp), intent(in) :: x(3), offset
+        integer, intent(out) :: leg, inlay
+
+        leg = net%add_node([x(1), x(2), x(3) - offset])
+        inlay = net%add_node([x(1), x(2), x(3) + offset])
+        call net%add_link(inlay, leg, [0.0_wp, 0.0_wp, 0.0_wp], .true.)
+    end subroutine add_crossing
+
+    !> The yarn of a course, from `ends(1)` to `ends(2)` through each loop i: its left foot,
+    !> its left leg's crossing with the inlay (`inlaid`), its two heads, its right leg's
+    !> crossing and its right foot.
+    subroutine add_course(fabric, net, ends, foot_left, foot_right, head_left, head_right, &
+            leg_left, leg_right, inlaid)
+        type(fabric_config_type), intent(in) :: fabric
+        type(net_builder_type), intent(inout) :: net
+        integer, intent(in) :: ends(2), foot_left(:), foot_right(:), head_left(:)
+        integer, intent(in) :: head_right(:), leg_left(:), leg_right(:)
+        logical, intent(in) :: inlaid
+        integer :: i
+
+        if (inlaid) then
+            call net%add_yarn(fabric%knit_material, [ends(1), (foot_left(i), leg_left(i), &
+                head_left(i), head_right(i), leg_right(i), foot_right(i), &
+                i = 1, size(foot_left)), ends(2)], fabric%elements_per_segment)
+        else
+            call net%add_yarn(fabric%knit_material, [ends(1), (foot_left(i), head_left(i), &
+                head_right(i), foot_right(i), i = 1, size(foot_left)), ends(2)], &
+                fabric%elements_per_segment)
+        end if
+    end subroutine add_course
+
+    !> The inlay yarn of a course, from `ends(1)` through its crossings of the loops'
+    !> left and right legs to `ends(2)`.
+    subroutine add_inlay(fabric, net, ends, left, right)
+        type(fabric_config_type), intent(in) :: fabric
+        type(net_builder_type), intent(inout) :: net
+        integer, intent(in) :: ends(2), left(:), right(:)
+        integer :: i
+
+        call net%add_yarn(fabric%inlay_material, [ends(1), (left(i), right(i), &
+            i = 1, size(left)), ends(2)], fabric%elements_per_segment)
+    end subroutine add_inlay
+
+    !> A clamped knit: the course (and inlay) ends `left` held, those at the right edge
+    !> (`right`) pulled along x; the first course's feet and the last course's heads
+    !> (`feet(i, 1:2)`, `heads(i, 1:2)`: left and right of loop i) on rollers in y or, with
+    !> free sides, closed by edge threads.
+    subroutine clamp_knit(fabric, net, left, right, feet, heads)
+        type(fabric_config_type), intent(in) :: fabric
+        type(net_builder_type), intent(inout) :: net
+        integer, intent(in) :: left(:), right(:), feet(:, :), heads(:, :)
+
+        call net%add_support('left', left, 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
+        call net%add_support('right', right, 'xyz', &
+            [fabric%strain * size(feet, 1) * fabric%spacing(1), 0.0_wp, 0.0_wp])
+        if (fabric%sides == 'rollers') then
+            call net%add_support('sides', [feet, heads], 'y', [0.0_wp, 0.0_wp, 0.0_wp])
+        else
+            call add_edge_threads(fabric, net, feet, heads)
+        end if
+    end subroutine clamp_knit
 
     !> Free sides of a clamped knit: a cast-on thread through the feet of the first
     !> course (`feet(i, 1:2)`: left and right foot of loop i) and a bind-off thread
@@ -232,7 +275,6 @@ contains
         integer, allocatable :: foot_left(:, :), foot_right(:, :), head_left(:, :)
         integer, allocatable :: head_right(:, :), sinker(:, :), leg_left(:, :), leg_right(:, :)
         integer, allocatable :: inlay_left(:, :), inlay_right(:, :), inlay_end(:, :)
-        integer, allocatable :: course(:), inlay(:)
         logical :: periodic
         logical, allocatable :: inlaid(:)
 
@@ -245,13 +287,7 @@ contains
         periodic = fabric%boundary == 'periodic'
         strain = [fabric%strain, fabric%lateral_strain, 0.0_wp]
         half_gap = 0.5_wp * max(fabric%gap, 0.0_wp)
-
-        allocate(inlaid(0:nc - 1), source=.false.)
-        if (len_trim(fabric%inlay_material) > 0) then
-            do j = 0, nc - 1
-                inlaid(j) = mod(j, fabric%inlay_every) == 0
-            end do
-        end if
+        call get_inlaid_courses(fabric, inlaid)
         allocate(foot_left(0:nw - 1, 0:nc - 1), foot_right(0:nw - 1, 0:nc - 1))
         allocate(head_left(0:nw - 1, 0:nc - 1), head_right(0:nw - 1, 0:nc - 1))
         allocate(leg_left(0:nw - 1, 0:nc - 1), leg_right(0:nw - 1, 0:nc - 1), source=0)
@@ -270,14 +306,10 @@ contains
                 head_right(i, j) = net%add_node([(i + 1) * w - a, (j + 1) * c, -0.5_wp * d])
                 foot_right(i, j) = net%add_node([(i + 1) * w - a, j * c, 0.5_wp * d])
                 if (.not. inlaid(j)) cycle
-                leg_left(i, j) = net%add_node([i * w + a, y_inlay, z_leg - half_gap])
-                inlay_left(i, j) = net%add_node([i * w + a, y_inlay, z_leg + half_gap])
-                call net%add_link(inlay_left(i, j), leg_left(i, j), [0.0_wp, 0.0_wp, 0.0_wp], &
-                    .true.)
-                leg_right(i, j) = net%add_node([(i + 1) * w - a, y_inlay, z_leg + half_gap])
-                inlay_right(i, j) = net%add_node([(i + 1) * w - a, y_inlay, z_leg - half_gap])
-                call net%add_link(inlay_right(i, j), leg_right(i, j), &
-                    [0.0_wp, 0.0_wp, 0.0_wp], .true.)
+                call add_crossing(net, [i * w + a, y_inlay, z_leg], half_gap, leg_left(i, j), &
+                    inlay_left(i, j))
+                call add_crossing(net, [(i + 1) * w - a, y_inlay, z_leg], -half_gap, &
+                    leg_right(i, j), inlay_right(i, j))
             end do
             if (.not. inlaid(j)) cycle
             inlay_end(1, j) = net%add_node([0.0_wp, y_inlay, z_leg])
@@ -285,23 +317,10 @@ contains
         end do
 
         do j = 0, nc - 1
-            course = [sinker(1, j)]
-            do i = 0, nw - 1
-                course = [course, foot_left(i, j)]
-                if (inlaid(j)) course = [course, leg_left(i, j)]
-                course = [course, head_left(i, j), head_right(i, j)]
-                if (inlaid(j)) course = [course, leg_right(i, j)]
-                course = [course, foot_right(i, j)]
-            end do
-            course = [course, sinker(2, j)]
-            call net%add_yarn(fabric%knit_material, course, fabric%elements_per_segment)
-            if (.not. inlaid(j)) cycle
-            inlay = [inlay_end(1, j)]
-            do i = 0, nw - 1
-                inlay = [inlay, inlay_left(i, j), inlay_right(i, j)]
-            end do
-            inlay = [inlay, inlay_end(2, j)]
-            call net%add_yarn(fabric%inlay_material, inlay, fabric%elements_per_segment)
+            call add_course(fabric, net, sinker(:, j), foot_left(:, j), foot_right(:, j), &
+                head_left(:, j), head_right(:, j), leg_left(:, j), leg_right(:, j), inlaid(j))
+            if (inlaid(j)) call add_inlay(fabric, net, inlay_end(:, j), inlay_left(:, j), &
+                inlay_right(:, j))
         end do
 
         ! Loop contacts: the feet of course j + 1 follow the head of course j, d in front.
@@ -330,19 +349,11 @@ contains
             end do
             call net%add_support('anchor', [foot_left(0, 0)], 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
         else
-            call net%add_support('left', [sinker(1, :), pack(inlay_end(1, :), inlaid)], 'xyz', &
-                [0.0_wp, 0.0_wp, 0.0_wp])
-            call net%add_support('right', [sinker(2, :), pack(inlay_end(2, :), inlaid)], 'xyz', &
-                [fabric%strain * nw * w, 0.0_wp, 0.0_wp])
+            call clamp_knit(fabric, net, [sinker(1, :), pack(inlay_end(1, :), inlaid)], &
+                [sinker(2, :), pack(inlay_end(2, :), inlaid)], reshape([foot_left(:, 0), &
+                foot_right(:, 0)], [nw, 2]), reshape([head_left(:, nc - 1), &
+                head_right(:, nc - 1)], [nw, 2]))
             pulled = 2
-            if (fabric%sides == 'rollers') then
-                call net%add_support('sides', [foot_left(:, 0), foot_right(:, 0), &
-                    head_left(:, nc - 1), head_right(:, nc - 1)], 'y', [0.0_wp, 0.0_wp, 0.0_wp])
-            else
-                call add_edge_threads(fabric, net, reshape([foot_left(:, 0), &
-                    foot_right(:, 0)], [nw, 2]), reshape([head_left(:, nc - 1), &
-                    head_right(:, nc - 1)], [nw, 2]))
-            end if
         end if
     end subroutine generate_knit_3d
 

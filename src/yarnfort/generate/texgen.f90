@@ -31,6 +31,7 @@ module yarnfort_generate_texgen
     use yarnfort_input_config, only: fabric_config_type, link_config_type
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_xml_subset, only: xml_document_type, read_xml_file
+    use yarnfort_sort, only: sort_index
     implicit none
     private
 
@@ -715,24 +716,6 @@ contains
         end if
     end subroutine closest_points
 
-    !> Indices that sort `values` ascending (insertion sort: contact lists are short).
-    pure function sort_index(values) result(order)
-        real(wp), intent(in) :: values(:)
-        integer :: order(size(values)), i, j, item
-
-        order = [(i, i = 1, size(values))]
-        do i = 2, size(values)
-            item = order(i)
-            j = i - 1
-            do while (j >= 1)
-                if (values(order(j)) <= values(item)) exit
-                order(j + 1) = order(j)
-                j = j - 1
-            end do
-            order(j + 1) = item
-        end do
-    end function sort_index
-
     !> Nodes, yarns, gap-holders, periodic links and the anchor of the cell (in m).
     subroutine build_cell(fabric, yarns, cell, scale, contacts, net, error)
         type(fabric_config_type), intent(in) :: fabric
@@ -936,14 +919,10 @@ contains
                 shift = lattice_part(link)
                 do b = 0, ny - 1
                     do a = 0, nx - 1
-                        if (inside(a + shift(1), b + shift(2))) cycle
-                        orphan(link%follower, a, b) = .true.
-                    end do
-                end do
-                do b = 0, ny - 1
-                    do a = 0, nx - 1
-                        if (inside(a - shift(1), b - shift(2))) cycle
-                        orphan(link%leader, a, b) = .true.
+                        if (.not. inside(a + shift(1), b + shift(2))) &
+                            orphan(link%follower, a, b) = .true.
+                        if (.not. inside(a - shift(1), b - shift(2))) &
+                            orphan(link%leader, a, b) = .true.
                     end do
                 end do
             end associate

@@ -9,8 +9,9 @@ module yarnfort_input_channel_checks
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, path_config_type, name_length
-    use yarnfort_input_fields, only: check_name, quoted_list, suggestion
-    use yarnfort_text, only: format_integer
+    use yarnfort_input_fields, only: check_name, quoted_list
+    use yarnfort_input_network_checks, only: check_defined
+    use yarnfort_text, only: format_integer, parse_integer
     implicit none
     private
 
@@ -61,23 +62,17 @@ contains
 
     !> Index in `names` of channel `name`, or of `default_name` when `name` is empty (only
     !> without &path channels; with them an empty name has no channel); 0: not found.
-    pure integer function find_channel(names, name, default_name, given) result(index)
+    pure integer function find_channel(names, name, default_name, given) result(found)
         character(len=*), intent(in) :: names(:), name, default_name
         logical, intent(in) :: given
 
-        index = 0
-        if (len_trim(name) == 0) then
-            if (given) return
-            do index = 1, size(names)
-                if (trim(names(index)) == default_name) return
-            end do
-            index = 0
-            return
+        if (len_trim(name) > 0) then
+            found = findloc(names, name, dim=1)
+        else if (given) then
+            found = 0
+        else
+            found = findloc(names, default_name, dim=1)
         end if
-        do index = 1, size(names)
-            if (trim(names(index)) == trim(name)) return
-        end do
-        index = 0
     end function find_channel
 
     !> Number of values of &path factors (0 when unallocated).
@@ -91,10 +86,8 @@ contains
     pure integer function count_given(path) result(n)
         type(path_config_type), intent(in) :: path
 
-        do n = 0, size(path%channels) - 1
-            if (len_trim(path%channels(n + 1)) == 0) return
-        end do
-        n = size(path%channels)
+        n = findloc(path%channels == '', .true., dim=1) - 1
+        if (n < 0) n = size(path%channels)
     end function count_given
 
     !> The prefix of the displacement columns of &load #k in curve.csv.
@@ -117,74 +110,61 @@ contains
             n = count_given(path)
             given = n > 0
             n_knots = size(path%time)
-            do k = n + 2, size(path%channels)
-                if (len_trim(path%channels(k)) > 0) then
+            k = findloc(path%channels(n + 2:) /= '', .true., dim=1)
+            if (k > 0) then
+                k = n + 1 + k
+                call fatal_error(error, '&path: channels(' // format_integer(k) // ") = '" &
+                    // trim(path%channels(k)) // "' follows the empty channels(" &
+                    // format_integer(n + 1) // ') (give the names one after another)')
+                return
+            end if
+            ! A config built in code (tests, benchmarks) may leave factors unallocated.
+            if (.not. given) then
+                if (n_factors(path) > 0) call fatal_error(error, '&path: factors is given ' &
+                    // 'but channels is not (factors are the columns of the channels that ' &
+                    // 'channels names; without channels give p_force and p_disp)')
+            else if (len_trim(config%fabric%kind) > 0) then
+                call fatal_error(error, '&path: channels is given with &fabric (a generated ' &
+                    // "fabric is driven by the channels 'p_force' and 'p_disp': give " &
+                    // 'p_force and p_disp instead)')
+            else if (any(path%p_force /= 0.0_wp) .or. any(path%p_disp /= 0.0_wp)) then
+                call fatal_error(error, '&path: p_force or p_disp is set together with ' &
+                    // 'channels (with channels every factor comes from factors: give ' &
+                    // "'p_force' / 'p_disp' as channel names if you want them)")
+            else if (n_factors(path) /= n * n_knots) then
+                call fatal_error(error, '&path: factors has ' // format_integer(n_factors(path)) &
+                    // ' values but the ' // format_integer(n) // ' channels (' &
+                    // quoted_list(path%channels(:n)) // ') at ' // format_integer(n_knots) &
+                    // ' knots need ' // format_integer(n * n_knots) // ' (one row per ' &
+                    // 'knot, one value per channel)')
+            end if
+            if (allocated(error)) return
+            do k = 1, n
+                call check_name(error, '&path channels(' // format_integer(k) // ')', &
+                    path%channels(k))
+                if (allocated(error)) return
+                j = findloc(path%channels(:k - 1), path%channels(k), dim=1)
+                if (j > 0) then
+                    call fatal_error(error, "&path: channel '" // trim(path%channels(k)) &
+                        // "' is named twice (channels(" // format_integer(j) &
+                        // ') and channels(' // format_integer(k) // '))')
+                    return
+                end if
+                if (any(fixed_curve_columns == path%channels(k))) then
                     call fatal_error(error, '&path: channels(' // format_integer(k) // ") = '" &
-                        // trim(path%channels(k)) // "' follows the empty channels(" &
-                        // format_integer(n + 1) // ') (give the names one after another)')
+                        // trim(path%channels(k)) // "' is the name of another column of " &
+                        // 'curve.csv (' // quoted_list(fixed_curve_columns) // '): choose ' &
+                        // 'another name')
                     return
                 end if
             end do
-            ! A config built in code (tests, benchmarks) may leave factors unallocated.
-            if (.not. given) then
-                if (n_factors(path) > 0) then
-                    call fatal_error(error, '&path: factors is given but channels is not ' &
-                        // '(factors are the columns of the channels that channels names; ' &
-                        // 'without channels give p_force and p_disp)')
-                    return
-                end if
-            else
-                if (len_trim(config%fabric%kind) > 0) then
-                    call fatal_error(error, '&path: channels is given with &fabric (a ' &
-                        // "generated fabric is driven by the channels 'p_force' and " &
-                        // "'p_disp': give p_force and p_disp instead)")
-                    return
-                end if
-                if (any(path%p_force /= 0.0_wp) .or. any(path%p_disp /= 0.0_wp)) then
-                    call fatal_error(error, '&path: p_force or p_disp is set together with ' &
-                        // 'channels (with channels every factor comes from factors: give ' &
-                        // "'p_force' / 'p_disp' as channel names if you want them)")
-                    return
-                end if
-                if (n_factors(path) /= n * n_knots) then
-                    call fatal_error(error, '&path: factors has ' &
-                        // format_integer(n_factors(path)) // ' values but the ' &
-                        // format_integer(n) // ' channels (' // quoted_list(path%channels(:n)) &
-                        // ') at ' // format_integer(n_knots) // ' knots need ' &
-                        // format_integer(n * n_knots) // ' (one row per knot, one value per ' &
-                        // 'channel)')
-                    return
-                end if
-                do k = 1, n
-                    call check_name(error, '&path channels(' // format_integer(k) // ')', &
-                        path%channels(k))
-                    if (allocated(error)) return
-                    do j = 1, k - 1
-                        if (path%channels(j) == path%channels(k)) then
-                            call fatal_error(error, "&path: channel '" // trim(path%channels(k)) &
-                                // "' is named twice (channels(" // format_integer(j) &
-                                // ') and channels(' // format_integer(k) // '))')
-                            return
-                        end if
-                    end do
-                    if (any(fixed_curve_columns == path%channels(k))) then
-                        call fatal_error(error, '&path: channels(' // format_integer(k) &
-                            // ") = '" // trim(path%channels(k)) // "' is the name of " &
-                            // 'another column of curve.csv (' &
-                            // quoted_list(fixed_curve_columns) // '): choose another name')
-                        return
-                    end if
-                end do
-            end if
         end associate
         names = get_channel_names(config%path)
         if (allocated(config%loads)) then
             do k = 1, size(config%loads)
-                associate(load => config%loads(k))
-                    call check_one('&load #' // format_integer(k), load%channel, &
-                        default_force_channel, any(load%force /= 0.0_wp), 'force')
-                    if (allocated(error)) return
-                end associate
+                call check_one('&load #' // format_integer(k), config%loads(k)%channel, &
+                    default_force_channel, any(config%loads(k)%force /= 0.0_wp), 'force')
+                if (allocated(error)) return
             end do
         end if
         if (allocated(config%supports)) then
@@ -205,17 +185,14 @@ contains
             character(len=*), intent(in) :: label, name, default_name, what
             logical, intent(in) :: used
 
-            if (find_channel(names, name, default_name, given) > 0) return
-            if (len_trim(name) == 0) then
-                if (.not. used) return
+            if (len_trim(name) > 0) then
+                call check_defined(error, label, 'channel', name, names, 'a channel of &path', &
+                    'channels')
+            else if (used .and. find_channel(names, name, default_name, given) == 0) then
                 call fatal_error(error, label // ': channel is not set, and &path names its ' &
                     // 'channels (' // quoted_list(names) // '): give the channel whose ' &
                     // 'factor scales its ' // what)
-                return
             end if
-            call fatal_error(error, label // ": channel = '" // trim(name) // "' is not a " &
-                // 'channel of &path (channels: ' // quoted_list(names) // ')' &
-                // suggestion(name, names))
         end subroutine check_one
 
     end subroutine check_channels
@@ -241,14 +218,12 @@ contains
             if (.not. any(suffixes == name(length - 2:))) cycle
             stem = name(:length - 3)
             if (allocated(config%supports)) then
-                do j = 1, size(config%supports)
-                    if (trim(config%supports(j)%name) == stem) then
-                        call fatal_error(error, "curve.csv would have two columns '" // name &
-                            // "' (the factor of channel " // name // " and &support '" &
-                            // stem // "'): rename one")
-                        return
-                    end if
-                end do
+                if (any(config%supports%name == stem)) then
+                    call fatal_error(error, "curve.csv would have two columns '" // name &
+                        // "' (the factor of channel " // name // " and &support '" // stem &
+                        // "'): rename one")
+                    return
+                end if
             end if
             j = load_number(stem)
             if (j > 0 .and. any(suffixes(4:) == name(length - 2:))) then
@@ -274,18 +249,15 @@ contains
         !> k if `text` is load_column_prefix(k) of an existing &load, else 0.
         integer function load_number(text)
             character(len=*), intent(in) :: text
-            integer :: status
+            logical :: ok
 
             load_number = 0
-            if (len(text) < 6) return
-            if (text(:5) /= 'load_') return
-            if (verify(text(6:), '0123456789') /= 0) return
-            read(text(6:), *, iostat=status) load_number
-            if (status /= 0) load_number = 0
-            if (load_number < 1 .or. load_number > n_loads) then
+            if (index(text, 'load_') /= 1) return
+            call parse_integer(text(6:), load_number, ok)
+            if (.not. ok .or. load_number < 1 .or. load_number > n_loads) then
                 load_number = 0
             else if (load_column_prefix(load_number) /= text) then
-                load_number = 0          ! 'load_01' is no column name
+                load_number = 0          ! 'load_01' or 'load_+1' is no column name
             end if
         end function load_number
     end subroutine check_curve_columns

@@ -5,10 +5,10 @@
 module yarnfort_input_contact_checks
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: config_type, contact_config_type, name_length
+    use yarnfort_input_config, only: config_type, name_length
     use yarnfort_input_groups, only: check_contact_variables
-    use yarnfort_input_fields, only: suggestion, quoted_list
-    use yarnfort_input_network_checks, only: yarn_label
+    use yarnfort_input_fields, only: quoted_list
+    use yarnfort_input_network_checks, only: yarn_label, check_defined, sort_by_key
     use yarnfort_input_contact_node_checks, only: check_node_contact, get_contact_node_sets
     use yarnfort_text, only: format_integer, format_real
     implicit none
@@ -50,17 +50,18 @@ contains
                     end do
                     a = findloc(material_names, contact%materials(1), dim=1)
                     b = findloc(material_names, contact%materials(2), dim=1)
-                    label = label // ' (' // pair_text(contact) // ')'
                     if (pair(a, b) /= 0) then
-                        call fatal_error(error, '&contact #' // format_integer(c) &
-                            // ': materials = ' // pair_text(contact) // ' is the same pair ' &
-                            // 'as &contact #' // format_integer(pair(a, b)) // ' (materials = ' &
-                            // pair_text(config%contacts(pair(a, b))) // '; the order does ' &
-                            // 'not matter): give one &contact per pair of yarn types')
+                        call fatal_error(error, label // ': materials = ' &
+                            // quoted_list(contact%materials) // ' is the same pair as ' &
+                            // '&contact #' // format_integer(pair(a, b)) // ' (materials = ' &
+                            // quoted_list(config%contacts(pair(a, b))%materials) // '; the ' &
+                            // 'order does not matter): give one &contact per pair of yarn ' &
+                            // 'types')
                         return
                     end if
                     pair(a, b) = c
                     pair(b, a) = c
+                    label = label // ' (' // quoted_list(contact%materials) // ')'
                 end if
                 call check_contact_variables(contact, label, error)
                 if (allocated(error)) return
@@ -77,14 +78,6 @@ contains
         call check_contacts_complete(config, pair, error)
     end subroutine check_contacts
 
-    !> 'a', 'b' of a contact, as in its materials variable.
-    pure function pair_text(contact) result(text)
-        type(contact_config_type), intent(in) :: contact
-        character(len=:), allocatable :: text
-
-        text = quoted_list(contact%materials)
-    end function pair_text
-
     !> materials(i) of a &contact: set, and the name of a &material.
     subroutine check_contact_material(error, label, i, name, material_names)
         type(error_type), allocatable, intent(out) :: error
@@ -100,11 +93,8 @@ contains
                 // trim(material_names(size(material_names))) // "')")
             return
         end if
-        if (.not. any(material_names == name)) then
-            call fatal_error(error, label // ': ' // variable // " = '" // trim(name) &
-                // "' is not defined by any &material (defined: " &
-                // quoted_list(material_names) // ')' // suggestion(name, material_names))
-        end if
+        call check_defined(error, label, variable, name, material_names, &
+            'defined by any &material', 'defined')
     end subroutine check_contact_material
 
     !> With any &contact, every pair of yarn types meeting at a node needs one. A node
@@ -114,62 +104,54 @@ contains
         type(config_type), intent(in) :: config
         integer, intent(in) :: pair(:, :)
         type(error_type), allocatable, intent(out) :: error
-        integer, allocatable :: material_of(:), first(:), yarns_at(:), last_yarn(:), filled(:)
-        integer, allocatable :: set_of(:)
+        !> Each yarn at each node it lists, once (a yarn may list a node twice): visit v
+        !> is yarn yarn_of(v) at node node_of(v); the visits of node n are
+        !> order(first(n):first(n + 1) - 1).
+        integer, allocatable :: yarn_of(:), node_of(:), first(:), order(:)
+        integer, allocatable :: material_of(:), last_yarn(:), set_of(:)
         character(len=name_length), allocatable :: set_names(:)
-        integer :: n_nodes, y, i, node, j, k, a, b, n_obstacles
+        integer :: n_nodes, n, y, i, node, j, k, a, b, n_obstacles
 
         n_nodes = size(config%node_positions, 2)
         allocate(material_of(size(config%yarns)))
         do y = 1, size(config%yarns)
             material_of(y) = findloc(config%materials%name, config%yarns(y)%material, dim=1)
         end do
-        ! Yarns through each node, each once (a yarn may list a node twice): the yarns
-        ! at node n are yarns_at(first(n):first(n + 1) - 1).
-        allocate(first(n_nodes + 1), source=0)
+        n = sum([(size(config%yarns(y)%nodes), y = 1, size(config%yarns))])
+        allocate(yarn_of(n), node_of(n))
         allocate(last_yarn(n_nodes), source=0)
+        n = 0
         do y = 1, size(config%yarns)
             do i = 1, size(config%yarns(y)%nodes)
                 node = config%yarns(y)%nodes(i)
                 if (last_yarn(node) == y) cycle
                 last_yarn(node) = y
-                first(node + 1) = first(node + 1) + 1
+                n = n + 1
+                yarn_of(n) = y
+                node_of(n) = node
             end do
         end do
-        first(1) = 1
-        do node = 1, n_nodes
-            first(node + 1) = first(node + 1) + first(node)
-        end do
-        allocate(yarns_at(first(n_nodes + 1) - 1))
-        allocate(filled(n_nodes), source=0)
-        last_yarn = 0
-        do y = 1, size(config%yarns)
-            do i = 1, size(config%yarns(y)%nodes)
-                node = config%yarns(y)%nodes(i)
-                if (last_yarn(node) == y) cycle
-                last_yarn(node) = y
-                yarns_at(first(node) + filled(node)) = y
-                filled(node) = filled(node) + 1
-            end do
-        end do
+        call sort_by_key(node_of(:n), n_nodes, first, order)
         call get_contact_node_sets(config, set_of, set_names, n_obstacles)
         do node = 1, n_nodes
             if (set_of(node) /= 0) cycle
-            do j = first(node), first(node + 1) - 1
-                do k = j + 1, first(node + 1) - 1
-                    a = material_of(yarns_at(j))
-                    b = material_of(yarns_at(k))
-                    if (pair(a, b) /= 0) cycle
-                    call fatal_error(error, "no &contact for yarn types '" &
-                        // trim(config%materials(a)%name) // "' and '" &
-                        // trim(config%materials(b)%name) // "' (they meet at node " &
-                        // format_integer(node) // '); ' // yarn_label(config, yarns_at(j)) &
-                        // ' and ' // yarn_label(config, yarns_at(k)) // ' share it, and ' &
-                        // 'with any &contact group every pair of yarn types that meet ' &
-                        // 'needs one')
-                    return
+            associate(yarns => yarn_of(order(first(node):first(node + 1) - 1)))
+                do j = 1, size(yarns)
+                    do k = j + 1, size(yarns)
+                        a = material_of(yarns(j))
+                        b = material_of(yarns(k))
+                        if (pair(a, b) /= 0) cycle
+                        call fatal_error(error, "no &contact for yarn types '" &
+                            // trim(config%materials(a)%name) // "' and '" &
+                            // trim(config%materials(b)%name) // "' (they meet at node " &
+                            // format_integer(node) // '); ' // yarn_label(config, yarns(j)) &
+                            // ' and ' // yarn_label(config, yarns(k)) // ' share it, and ' &
+                            // 'with any &contact group every pair of yarn types that meet ' &
+                            // 'needs one')
+                        return
+                    end do
                 end do
-            end do
+            end associate
         end do
     end subroutine check_contacts_complete
 

@@ -7,14 +7,23 @@ module yarnfort_input_contact_node_checks
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, name_length
-    use yarnfort_input_fields, only: suggestion, quoted_list, check_item_name, group_label
-    use yarnfort_input_network_checks, only: check_node_list, yarn_label
+    use yarnfort_input_fields, only: check_item_name, group_label
+    use yarnfort_input_network_checks, only: check_node_list, yarn_label, check_defined
     use yarnfort_text, only: format_integer, format_real
     implicit none
     private
 
     public :: check_contact_nodes, check_node_contact, check_contact_node_laws
-    public :: get_contact_node_sets, find_node_contact, contact_node_label
+    public :: get_contact_node_sets, find_node_contact
+
+    !> An &obstacle or &ring group: 'obstacle' or 'ring', its number among the groups of
+    !> its kind, its name and its node ids.
+    type :: node_set_type
+        character(len=8) :: group = ''
+        integer :: number = 0
+        character(len=name_length) :: name = ''
+        integer, allocatable :: nodes(:)
+    end type node_set_type
 
 contains
 
@@ -26,41 +35,50 @@ contains
         integer, allocatable, intent(out) :: set_of(:)
         character(len=name_length), allocatable, intent(out) :: names(:)
         integer, intent(out) :: n_obstacles
-        integer :: s
+        type(node_set_type), allocatable :: sets(:)
 
-        allocate(set_of(size(config%node_positions, 2)), source=0)
-        allocate(names(0))
-        n_obstacles = 0
-        if (allocated(config%obstacles)) then
-            n_obstacles = size(config%obstacles)
-            do s = 1, n_obstacles
-                names = [names, config%obstacles(s)%name]
-                set_of(config%obstacles(s)%nodes) = s
-            end do
-        end if
-        if (allocated(config%rings)) then
-            do s = 1, size(config%rings)
-                names = [names, config%rings(s)%name]
-                set_of(config%rings(s)%nodes) = n_obstacles + s
-            end do
-        end if
+        call get_node_sets(config, sets, set_of)
+        names = sets%name
+        n_obstacles = count(sets%group == 'obstacle')
     end subroutine get_contact_node_sets
 
-    !> "&obstacle 'name'" or "&ring 'name'" of set s (numbered as by get_contact_node_sets).
-    function contact_node_label(config, s) result(label)
+    !> The &obstacle groups, then the &ring groups; with `set_of`, the set of each node
+    !> (0: none; the node ids must be checked).
+    subroutine get_node_sets(config, sets, set_of)
         type(config_type), intent(in) :: config
-        integer, intent(in) :: s
-        character(len=:), allocatable :: label
-        integer :: n_obstacles
+        type(node_set_type), allocatable, intent(out) :: sets(:)
+        integer, allocatable, intent(out), optional :: set_of(:)
+        integer :: n_obstacles, n_rings, s
 
         n_obstacles = 0
+        n_rings = 0
         if (allocated(config%obstacles)) n_obstacles = size(config%obstacles)
-        if (s <= n_obstacles) then
-            label = "&obstacle '" // trim(config%obstacles(s)%name) // "'"
-        else
-            label = "&ring '" // trim(config%rings(s - n_obstacles)%name) // "'"
-        end if
-    end function contact_node_label
+        if (allocated(config%rings)) n_rings = size(config%rings)
+        allocate(sets(n_obstacles + n_rings))
+        do s = 1, n_obstacles
+            associate(obstacle => config%obstacles(s))
+                sets(s) = node_set_type('obstacle', s, obstacle%name, obstacle%nodes)
+            end associate
+        end do
+        do s = 1, n_rings
+            associate(ring => config%rings(s))
+                sets(n_obstacles + s) = node_set_type('ring', s, ring%name, ring%nodes)
+            end associate
+        end do
+        if (.not. present(set_of)) return
+        allocate(set_of(size(config%node_positions, 2)), source=0)
+        do s = 1, size(sets)
+            set_of(sets(s)%nodes) = s
+        end do
+    end subroutine get_node_sets
+
+    !> "&obstacle 'name'" or "&ring 'name'".
+    pure function set_label(set) result(label)
+        type(node_set_type), intent(in) :: set
+        character(len=:), allocatable :: label
+
+        label = '&' // trim(set%group) // " '" // trim(set%name) // "'"
+    end function set_label
 
     !> The law of a yarn of type `material` at a node of the obstacle or ring `name`: the
     !> &contact with at = name and materials(1) = material; else the one with at = name
@@ -68,18 +86,14 @@ contains
     pure integer function find_node_contact(config, name, material) result(contact)
         type(config_type), intent(in) :: config
         character(len=*), intent(in) :: name, material
-        integer :: c
 
         contact = 0
         if (.not. allocated(config%contacts)) return
-        do c = 1, size(config%contacts)
-            if (config%contacts(c)%at /= name) cycle
-            if (config%contacts(c)%materials(1) == material) then
-                contact = c
-                return
-            end if
-            if (len_trim(config%contacts(c)%materials(1)) == 0) contact = c
-        end do
+        associate(at => config%contacts%at, first => config%contacts%materials(1))
+            contact = findloc(at == name .and. first == material, .true., dim=1)
+            if (contact == 0) contact = findloc(at == name .and. first == '', .true., dim=1, &
+                back=.true.)
+        end associate
     end function find_node_contact
 
     !> &obstacle and &ring groups: named (one word, unique among obstacles, rings and
@@ -89,64 +103,46 @@ contains
     subroutine check_contact_nodes(config, error)
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
-        integer, allocatable :: set_of(:), visits(:), nodes(:)
-        character(len=name_length), allocatable :: names(:)
+        type(node_set_type), allocatable :: sets(:)
+        integer, allocatable :: set_of(:), visits(:)
         character(len=24), allocatable :: labels(:)
-        character(len=:), allocatable :: label, group, what
-        integer :: n_obstacles, n_sets, n_nodes, s, other, i, y, node, l, k
+        character(len=:), allocatable :: what
+        integer :: n_nodes, s, other, i, y, node, l, k
 
+        call get_node_sets(config, sets)
+        if (size(sets) == 0) return
         n_nodes = size(config%node_positions, 2)
-        n_obstacles = 0
-        n_sets = 0
-        if (allocated(config%obstacles)) n_obstacles = size(config%obstacles)
-        n_sets = n_obstacles
-        if (allocated(config%rings)) n_sets = n_sets + size(config%rings)
-        if (n_sets == 0) return
         allocate(set_of(n_nodes), source=0)
-        allocate(names(n_sets), labels(n_sets))
-        do s = 1, n_sets
-            if (s <= n_obstacles) then
-                names(s) = config%obstacles(s)%name
-                labels(s) = group_label('obstacle', s)
-            else
-                names(s) = config%rings(s - n_obstacles)%name
-                labels(s) = group_label('ring', s - n_obstacles)
-            end if
-        end do
-        do s = 1, n_sets
-            group = labels(s)(:index(labels(s), ' #') - 1)
-            if (s <= n_obstacles) then
-                nodes = config%obstacles(s)%nodes
-            else
-                nodes = config%rings(s - n_obstacles)%nodes
-            end if
-            call check_item_name(error, names, labels, s, ' (give each ' // group(2:) &
-                // " a name; &contact at = 'name' gives its friction law)", 'used', &
-                '; &contact at names one of them')
-            if (allocated(error)) return
-            if (allocated(config%supports)) then
-                do other = 1, size(config%supports)
-                    if (config%supports(other)%name == names(s)) then
-                        call fatal_error(error, group // ": name = '" // trim(names(s)) &
-                            // "' is also the name of &support #" // format_integer(other) &
-                            // ' (they would share the reaction columns of curve.csv)')
-                        return
-                    end if
-                end do
-            end if
-            label = group // " '" // trim(names(s)) // "'"
-            call check_node_list(error, label, nodes, n_nodes)
-            if (allocated(error)) return
-            do i = 1, size(nodes)
-                if (set_of(nodes(i)) /= 0) then
-                    call fatal_error(error, label // ': node ' // format_integer(nodes(i)) &
-                        // ' is already a node of ' &
-                        // contact_node_label(config, set_of(nodes(i))) &
+        labels = [character(len=24) :: (group_label(trim(sets(s)%group), sets(s)%number), &
+            s = 1, size(sets))]
+        do s = 1, size(sets)
+            associate(set => sets(s))
+                call check_item_name(error, sets%name, labels, s, ' (give each ' &
+                    // trim(set%group) // " a name; &contact at = 'name' gives its friction " &
+                    // 'law)', 'used', '; &contact at names one of them')
+                if (allocated(error)) return
+                other = 0
+                if (allocated(config%supports)) &
+                    other = findloc(config%supports%name, set%name, dim=1)
+                if (other > 0) then
+                    call fatal_error(error, '&' // trim(set%group) // ": name = '" &
+                        // trim(set%name) // "' is also the name of &support #" &
+                        // format_integer(other) // ' (they would share the reaction ' &
+                        // 'columns of curve.csv)')
+                    return
+                end if
+                call check_node_list(error, set_label(set), set%nodes, n_nodes)
+                if (allocated(error)) return
+                i = findloc(set_of(set%nodes) /= 0, .true., dim=1)
+                if (i > 0) then
+                    call fatal_error(error, set_label(set) // ': node ' &
+                        // format_integer(set%nodes(i)) // ' is already a node of ' &
+                        // set_label(sets(set_of(set%nodes(i)))) &
                         // ' (a node is one obstacle or one ring)')
                     return
                 end if
-                set_of(nodes(i)) = s
-            end do
+                set_of(set%nodes) = s
+            end associate
         end do
         ! Every yarn passes through the contact nodes it lists; every one has a yarn.
         allocate(visits(n_nodes), source=0)
@@ -159,7 +155,7 @@ contains
                     if (i == 1 .or. i == size(list)) then
                         call fatal_error(error, yarn_label(config, y) // ' ends at node ' &
                             // format_integer(node) // ', a node of ' &
-                            // contact_node_label(config, set_of(node)) // ': a yarn passes ' &
+                            // set_label(sets(set_of(node))) // ': a yarn passes ' &
                             // 'through an obstacle or a ring (a node on each side); to fix ' &
                             // 'a yarn end there, end it at a node of its own held by a ' &
                             // '&support')
@@ -169,38 +165,37 @@ contains
                 end do
             end associate
         end do
-        do s = 1, n_sets
-            if (s <= n_obstacles) then
-                nodes = config%obstacles(s)%nodes
+        do s = 1, size(sets)
+            i = findloc(visits(sets(s)%nodes), 0, dim=1)
+            if (i == 0) cycle
+            if (sets(s)%group == 'obstacle') then
                 what = 'an obstacle with no yarn has nothing to hold'
             else
-                nodes = config%rings(s - n_obstacles)%nodes
                 what = 'a ring needs at least one yarn through it'
             end if
-            do i = 1, size(nodes)
-                if (visits(nodes(i)) > 0) cycle
-                call fatal_error(error, contact_node_label(config, s) // ': no yarn passes ' &
-                    // 'through node ' // format_integer(nodes(i)) // ' (nodes(' &
-                    // format_integer(i) // '); ' // what // ')')
-                return
-            end do
+            call fatal_error(error, set_label(sets(s)) // ': no yarn passes through node ' &
+                // format_integer(sets(s)%nodes(i)) // ' (nodes(' // format_integer(i) &
+                // '); ' // what // ')')
+            return
         end do
         if (.not. allocated(config%loads)) return
         do l = 1, size(config%loads)
-            do i = 1, size(config%loads(l)%nodes)
-                node = config%loads(l)%nodes(i)
-                if (node < 1 .or. node > n_nodes) cycle
-                if (set_of(node) == 0 .or. set_of(node) > n_obstacles) cycle
-                do k = 1, 3
-                    if (config%loads(l)%force(k) == 0.0_wp) cycle
+            associate(load => config%loads(l))
+                k = findloc(load%force /= 0.0_wp, .true., dim=1)
+                if (k == 0) cycle
+                do i = 1, size(load%nodes)
+                    node = load%nodes(i)
+                    if (node < 1 .or. node > n_nodes) cycle
+                    if (set_of(node) == 0) cycle
+                    if (sets(set_of(node))%group /= 'obstacle') cycle
                     call fatal_error(error, '&load #' // format_integer(l) // ': node ' &
                         // format_integer(node) // ' has force(' // format_integer(k) &
-                        // ') = ' // format_real(config%loads(l)%force(k)) &
-                        // ' but it is a node of ' // contact_node_label(config, set_of(node)) &
-                        // ', held in place (the force would be ignored; a &ring is free)')
+                        // ') = ' // format_real(load%force(k)) // ' but it is a node of ' &
+                        // set_label(sets(set_of(node))) // ', held in place (the force ' &
+                        // 'would be ignored; a &ring is free)')
                     return
                 end do
-            end do
+            end associate
         end do
     end subroutine check_contact_nodes
 
@@ -211,26 +206,22 @@ contains
         type(config_type), intent(in) :: config
         integer, intent(in) :: c
         type(error_type), allocatable, intent(out) :: error
-        integer, allocatable :: set_of(:)
-        character(len=name_length), allocatable :: names(:)
-        character(len=:), allocatable :: label
-        integer :: n_obstacles, other
+        type(node_set_type), allocatable :: sets(:)
+        character(len=:), allocatable :: label, which
+        integer :: other
 
-        call get_contact_node_sets(config, set_of, names, n_obstacles)
-        associate(contact => config%contacts(c))
+        call get_node_sets(config, sets)
+        associate(contact => config%contacts(c), before => config%contacts(:c - 1))
             label = '&contact #' // format_integer(c)
-            if (.not. any(names == contact%at)) then
-                if (size(names) == 0) then
-                    call fatal_error(error, label // ": at = '" // trim(contact%at) &
-                        // "' names no &obstacle or &ring (the input has none; leave at " &
-                        // 'empty for the law of a pair of yarn types)')
-                else
-                    call fatal_error(error, label // ": at = '" // trim(contact%at) &
-                        // "' is not the name of an &obstacle or &ring (defined: " &
-                        // quoted_list(names) // ')' // suggestion(contact%at, names))
-                end if
+            if (size(sets) == 0) then
+                call fatal_error(error, label // ": at = '" // trim(contact%at) &
+                    // "' names no &obstacle or &ring (the input has none; leave at " &
+                    // 'empty for the law of a pair of yarn types)')
                 return
             end if
+            call check_defined(error, label, 'at', contact%at, sets%name, &
+                'the name of an &obstacle or &ring', 'defined')
+            if (allocated(error)) return
             if (len_trim(contact%materials(2)) > 0) then
                 call fatal_error(error, label // ": at = '" // trim(contact%at) &
                     // "' with materials(2) = '" // trim(contact%materials(2)) // "': a law " &
@@ -238,30 +229,20 @@ contains
                     // '(every yarn type)')
                 return
             end if
-            if (len_trim(contact%materials(1)) > 0 &
-                .and. .not. any(config%materials%name == contact%materials(1))) then
-                call fatal_error(error, label // ": materials(1) = '" &
-                    // trim(contact%materials(1)) // "' is not defined by any &material " &
-                    // '(defined: ' // quoted_list(config%materials%name) // ')' &
-                    // suggestion(contact%materials(1), config%materials%name))
-                return
+            which = "' for every yarn type"
+            if (len_trim(contact%materials(1)) > 0) then
+                call check_defined(error, label, 'materials(1)', contact%materials(1), &
+                    config%materials%name, 'defined by any &material', 'defined')
+                if (allocated(error)) return
+                which = "', materials = '" // trim(contact%materials(1)) // "'"
             end if
-            do other = 1, c - 1
-                if (config%contacts(other)%at /= contact%at) cycle
-                if (config%contacts(other)%materials(1) /= contact%materials(1)) cycle
-                if (len_trim(contact%materials(1)) > 0) then
-                    call fatal_error(error, label // ": at = '" // trim(contact%at) &
-                        // "', materials = '" // trim(contact%materials(1)) // "' is also " &
-                        // '&contact #' // format_integer(other) // ': give one law per ' &
-                        // 'obstacle or ring and yarn type')
-                else
-                    call fatal_error(error, label // ": at = '" // trim(contact%at) &
-                        // "' for every yarn type is also &contact #" &
-                        // format_integer(other) // ': give one law per obstacle or ring ' &
-                        // 'and yarn type')
-                end if
-                return
-            end do
+            other = findloc(before%at == contact%at &
+                .and. before%materials(1) == contact%materials(1), .true., dim=1)
+            if (other > 0) then
+                call fatal_error(error, label // ": at = '" // trim(contact%at) // which &
+                    // ' is also &contact #' // format_integer(other) // ': give one law ' &
+                    // 'per obstacle or ring and yarn type')
+            end if
         end associate
     end subroutine check_node_contact
 
@@ -269,27 +250,29 @@ contains
     subroutine check_contact_node_laws(config, error)
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
+        type(node_set_type), allocatable :: sets(:)
         integer, allocatable :: set_of(:)
-        character(len=name_length), allocatable :: names(:)
-        integer :: n_obstacles, y, i, s
+        integer :: y, i, s
 
-        call get_contact_node_sets(config, set_of, names, n_obstacles)
-        if (size(names) == 0) return
+        call get_node_sets(config, sets, set_of)
+        if (size(sets) == 0) return
         do y = 1, size(config%yarns)
-            do i = 2, size(config%yarns(y)%nodes) - 1
-                s = set_of(config%yarns(y)%nodes(i))
-                if (s == 0) cycle
-                if (find_node_contact(config, names(s), config%yarns(y)%material) > 0) cycle
-                call fatal_error(error, "no &contact for yarn type '" &
-                    // trim(config%yarns(y)%material) // "' at " &
-                    // contact_node_label(config, s) // ' (' // yarn_label(config, y) &
-                    // ' passes through its node ' // format_integer(config%yarns(y)%nodes(i)) &
-                    // "); give one, e.g. &contact at = '" // trim(names(s)) &
-                    // "', materials = '" // trim(config%yarns(y)%material) // "', law = " &
-                    // "'coulomb', friction_coefficient = 0.3 / (or leave materials out for " &
-                    // 'every yarn type)')
-                return
-            end do
+            associate(yarn => config%yarns(y))
+                do i = 2, size(yarn%nodes) - 1
+                    s = set_of(yarn%nodes(i))
+                    if (s == 0) cycle
+                    if (find_node_contact(config, sets(s)%name, yarn%material) > 0) cycle
+                    call fatal_error(error, "no &contact for yarn type '" &
+                        // trim(yarn%material) // "' at " // set_label(sets(s)) // ' (' &
+                        // yarn_label(config, y) // ' passes through its node ' &
+                        // format_integer(yarn%nodes(i)) // "); give one, e.g. &contact " &
+                        // "at = '" // trim(sets(s)%name) // "', materials = '" &
+                        // trim(yarn%material) // "', law = 'coulomb', " &
+                        // 'friction_coefficient = 0.3 / (or leave materials out for every ' &
+                        // 'yarn type)')
+                    return
+                end do
+            end associate
         end do
     end subroutine check_contact_node_laws
 

@@ -86,7 +86,3 @@ class Group:
     @property
     def type_name(self) -> str:
         return f"{self.name}_config_type"
-
-    @property
-    def selector(self) -> Var | None:
-        return next((v for v in self.variables if v.selects), None)

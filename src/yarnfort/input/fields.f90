@@ -15,10 +15,9 @@ module yarnfort_input_fields
     private
 
     public :: max_list, max_coordinates, indent
-    public :: post_read_error, group_label, take_scalar, take_array, list_length
-    public :: check_real, check_at_least, check_choice, check_law_parameter
-    public :: not_finite, suggestion, quoted_list, check_name, check_item_name
-    public :: put, put_list, format_logical
+    public :: group_label, take_scalar, take_array, list_length, is_assigned
+    public :: check_range, check_choice, check_law_parameter
+    public :: suggestion, quoted_list, check_name, check_item_name, put, put_list
 
     !> Most node ids in one &yarn, &support or &load group, and most knots in &path.
     integer, parameter :: max_list = 100000
@@ -32,24 +31,6 @@ module yarnfort_input_fields
         'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.'
 
 contains
-
-    !> An error of a group found after reading it, with the group's line.
-    subroutine post_read_error(error, scan, name, occurrence, text)
-        type(error_type), allocatable, intent(out) :: error
-        type(namelist_scan_type), intent(in) :: scan
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: occurrence
-        character(len=*), intent(in) :: text
-        integer :: g
-
-        g = scan%find_group(name, max(occurrence, 1))
-        if (g == 0) then
-            call fatal_error(error, group_label(name, occurrence) // ': ' // text)
-        else
-            call fatal_error(error, group_label(name, occurrence) // ': ' // text &
-                // ' (group on line ' // format_integer(scan%groups(g)%first_line) // ')')
-        end if
-    end subroutine post_read_error
 
     !> Scalar variable `name` of group `label` (real(wp), integer, logical or character,
     !> folded to lower case if `lower`, leading blanks dropped if `adjust`) from its
@@ -136,6 +117,18 @@ contains
         if (j > 0) call fatal_error(error, label // ': ' // name // '(' // format_integer(j) &
             // ') has no value, but later entries have (an empty entry between commas?)')
     end subroutine list_length
+
+    !> Whether an assignment among `sets` sets variable `name` (any of its entries).
+    pure logical function is_assigned(sets, name)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: name
+        integer :: k
+
+        is_assigned = .false.
+        do k = 1, size(sets)
+            if (sets(k)%name == name) is_assigned = .true.
+        end do
+    end function is_assigned
 
     !> For each entry of array `name` (at most `most`) up to the last one its assignments
     !> reach, the assignment that sets it (negative for a null value, 0 for none); an
@@ -305,55 +298,29 @@ contains
         text = text(:n)
     end function unquoted
 
-    !> A real that must be finite and, where bounds are given, within them (the texts
-    !> of the bounds are those of the description, for the message).
-    subroutine check_real(error, label, variable, value, lower, lower_text, lower_open, &
-            upper, upper_text, upper_open)
+    !> A real or integer `value` that must lie where `inside` says (`rule`, from the
+    !> description, says where: 'must be >= 0'); a real must also be finite.
+    subroutine check_range(error, label, variable, value, inside, rule)
         type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable
-        real(wp), intent(in) :: value
-        real(wp), intent(in), optional :: lower, upper
-        character(len=*), intent(in), optional :: lower_text, upper_text
-        logical, intent(in), optional :: lower_open, upper_open
-        character(len=:), allocatable :: rule
-        logical :: outside
+        character(len=*), intent(in) :: label, variable, rule
+        class(*), intent(in) :: value
+        logical, intent(in) :: inside
+        character(len=:), allocatable :: text
 
-        if (.not. ieee_is_finite(value)) then
-            call not_finite(error, label, variable, value)
-            return
-        end if
-        if (.not. present(lower)) return
-        if (present(upper)) then
-            outside = value < lower .or. value > upper .or. (lower_open .and. value == lower) &
-                .or. (upper_open .and. value == upper)
-            if (lower_open .and. upper_open) then
-                rule = 'must lie strictly between ' // lower_text // ' and ' // upper_text
-            else
-                rule = 'must lie in ' // merge('(', '[', lower_open) // lower_text // ', ' &
-                    // upper_text // merge(')', ']', upper_open)
+        select type (value)
+        type is (integer)
+            text = format_integer(value)
+        type is (real(wp))
+            text = format_real(value)
+            if (.not. ieee_is_finite(value)) then
+                call fatal_error(error, label // ': ' // variable // ' = ' // text &
+                    // ' is not finite')
+                return
             end if
-        else if (lower_open) then
-            outside = value <= lower
-            rule = 'must be > ' // lower_text
-            if (lower == 0.0_wp) rule = 'must be positive'
-        else
-            outside = value < lower
-            rule = 'must be >= ' // lower_text
-        end if
-        if (outside) call fatal_error(error, label // ': ' // variable // ' = ' &
-            // format_real(value) // ' ' // rule)
-    end subroutine check_real
-
-    subroutine check_at_least(error, label, variable, value, minimum)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable
-        integer, intent(in) :: value, minimum
-
-        if (value < minimum) then
-            call fatal_error(error, label // ': ' // variable // ' = ' // format_integer(value) &
-                // ' must be >= ' // format_integer(minimum))
-        end if
-    end subroutine check_at_least
+        end select
+        if (.not. inside) call fatal_error(error, label // ': ' // variable // ' = ' // text &
+            // ' ' // rule)
+    end subroutine check_range
 
     !> A value that must be one of `choices`; '' is "not set" for a `required` one.
     subroutine check_choice(error, label, variable, value, choices, required)
@@ -388,15 +355,6 @@ contains
                 // " is not used by law '" // law // "' (remove it)")
         end if
     end subroutine check_law_parameter
-
-    subroutine not_finite(error, label, variable, value)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable
-        real(wp), intent(in) :: value
-
-        call fatal_error(error, label // ': ' // variable // ' = ' // format_real(value) &
-            // ' is not finite')
-    end subroutine not_finite
 
     !> "; did you mean 'x'?" for the known name closest to `name`, or ''.
     pure function suggestion(name, names) result(text)
@@ -499,13 +457,5 @@ contains
             end if
         end do
     end subroutine put_list
-
-    pure function format_logical(value) result(text)
-        logical, intent(in) :: value
-        character(len=:), allocatable :: text
-
-        text = merge('.true. ', '.false.', value)
-        text = trim(text)
-    end function format_logical
 
 end module yarnfort_input_fields

@@ -60,11 +60,9 @@ def fortran_default(var: Var) -> str:
     return fortran_value(var, var.default)
 
 
-def declaration(var: Var, buffer: bool = False) -> str:
-    if var.type == "character":
-        kind = "character(len=buffer_length)" if buffer else f"character(len={var.length})"
-    else:
-        kind = {"real": "real(wp)", "integer": "integer", "logical": "logical"}[var.type]
+def declaration(var: Var) -> str:
+    kind = {"real": "real(wp)", "integer": "integer", "logical": "logical",
+            "character": f"character(len={var.length})"}[var.type]
     if var.is_list:
         return f"{kind}, allocatable :: {var.name}(:)"
     shape = f"({var.size})" if var.size else ""
@@ -102,59 +100,63 @@ def doc_comment(text: str, indent: str) -> list[str]:
     return [indent + "!> " + line for line in textwrap.wrap(first, WIDTH - len(indent) - 4)]
 
 
-def string_array(name: str, values: list[str], indent: str) -> list[str]:
+def string_array(name: str, values: list[str]) -> str:
     length = max(len(v) for v in values)
     items = ", ".join(f"'{v}'" for v in values)
-    return wrap_statement(f"character(len=*), parameter :: {name}(*) = "
-                          f"[character(len={length}) :: {items}]", indent)
+    return f"character(len=*), parameter :: {name}(*) = [character(len={length}) :: {items}]"
 
 
 # ---------------------------------------------------------------- the Fortran module
-def range_call(var: Var, label: str, value: str, variable: str) -> list[str]:
-    """The call checking `value` against var.range (reals and integers)."""
+def fill(template: str, at: str = INDENT, **parts: object) -> list[str]:
+    """The lines of a template (dedented, then indented by `at`; '{name}' replaced by
+    parts[name]) and a blank line; a line that is a lone '{name}' of a list part becomes its
+    statements, wrapped, at its indent (an item (depth, text) one indent deeper per depth)."""
+    out = []
+    for line in textwrap.dedent(template).strip("\n").split("\n"):
+        key, indent = line.strip()[1:-1], at + line[:len(line) - len(line.lstrip())]
+        if isinstance(parts.get(key), list):
+            for item in parts[key]:  # type: ignore[attr-defined]
+                depth, text = item if isinstance(item, tuple) else (0, item)
+                out += wrap_statement(text, indent + INDENT * depth)
+        else:
+            out += wrap_statement(line.strip().format(**parts), indent) if line else [""]
+    return out + [""]
+
+
+def range_check(var: Var, value: str, variable: str) -> list[str]:
+    """The call checking `value` against var.range: the condition and the rule of its
+    message (reals must also be finite)."""
     if var.range is None:
         return []
     text = var.range.strip()
-    if var.type == "integer":
-        minimum = re.fullmatch(r">=\s*(-?\d+)", text)
-        if not minimum:
-            raise ValueError(f"{var.name}: integer range {text!r} is not '>= n'")
-        return [f"call check_at_least(error, {label}, {variable}, {value}, {minimum[1]})"]
-    if text == "finite":
-        return [f"call check_real(error, {label}, {variable}, {value})"]
+    bound = fortran_real if var.type == "real" else str
+    inside, rule = ".true.", ""
     one = re.fullmatch(r"(>=|>)\s*(\S+)", text)
-    if one:
-        bound = one[2]
-        return [f"call check_real(error, {label}, {variable}, {value}, "
-                f"lower={fortran_real(float(bound))}, lower_text='{bound}', "
-                f"lower_open={'.true.' if one[1] == '>' else '.false.'})"]
     interval = re.fullmatch(r"([(\[])\s*(\S+),\s*(\S+)\s*([)\]])", text)
-    if interval:
-        lo, hi = interval[2], interval[3]
-        return [f"call check_real(error, {label}, {variable}, {value}, "
-                f"lower={fortran_real(float(lo))}, lower_text='{lo}', "
-                f"lower_open={'.true.' if interval[1] == '(' else '.false.'}, "
-                f"upper={fortran_real(float(hi))}, upper_text='{hi}', "
-                f"upper_open={'.true.' if interval[4] == ')' else '.false.'})"]
-    raise ValueError(f"{var.name}: range {text!r} is not understood")
+    if one:
+        inside, rule = f"{value} {one[1]} {bound(one[2])}", f"must be {one[1]} {one[2]}"
+        if rule == "must be > 0":
+            rule = "must be positive"
+    elif interval:
+        lower, upper = ">" if interval[1] == "(" else ">=", "<" if interval[4] == ")" else "<="
+        inside = (f"{value} {lower} {bound(interval[2])} .and. "
+                  f"{value} {upper} {bound(interval[3])}")
+        rule = f"must lie in {interval[1]}{interval[2]}, {interval[3]}{interval[4]}"
+        if interval[1] + interval[4] == "()":
+            rule = f"must lie strictly between {interval[2]} and {interval[3]}"
+    elif text != "finite":
+        raise ValueError(f"{var.name}: range {text!r} is not understood")
+    return [f"call check_range(error, label, {variable}, {value}, {inside}, '{rule}')"]
 
 
-def element_checks(var: Var, calls_for) -> list[tuple[int, str]]:
-    """Checks of every entry of `var` (scalar, fixed array or list), as (depth, line)."""
+def element_checks(var: Var) -> list[tuple[int, str]]:
+    """The range checks of every entry of `var` (scalar, fixed array or list)."""
     field = f"value%{var.name}"
-    if var.size or var.is_list:
-        calls = calls_for(f"{field}(i)", f"'{var.name}(' // format_integer(i) // ')'")
-        if not calls:
-            return []
-        upper = str(var.size) if var.size else f"size({field})"
-        lines = [(0, f"do i = 1, {upper}")]
-        for call in calls:
-            lines += [(1, call), (1, "if (allocated(error)) return")]
-        return lines + [(0, "end do")]
-    lines = []
-    for call in calls_for(field, f"'{var.name}'"):
-        lines += [(0, call), (0, "if (allocated(error)) return")]
-    return lines
+    if not (var.size or var.is_list):
+        return [(0, call) for call in range_check(var, field, f"'{var.name}'")]
+    calls = range_check(var, f"{field}(i)", f"'{var.name}(' // format_integer(i) // ')'")
+    upper = var.size or f"size({field})"
+    return [(0, f"do i = 1, {upper}"), *[(1, c) for c in calls], (0, "end do")] if calls else []
 
 
 def choices_name(group: Group, var: Var) -> str:
@@ -175,13 +177,14 @@ def law_block(var: Var, law_bound: list[Var]) -> list[tuple[int, str]]:
                 text = f"format_real(value%{v.name})"
             body.append((1, f"call check_law_parameter(error, label, '{v.name}', {is_set}, "
                             f"{text}, '{law}', {'.true.' if needed else '.false.'})"))
-            for call in range_call(v, "label", f"value%{v.name}", f"'{v.name}'") if needed else []:
-                body += [(1, "if (allocated(error)) return"), (1, call)]
-            body.append((1, "if (allocated(error)) return"))
+            for call in range_check(v, f"value%{v.name}", f"'{v.name}'") if needed else []:
+                body.append((1, call))
     return body + [(0, "end select")]
 
 
 def check_routine(group: Group) -> list[str]:
+    """check_<group>_variables: ranges, choices and law parameters, each check followed
+    by a return on error."""
     checked = [v for v in group.variables if not v.checked_by]
     law_bound = [v for v in checked if v.laws]
     body: list[tuple[int, str]] = []
@@ -189,159 +192,171 @@ def check_routine(group: Group) -> list[str]:
         if var.laws:
             continue
         if var.choices:
-            body += [(0, f"call check_choice(error, label, '{var.name}', value%{var.name}, "
-                         f"{choices_name(group, var)}, {'.true.' if var.selects else '.false.'})"),
-                     (0, "if (allocated(error)) return")]
+            required = ".true." if var.selects else ".false."
+            body.append((0, f"call check_choice(error, label, '{var.name}', value%{var.name}, "
+                            f"{choices_name(group, var)}, {required})"))
         if var.selects and law_bound:
             body += law_block(var, law_bound)
         elif var.type in ("real", "integer"):
-            body += element_checks(var, lambda value, name, v=var: range_call(
-                v, "label", value, name))
+            body += element_checks(var)
     if not body:
         return []
-    if body[-1][1] == "if (allocated(error)) return":
-        body = body[:-1]
-    out = [f"{INDENT}!> The checks of &{group.name} that its description gives: ranges, "
-           "choices and",
-           f"{INDENT}!> the parameters of the selected law. `label` names the group in "
-           "messages.",
-           f"{INDENT}subroutine check_{group.name}_variables(value, label, error)",
-           f"{INDENT * 2}type({group.type_name}), intent(in) :: value",
-           f"{INDENT * 2}character(len=*), intent(in) :: label",
-           f"{INDENT * 2}type(error_type), allocatable, intent(out) :: error"]
-    if any(line.startswith("do i") for _, line in body):
-        out.append(f"{INDENT * 2}integer :: i")
-    out.append("")
+    steps = []
     for depth, line in body:
-        out += wrap_statement(line, INDENT * (2 + depth))
-    out.append(f"{INDENT}end subroutine check_{group.name}_variables")
-    return out + [""]
+        steps.append((depth, line))
+        if line.startswith("call check_"):
+            steps.append((depth, "if (allocated(error)) return"))
+    while steps[-1][1].startswith("if (allocated"):
+        steps.pop()
+    return fill("""
+        !> The checks of &{name} that its description gives: ranges, choices and
+        !> the parameters of the selected law. `label` names the group in messages.
+        subroutine check_{name}_variables(value, label, error)
+            type({type}), intent(in) :: value
+            character(len=*), intent(in) :: label
+            type(error_type), allocatable, intent(out) :: error
+            {loops}
+
+            {steps}
+        end subroutine check_{name}_variables
+        """, name=group.name, type=group.type_name, steps=steps,
+        loops=["integer :: i"] if any(line.startswith("do i") for _, line in body) else [])
 
 
 def read_routine(group: Group) -> list[str]:
     """read_<group>: one occurrence from its assignments; read_<group>_groups: all."""
-    i2, i3 = INDENT * 2, INDENT * 3
-    name = group.name
-    out = [f"{INDENT}!> The `occurrence`-th &{name} group (0 for a singleton) into `value`.",
-           f"{INDENT}subroutine read_{name}(scan, occurrence, value, error)",
-           f"{i2}type(namelist_scan_type), intent(in) :: scan",
-           f"{i2}integer, intent(in) :: occurrence",
-           f"{i2}type({group.type_name}), intent(inout) :: value",
-           f"{i2}type(error_type), allocatable, intent(out) :: error",
-           f"{i2}type(assignment_type), allocatable :: sets(:)",
-           f"{i2}character(len=:), allocatable :: label",
-           f"{i2}integer :: n", "",
-           f"{i2}label = group_label('{name}', occurrence)",
-           f"{i2}call get_assignments(scan, '{name}', occurrence, {name}_variables, sets, error)",
-           f"{i2}if (allocated(error)) return"]
+    takes = []
     for var in group.variables:
         args = (f"sets, label, '{var.name}', value%{var.name}, error, "
                 f"{'.true.' if var.lower else '.false.'}, "
                 f"{'.true.' if var.adjust and var.type == 'character' else '.false.'}")
         if var.is_list:
-            out += wrap_statement(f"call list_length(sets, label, '{var.name}', {var.max}, n, "
-                                  "error)", i2)
-            out += [f"{i2}if (allocated(error)) return", f"{i2}allocate(value%{var.name}(n))"]
-        kind = "array" if var.is_list or var.size else "scalar"
-        if var.is_list:
-            args += f", most={var.max}"
-        out += wrap_statement(f"call take_{kind}({args})", i2)
-        out.append(f"{i2}if (allocated(error)) return")
-    out = out[:-1] + [f"{INDENT}end subroutine read_{name}", ""]
+            takes += [f"call list_length(sets, label, '{var.name}', {var.max}, n, error)",
+                      "if (allocated(error)) return", f"allocate(value%{var.name}(n))",
+                      f"call take_array({args}, most={var.max})"]
+        else:
+            takes.append(f"call take_{'array' if var.size else 'scalar'}({args})")
+        takes.append("if (allocated(error)) return")
+    one = fill("""
+        !> The `occurrence`-th &{name} group (0 for a singleton) into `value`.
+        subroutine read_{name}(scan, occurrence, value, error)
+            type(namelist_scan_type), intent(in) :: scan
+            integer, intent(in) :: occurrence
+            type({type}), intent(inout) :: value
+            type(error_type), allocatable, intent(out) :: error
+            type(assignment_type), allocatable :: sets(:)
+            character(len=:), allocatable :: label
+            integer :: n
+
+            label = group_label('{name}', occurrence)
+            call get_assignments(scan, '{name}', occurrence, {name}_variables, sets, error)
+            if (allocated(error)) return
+            {takes}
+        end subroutine read_{name}
+
+        """, name=group.name, type=group.type_name,
+        takes=takes + [f"call apply_{group.name}_preset(sets, value)"] if preset_routine(group)
+        else takes[:-1])
     if group.kind == "singleton":
-        return out + [f"{INDENT}!> The &{name} group into `value` if there is one (`value` is "
-                      "unchanged otherwise).",
-                      f"{INDENT}subroutine read_{name}_groups(scan, value, error)",
-                      f"{i2}type(namelist_scan_type), intent(in) :: scan",
-                      f"{i2}type({group.type_name}), intent(inout) :: value",
-                      f"{i2}type(error_type), allocatable, intent(out) :: error", "",
-                      f"{i2}if (scan%count_group('{name}') > 0) call read_{name}(scan, 0, "
-                      "value, error)",
-                      f"{INDENT}end subroutine read_{name}_groups", ""]
-    return out + [f"{INDENT}!> Every &{name} group, in the order of the text.",
-                  f"{INDENT}subroutine read_{name}_groups(scan, values, error)",
-                  f"{i2}type(namelist_scan_type), intent(in) :: scan",
-                  f"{i2}type({group.type_name}), allocatable, intent(out) :: values(:)",
-                  f"{i2}type(error_type), allocatable, intent(out) :: error",
-                  f"{i2}integer :: k", "",
-                  f"{i2}allocate(values(scan%count_group('{name}')))",
-                  f"{i2}do k = 1, size(values)",
-                  f"{i3}call read_{name}(scan, k, values(k), error)",
-                  f"{i3}if (allocated(error)) return",
-                  f"{i2}end do",
-                  f"{INDENT}end subroutine read_{name}_groups", ""]
+        return one + fill("""
+            !> The &{name} group into `value` if there is one (`value` is unchanged otherwise).
+            subroutine read_{name}_groups(scan, value, error)
+                type(namelist_scan_type), intent(in) :: scan
+                type({type}), intent(inout) :: value
+                type(error_type), allocatable, intent(out) :: error
+
+                if (scan%count_group('{name}') > 0) call read_{name}(scan, 0, value, error)
+            end subroutine read_{name}_groups
+            """, name=group.name, type=group.type_name)
+    return one + fill("""
+        !> Every &{name} group, in the order of the text.
+        subroutine read_{name}_groups(scan, values, error)
+            type(namelist_scan_type), intent(in) :: scan
+            type({type}), allocatable, intent(out) :: values(:)
+            type(error_type), allocatable, intent(out) :: error
+            integer :: k
+
+            allocate(values(scan%count_group('{name}')))
+            do k = 1, size(values)
+                call read_{name}(scan, k, values(k), error)
+                if (allocated(error)) return
+            end do
+        end subroutine read_{name}_groups
+        """, name=group.name, type=group.type_name)
 
 
 def preset_routine(group: Group) -> list[str]:
     preset = [v for v in group.variables if v.presets]
     if not preset:
         return []
-    i2, i3 = INDENT * 2, INDENT * 3
-    out = [f"{INDENT}!> The values the preset named by `value%preset` gives the variables of "
-           f"&{group.name}",
-           f"{INDENT}!> that the input does not set (none for another name).",
-           f"{INDENT}subroutine apply_{group.name}_preset(scan, value)",
-           f"{i2}type(namelist_scan_type), intent(in) :: scan",
-           f"{i2}type({group.type_name}), intent(inout) :: value", "",
-           f"{i2}select case (trim(value%preset))"]
-    names = [c for c in next(v for v in group.variables if v.name == "preset").choices
-             if any(c in v.presets for v in preset)]
-    for name in names:
-        out.append(f"{i2}case ('{name}')")
-        for var in preset:
-            if name in var.presets:
-                out += wrap_statement(f"if (.not. scan%is_set('{group.name}', 1, '{var.name}')) "
-                                      f"value%{var.name} = {fortran_value(var, var.presets[name])}",
-                                      i3)
-    return out + [f"{i2}end select", f"{INDENT}end subroutine apply_{group.name}_preset", ""]
+    cases = []
+    for name in next(v for v in group.variables if v.name == "preset").choices or []:
+        settings = [(1, f"if (.not. is_assigned(sets, '{v.name}')) "
+                        f"value%{v.name} = {fortran_value(v, v.presets[name])}")
+                    for v in preset if name in v.presets]  # type: ignore[operator]
+        cases += [f"case ('{name}')", *settings] if settings else []
+    return fill("""
+        !> The values the preset named by `value%preset` gives the variables of &{name}
+        !> that the input does not set (none for another name).
+        subroutine apply_{name}_preset(sets, value)
+            type(assignment_type), intent(in) :: sets(:)
+            type({type}), intent(inout) :: value
+
+            select case (trim(value%preset))
+            {cases}
+            end select
+        end subroutine apply_{name}_preset
+        """, name=group.name, type=group.type_name, cases=cases)
 
 
 def write_routine(group: Group) -> list[str]:
-    i2 = INDENT * 2
-    out = [f"{INDENT}!> Write `value` as a &{group.name} group, every variable with its value.",
-           f"{INDENT}subroutine write_{group.name}(unit, value)",
-           f"{i2}integer, intent(in) :: unit",
-           f"{i2}type({group.type_name}), intent(in) :: value", "",
-           f"{i2}call put(unit, '&{group.name}')"]
+    puts = []
     for var in group.variables:
         field = f"value%{var.name}"
         if var.is_list:
-            out += wrap_statement(f"if (allocated({field})) call put_list(unit, "
-                                  f"'{var.name}', {field})", i2)
+            puts.append(f"if (allocated({field})) call put_list(unit, '{var.name}', {field})")
             continue
-        text = {"character": "quote_string", "real": "format_real",
-                "integer": "format_integer", "logical": "format_logical"}[var.type]
-        if var.size:
-            joined = f" // ', ' // ".join(f"{text}({field}({k}))" for k in range(1, var.size + 1))
-        else:
-            joined = f"{text}({field})"
-        out += wrap_statement(f"call put(unit, indent // '{var.name} = ' // {joined})", i2)
-    out += [f"{i2}call put(unit, '/')", f"{INDENT}end subroutine write_{group.name}", ""]
-    if group.kind == "repeatable":
-        out += [f"{INDENT}!> Write each of `values` as a &{group.name} group.",
-                f"{INDENT}subroutine write_{group.name}_groups(unit, values)",
-                f"{i2}integer, intent(in) :: unit",
-                f"{i2}type({group.type_name}), allocatable, intent(in) :: values(:)",
-                f"{i2}integer :: k", "",
-                f"{i2}if (.not. allocated(values)) return",
-                f"{i2}do k = 1, size(values)",
-                f"{i2}{INDENT}call write_{group.name}(unit, values(k))",
-                f"{i2}end do",
-                f"{INDENT}end subroutine write_{group.name}_groups", ""]
-    return out
+        text = {"character": "quote_string({})", "real": "format_real({})",
+                "integer": "format_integer({})",
+                "logical": "trim(merge('.true. ', '.false.', {}))"}[var.type]
+        entries = [f"{field}({k})" for k in range(1, var.size + 1)] if var.size else [field]
+        joined = " // ', ' // ".join(text.format(entry) for entry in entries)
+        puts.append(f"call put(unit, indent // '{var.name} = ' // {joined})")
+    out = fill("""
+        !> Write `value` as a &{name} group, every variable with its value.
+        subroutine write_{name}(unit, value)
+            integer, intent(in) :: unit
+            type({type}), intent(in) :: value
+
+            call put(unit, '&{name}')
+            {puts}
+            call put(unit, '/')
+        end subroutine write_{name}
+        """, name=group.name, type=group.type_name, puts=puts)
+    if group.kind == "singleton":
+        return out
+    return out + fill("""
+        !> Write each of `values` as a &{name} group.
+        subroutine write_{name}_groups(unit, values)
+            integer, intent(in) :: unit
+            type({type}), allocatable, intent(in) :: values(:)
+            integer :: k
+
+            if (.not. allocated(values)) return
+            do k = 1, size(values)
+                call write_{name}(unit, values(k))
+            end do
+        end subroutine write_{name}_groups
+        """, name=group.name, type=group.type_name)
 
 
 def type_definition(group: Group) -> list[str]:
     out = doc_comment(f"&{group.name}: {group.doc}", INDENT)
     out.append(f"{INDENT}type, public :: {group.type_name}")
     for var in group.variables:
-        out += doc_comment(var.doc, INDENT * 2)
-        text = declaration(var)
-        if not var.is_list:
-            text += f" = {fortran_default(var)}"
-        out.append(INDENT * 2 + text)
-    out += [f"{INDENT}end type {group.type_name}", ""]
-    return out
+        default = "" if var.is_list else f" = {fortran_default(var)}"
+        out += doc_comment(var.doc, INDENT * 2) + [INDENT * 2 + declaration(var) + default]
+    return out + [f"{INDENT}end type {group.type_name}", ""]
 
 
 def help_lines() -> list[str]:
@@ -355,80 +370,69 @@ def help_lines() -> list[str]:
 
 
 def fortran_module() -> str:
-    out = ["! SPDX-License-Identifier: MIT",
-           "! Generated by src/yarnfort/input/generate.py from variables.py: do not edit.",
-           "!> The namelist groups as described in variables.py: config types, one reader, "
-           "the",
-           "!> generic checks and the echo per group, the group and variable names and the "
-           "--help",
-           "!> summary. The helpers they call are in yarnfort_input_fields.",
-           "module yarnfort_input_groups",
-           f"{INDENT}use yarnfort_kinds, only: wp",
-           f"{INDENT}use yarnfort_error, only: error_type",
-           f"{INDENT}use yarnfort_text, only: format_integer, format_real, quote_string",
-           f"{INDENT}use yarnfort_input_scan, only: namelist_scan_type, assignment_type, "
-           "get_assignments",
-           f"{INDENT}use yarnfort_input_fields, only: max_list, max_coordinates, group_label, &",
-           f"{INDENT * 3}take_scalar, take_array, list_length, check_real, check_at_least, &",
-           f"{INDENT * 3}check_choice, check_law_parameter, put, put_list, format_logical, indent",
-           f"{INDENT}implicit none",
-           f"{INDENT}private", ""]
-    publics = []
+    publics, names = [], []
     for group in GROUPS:
         publics += [f"read_{group.name}_groups", f"write_{group.name}"]
-        if group.kind == "repeatable":
-            publics.append(f"write_{group.name}_groups")
-        if check_routine(group):
-            publics.append(f"check_{group.name}_variables")
-        if preset_routine(group):
-            publics.append(f"apply_{group.name}_preset")
-    out += wrap_statement("public :: " + ", ".join(publics), INDENT)
-    out += wrap_statement("public :: group_names, singleton_names, help_lines, "
-                          "name_length, path_length", INDENT)
-    choice_names = [choices_name(g, v) for g in GROUPS for v in g.variables if v.choices]
-    out += wrap_statement("public :: " + ", ".join(choice_names), INDENT)
-    out.append("")
-    for name, value in LENGTHS.items():
-        out.append(f"{INDENT}integer, parameter :: {name} = {value}")
-    out.append(f"{INDENT}!> All group names, in the order they are read and echoed.")
-    out += string_array("group_names", [g.name for g in GROUPS], INDENT)
-    out.append(f"{INDENT}!> Groups that may appear at most once.")
-    out += string_array("singleton_names", [g.name for g in GROUPS if g.kind == "singleton"],
-                        INDENT)
-    for group in GROUPS:
-        out += string_array(f"{group.name}_variables", [v.name for v in group.variables],
-                            INDENT)
-        for var in group.variables:
-            if var.choices:
-                out.append(f"{INDENT}!> Values of &{group.name} {var.name}.")
-                out += string_array(choices_name(group, var), var.choices, INDENT)
-    out.append(f"{INDENT}!> The group and variable summary of --help.")
-    out += string_array("help_lines", help_lines(), INDENT)
-    out.append("")
+        publics += [f"write_{group.name}_groups"] if group.kind == "repeatable" else []
+        publics += [f"check_{group.name}_variables"] if check_routine(group) else []
+        names.append(string_array(f"{group.name}_variables", [v.name for v in group.variables]))
+        for var in (v for v in group.variables if v.choices):
+            names += [f"!> Values of &{group.name} {var.name}."]
+            names.append(string_array(choices_name(group, var), var.choices or []))
+    choices = [choices_name(g, v) for g in GROUPS for v in g.variables if v.choices]
+    out = fill("""
+        ! SPDX-License-Identifier: MIT
+        ! Generated by src/yarnfort/input/generate.py from variables.py: do not edit.
+        !> The namelist groups as described in variables.py: config types, one reader, the
+        !> generic checks and the echo per group, the group and variable names and the --help
+        !> summary. The helpers they call are in yarnfort_input_fields.
+        module yarnfort_input_groups
+            use yarnfort_kinds, only: wp
+            use yarnfort_error, only: error_type
+            use yarnfort_text, only: format_integer, format_real, quote_string
+            use yarnfort_input_scan, only: namelist_scan_type, assignment_type, get_assignments
+            use yarnfort_input_fields, only: {fields}
+            implicit none
+            private
+
+            public :: {publics}
+            public :: group_names, singleton_names, help_lines, name_length, path_length
+            public :: {choices}
+
+            {lengths}
+            !> All group names, in the order they are read and echoed.
+            {group_names}
+            !> Groups that may appear at most once.
+            {singleton_names}
+            {names}
+            !> The group and variable summary of --help.
+            {help}
+
+        """, at="", publics=", ".join(publics), choices=", ".join(choices),
+        fields="max_list, max_coordinates, group_label, take_scalar, take_array, list_length, "
+        "is_assigned, check_range, check_choice, check_law_parameter, put, put_list, indent",
+        lengths=[f"integer, parameter :: {k} = {v}" for k, v in LENGTHS.items()],
+        group_names=[string_array("group_names", [g.name for g in GROUPS])],
+        singleton_names=[string_array("singleton_names",
+                                      [g.name for g in GROUPS if g.kind == "singleton"])],
+        names=names, help=[string_array("help_lines", help_lines())])
     for group in GROUPS:
         out += type_definition(group)
     out += ["contains", ""]
     for group in GROUPS:
-        out += read_routine(group)
-        out += preset_routine(group)
-        out += write_routine(group)
+        out += read_routine(group) + preset_routine(group) + write_routine(group)
         out += check_routine(group)
-    out.append("end module yarnfort_input_groups")
-    return "\n".join(out) + "\n"
+    return "\n".join(out + ["end module yarnfort_input_groups"]) + "\n"
 
 
 # ---------------------------------------------------------------- REFERENCE.md tables
-def markdown_real(value: float) -> str:
-    return fortran_real(value)[:-3]
-
-
 def default_text(var: Var) -> str:
     if var.default_doc is not None:
         return var.default_doc
     if var.is_list:
         return "none"
     values = var.default if isinstance(var.default, list) else [var.default]
-    text = ", ".join(markdown_real(v) if var.type == "real" else
+    text = ", ".join(fortran_real(v)[:-3] if var.type == "real" else
                      fortran_value(var, v) for v in values)  # type: ignore[arg-type]
     return f"`{text}`"
 

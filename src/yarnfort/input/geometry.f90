@@ -29,18 +29,16 @@ contains
         real(wp), allocatable, intent(out) :: node_positions(:, :)
         type(yarn_config_type), allocatable, intent(out) :: yarns(:)
         type(error_type), allocatable, intent(out) :: error
-        character(len=:), allocatable :: content, line, record
+        character(len=:), allocatable :: content, line, record, keyword
         type(string_type), allocatable :: words(:)
         integer :: position, line_number, first_line, n_nodes, n_yarns, id, k, i
         integer, allocatable :: node_ids(:), node_lines(:), yarn_lines(:), defined_on(:)
         real(wp), allocatable :: node_xyz(:, :), values(:)
-        type(yarn_config_type), allocatable :: grown(:)
         real(wp) :: xyz(3)
         logical :: ok
         integer :: stat
         character(len=256) :: message
 
-        content = ''
         call read_file_text(path, "file '" // path // "'", content, error)
         if (allocated(error)) then
             error%message = '&geometry: ' // error%message
@@ -50,10 +48,8 @@ contains
         if (index(content, byte_order_mark) == 1) content = content(len(byte_order_mark) + 1:)
         allocate(node_ids(1024), node_lines(1024), node_xyz(3, 1024), yarns(16), &
             yarn_lines(16), stat=stat, errmsg=message)
-        if (stat /= 0) then
-            call out_of_memory()
-            return
-        end if
+        call check_memory()
+        if (allocated(error)) return
         n_nodes = 0
         n_yarns = 0
         line_number = 0
@@ -74,18 +70,17 @@ contains
                 line_number = line_number + 1
                 if (index(line, '#') > 0) line = line(:index(line, '#') - 1)
                 line = trim(line)
-                if (len(line) > 0) then
-                    if (line(len(line):len(line)) == '&') then
-                        record = record // ' ' // line(:len(line) - 1)
-                        cycle
-                    end if
+                if (len(line) > 0 .and. index(line, '&', back=.true.) == len(line)) then
+                    record = record // ' ' // line(:len(line) - 1)
+                    cycle
                 end if
                 record = record // ' ' // line
                 exit
             end do
             call split_words(record, words)
             if (size(words) == 0) cycle read_lines
-            select case (to_lower(words(1)%text))
+            keyword = to_lower(words(1)%text)
+            select case (keyword)
             case ('node')
                 if (size(words) /= 5) then
                     call fail(first_line, 'a node line is: node <id> <x> <y> <z>')
@@ -106,13 +101,8 @@ contains
                         return
                     end if
                 end do
-                if (n_nodes == size(node_ids)) then
-                    call grow_nodes(stat)
-                    if (stat /= 0) then
-                        call out_of_memory()
-                        return
-                    end if
-                end if
+                if (n_nodes == size(node_ids)) call grow_nodes()
+                if (allocated(error)) return
                 n_nodes = n_nodes + 1
                 node_ids(n_nodes) = id
                 node_lines(n_nodes) = first_line
@@ -129,20 +119,8 @@ contains
                         // ' characters')
                     return
                 end if
-                if (n_yarns == size(yarns)) then
-                    allocate(grown(2 * n_yarns), stat=stat, errmsg=message)
-                    if (stat /= 0) then
-                        call out_of_memory()
-                        return
-                    end if
-                    grown(:n_yarns) = yarns
-                    call move_alloc(grown, yarns)
-                    call grow_integers(yarn_lines, stat)
-                    if (stat /= 0) then
-                        call out_of_memory()
-                        return
-                    end if
-                end if
+                if (n_yarns == size(yarns)) call grow_yarns()
+                if (allocated(error)) return
                 n_yarns = n_yarns + 1
                 yarn_lines(n_yarns) = first_line
                 yarns(n_yarns)%material = words(2)%text
@@ -153,10 +131,8 @@ contains
                     return
                 end if
                 allocate(yarns(n_yarns)%nodes(size(words) - 3), stat=stat, errmsg=message)
-                if (stat /= 0) then
-                    call out_of_memory()
-                    return
-                end if
+                call check_memory()
+                if (allocated(error)) return
                 do k = 4, size(words)
                     call parse_integer(words(k)%text, yarns(n_yarns)%nodes(k - 3), ok)
                     if (.not. ok) then
@@ -168,8 +144,8 @@ contains
             case ('length0', 'stretch')
                 ! Per-element reference lengths or stretches of the yarn line before it.
                 if (n_yarns == 0) then
-                    call fail(first_line, "a '" // to_lower(words(1)%text) // "' line " &
-                        // 'belongs to the yarn line before it, and there is none')
+                    call fail(first_line, "a '" // keyword // "' line belongs to the yarn " &
+                        // 'line before it, and there is none')
                     return
                 end if
                 if (allocated(yarns(n_yarns)%length0) .or. allocated(yarns(n_yarns)%stretch)) &
@@ -180,24 +156,22 @@ contains
                     return
                 end if
                 if (size(words) < 2) then
-                    call fail(first_line, "a '" // to_lower(words(1)%text) // "' line " &
-                        // 'lists one value per element of the yarn before it')
+                    call fail(first_line, "a '" // keyword // "' line lists one value per " &
+                        // 'element of the yarn before it')
                     return
                 end if
                 allocate(values(size(words) - 1), stat=stat, errmsg=message)
-                if (stat /= 0) then
-                    call out_of_memory()
-                    return
-                end if
+                call check_memory()
+                if (allocated(error)) return
                 do k = 2, size(words)
                     call parse_real(words(k)%text, values(k - 1), ok)
                     if (.not. ok) then
-                        call fail(first_line, to_lower(words(1)%text) // " value '" &
+                        call fail(first_line, keyword // " value '" &
                             // words(k)%text // "' is not a number")
                         return
                     end if
                 end do
-                if (to_lower(words(1)%text) == 'length0') then
+                if (keyword == 'length0') then
                     call move_alloc(values, yarns(n_yarns)%length0)
                 else
                     call move_alloc(values, yarns(n_yarns)%stretch)
@@ -218,10 +192,8 @@ contains
         if (n_nodes > 0) id = maxval(node_ids(:n_nodes))
         allocate(node_positions(3, min(id, n_nodes)), defined_on(min(id, n_nodes)), stat=stat, &
             errmsg=message)
-        if (stat /= 0) then
-            call out_of_memory()
-            return
-        end if
+        call check_memory()
+        if (allocated(error)) return
         defined_on = 0
         do i = 1, n_nodes
             if (node_ids(i) > size(defined_on)) cycle
@@ -234,56 +206,68 @@ contains
             defined_on(node_ids(i)) = node_lines(i)
             node_positions(:, node_ids(i)) = node_xyz(:, i)
         end do
-        do i = 1, size(defined_on)
-            if (defined_on(i) == 0) then
-                call fatal_error(error, "&geometry: file '" // path // "': node " &
-                    // format_integer(i) // ' is missing (node ids must be 1..n, each ' &
-                    // 'once; the largest id is ' // format_integer(id) // ')')
-                return
-            end if
-        end do
+        i = findloc(defined_on, 0, dim=1)
+        if (i > 0) then
+            call fatal_error(error, "&geometry: file '" // path // "': node " &
+                // format_integer(i) // ' is missing (node ids must be 1..n, each ' &
+                // 'once; the largest id is ' // format_integer(id) // ')')
+            return
+        end if
         do i = 1, n_yarns
-            do k = 1, size(yarns(i)%nodes)
-                if (yarns(i)%nodes(k) < 1 .or. yarns(i)%nodes(k) > id) then
-                    call fail(yarn_lines(i), 'yarn node id ' &
-                        // format_integer(yarns(i)%nodes(k)) // ' is not a node (ids are 1..' &
-                        // format_integer(id) // ')')
-                    return
-                end if
-            end do
+            associate(nodes => yarns(i)%nodes)
+                k = findloc(nodes < 1 .or. nodes > id, .true., dim=1)
+                if (k == 0) cycle
+                call fail(yarn_lines(i), 'yarn node id ' // format_integer(nodes(k)) &
+                    // ' is not a node (ids are 1..' // format_integer(id) // ')')
+                return
+            end associate
         end do
 
     contains
 
-        !> Double the node arrays (explicit allocations, so that a failure is a status).
-        subroutine grow_nodes(stat)
-            integer, intent(out) :: stat
-            real(wp), allocatable :: xyz_grown(:, :)
+        !> Double the node arrays (explicit allocations, so that a failure is an error).
+        subroutine grow_nodes()
+            real(wp), allocatable :: grown(:, :)
 
-            call grow_integers(node_ids, stat)
-            if (stat == 0) call grow_integers(node_lines, stat)
-            if (stat /= 0) return
-            allocate(xyz_grown(3, 2 * size(node_xyz, 2)), stat=stat, errmsg=message)
-            if (stat /= 0) return
-            xyz_grown(:, :size(node_xyz, 2)) = node_xyz
-            call move_alloc(xyz_grown, node_xyz)
+            call grow_integers(node_ids)
+            call grow_integers(node_lines)
+            if (allocated(error)) return
+            allocate(grown(3, 2 * size(node_xyz, 2)), stat=stat, errmsg=message)
+            call check_memory()
+            if (allocated(error)) return
+            grown(:, :size(node_xyz, 2)) = node_xyz
+            call move_alloc(grown, node_xyz)
         end subroutine grow_nodes
 
-        subroutine grow_integers(values, stat)
-            integer, allocatable, intent(inout) :: values(:)
-            integer, intent(out) :: stat
-            integer, allocatable :: grown_values(:)
+        subroutine grow_yarns()
+            type(yarn_config_type), allocatable :: grown(:)
 
-            allocate(grown_values(2 * size(values)), stat=stat, errmsg=message)
-            if (stat /= 0) return
-            grown_values(:size(values)) = values
-            call move_alloc(grown_values, values)
+            allocate(grown(2 * size(yarns)), stat=stat, errmsg=message)
+            call check_memory()
+            if (allocated(error)) return
+            grown(:size(yarns)) = yarns
+            call move_alloc(grown, yarns)
+            call grow_integers(yarn_lines)
+        end subroutine grow_yarns
+
+        subroutine grow_integers(values)
+            integer, allocatable, intent(inout) :: values(:)
+            integer, allocatable :: grown(:)
+
+            if (allocated(error)) return
+            allocate(grown(2 * size(values)), stat=stat, errmsg=message)
+            call check_memory()
+            if (allocated(error)) return
+            grown(:size(values)) = values
+            call move_alloc(grown, values)
         end subroutine grow_integers
 
-        subroutine out_of_memory()
+        !> After an allocation with stat=stat, errmsg=message: an error if it failed.
+        subroutine check_memory()
+            if (stat == 0) return
             call fatal_error(error, "&geometry: file '" // path // "': not enough memory " &
                 // 'to read it (' // trim(message) // ')')
-        end subroutine out_of_memory
+        end subroutine check_memory
 
         subroutine fail(line, text)
             integer, intent(in) :: line

@@ -78,31 +78,29 @@ contains
         real(wp) :: reach, factor
         integer :: s, k, c
 
+        if (.not. allocated(config%supports)) return
         reach = maxval(abs(config%node_positions))
         names = get_channel_names(config%path)
         factors = get_channel_factors(config%path)
-        if (allocated(config%supports)) then
-            do s = 1, size(config%supports)
-                c = find_channel(names, config%supports(s)%channel, &
-                    default_displacement_channel, len_trim(config%path%channels(1)) > 0)
+        do s = 1, size(config%supports)
+            associate(support => config%supports(s))
+                c = find_channel(names, support%channel, default_displacement_channel, &
+                    len_trim(config%path%channels(1)) > 0)
                 factor = 0.0_wp
                 if (c > 0) factor = maxval(abs(factors(:, c)))
-                do k = 1, 3
-                    associate(d => config%supports(s)%displacement(k))
-                        if (.not. (abs(d) * factor + reach <= max_coordinate)) then
-                            call fatal_error(error, "&support '" &
-                                // trim(config%supports(s)%name) // "': displacement(" &
-                                // format_integer(k) // ') = ' // format_real(d) &
-                                // ' times ' // trim(names(max(c, 1))) // ' up to ' &
-                                // format_real(factor) &
-                                // ' moves nodes beyond ' // format_real(max_coordinate) &
-                                // ' m, where squared lengths overflow')
-                            return
-                        end if
-                    end associate
-                end do
-            end do
-        end if
+                k = findloc(.not. (abs(support%displacement) * factor + reach <= max_coordinate), &
+                    .true., dim=1)
+                if (k > 0) then
+                    call fatal_error(error, "&support '" // trim(support%name) &
+                        // "': displacement(" // format_integer(k) // ') = ' &
+                        // format_real(support%displacement(k)) // ' times ' &
+                        // trim(names(max(c, 1))) // ' up to ' // format_real(factor) &
+                        // ' moves nodes beyond ' // format_real(max_coordinate) &
+                        // ' m, where squared lengths overflow')
+                    return
+                end if
+            end associate
+        end do
     end subroutine check_prescribed_reach
 
 end module yarnfort_input_magnitudes

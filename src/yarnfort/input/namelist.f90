@@ -16,9 +16,8 @@ module yarnfort_input_namelist
         read_control_groups, read_solver_groups, read_material_groups, read_contact_groups, &
         read_fabric_groups, read_nodes_groups, read_geometry_groups, read_yarn_groups, &
         read_support_groups, read_load_groups, read_path_groups, read_output_groups, &
-        read_obstacle_groups, read_ring_groups, apply_solver_preset
-    use yarnfort_input_fields, only: max_list, max_coordinates, &
-        post_read_error
+        read_obstacle_groups, read_ring_groups
+    use yarnfort_input_fields, only: max_list, max_coordinates
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
     use yarnfort_input_geometry, only: read_geometry_file
     use yarnfort_text, only: format_integer, folder_of, resolve_path, open_to_read
@@ -84,16 +83,16 @@ contains
         if (allocated(error)) return
 
         if (len_trim(config%geometry%file) > 0) then
-            if (scan%count_group('nodes') > 0) then
-                call fatal_error(error, '&nodes: not allowed together with &geometry file = ' &
-                    // "'" // trim(config%geometry%file) // "' (the file gives the nodes)")
-                return
-            end if
-            if (scan%count_group('yarn') > 0) then
-                call fatal_error(error, '&yarn: not allowed together with &geometry file = ' &
-                    // "'" // trim(config%geometry%file) // "' (the file gives the yarns)")
-                return
-            end if
+            do k = 1, 2
+                name = trim(merge('nodes', 'yarn ', k == 1))
+                if (scan%count_group(name) > 0) then
+                    call fatal_error(error, '&' // name // ': not allowed together with ' &
+                        // "&geometry file = '" // trim(config%geometry%file) &
+                        // "' (the file gives the " // trim(merge('nodes', 'yarns', k == 1)) &
+                        // ')')
+                    return
+                end if
+            end do
             call read_geometry_file(resolve_path(config%geometry%file, config%input_folder), &
                 config%node_positions, config%yarns, error)
             if (allocated(error)) return
@@ -113,8 +112,8 @@ contains
         if (.not. allocated(config%links)) allocate(config%links(0))
     end subroutine read_config
 
-    !> Each group, in a fixed order; then what is not one variable's business: the
-    !> solver preset, the node triplets, the default load factors.
+    !> Each group, in a fixed order, with what is not one variable's business: the
+    !> fabric kind and the node triplets; then the defaults of lists.
     subroutine read_groups(scan, config, error)
         type(namelist_scan_type), intent(in) :: scan
         type(config_type), intent(inout) :: config
@@ -122,59 +121,57 @@ contains
         type(nodes_config_type) :: nodes
         integer :: n
 
+        ! Each group is read only while all before it were read without error.
         call read_control_groups(scan, config%control, error)
-        if (allocated(error)) return
-        call read_solver_groups(scan, config%solver, error)
-        if (allocated(error)) return
-        ! An unknown preset leaves the plain defaults here; check_config rejects its name.
-        call apply_solver_preset(scan, config%solver)
-        call read_material_groups(scan, config%materials, error)
-        if (allocated(error)) return
-        call read_contact_groups(scan, config%contacts, error)
-        if (allocated(error)) return
-        call read_fabric_groups(scan, config%fabric, error)
+        if (.not. allocated(error)) call read_solver_groups(scan, config%solver, error)
+        if (.not. allocated(error)) call read_material_groups(scan, config%materials, error)
+        if (.not. allocated(error)) call read_contact_groups(scan, config%contacts, error)
+        if (.not. allocated(error)) call read_fabric_groups(scan, config%fabric, error)
         if (allocated(error)) return
         if (scan%count_group('fabric') > 0 .and. len_trim(config%fabric%kind) == 0) then
-            call post_read_error(error, scan, 'fabric', 0, &
-                "kind is required (knit, plain or twill)")
+            call post_read_error(error, scan, 'fabric', 'kind is required (knit, plain or twill)')
             return
         end if
-        if (.not. allocated(config%fabric%gap_factor)) allocate(config%fabric%gap_factor(0))
-        if (.not. allocated(config%fabric%gap_factor_p_disp)) &
-            allocate(config%fabric%gap_factor_p_disp(0))
         call read_nodes_groups(scan, nodes, error)
         if (allocated(error)) return
         if (allocated(nodes%xyz)) then
             n = size(nodes%xyz)
             if (mod(n, 3) /= 0) then
-                call post_read_error(error, scan, 'nodes', 0, 'xyz has ' // format_integer(n) &
+                call post_read_error(error, scan, 'nodes', 'xyz has ' // format_integer(n) &
                     // ' values, not a multiple of 3 (x, y, z of each node)')
                 return
             end if
             config%node_positions = reshape(nodes%xyz, [3, n / 3])
         end if
         call read_geometry_groups(scan, config%geometry, error)
+        if (.not. allocated(error)) call read_yarn_groups(scan, config%yarns, error)
+        if (.not. allocated(error)) call read_support_groups(scan, config%supports, error)
+        if (.not. allocated(error)) call read_load_groups(scan, config%loads, error)
+        if (.not. allocated(error)) call read_path_groups(scan, config%path, error)
+        if (.not. allocated(error)) call read_output_groups(scan, config%output, error)
+        if (.not. allocated(error)) call read_obstacle_groups(scan, config%obstacles, error)
+        if (.not. allocated(error)) call read_ring_groups(scan, config%rings, error)
         if (allocated(error)) return
-        call read_yarn_groups(scan, config%yarns, error)
-        if (allocated(error)) return
-        call read_support_groups(scan, config%supports, error)
-        if (allocated(error)) return
-        call read_load_groups(scan, config%loads, error)
-        if (allocated(error)) return
-        call read_path_groups(scan, config%path, error)
-        if (allocated(error)) return
+        if (.not. allocated(config%fabric%gap_factor)) allocate(config%fabric%gap_factor(0))
+        if (.not. allocated(config%fabric%gap_factor_p_disp)) &
+            allocate(config%fabric%gap_factor_p_disp(0))
         ! An omitted p_force or p_disp is all zeros.
         if (allocated(config%path%time)) then
             n = size(config%path%time)
             if (size(config%path%p_force) == 0) config%path%p_force = spread(0.0_wp, 1, n)
             if (size(config%path%p_disp) == 0) config%path%p_disp = spread(0.0_wp, 1, n)
         end if
-        call read_output_groups(scan, config%output, error)
-        if (allocated(error)) return
-        call read_obstacle_groups(scan, config%obstacles, error)
-        if (allocated(error)) return
-        call read_ring_groups(scan, config%rings, error)
     end subroutine read_groups
+
+    !> An error of singleton group `name` found after reading it, with the group's line.
+    subroutine post_read_error(error, scan, name, text)
+        type(error_type), allocatable, intent(out) :: error
+        type(namelist_scan_type), intent(in) :: scan
+        character(len=*), intent(in) :: name, text
+
+        call fatal_error(error, '&' // name // ': ' // text // ' (group on line ' &
+            // format_integer(scan%groups(scan%find_group(name, 1))%first_line) // ')')
+    end subroutine post_read_error
 
     !> Read the namelist input from the file `path`; relative file names in it are
     !> resolved against the folder of `path`, or with `from_working_directory` against

@@ -2,13 +2,14 @@
 !> Checks of the network part of a read `config_type`: nodes finite, yarns through
 !> existing nodes of a defined material with no zero-length segments or elements and no
 !> two segments joining the same two nodes, supports and loads on existing nodes with at
-!> most one support per coordinate and no force on a prescribed one.
+!> most one support per coordinate and no force on a prescribed one. Also the small
+!> helpers the other checks share: a name defined, a list of node ids, bucketing by node.
 module yarnfort_input_network_checks
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use, intrinsic :: iso_fortran_env, only: int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: config_type, name_length, yarn_config_type
+    use yarnfort_input_config, only: config_type, yarn_config_type
     use yarnfort_input_groups, only: check_yarn_variables, check_support_variables, &
         check_load_variables
     use yarnfort_input_fields, only: quoted_list, suggestion, check_item_name, group_label
@@ -18,6 +19,7 @@ module yarnfort_input_network_checks
 
     public :: check_nodes, check_yarns, check_duplicate_segments, check_supports
     public :: check_loads, yarn_label, coincidence_tolerance, check_node_list
+    public :: check_defined, sort_by_key
 
     !> A segment between consecutive yarn nodes is of zero length when it is not longer
     !> than this times the diagonal of the box around all nodes.
@@ -33,34 +35,29 @@ contains
     subroutine check_nodes(config, error)
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
-        integer :: n, k
+        integer :: n_nodes, bad(2)
 
-        if (.not. allocated(config%node_positions)) then
+        n_nodes = 0
+        if (allocated(config%node_positions)) n_nodes = size(config%node_positions, 2)
+        if (n_nodes == 0) then
             call fatal_error(error, "no nodes: give &nodes xyz = ... / or &geometry file = " &
                 // "'...' /")
             return
         end if
-        if (size(config%node_positions, 2) == 0) then
-            call fatal_error(error, "no nodes: give &nodes xyz = ... / or &geometry file = " &
-                // "'...' /")
-            return
-        end if
-        do n = 1, size(config%node_positions, 2)
-            do k = 1, 3
-                if (ieee_is_finite(config%node_positions(k, n))) cycle
-                if (len_trim(config%geometry%file) > 0) then
-                    call fatal_error(error, "&geometry: file '" &
-                        // trim(config%geometry%file) // "': node " // format_integer(n) &
-                        // ' ' // axis(k) // ' = ' // format_real(config%node_positions(k, n)) &
-                        // ' is not finite')
-                else
-                    call fatal_error(error, '&nodes: xyz(' // format_integer(3 * (n - 1) + k) &
-                        // ') = ' // format_real(config%node_positions(k, n)) // ' (node ' &
-                        // format_integer(n) // ' ' // axis(k) // ') is not finite')
-                end if
-                return
-            end do
-        end do
+        ! The first coordinate that is not finite (k, n), in input order.
+        bad = findloc(ieee_is_finite(config%node_positions), .false.)
+        if (bad(2) == 0) return
+        associate(k => bad(1), n => bad(2))
+            if (len_trim(config%geometry%file) > 0) then
+                call fatal_error(error, node_source(config) // ': node ' // format_integer(n) &
+                    // ' ' // axis(k) // ' = ' // format_real(config%node_positions(k, n)) &
+                    // ' is not finite')
+            else
+                call fatal_error(error, '&nodes: xyz(' // format_integer(3 * (n - 1) + k) &
+                    // ') = ' // format_real(config%node_positions(k, n)) // ' (node ' &
+                    // format_integer(n) // ' ' // axis(k) // ') is not finite')
+            end if
+        end associate
     end subroutine check_nodes
 
     !> '&yarn #k', or 'yarn #k of the geometry file' when the yarns come from a file.
@@ -80,51 +77,41 @@ contains
     subroutine check_yarns(config, error)
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
-        integer :: y, i, n_nodes, a, b
+        integer :: y, i, n_nodes, n_yarns, a, b
         !> Elements and new nodes of the yarns so far (elements_per_segment may be large).
         integer(int64) :: n_elements, n_new_nodes
         logical, allocatable :: used(:)
-        real(wp) :: scale, length
+        !> The yarn with its unset per-element lists empty.
+        type(yarn_config_type) :: listed
+        real(wp) :: scale
         character(len=:), allocatable :: label
-        character(len=name_length), allocatable :: material_names(:)
         character(len=80) :: counts
 
-        if (.not. allocated(config%yarns)) then
+        n_yarns = 0
+        if (allocated(config%yarns)) n_yarns = size(config%yarns)
+        if (n_yarns == 0) then
             call fatal_error(error, 'no yarns: give &yarn groups or yarn lines in the ' &
                 // '&geometry file')
             return
         end if
-        if (size(config%yarns) == 0) then
-            call fatal_error(error, 'no yarns: give &yarn groups or yarn lines in the ' &
-                // '&geometry file')
-            return
-        end if
-        material_names = config%materials%name
         n_nodes = size(config%node_positions, 2)
         scale = norm2(maxval(config%node_positions, dim=2) - minval(config%node_positions, dim=2))
         allocate(used(n_nodes), source=.false.)
         n_elements = 0
         n_new_nodes = 0
-        do y = 1, size(config%yarns)
+        do y = 1, n_yarns
             associate(yarn => config%yarns(y))
                 label = yarn_label(config, y)
                 if (len_trim(yarn%material) == 0) then
                     call fatal_error(error, label // ': material is not set')
                     return
                 end if
-                if (.not. any(material_names == yarn%material)) then
-                    call fatal_error(error, label // ": material = '" // trim(yarn%material) &
-                        // "' is not defined by any &material (defined: " &
-                        // quoted_list(material_names) // ')' &
-                        // suggestion(yarn%material, material_names))
-                    return
-                end if
-                if (allocated(yarn%length0) .and. allocated(yarn%stretch)) then
-                    call check_yarn_variables(yarn, label, error)
-                else
-                    ! Yarns of a geometry file or a generator may leave the lists unset.
-                    call check_yarn_variables(with_lists(yarn), label, error)
-                end if
+                call check_defined(error, label, 'material', yarn%material, &
+                    config%materials%name, 'defined by any &material', 'defined')
+                if (allocated(error)) return
+                ! Yarns of a geometry file or a generator may leave the lists unset.
+                listed = with_lists(yarn)
+                call check_yarn_variables(listed, label, error)
                 if (allocated(error)) return
                 if (size(yarn%nodes) < 2) then
                     call fatal_error(error, label // ': nodes has ' &
@@ -132,7 +119,7 @@ contains
                         // ' node id(s); a yarn needs at least 2')
                     return
                 end if
-                call check_element_lengths(config, y, label, error)
+                call check_element_lengths(config, listed, label, error)
                 if (allocated(error)) return
                 n_elements = n_elements + (size(yarn%nodes) - 1) &
                     * int(yarn%elements_per_segment, int64)
@@ -150,7 +137,7 @@ contains
                     return
                 end if
                 do i = 1, size(yarn%nodes)
-                    call require_node(error, label, 'nodes', i, yarn%nodes(i), n_nodes)
+                    call require_node(error, label, i, yarn%nodes(i), n_nodes)
                     if (allocated(error)) return
                     used(yarn%nodes(i)) = .true.
                 end do
@@ -163,25 +150,24 @@ contains
                             // format_integer(a) // ': zero-length segment')
                         return
                     end if
-                    length = norm2(config%node_positions(:, b) - config%node_positions(:, a))
-                    if (length <= coincidence_tolerance * scale) then
-                        call fatal_error(error, label // ': nodes ' // format_integer(a) &
-                            // ' and ' // format_integer(b) // ' (nodes(' // format_integer(i) &
-                            // ') and nodes(' // format_integer(i + 1) // ')) are at the ' &
-                            // 'same position (' // format_position(config%node_positions(:, a)) &
-                            // '): zero-length element')
-                        return
-                    end if
+                    associate(x => config%node_positions(:, a))
+                        if (norm2(config%node_positions(:, b) - x) &
+                                <= coincidence_tolerance * scale) then
+                            call fatal_error(error, label // ': nodes ' // format_integer(a) &
+                                // ' and ' // format_integer(b) // ' (nodes(' &
+                                // format_integer(i) // ') and nodes(' &
+                                // format_integer(i + 1) // ')) are at the same position (' &
+                                // format_real(x(1)) // ', ' // format_real(x(2)) // ', ' &
+                                // format_real(x(3)) // '): zero-length element')
+                            return
+                        end if
+                    end associate
                 end do
             end associate
         end do
-        do i = 1, n_nodes
-            if (.not. used(i)) then
-                call fatal_error(error, node_source(config) // ': node ' // format_integer(i) &
-                    // ' is on no yarn (a node off all yarns has no stiffness)')
-                return
-            end if
-        end do
+        i = findloc(used, .false., dim=1)
+        if (i > 0) call fatal_error(error, node_source(config) // ': node ' &
+            // format_integer(i) // ' is on no yarn (a node off all yarns has no stiffness)')
     end subroutine check_yarns
 
     !> A copy of `yarn` with its unset per-element lists empty.
@@ -194,61 +180,53 @@ contains
         if (.not. allocated(copy%stretch)) allocate(copy%stretch(0))
     end function with_lists
 
-    !> Per-element reference lengths of yarn y (`length0` or `stretch`): one value per
-    !> element, not both, and not on a yarn whose material has a prestress (which would
-    !> set the same lengths another way). Their ranges (> 0) are checked with the group.
-    subroutine check_element_lengths(config, y, label, error)
+    !> Per-element reference lengths of a yarn (`length0` or `stretch`, both allocated):
+    !> one value per element, not both, and not on a yarn whose material has a prestress
+    !> (which would set the same lengths another way). Their ranges (> 0) are checked
+    !> with the group.
+    subroutine check_element_lengths(config, yarn, label, error)
         type(config_type), intent(in) :: config
-        integer, intent(in) :: y
+        type(yarn_config_type), intent(in) :: yarn
         character(len=*), intent(in) :: label
         type(error_type), allocatable, intent(out) :: error
         integer(int64) :: n_elements
-        integer :: m
+        integer :: n_values
         character(len=:), allocatable :: name
 
-        associate(yarn => config%yarns(y))
-            if (is_given(yarn%length0) .and. is_given(yarn%stretch)) then
-                call fatal_error(error, label // ': length0 and stretch are both given ' &
-                    // '(each sets the reference lengths of the elements: give one)')
-                return
+        if (size(yarn%length0) > 0 .and. size(yarn%stretch) > 0) then
+            call fatal_error(error, label // ': length0 and stretch are both given ' &
+                // '(each sets the reference lengths of the elements: give one)')
+            return
+        end if
+        if (size(yarn%length0) > 0) then
+            name = 'length0'
+            n_values = size(yarn%length0)
+        else if (size(yarn%stretch) > 0) then
+            name = 'stretch'
+            n_values = size(yarn%stretch)
+        else
+            return
+        end if
+        n_elements = (size(yarn%nodes) - 1) * int(yarn%elements_per_segment, int64)
+        if (n_values /= n_elements) then
+            call fatal_error(error, label // ': ' // name // ' has ' &
+                // format_integer(n_values) // ' values but the yarn has ' &
+                // format_integer(int(n_elements)) // ' elements (' &
+                // format_integer(size(yarn%nodes) - 1) // ' segments of ' &
+                // format_integer(yarn%elements_per_segment) &
+                // '): give one value per element, in order along the yarn')
+            return
+        end if
+        ! The material is defined (checked before).
+        associate(material => config%materials(findloc(config%materials%name, &
+                yarn%material, dim=1)))
+            if (material%prestress > 0.0_wp) then
+                call fatal_error(error, label // ': ' // name // " is given, but its " &
+                    // "material '" // trim(yarn%material) // "' has prestress = " &
+                    // format_real(material%prestress) // ' (both set the ' &
+                    // 'reference lengths: give one)')
             end if
-            if (is_given(yarn%length0)) then
-                name = 'length0'
-                n_elements = size(yarn%length0)
-            else if (is_given(yarn%stretch)) then
-                name = 'stretch'
-                n_elements = size(yarn%stretch)
-            else
-                return
-            end if
-            if (n_elements /= (size(yarn%nodes) - 1) * int(yarn%elements_per_segment, int64)) &
-                    then
-                call fatal_error(error, label // ': ' // name // ' has ' &
-                    // format_integer(int(n_elements)) // ' values but the yarn has ' &
-                    // format_integer(int((size(yarn%nodes) - 1) &
-                    * int(yarn%elements_per_segment, int64))) // ' elements (' &
-                    // format_integer(size(yarn%nodes) - 1) // ' segments of ' &
-                    // format_integer(yarn%elements_per_segment) &
-                    // '): give one value per element, in order along the yarn')
-                return
-            end if
-            do m = 1, size(config%materials)
-                if (trim(config%materials(m)%name) /= trim(yarn%material)) cycle
-                if (config%materials(m)%prestress > 0.0_wp) then
-                    call fatal_error(error, label // ': ' // name // " is given, but its " &
-                        // "material '" // trim(yarn%material) // "' has prestress = " &
-                        // format_real(config%materials(m)%prestress) // ' (both set the ' &
-                        // 'reference lengths: give one)')
-                    return
-                end if
-            end do
         end associate
-    contains
-        pure logical function is_given(values)
-            real(wp), allocatable, intent(in) :: values(:)
-            is_given = allocated(values)
-            if (is_given) is_given = size(values) > 0
-        end function is_given
     end subroutine check_element_lengths
 
     !> No two segments, of one yarn or of two, join the same two nodes: their elements
@@ -257,78 +235,87 @@ contains
     subroutine check_duplicate_segments(config, error)
         type(config_type), intent(in) :: config
         type(error_type), allocatable, intent(out) :: error
-        !> The segments whose lower node is `a` are slots first(a):first(a + 1) - 1, each
-        !> with its yarn and its position i in the yarn (nodes(i), nodes(i + 1)).
-        integer, allocatable :: first(:), filled(:), yarn_of(:), position_of(:)
-        !> `seen(b)`: the last slot met with upper node b (a slot of the current lower
-        !> node when it is >= first(a)).
+        !> Segment s is nodes(i), nodes(i + 1) of a yarn (i = position_of(s)), from its
+        !> lower to its upper node id.
+        integer, allocatable :: yarn_of(:), position_of(:), lower(:), upper(:)
+        !> The segments with lower node a: order(first(a):first(a + 1) - 1).
+        integer, allocatable :: first(:), order(:)
+        !> `seen(b)`: the last place k in `order` met with upper node b (one of the
+        !> current lower node when it is >= first(a)).
         integer, allocatable :: seen(:)
-        integer :: n_nodes, y, i, a, b, k, slot
+        integer :: n_nodes, n, y, i, a, k
 
         n_nodes = size(config%node_positions, 2)
-        allocate(first(n_nodes + 1), source=0)
+        n = sum([(size(config%yarns(y)%nodes) - 1, y = 1, size(config%yarns))])
+        allocate(yarn_of(n), position_of(n), lower(n), upper(n))
+        n = 0
         do y = 1, size(config%yarns)
             associate(nodes => config%yarns(y)%nodes)
                 do i = 1, size(nodes) - 1
-                    a = min(nodes(i), nodes(i + 1))
-                    first(a + 1) = first(a + 1) + 1
+                    n = n + 1
+                    yarn_of(n) = y
+                    position_of(n) = i
+                    lower(n) = min(nodes(i), nodes(i + 1))
+                    upper(n) = max(nodes(i), nodes(i + 1))
                 end do
             end associate
         end do
-        first(1) = 1
-        do a = 1, n_nodes
-            first(a + 1) = first(a + 1) + first(a)
-        end do
-        allocate(yarn_of(first(n_nodes + 1) - 1), position_of(first(n_nodes + 1) - 1))
-        allocate(filled(n_nodes), source=0)
-        do y = 1, size(config%yarns)
-            associate(nodes => config%yarns(y)%nodes)
-                do i = 1, size(nodes) - 1
-                    a = min(nodes(i), nodes(i + 1))
-                    slot = first(a) + filled(a)
-                    yarn_of(slot) = y
-                    position_of(slot) = i
-                    filled(a) = filled(a) + 1
-                end do
-            end associate
-        end do
+        call sort_by_key(lower, n_nodes, first, order)
         allocate(seen(n_nodes), source=0)
         do a = 1, n_nodes
             do k = first(a), first(a + 1) - 1
-                b = upper_node(k)
-                if (seen(b) >= first(a)) then
-                    call fatal_error(error, segment_text(k) // ' join the same two nodes as ' &
-                        // segment_text(seen(b)) // ': duplicate segment (two strings ' &
-                        // 'between one pair of nodes would lie on top of each other)')
-                    return
-                end if
-                seen(b) = k
+                associate(b => upper(order(k)))
+                    if (seen(b) >= first(a)) then
+                        call fatal_error(error, segment_text(order(k)) // ' join the same ' &
+                            // 'two nodes as ' // segment_text(order(seen(b))) // ': ' &
+                            // 'duplicate segment (two strings between one pair of nodes ' &
+                            // 'would lie on top of each other)')
+                        return
+                    end if
+                    seen(b) = k
+                end associate
             end do
         end do
 
     contains
 
-        integer function upper_node(slot)
-            integer, intent(in) :: slot
-
-            associate(nodes => config%yarns(yarn_of(slot))%nodes, i => position_of(slot))
-                upper_node = max(nodes(i), nodes(i + 1))
-            end associate
-        end function upper_node
-
         !> "&yarn #2: nodes(3), nodes(4) = 5, 2"
-        function segment_text(slot) result(text)
-            integer, intent(in) :: slot
+        function segment_text(s) result(text)
+            integer, intent(in) :: s
             character(len=:), allocatable :: text
 
-            associate(nodes => config%yarns(yarn_of(slot))%nodes, i => position_of(slot))
-                text = yarn_label(config, yarn_of(slot)) // ': nodes(' // format_integer(i) &
+            associate(nodes => config%yarns(yarn_of(s))%nodes, i => position_of(s))
+                text = yarn_label(config, yarn_of(s)) // ': nodes(' // format_integer(i) &
                     // '), nodes(' // format_integer(i + 1) // ') = ' &
                     // format_integer(nodes(i)) // ', ' // format_integer(nodes(i + 1))
             end associate
         end function segment_text
 
     end subroutine check_duplicate_segments
+
+    !> A counting sort of items 1..size(keys) by their key (1..n_keys), linear in both:
+    !> the items with key a are order(first(a):first(a + 1) - 1), in their given order.
+    pure subroutine sort_by_key(keys, n_keys, first, order)
+        integer, intent(in) :: keys(:), n_keys
+        integer, allocatable, intent(out) :: first(:), order(:)
+        integer, allocatable :: next(:)
+        integer :: i, a
+
+        allocate(first(n_keys + 1), source=0)
+        do i = 1, size(keys)
+            first(keys(i) + 1) = first(keys(i) + 1) + 1
+        end do
+        first(1) = 1
+        do a = 1, n_keys
+            first(a + 1) = first(a + 1) + first(a)
+        end do
+        allocate(order(size(keys)))
+        next = first(:n_keys)
+        do i = 1, size(keys)
+            order(next(keys(i))) = i
+            next(keys(i)) = next(keys(i)) + 1
+        end do
+    end subroutine sort_by_key
 
     !> Where the nodes come from, for messages.
     function node_source(config) result(source)
@@ -348,12 +335,13 @@ contains
         type(config_type), intent(in) :: config
         integer, allocatable, intent(out) :: owner(:, :)
         type(error_type), allocatable, intent(out) :: error
-        integer :: s, i, k, n_nodes, node
+        integer :: s, k, i, node
+        !> The components that the support prescribes.
+        logical :: fixed(3)
         character(len=:), allocatable :: label
         character(len=24), allocatable :: labels(:)
 
-        n_nodes = size(config%node_positions, 2)
-        allocate(owner(3, n_nodes), source=0)
+        allocate(owner(3, size(config%node_positions, 2)), source=0)
         if (.not. allocated(config%supports)) return
         labels = [character(len=24) :: (group_label('support', s), s = 1, size(config%supports))]
         do s = 1, size(config%supports)
@@ -366,31 +354,27 @@ contains
                 if (allocated(error)) return
                 call check_support_variables(support, label, error)
                 if (allocated(error)) return
-                do k = 1, 3
-                    if (support%displacement(k) /= 0.0_wp &
-                        .and. index(support%fix, axis(k)) == 0) then
-                        call fatal_error(error, label // ': displacement(' &
-                            // format_integer(k) // ') = ' &
-                            // format_real(support%displacement(k)) // ' but ' // axis(k) &
-                            // " is not in fix = '" // trim(support%fix) &
-                            // "' (it would be ignored)")
-                        return
-                    end if
-                end do
-                call check_node_list(error, label, support%nodes, n_nodes)
+                fixed = index(support%fix, axis) > 0
+                k = findloc(support%displacement /= 0.0_wp .and. .not. fixed, .true., dim=1)
+                if (k > 0) then
+                    call fatal_error(error, label // ': displacement(' // format_integer(k) &
+                        // ') = ' // format_real(support%displacement(k)) // ' but ' &
+                        // axis(k) // " is not in fix = '" // trim(support%fix) &
+                        // "' (it would be ignored)")
+                    return
+                end if
+                call check_node_list(error, label, support%nodes, size(owner, 2))
                 if (allocated(error)) return
                 do i = 1, size(support%nodes)
                     node = support%nodes(i)
-                    do k = 1, 3
-                        if (index(support%fix, axis(k)) == 0) cycle
-                        if (owner(k, node) /= 0) then
-                            call fatal_error(error, label // ': node ' // format_integer(node) &
-                                // ' ' // axis(k) // " is already prescribed by &support '" &
-                                // trim(config%supports(owner(k, node))%name) // "'")
-                            return
-                        end if
-                        owner(k, node) = s
-                    end do
+                    k = findloc(fixed .and. owner(:, node) /= 0, .true., dim=1)
+                    if (k > 0) then
+                        call fatal_error(error, label // ': node ' // format_integer(node) &
+                            // ' ' // axis(k) // " is already prescribed by &support '" &
+                            // trim(config%supports(owner(k, node))%name) // "'")
+                        return
+                    end if
+                    where (fixed) owner(:, node) = s
                 end do
             end associate
         end do
@@ -425,7 +409,7 @@ contains
         type(config_type), intent(in) :: config
         integer, intent(in) :: owner(:, :)
         type(error_type), allocatable, intent(out) :: error
-        integer :: l, i, k, node
+        integer :: l, i, k
         character(len=:), allocatable :: label
 
         if (.not. allocated(config%loads)) return
@@ -434,12 +418,13 @@ contains
                 label = '&load #' // format_integer(l)
                 call check_load_variables(load, label, error)
                 if (allocated(error)) return
-                call check_node_list(error, label, load%nodes, size(config%node_positions, 2))
+                call check_node_list(error, label, load%nodes, size(owner, 2))
                 if (allocated(error)) return
                 do i = 1, size(load%nodes)
-                    node = load%nodes(i)
-                    do k = 1, 3
-                        if (load%force(k) == 0.0_wp .or. owner(k, node) == 0) cycle
+                    associate(node => load%nodes(i))
+                        k = findloc(load%force /= 0.0_wp .and. owner(:, node) /= 0, .true., &
+                            dim=1)
+                        if (k == 0) cycle
                         call fatal_error(error, label // ': node ' // format_integer(node) &
                             // ' has force(' // format_integer(k) // ') = ' &
                             // format_real(load%force(k)) // ' but its ' // axis(k) &
@@ -447,13 +432,14 @@ contains
                             // trim(config%supports(owner(k, node))%name) &
                             // "' (the force would be ignored)")
                         return
-                    end do
+                    end associate
                 end do
             end associate
         end do
     end subroutine check_loads
 
-    !> A list of node ids of a support or load: not empty, in range, no repeats.
+    !> A list of node ids of a support, load, obstacle or ring: not empty, in range, no
+    !> repeats.
     subroutine check_node_list(error, label, nodes, n_nodes)
         type(error_type), allocatable, intent(out) :: error
         character(len=*), intent(in) :: label
@@ -468,7 +454,7 @@ contains
         end if
         allocate(position(n_nodes), source=0)
         do i = 1, size(nodes)
-            call require_node(error, label, 'nodes', i, nodes(i), n_nodes)
+            call require_node(error, label, i, nodes(i), n_nodes)
             if (allocated(error)) return
             if (position(nodes(i)) /= 0) then
                 call fatal_error(error, label // ': nodes(' // format_integer(position(nodes(i))) &
@@ -480,23 +466,29 @@ contains
         end do
     end subroutine check_node_list
 
-    subroutine require_node(error, label, variable, i, node, n_nodes)
+    !> nodes(i) = node of group `label` is a node id (1..n_nodes).
+    subroutine require_node(error, label, i, node, n_nodes)
         type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, variable
+        character(len=*), intent(in) :: label
         integer, intent(in) :: i, node, n_nodes
 
         if (node < 1 .or. node > n_nodes) then
-            call fatal_error(error, label // ': ' // variable // '(' // format_integer(i) &
-                // ') = ' // format_integer(node) // ' is not a node (node ids are 1..' &
+            call fatal_error(error, label // ': nodes(' // format_integer(i) // ') = ' &
+                // format_integer(node) // ' is not a node (node ids are 1..' &
                 // format_integer(n_nodes) // ')')
         end if
     end subroutine require_node
 
-    function format_position(x) result(text)
-        real(wp), intent(in) :: x(3)
-        character(len=:), allocatable :: text
+    !> `name` is one of `names`; else "<label>: <variable> = 'name' is not <what>
+    !> (<listed>: 'a', 'b')" and a did-you-mean.
+    subroutine check_defined(error, label, variable, name, names, what, listed)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, variable, name, names(:), what, listed
 
-        text = format_real(x(1)) // ', ' // format_real(x(2)) // ', ' // format_real(x(3))
-    end function format_position
+        if (any(names == name)) return
+        call fatal_error(error, label // ': ' // variable // " = '" // trim(name) &
+            // "' is not " // what // ' (' // listed // ': ' // quoted_list(names) // ')' &
+            // suggestion(name, names))
+    end subroutine check_defined
 
 end module yarnfort_input_network_checks

@@ -26,12 +26,11 @@ module yarnfort_input_scan
         logical :: is_name = .false.
     end type token_type
 
-    !> One '&name ... /' group in the text.
+    !> One '&name ... /' group in the text, with the range of its tokens in the scan's.
     type :: group_occurrence_type
         character(len=:), allocatable :: name
-        integer :: first_line = 0, last_line = 0
-        type(token_type), allocatable :: tokens(:)
-        integer :: n_tokens = 0
+        integer :: first_line = 0
+        integer :: first_token = 1, last_token = 0
     end type group_occurrence_type
 
     !> The text and its groups, in the order of the text.
@@ -39,6 +38,8 @@ module yarnfort_input_scan
         type(string_type), allocatable :: lines(:)
         type(group_occurrence_type), allocatable :: groups(:)
         integer :: n_groups = 0
+        !> The tokens of all groups, in the order of the text.
+        type(token_type), allocatable :: tokens(:)
     contains
         !> Number of occurrences of a group.
         procedure :: count_group
@@ -46,8 +47,6 @@ module yarnfort_input_scan
         procedure :: find_group
         !> Text of a token.
         procedure :: token_text
-        !> Whether a group sets a variable (any of its entries).
-        procedure :: is_set
     end type namelist_scan_type
 
     !> One assignment `name = values` or `name(first) = values` of a group occurrence.
@@ -114,12 +113,11 @@ contains
         type(error_type), allocatable, intent(out) :: error
         logical :: in_group, after_comma
         character(len=1) :: c
-        character(len=:), allocatable :: name
-        integer :: iline, i, j, k, depth
-        type(group_occurrence_type), allocatable :: grown(:)
+        character(len=:), allocatable :: name, hint
+        integer :: iline, i, j, k, depth, n_tokens
 
-        allocate(scan%groups(16))
-        scan%n_groups = 0
+        allocate(scan%groups(16), scan%tokens(64))
+        n_tokens = 0
         in_group = .false.
         after_comma = .false.
         do iline = 1, size(scan%lines)
@@ -136,24 +134,25 @@ contains
                         case ('&', '$')
                             call read_name(text, i + 1, j, name)
                             if (len(name) == 0) then
-                                call fatal_error(error, 'line ' // format_integer(iline) &
-                                    // ": '" // c // "' is not followed by a group name")
-                                return
+                                call fail(": '" // c // "' is not followed by a group name")
                             else if (name == 'end') then
-                                call fatal_error(error, 'line ' // format_integer(iline) &
-                                    // ': ' // c // 'end outside a group')
-                                return
+                                call fail(': ' // c // 'end outside a group')
                             else if (.not. any(known_groups == name)) then
-                                call unknown_group_error(error, text(i + 1:j - 1), iline, &
-                                    known_groups)
-                                return
+                                hint = closest_name(text(i + 1:j - 1), known_groups)
+                                if (len(hint) > 0) then
+                                    hint = ' (did you mean &' // hint // '?)'
+                                else
+                                    hint = ' (known groups: ' // join_names(known_groups, '&') &
+                                        // ')'
+                                end if
+                                call fatal_error(error, 'unknown group &' // text(i + 1:j - 1) &
+                                    // ' on line ' // format_integer(iline) // hint)
                             end if
-                            call start_group(name)
-                            in_group = .true.
+                            if (allocated(error)) return
+                            call start_group()
                             i = j
                         case default
-                            call fatal_error(error, 'line ' // format_integer(iline) &
-                                // ": text outside a group: '" // shorten(text(i:)) &
+                            call fail(": text outside a group: '" // shorten(text(i:)) &
                                 // "' (a group starts with &name and ends with /; " &
                                 // 'comments start with !)')
                             return
@@ -166,7 +165,7 @@ contains
                     select case (c)
                     case (',')
                         ! Two commas with nothing but blanks between: a null value.
-                        if (after_comma) call add_token(iline, i, i - 1)
+                        if (after_comma) call add_token(i, i - 1)
                         after_comma = .true.
                         i = i + 1
                     case (' ', tab, carriage_return, ';')
@@ -179,9 +178,8 @@ contains
                         do
                             k = index(text(j:), c)
                             if (k == 0) then
-                                call add_token(iline, i, len(text))
-                                call fatal_error(error, 'line ' // format_integer(iline) &
-                                    // ': character value not closed with ' // c &
+                                call add_token(i, len(text))
+                                call fail(': character value not closed with ' // c &
                                     // ' on its line: ' // open_value())
                                 return
                             end if
@@ -190,7 +188,7 @@ contains
                             if (text(j:j) /= c) exit
                             j = j + 1
                         end do
-                        call add_token(iline, i, j - 1)
+                        call add_token(i, j - 1)
                         i = j
                     case ('=')
                         call mark_name()
@@ -198,31 +196,23 @@ contains
                         ! A comma right after '=' follows a null value too.
                         after_comma = .true.
                         i = i + 1
-                    case ('/')
-                        call end_group(iline)
-                        if (allocated(error)) return
-                        i = i + 1
-                    case ('&', '$')
-                        call read_name(text, i + 1, j, name)
-                        if (name == 'end') then
-                            call end_group(iline)
-                            if (allocated(error)) return
-                            i = j
-                        else if (len(name) == 0) then
-                            call fatal_error(error, 'line ' // format_integer(iline) &
-                                // ": stray '" // c // "' in &" &
-                                // scan%groups(scan%n_groups)%name)
-                            return
-                        else
-                            associate(group => scan%groups(scan%n_groups))
-                                call fatal_error(error, 'line ' // format_integer(iline) &
-                                    // ': ' // text(i:j - 1) // ' starts before &' &
+                    case ('/', '&', '$')
+                        ! '/' or '&end' ends the group; another '&' is an error.
+                        name = 'end'
+                        j = i + 1
+                        if (c /= '/') call read_name(text, i + 1, j, name)
+                        associate(group => scan%groups(scan%n_groups))
+                            if (len(name) == 0) then
+                                call fail(": stray '" // c // "' in &" // group%name)
+                            else if (name /= 'end') then
+                                call fail(': ' // text(i:j - 1) // ' starts before &' &
                                     // group%name // ' (line ' &
-                                    // format_integer(group%first_line) &
-                                    // ") is closed with '/'")
-                            end associate
-                            return
-                        end if
+                                    // format_integer(group%first_line) // ") is closed with '/'")
+                            end if
+                        end associate
+                        if (allocated(error)) return
+                        in_group = .false.
+                        i = j
                     case default
                         ! A bare word; a subscript in parentheses may contain blanks.
                         j = i
@@ -233,7 +223,7 @@ contains
                             if (depth == 0 .and. index(word_ends, text(j:j)) > 0) exit
                             j = j + 1
                         end do
-                        call add_token(iline, i, j - 1)
+                        call add_token(i, j - 1)
                         i = j
                     end select
                 end do
@@ -246,74 +236,61 @@ contains
             end associate
         end if
         scan%groups = scan%groups(:scan%n_groups)
+        scan%tokens = scan%tokens(:n_tokens)
 
     contains
 
-        subroutine start_group(group_name)
-            character(len=*), intent(in) :: group_name
+        !> An error on the line being read.
+        subroutine fail(text)
+            character(len=*), intent(in) :: text
+
+            call fatal_error(error, 'line ' // format_integer(iline) // text)
+        end subroutine fail
+
+        subroutine start_group()
+            type(group_occurrence_type), allocatable :: more(:)
 
             if (scan%n_groups == size(scan%groups)) then
-                allocate(grown(2 * scan%n_groups))
-                grown(:scan%n_groups) = scan%groups
-                call move_alloc(grown, scan%groups)
+                allocate(more(2 * scan%n_groups))
+                more(:scan%n_groups) = scan%groups
+                call move_alloc(more, scan%groups)
             end if
             scan%n_groups = scan%n_groups + 1
-            associate(group => scan%groups(scan%n_groups))
-                group%name = group_name
-                group%first_line = iline
-                allocate(group%tokens(16))
-                group%n_tokens = 0
-            end associate
+            scan%groups(scan%n_groups) = group_occurrence_type(name, iline, n_tokens + 1, &
+                n_tokens)
+            in_group = .true.
         end subroutine start_group
 
-        subroutine end_group(last_line)
-            integer, intent(in) :: last_line
-
-            associate(group => scan%groups(scan%n_groups))
-                group%last_line = last_line
-                group%tokens = group%tokens(:group%n_tokens)
-            end associate
-            in_group = .false.
-        end subroutine end_group
-
-        subroutine add_token(line, first, last)
-            integer, intent(in) :: line, first, last
+        subroutine add_token(first, last)
+            integer, intent(in) :: first, last
             type(token_type), allocatable :: more(:)
 
-            associate(group => scan%groups(scan%n_groups))
-                if (group%n_tokens == size(group%tokens)) then
-                    allocate(more(2 * group%n_tokens))
-                    more(:group%n_tokens) = group%tokens
-                    call move_alloc(more, group%tokens)
-                end if
-                group%n_tokens = group%n_tokens + 1
-                group%tokens(group%n_tokens) = token_type(line, first, last, .false.)
-            end associate
+            if (n_tokens == size(scan%tokens)) then
+                allocate(more(2 * n_tokens))
+                more(:n_tokens) = scan%tokens
+                call move_alloc(more, scan%tokens)
+            end if
+            n_tokens = n_tokens + 1
+            scan%tokens(n_tokens) = token_type(iline, first, last, .false.)
+            scan%groups(scan%n_groups)%last_token = n_tokens
         end subroutine add_token
 
-        !> The token before '=' is a variable name.
+        !> The token before '=' is a variable name: a word of this group, not a value in
+        !> quotes, not a null value, not already a name.
         subroutine mark_name()
-            associate(group => scan%groups(scan%n_groups))
-                if (group%n_tokens == 0) then
-                    call no_name_error()
-                    return
-                end if
-                associate(last => group%tokens(group%n_tokens))
-                    if (last%is_name .or. last%last < last%first .or. index("'""", &
-                        scan%lines(last%line)%text(last%first:last%first)) > 0) then
-                        call no_name_error()
-                        return
-                    end if
-                    last%is_name = .true.
-                end associate
-            end associate
-        end subroutine mark_name
+            logical :: ok
 
-        subroutine no_name_error()
-            call fatal_error(error, 'line ' // format_integer(iline) &
-                // ": '=' without a variable name before it in &" &
+            ok = n_tokens >= scan%groups(scan%n_groups)%first_token
+            if (ok) then
+                associate(last => scan%tokens(n_tokens))
+                    ok = .not. last%is_name .and. last%last >= last%first .and. &
+                        index("'""", scan%lines(last%line)%text(last%first:last%first)) == 0
+                    last%is_name = ok
+                end associate
+            end if
+            if (.not. ok) call fail(": '=' without a variable name before it in &" &
                 // scan%groups(scan%n_groups)%name)
-        end subroutine no_name_error
+        end subroutine mark_name
 
         !> The group, the variable and the start of the character value being read:
         !> "&control title = 'see &yarn..." (the variable is the last name before it).
@@ -321,18 +298,14 @@ contains
             character(len=:), allocatable :: text
             integer :: k
 
-            associate(group => scan%groups(scan%n_groups))
-                text = '&' // group%name
-                do k = group%n_tokens - 1, 1, -1
-                    if (group%tokens(k)%is_name) then
-                        text = text // ' ' // scan%token_text(group%tokens(k)) // ' ='
-                        exit
-                    end if
-                end do
-                associate(value => group%tokens(group%n_tokens))
-                    text = text // ' ' // shorten(scan%lines(value%line)%text(value%first:))
-                end associate
-            end associate
+            text = '&' // scan%groups(scan%n_groups)%name
+            do k = n_tokens - 1, scan%groups(scan%n_groups)%first_token, -1
+                if (scan%tokens(k)%is_name) then
+                    text = text // ' ' // scan%token_text(scan%tokens(k)) // ' ='
+                    exit
+                end if
+            end do
+            text = text // ' ' // shorten(scan%lines(iline)%text(scan%tokens(n_tokens)%first:))
         end function open_value
 
     end subroutine find_groups
@@ -352,31 +325,6 @@ contains
         end do
         name = to_lower(text(first:next - 1))
     end subroutine read_name
-
-    subroutine unknown_group_error(error, name, line, known_groups)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: line
-        character(len=*), intent(in) :: known_groups(:)
-        character(len=:), allocatable :: guess, hint
-
-        guess = closest_name(name, known_groups)
-        if (len(guess) > 0) then
-            hint = ' (did you mean &' // guess // '?)'
-        else
-            hint = ' (known groups: ' // join_names(known_groups, '&') // ')'
-        end if
-        call fatal_error(error, 'unknown group &' // name // ' on line ' &
-            // format_integer(line) // hint)
-    end subroutine unknown_group_error
-
-    !> A variable name in lower case without blanks (subscript kept).
-    pure function normalized_name(text) result(name)
-        character(len=*), intent(in) :: text
-        character(len=:), allocatable :: name
-
-        name = to_lower(remove_characters(text, ' ' // tab))
-    end function normalized_name
 
     !> At most 40 characters of a text for a message.
     pure function shorten(text) result(short)
@@ -420,25 +368,6 @@ contains
         end do
     end function find_group
 
-    !> Whether the `occurrence`-th group `name` has an assignment to `variable` (whole
-    !> or subscripted).
-    pure logical function is_set(self, name, occurrence, variable)
-        class(namelist_scan_type), intent(in) :: self
-        character(len=*), intent(in) :: name, variable
-        integer, intent(in) :: occurrence
-        integer :: g, k
-
-        is_set = .false.
-        g = self%find_group(name, occurrence)
-        if (g == 0) return
-        associate(group => self%groups(g))
-            do k = 1, group%n_tokens
-                if (.not. group%tokens(k)%is_name) cycle
-                if (base_name(self%token_text(group%tokens(k))) == variable) is_set = .true.
-            end do
-        end associate
-    end function is_set
-
     !> The assignments of the `occurrence`-th group `name` (1 for a singleton), in text
     !> order. An error for a value before the first name, a variable not in `variables`
     !> (with the closest one), a known variable name among the values (a missing '='),
@@ -456,34 +385,36 @@ contains
 
         label = group_label(name, occurrence)
         g = scan%find_group(name, max(occurrence, 1))
-        associate(group => scan%groups(g))
-            allocate(sets(count(group%tokens(:group%n_tokens)%is_name)))
+        associate(tokens => scan%tokens(scan%groups(g)%first_token:scan%groups(g)%last_token))
+            allocate(sets(count(tokens%is_name)))
             n = 0
-            do k = 1, group%n_tokens
-                text = scan%token_text(group%tokens(k))
-                if (group%tokens(k)%is_name) then
+            do k = 1, size(tokens)
+                text = scan%token_text(tokens(k))
+                if (tokens(k)%is_name) then
                     n = n + 1
-                    sets(n)%line = group%tokens(k)%line
-                    sets(n)%name = base_name(text)
-                    j = k + 1
-                    do while (j <= group%n_tokens)
-                        if (group%tokens(j)%is_name) exit
+                    sets(n)%line = tokens(k)%line
+                    ! Its values: the tokens up to the next name.
+                    j = k
+                    do while (j < size(tokens))
+                        if (tokens(j + 1)%is_name) exit
                         j = j + 1
                     end do
-                    allocate(sets(n)%values(j - k - 1))
+                    allocate(sets(n)%values(j - k))
                     m = 0
-                    paren = index(text, '(')
+                    ! The name in lower case without blanks, then without its subscript.
+                    sets(n)%name = to_lower(remove_characters(text, ' ' // tab))
+                    paren = index(sets(n)%name, '(')
                     sets(n)%subscripted = paren > 0
                     if (paren > 0) then
-                        call read_subscript(normalized_name(text(paren:)), sets(n), ok)
+                        call read_subscript(sets(n)%name(paren:), sets(n), ok)
                         if (.not. ok) then
-                            call fatal_error(error, label // ': ' // normalized_name( &
-                                scan%token_text(group%tokens(k))) // ' (line ' &
+                            call fatal_error(error, label // ': ' // sets(n)%name // ' (line ' &
                                 // format_integer(sets(n)%line) // '): a subscript is an ' &
-                                // 'integer or a section, as in ' // sets(n)%name // '(2) or ' &
-                                // sets(n)%name // '(2:3)')
+                                // 'integer or a section, as in ' // sets(n)%name(:paren - 1) &
+                                // '(2) or ' // sets(n)%name(:paren - 1) // '(2:3)')
                             return
                         end if
+                        sets(n)%name = sets(n)%name(:paren - 1)
                     end if
                     if (.not. any(variables == sets(n)%name)) then
                         guess = closest_name(sets(n)%name, variables)
@@ -498,15 +429,13 @@ contains
                         return
                     end if
                 else if (n == 0) then
-                    call fatal_error(error, label // ' (line ' &
-                        // format_integer(group%tokens(k)%line) // '): value ' // text &
-                        // ' before any variable name')
+                    call fatal_error(error, label // ' (line ' // format_integer(tokens(k)%line) &
+                        // '): value ' // text // ' before any variable name')
                     return
                 else if (any(variables == to_lower(text))) then
                     call fatal_error(error, label // ": '=' must follow the variable name " &
-                        // text // ' (line ' // format_integer(group%tokens(k)%line) &
-                        // ': ' // shorten(adjustl(scan%lines(group%tokens(k)%line)%text)) &
-                        // ')')
+                        // text // ' (line ' // format_integer(tokens(k)%line) // ': ' &
+                        // shorten(adjustl(scan%lines(tokens(k)%line)%text)) // ')')
                     return
                 else
                     m = m + 1
@@ -553,19 +482,5 @@ contains
         label = '&' // name
         if (occurrence > 0) label = label // ' #' // format_integer(occurrence)
     end function group_label
-
-    !> A variable name without subscript, lower case.
-    pure function base_name(text) result(name)
-        character(len=*), intent(in) :: text
-        character(len=:), allocatable :: name
-        integer :: paren
-
-        paren = index(text, '(')
-        if (paren == 0) then
-            name = to_lower(trim(text))
-        else
-            name = to_lower(trim(text(:paren - 1)))
-        end if
-    end function base_name
 
 end module yarnfort_input_scan

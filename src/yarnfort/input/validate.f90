@@ -38,32 +38,21 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer, allocatable :: owner(:, :)
 
+        ! Each check runs only while all before it have passed.
         call check_control_variables(config%control, '&control', error)
-        if (allocated(error)) return
-        call check_solver(config%solver, error)
-        if (allocated(error)) return
-        call check_output(config%output, error)
-        if (allocated(error)) return
-        call check_materials(config%materials, error)
-        if (allocated(error)) return
-        call check_nodes(config, error)
-        if (allocated(error)) return
-        call check_scene_size(config, error)
-        if (allocated(error)) return
+        if (.not. allocated(error)) call check_solver(config%solver, error)
+        if (.not. allocated(error)) call check_output(config%output, error)
+        if (.not. allocated(error)) call check_materials(config%materials, error)
+        if (.not. allocated(error)) call check_nodes(config, error)
+        if (.not. allocated(error)) call check_scene_size(config, error)
         ! Before check_yarns, whose "node on no yarn" would hide a ring with no yarn.
-        call check_contact_nodes(config, error)
-        if (allocated(error)) return
-        call check_yarns(config, error)
-        if (allocated(error)) return
-        call check_duplicate_segments(config, error)
-        if (allocated(error)) return
-        call check_contacts(config, error)
-        if (allocated(error)) return
-        call check_contact_node_laws(config, error)
-        if (allocated(error)) return
-        call check_supports(config, owner, error)
-        if (allocated(error)) return
-        call check_loads(config, owner, error)
+        if (.not. allocated(error)) call check_contact_nodes(config, error)
+        if (.not. allocated(error)) call check_yarns(config, error)
+        if (.not. allocated(error)) call check_duplicate_segments(config, error)
+        if (.not. allocated(error)) call check_contacts(config, error)
+        if (.not. allocated(error)) call check_contact_node_laws(config, error)
+        if (.not. allocated(error)) call check_supports(config, owner, error)
+        if (.not. allocated(error)) call check_loads(config, owner, error)
         if (allocated(error)) return
         ! New nodes inside segments, sliding at contacts and generated fabrics are unknowns.
         if (all(owner > 0) .and. all(config%yarns%elements_per_segment == 1) &
@@ -73,12 +62,9 @@ contains
             return
         end if
         call check_path(config%path, error)
-        if (allocated(error)) return
-        call check_channels(config, error)
-        if (allocated(error)) return
-        call check_prescribed_reach(config, error)
-        if (allocated(error)) return
-        call check_step_resolution(config%solver, config%path, error)
+        if (.not. allocated(error)) call check_channels(config, error)
+        if (.not. allocated(error)) call check_prescribed_reach(config, error)
+        if (.not. allocated(error)) call check_step_resolution(config%solver, config%path, error)
     end subroutine check_config
 
     !> &solver: its variables, and min_step <= initial_step (larger ones are capped at
@@ -136,7 +122,7 @@ contains
     subroutine check_path(path, error)
         type(path_config_type), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
-        integer :: n, i
+        integer :: n, i, m
 
         if (.not. allocated(path%time)) then
             call fatal_error(error, '&path: group missing (give the load path, e.g. ' &
@@ -149,16 +135,15 @@ contains
                 // ' knot(s); at least 2 are needed')
             return
         end if
-        if (size(path%p_force) /= n) then
-            call fatal_error(error, '&path: p_force has ' // format_integer(size(path%p_force)) &
-                // ' values but time has ' // format_integer(n))
-            return
-        end if
-        if (size(path%p_disp) /= n) then
-            call fatal_error(error, '&path: p_disp has ' // format_integer(size(path%p_disp)) &
-                // ' values but time has ' // format_integer(n))
-            return
-        end if
+        do i = 1, 2
+            m = merge(size(path%p_force), size(path%p_disp), i == 1)
+            if (m /= n) then
+                call fatal_error(error, '&path: ' // trim(merge('p_force', 'p_disp ', i == 1)) &
+                    // ' has ' // format_integer(m) // ' values but time has ' &
+                    // format_integer(n))
+                return
+            end if
+        end do
         call check_path_variables(path, '&path', error)
         if (allocated(error)) return
         do i = 2, n

@@ -20,6 +20,11 @@ from __future__ import annotations
 
 from descriptors import Group, Var
 
+#: Both columns of the gap-factor curve of &fabric.
+GAP_FACTOR = ('The gap factor as a piecewise-linear function of the displacement factor p_disp '
+              "(constant beyond the end knots): the holders' length is gap * factor (paper "
+              'Fig. 13b). `gap_factor_p_disp` increasing; factors positive.')
+
 GROUPS = [
     Group('control', 'singleton',
           'What the run is.', [
@@ -291,14 +296,10 @@ GROUPS = [
             doc='Gap-holder length: distance between the axes of the two yarns at a crossing.'),
         Var('gap_factor_p_disp', 'real', None, shape='list', unit='1', checked_by='fabric',
             default_doc='empty (factor 1)',
-            doc='The gap factor as a piecewise-linear function of the displacement factor p_disp '
-                "(constant beyond the end knots): the holders' length is gap * factor (paper "
-                'Fig. 13b). `gap_factor_p_disp` increasing; factors positive.'),
+            doc=GAP_FACTOR),
         Var('gap_factor', 'real', None, shape='list', unit='1', checked_by='fabric',
             default_doc='empty (factor 1)',
-            doc='The gap factor as a piecewise-linear function of the displacement factor p_disp '
-                "(constant beyond the end knots): the holders' length is gap * factor (paper "
-                'Fig. 13b). `gap_factor_p_disp` increasing; factors positive.'),
+            doc=GAP_FACTOR),
         Var('texgen_file', 'character', '', length='path_length', adjust=False,
             checked_by='fabric', default_doc='required (texgen)',
             doc="TexGen: the model file (`.tg3`, TexGen's XML), relative to the input file's "

@@ -12,7 +12,7 @@ module yarnfort_output_curve
     use yarnfort_output_csv_rows, only: csv_rows_type, format_csv_real
     use yarnfort_input_channel_checks, only: load_column_prefix
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, open_append, &
-        flush_checked, truncate_file
+        flush_checked, truncate_file, open_new_file, close_new_file
     implicit none
     private
 
@@ -63,18 +63,10 @@ contains
         class(curve_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: folder, name, header
         type(error_type), allocatable, intent(out) :: error
-        character(len=256) :: message
-        integer :: status
 
         self%path = folder // '/' // name
-        message = ''
-        open(newunit=self%unit, file=self%path, status='replace', action='write', &
-            iostat=status, iomsg=message)
-        if (status /= 0) then
-            self%unit = -1
-            call fatal_error(error, "cannot write '" // self%path // "': " // trim(message))
-            return
-        end if
+        call open_new_file(self%unit, self%path, error)
+        if (allocated(error)) return
         call self%put_line(header, error)
     end subroutine open_table
 
@@ -157,14 +149,12 @@ contains
                 // 'than this scene writes')
             return
         end if
-        message = ''
-        open(newunit=new, file=temporary, status='replace', action='write', iostat=status, &
-            iomsg=message)
-        if (status /= 0) then
+        call open_new_file(new, temporary, error)
+        if (allocated(error)) then
             close(old)
-            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
             return
         end if
+        message = ''
         write(new, '(a)', iostat=write_status, iomsg=message) header
         last_kept = -1
         row_time = -huge(row_time)
@@ -191,16 +181,8 @@ contains
             end if
         end do
         close(old)
-        if (write_status == 0) then
-            call close_checked(new, temporary, error)
-        else
-            close(new)
-            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
-        end if
-        if (allocated(error)) then
-            call remove_file(temporary, ignored)
-            return
-        end if
+        call close_new_file(new, temporary, error, write_status, message)
+        if (allocated(error)) return
         if (present(row_required)) then
             if (.not. row_required) last_kept = step
         end if
@@ -211,39 +193,36 @@ contains
                 // trim(text) // ', the step of the restart file')
             return
         end if
-        ! The row was written from the same double with 17 significant digits: it reads
-        ! back to within a unit in the last place.
-        if (present(time)) then
-            if (.not. abs(row_time - time) <= 2 * spacing(max(abs(time), tiny(time)))) then
-                call remove_file(temporary, ignored)
-                write(text, '(i0)') step
-                call fatal_error(error, "&control restart: the restart file's time " &
-                    // format_csv_real(time) // ' is not that of step ' // trim(text) &
-                    // " in '" // path // "' (" // format_csv_real(row_time) &
-                    // '): the two files are not of the same run')
-                return
-            end if
-        end if
+        if (present(time)) call check_time('time', time, row_time, step)
         ! (A folder whose rows were renumbered may lack the row before: then unchecked.)
         if (present(previous_time) .and. step > 0 .and. row_time_previous > -huge(row_time)) &
-                then
-            if (.not. abs(row_time_previous - previous_time) &
-                    <= 2 * spacing(max(abs(previous_time), tiny(previous_time)))) then
-                call remove_file(temporary, ignored)
-                write(text, '(i0)') step - 1
-                call fatal_error(error, "&control restart: the restart file's previous " &
-                    // 'time ' // format_csv_real(previous_time) // ' is not that of step ' &
-                    // trim(text) // " in '" // path // "' (" &
-                    // format_csv_real(row_time_previous) // '): the two files are not ' &
-                    // 'of the same run')
-                return
-            end if
+            call check_time('previous time', previous_time, row_time_previous, step - 1)
+        if (allocated(error)) then
+            call remove_file(temporary, ignored)
+            return
         end if
         call rename_file(temporary, path, error)
         if (allocated(error)) return
         self%path = path
         call open_append(self%unit, path, error)
     contains
+        !> The restart file's `what` (`expected`) must be the time `found` in the row of
+        !> `row_step`: written from the same double with 17 significant digits, it reads
+        !> back to within a unit in the last place. Nothing to do after an error.
+        subroutine check_time(what, expected, found, row_step)
+            character(len=*), intent(in) :: what
+            real(wp), intent(in) :: expected, found
+            integer, intent(in) :: row_step
+
+            if (allocated(error)) return
+            if (abs(found - expected) <= 2 * spacing(max(abs(expected), tiny(expected)))) return
+            write(text, '(i0)') row_step
+            call fatal_error(error, "&control restart: the restart file's " // what // ' ' &
+                // format_csv_real(expected) // ' is not that of step ' // trim(text) // " in '" &
+                // path // "' (" // format_csv_real(found) // '): the two files are not of ' &
+                // 'the same run')
+        end subroutine check_time
+
         pure integer function count_commas(text)
             character(len=*), intent(in) :: text
             integer :: i

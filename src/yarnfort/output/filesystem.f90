@@ -10,7 +10,7 @@ module yarnfort_output_filesystem
 
     public :: make_folder, rename_file, remove_file, sync_file, folder_lock_type
     public :: close_checked, flush_checked, truncate_file, ignore_file_size_signal
-    public :: open_append
+    public :: open_append, open_new_file, close_new_file
     public :: lock_file_name
 
     !> The lock file of an output folder (kept; the lock is the kernel's, not the file).
@@ -195,6 +195,52 @@ contains
             call fatal_error(error, "cannot write '" // path // "': " // trim(message))
         end if
     end subroutine open_append
+
+    !> Open `path` to write it anew (a file of that name is replaced): formatted lines, or
+    !> bytes with `stream` (`unit` = -1 on failure).
+    subroutine open_new_file(unit, path, error, stream)
+        integer, intent(out) :: unit
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: stream
+        character(len=256) :: message
+        integer :: status
+        logical :: bytes
+
+        bytes = .false.
+        if (present(stream)) bytes = stream
+        message = ''
+        open(newunit=unit, file=path, access=merge('stream    ', 'sequential', bytes), &
+            form=merge('unformatted', 'formatted  ', bytes), status='replace', action='write', &
+            iostat=status, iomsg=message)
+        if (status /= 0) then
+            unit = -1
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+        end if
+    end subroutine open_new_file
+
+    !> Close `unit`, on which the file `path` was written anew, after its last write
+    !> (`status`, 0 if absent, and its iomsg `message`), checking that every byte reached
+    !> the file (close_checked). On failure the file is removed and the error says why.
+    subroutine close_new_file(unit, path, error, status, message)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        integer, intent(in), optional :: status
+        character(len=*), intent(in), optional :: message
+        type(error_type), allocatable :: ignored
+        logical :: failed
+
+        failed = .false.
+        if (present(status)) failed = status /= 0
+        if (failed) then
+            close(unit)
+            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
+        else
+            call close_checked(unit, path, error)
+        end if
+        if (allocated(error)) call remove_file(path, ignored)
+    end subroutine close_new_file
 
     !> Close `unit`, connected to the file `path`, and check that every byte written
     !> reached the file. (gfortran's CLOSE and FLUSH report no error when the buffered

@@ -15,7 +15,7 @@ module yarnfort_output_manifest
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, open_append, &
-        close_checked, flush_checked
+        flush_checked, open_new_file, close_new_file
     implicit none
     private
 
@@ -116,28 +116,21 @@ contains
         call self%close()
         path = self%folder // '/' // manifest_file_name
         temporary = path // '.tmp'
-        open(newunit=unit, file=temporary, status='replace', action='write', iostat=status, &
-            iomsg=message)
-        if (status == 0) then
-            do i = 1, size(self%files)
-                if (status == 0) write(unit, '(a)', iostat=status, iomsg=message) &
-                    'file ' // trim(self%files(i))
-            end do
-            do i = 1, size(self%states)
-                if (status == 0) call put_state(unit, self%states(i), self%steps(i), &
-                    self%times(i), status, message)
-            end do
-            if (status == 0) then
-                call close_checked(unit, temporary, error)
-            else
-                close(unit, status='delete')
-            end if
-        end if
-        if (status /= 0) then
-            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
-            return
-        end if
-        if (.not. allocated(error)) call sync_file(temporary, error)
+        call open_new_file(unit, temporary, error)
+        if (allocated(error)) return
+        status = 0
+        message = ''
+        do i = 1, size(self%files)
+            if (status == 0) write(unit, '(a)', iostat=status, iomsg=message) &
+                'file ' // trim(self%files(i))
+        end do
+        do i = 1, size(self%states)
+            if (status == 0) call put_state(unit, self%states(i), self%steps(i), &
+                self%times(i), status, message)
+        end do
+        call close_new_file(unit, temporary, error, status, message)
+        if (allocated(error)) return
+        call sync_file(temporary, error)
         if (.not. allocated(error)) call rename_file(temporary, path, error)
         if (allocated(error)) then
             call remove_file(temporary, ignored)

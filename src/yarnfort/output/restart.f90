@@ -26,7 +26,8 @@ module yarnfort_output_restart
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_text, only: resolve_path, format_integer, format_real, join_names
     use yarnfort_solver_restart, only: restart_type, stepper_elastic, stepper_friction
-    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, close_checked
+    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, close_checked, &
+        open_new_file, close_new_file
     implicit none
     private
 
@@ -72,13 +73,9 @@ contains
 
         path = folder // '/' // restart_file_name
         temporary = path // '.tmp'
+        call open_new_file(unit, temporary, error, stream=.true.)
+        if (allocated(error)) return
         message = ''
-        open(newunit=unit, file=temporary, access='stream', form='unformatted', &
-            status='replace', action='write', iostat=status, iomsg=message)
-        if (status /= 0) then
-            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message))
-            return
-        end if
         stamp = input_hash
         stepper = snapshot%stepper
         associate(s => snapshot)
@@ -102,13 +99,7 @@ contains
             end if
             if (status == 0) write(unit, iostat=status, iomsg=message) end_marker
         end associate
-        if (status /= 0) then
-            close(unit, status='delete')
-            call fatal_error(error, "cannot write '" // temporary // "': " // trim(message) &
-                // kept())
-            return
-        end if
-        call close_checked(unit, temporary, error)
+        call close_new_file(unit, temporary, error, status, message)
         if (.not. allocated(error)) call append_checksum(temporary, error)
         if (allocated(error)) then
             call remove_file(temporary, ignored)
@@ -153,9 +144,8 @@ contains
         type(restart_type), intent(out) :: snapshot
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: path
-        character(len=16) :: header, marker, checksum, digest
+        character(len=16) :: header, marker, checksum
         character(len=32) :: text
-        integer(int64) :: state(2)
         character(len=256) :: message
         integer :: unit, status, version, have_old, n_channels
         integer(int64) :: file_size, position, expected
@@ -245,10 +235,7 @@ contains
                 // "' is cut short or unreadable")
             return
         end if
-        state = hash_basis
-        call add_file_bytes(state, path, file_size - len(checksum))
-        write(digest, '(z8.8, z8.8)') state(1), state(2)
-        if (digest /= checksum) then
+        if (get_checksum(path, file_size - len(checksum)) /= checksum) then
             call fatal_error(error, "&control restart: '" // path // "' is damaged: its " &
                 // 'checksum does not match its content')
             return
@@ -468,18 +455,15 @@ contains
         end if
         if (allocated(config%materials)) then
             do m = 1, size(config%materials)
-                if (len_trim(config%materials(m)%table_file) > 0) call add_file( &
-                    resolve_path(config%materials(m)%table_file, config%input_folder))
+                call add_named_file(config%materials(m)%table_file)
             end do
         end if
         if (allocated(config%contacts)) then
             do m = 1, size(config%contacts)
-                if (len_trim(config%contacts(m)%rate_table) > 0) call add_file( &
-                    resolve_path(config%contacts(m)%rate_table, config%input_folder))
+                call add_named_file(config%contacts(m)%rate_table)
             end do
         end if
-        if (len_trim(config%geometry%file) > 0) &
-            call add_file(resolve_path(config%geometry%file, config%input_folder))
+        call add_named_file(config%geometry%file)
         call add_bytes(transfer(scene%network%position, [0_int8]))
         call add_bytes(transfer(scene%network%element_nodes, [0_int8]))
         call add_bytes(transfer(scene%network%length0, [0_int8]))
@@ -495,10 +479,12 @@ contains
             call add_hash_bytes(state, bytes)
         end subroutine add_bytes
 
-        subroutine add_file(path)
-            character(len=*), intent(in) :: path
-            call add_file_bytes(state, path)
-        end subroutine add_file
+        !> The content of a file the input names (nothing for a blank name).
+        subroutine add_named_file(name)
+            character(len=*), intent(in) :: name
+            if (len_trim(name) > 0) &
+                call add_file_bytes(state, resolve_path(name, config%input_folder))
+        end subroutine add_named_file
     end function get_input_hash
 
     !> Add `bytes` to the two 32-bit FNV-1a-like hashes of `state`.
@@ -549,14 +535,11 @@ contains
     subroutine append_checksum(path, error)
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
-        integer(int64) :: state(2)
         character(len=16) :: digest
         character(len=256) :: message
         integer :: unit, status
 
-        state = hash_basis
-        call add_file_bytes(state, path)
-        write(digest, '(z8.8, z8.8)') state(1), state(2)
+        digest = get_checksum(path)
         message = ''
         open(newunit=unit, file=path, access='stream', form='unformatted', status='old', &
             position='append', action='write', iostat=status, iomsg=message)
@@ -567,5 +550,17 @@ contains
         end if
         call close_checked(unit, path, error)
     end subroutine append_checksum
+
+    !> The checksum (16 hex digits) of the file `path`, or of its first `limit` bytes.
+    function get_checksum(path, limit) result(digest)
+        character(len=*), intent(in) :: path
+        integer(int64), intent(in), optional :: limit
+        character(len=16) :: digest
+        integer(int64) :: state(2)
+
+        state = hash_basis
+        call add_file_bytes(state, path, limit)
+        write(digest, '(z8.8, z8.8)') state(1), state(2)
+    end function get_checksum
 
 end module yarnfort_output_restart

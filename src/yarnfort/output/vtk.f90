@@ -24,10 +24,11 @@
 module yarnfort_output_vtk
     use, intrinsic :: iso_fortran_env, only: int8, int32, int64
     use yarnfort_kinds, only: wp
-    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_error, only: error_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
-    use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked
+    use yarnfort_output_filesystem, only: rename_file, remove_file, open_new_file, &
+        close_new_file
     use yarnfort_text, only: format_integer
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
     implicit none
@@ -268,27 +269,17 @@ contains
         if (present(atomic)) through_temporary = atomic
         target = path
         if (through_temporary) target = path // '.tmp'
-        message = ''
-        open(newunit=unit, file=target, access='stream', form='unformatted', &
-            status='replace', action='write', iostat=status, iomsg=message)
-        if (status == 0) then
-            write(unit, iostat=status, iomsg=message) text
-            if (status == 0) then
-                call close_checked(unit, target, error)
-            else
-                close(unit)
-            end if
-        end if
-        if (status /= 0) call fatal_error(error, "cannot write '" // target // "': " &
-            // trim(message))
+        call open_new_file(unit, target, error, stream=.true.)
         if (allocated(error)) then
             call remove_file(target, ignored)
             return
         end if
-        if (through_temporary) then
-            call rename_file(target, path, error)
-            if (allocated(error)) call remove_file(target, ignored)
-        end if
+        message = ''
+        write(unit, iostat=status, iomsg=message) text
+        call close_new_file(unit, target, error, status, message)
+        if (allocated(error) .or. .not. through_temporary) return
+        call rename_file(target, path, error)
+        if (allocated(error)) call remove_file(target, ignored)
     end subroutine write_text_file
 
     subroutine add_text(vtu, text)
@@ -391,54 +382,47 @@ contains
         character(len=*), intent(in) :: label
         integer(int32), intent(in) :: values(:)
         logical, intent(in), optional :: field
-        character(len=:), allocatable :: text
-        integer :: status
 
-        if (vtu%ascii) then
-            allocate(character(len=12 * size(values) + 1) :: text)
-            write(text, '(*(1x, i0))', iostat=status) values
-            call add_array(vtu, 'Int32', label, 1, size(values), is_field(field), &
-                [integer(int8) :: ], trim(text))
-        else
-            call add_array(vtu, 'Int32', label, 1, size(values), is_field(field), &
-                transfer(values, [0_int8], 4 * size(values)), '')
-        end if
+        call add_integers(vtu, 'Int32', label, int(values, int64), &
+            transfer(values, [0_int8], 4 * size(values)), field)
     end subroutine add_int32
 
     subroutine add_int64(vtu, label, values)
         type(vtu_builder_type), intent(inout) :: vtu
         character(len=*), intent(in) :: label
         integer(int64), intent(in) :: values(:)
-        character(len=:), allocatable :: text
-        integer :: status
 
-        if (vtu%ascii) then
-            allocate(character(len=21 * size(values) + 1) :: text)
-            write(text, '(*(1x, i0))', iostat=status) values
-            call add_array(vtu, 'Int64', label, 1, size(values), .false., &
-                [integer(int8) :: ], trim(text))
-        else
-            call add_array(vtu, 'Int64', label, 1, size(values), .false., &
-                transfer(values, [0_int8], 8 * size(values)), '')
-        end if
+        call add_integers(vtu, 'Int64', label, values, transfer(values, [0_int8], 8 * size(values)))
     end subroutine add_int64
 
     subroutine add_uint8(vtu, label, values)
         type(vtu_builder_type), intent(inout) :: vtu
         character(len=*), intent(in) :: label
         integer(int8), intent(in) :: values(:)
+
+        call add_integers(vtu, 'UInt8', label, int(values, int64), values)
+    end subroutine add_uint8
+
+    !> An integer array of VTK type `type_name`: `values` in ASCII, or `bytes`, their
+    !> binary form in that type, appended.
+    subroutine add_integers(vtu, type_name, label, values, bytes, field)
+        type(vtu_builder_type), intent(inout) :: vtu
+        character(len=*), intent(in) :: type_name, label
+        integer(int64), intent(in) :: values(:)
+        integer(int8), intent(in) :: bytes(:)
+        logical, intent(in), optional :: field
         character(len=:), allocatable :: text
         integer :: status
 
         if (vtu%ascii) then
-            allocate(character(len=5 * size(values) + 1) :: text)
+            allocate(character(len=21 * size(values) + 1) :: text)
             write(text, '(*(1x, i0))', iostat=status) values
-            call add_array(vtu, 'UInt8', label, 1, size(values), .false., &
+            call add_array(vtu, type_name, label, 1, size(values), is_field(field), &
                 [integer(int8) :: ], trim(text))
         else
-            call add_array(vtu, 'UInt8', label, 1, size(values), .false., values, '')
+            call add_array(vtu, type_name, label, 1, size(values), is_field(field), bytes, '')
         end if
-    end subroutine add_uint8
+    end subroutine add_integers
 
     pure logical function is_field(field)
         logical, intent(in), optional :: field

@@ -20,7 +20,7 @@ module yarnfort_output_writer
         get_contact_rows
     use yarnfort_output_vtk, only: vtk_writer_type, get_state_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
-        remove_file, lock_file_name, close_checked
+        remove_file, lock_file_name, open_new_file, close_new_file
     use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_output_restart, only: write_restart, remove_restart
@@ -249,25 +249,19 @@ contains
         type(error_type), allocatable, intent(out) :: error
         type(error_type), allocatable :: ignored
         character(len=:), allocatable :: path, temporary
-        character(len=256) :: message
-        integer :: unit, status
+        integer :: unit
 
         path = self%folder // '/' // input_file_name
         temporary = path // '.tmp'
-        message = ''
-        open(newunit=unit, file=temporary, status='replace', action='write', iostat=status, &
-            iomsg=message)
-        if (status == 0) then
-            ! A failed write shows when closing: the file is shorter than what was written.
-            call write_config(unit, config)
-            call close_checked(unit, temporary, error)
-        end if
-        if (status /= 0) call fatal_error(error, "cannot write '" // temporary // "': " &
-            // trim(message))
+        call open_new_file(unit, temporary, error)
         if (allocated(error)) then
             call remove_file(temporary, ignored)
             return
         end if
+        ! A failed write shows when closing: the file is shorter than what was written.
+        call write_config(unit, config)
+        call close_new_file(unit, temporary, error)
+        if (allocated(error)) return
         call rename_file(temporary, path, error)
     end subroutine write_input
 
@@ -377,7 +371,6 @@ contains
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
-        type(error_type), allocatable :: close_error
 
         if (.not. self%last_written .and. self%vtk_every > 0 .and. allocated(self%last%position)) &
             call write_last_state(self, scene, error)
@@ -385,23 +378,23 @@ contains
             if (self%vtk%listed /= size(self%vtk%files)) call self%vtk%write_collection(error)
             if (allocated(error)) self%failed = .true.
         end if
-        call self%curve%close(close_error)
-        if (allocated(close_error) .and. .not. allocated(error)) then
-            self%failed = .true.
-            call move_alloc(close_error, error)
-        end if
-        call self%contacts%close(close_error)
-        if (allocated(close_error) .and. .not. allocated(error)) then
-            self%failed = .true.
-            call move_alloc(close_error, error)
-        end if
-        call self%reactions%close(close_error)
-        if (allocated(close_error) .and. .not. allocated(error)) then
-            self%failed = .true.
-            call move_alloc(close_error, error)
-        end if
+        call close_table(self%curve)
+        call close_table(self%contacts)
+        call close_table(self%reactions)
         call self%manifest%close()
         call self%folder_lock%release()
+    contains
+        !> Close a CSV file; its error is the run's unless an earlier one is.
+        subroutine close_table(table)
+            type(curve_writer_type), intent(inout) :: table
+            type(error_type), allocatable :: close_error
+
+            call table%close(close_error)
+            if (allocated(close_error) .and. .not. allocated(error)) then
+                self%failed = .true.
+                call move_alloc(close_error, error)
+            end if
+        end subroutine close_table
     end subroutine finish
 
     !> Whether any support set prescribes a coordinate (reactions.csv has rows).

@@ -82,32 +82,23 @@ contains
         type(material_config_type), intent(in) :: material
         type(error_type), allocatable, intent(out) :: error
         character(len=*), intent(in), optional :: folder
+        type(linear_law_type) :: linear
+        type(neo_hookean_law_type) :: neo
+        type(table_law_type) :: table
         character(len=:), allocatable :: path
 
         select case (trim(material%law))
         case ('linear')
-            block
-                type(linear_law_type), allocatable :: linear
-                allocate(linear)
-                call new_linear_law(linear, material%stiffness, error)
-                call move_alloc(linear, law)
-            end block
+            call new_linear_law(linear, material%stiffness, error)
+            allocate(law, source=linear)
         case ('neo_hookean')
-            block
-                type(neo_hookean_law_type), allocatable :: neo
-                allocate(neo)
-                call new_neo_hookean_law(neo, material%modulus, material%area, error)
-                call move_alloc(neo, law)
-            end block
+            call new_neo_hookean_law(neo, material%modulus, material%area, error)
+            allocate(law, source=neo)
         case ('table')
-            block
-                type(table_law_type), allocatable :: table
-                allocate(table)
-                path = trim(material%table_file)
-                if (present(folder)) path = resolve_path(path, folder)
-                call read_table_law(table, path, error)
-                call move_alloc(table, law)
-            end block
+            path = trim(material%table_file)
+            if (present(folder)) path = resolve_path(path, folder)
+            call read_table_law(table, path, error)
+            allocate(law, source=table)
         case default
             call fatal_error(error, "law '" // trim(material%law) &
                 // "' is unknown (use linear, neo_hookean or table)")
@@ -565,11 +556,7 @@ contains
         allocate(scene%passages%share(scene%network%n_elements()), source=1.0_wp)
         allocate(yarn(0), at_node(0), before(0), after(0), laws(0))
         if (size(config%contacts) == 0) then
-            scene%passages%yarn = yarn
-            scene%passages%node = at_node
-            scene%passages%element_before = before
-            scene%passages%element_after = after
-            scene%passages%law = laws
+            call store_passages()
             return
         end if
 
@@ -651,12 +638,17 @@ contains
                     / sum(scene%network%length0(e:e + m - 1))
             end do
         end do
-        scene%passages%yarn = yarn
-        scene%passages%node = at_node
-        scene%passages%element_before = before
-        scene%passages%element_after = after
-        scene%passages%law = laws
+        call store_passages()
     contains
+        !> Hand the passages found (none without &contact groups) to the scene.
+        subroutine store_passages()
+            scene%passages%yarn = yarn
+            scene%passages%node = at_node
+            scene%passages%element_before = before
+            scene%passages%element_after = after
+            scene%passages%law = laws
+        end subroutine store_passages
+
         !> The &contact of yarn y's k-th listed node (visits at `node`, a root), or 0.
         subroutine find_passage_contact(node, y, k, contact, error)
             integer, intent(in) :: node, y, k
@@ -701,39 +693,27 @@ contains
         type(contact_config_type), intent(in) :: contact
         type(error_type), allocatable, intent(out) :: error
         character(len=*), intent(in) :: folder
+        type(coulomb_law_type) :: coulomb
+        type(adhesion_law_type) :: adhesion
+        type(decaying_adhesion_law_type) :: decaying
+        type(rate_table_law_type) :: general
 
         select case (trim(contact%law))
         case ('bonded')
         case ('coulomb')
-            block
-                type(coulomb_law_type), allocatable :: coulomb
-                allocate(coulomb)
-                call new_coulomb_law(coulomb, contact%friction_coefficient, error)
-                call move_alloc(coulomb, law)
-            end block
+            call new_coulomb_law(coulomb, contact%friction_coefficient, error)
+            allocate(law, source=coulomb)
         case ('adhesion')
-            block
-                type(adhesion_law_type), allocatable :: adhesion
-                allocate(adhesion)
-                call new_adhesion_law(adhesion, contact%friction_coefficient, &
-                    contact%adhesion, error)
-                call move_alloc(adhesion, law)
-            end block
+            call new_adhesion_law(adhesion, contact%friction_coefficient, contact%adhesion, &
+                error)
+            allocate(law, source=adhesion)
         case ('decaying_adhesion')
-            block
-                type(decaying_adhesion_law_type), allocatable :: decaying
-                allocate(decaying)
-                call new_decaying_adhesion_law(decaying, contact%friction_coefficient, &
-                    contact%adhesion, contact%decay_start, contact%decay_end, error)
-                call move_alloc(decaying, law)
-            end block
+            call new_decaying_adhesion_law(decaying, contact%friction_coefficient, &
+                contact%adhesion, contact%decay_start, contact%decay_end, error)
+            allocate(law, source=decaying)
         case ('general')
-            block
-                type(rate_table_law_type), allocatable :: general
-                allocate(general)
-                call read_rate_table(general, resolve_path(contact%rate_table, folder), error)
-                call move_alloc(general, law)
-            end block
+            call read_rate_table(general, resolve_path(contact%rate_table, folder), error)
+            allocate(law, source=general)
         case default
             call fatal_error(error, "law '" // trim(contact%law) // "' is unknown")
         end select
