@@ -64,7 +64,9 @@ GROUPS = [
                 'of taut strings is positive semi-definite and slack strings get the '
                 "regularising spring's, see `slack_stiffness`), otherwise KLU up to 5e3 "
                 'unknowns and UMFPACK above; the unsymmetric friction systems never use '
-                'CHOLMOD.'),
+                'CHOLMOD: with stick flows eliminated, their reduced system goes to KLU, or to '
+                "UMFPACK where KLU's analysis predicts 100 or more flops per factor nonzero "
+                '(decided per pattern, `benchmarks/results-lu-choice.md`).'),
         Var('residual_tolerance', 'real', 1e-10, unit='1', range='> 0',
             presets={'fast': 1e-6, 'balanced': 1e-9, 'accurate': 1e-11},
             doc='Relative. Newton stops when every row meets \\|F_i\\| <= residual_tolerance * '
