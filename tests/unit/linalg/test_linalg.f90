@@ -8,7 +8,7 @@ module test_linalg
     use yarnfort_testing, only: unittest_type, new_unittest, check
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
-        klu_max_order
+        klu_max_order, chosen_lu_name
     use yarnfort_linalg_klu, only: klu_solver_type
     use yarnfort_linalg_umfpack, only: umfpack_solver_type, umfpack_memory_type
     use yarnfort_linalg_threads, only: apply_thread_policy
@@ -497,8 +497,8 @@ contains
         class(linear_solver_type), allocatable :: solver
         type(csc_type) :: a
         real(wp), allocatable :: x(:)
-        character(len=7), parameter :: names(4) = [character(len=7) :: 'umfpack', 'klu', &
-            'cholmod', 'dense']
+        character(len=11), parameter :: names(5) = [character(len=11) :: 'umfpack', 'klu', &
+            'cholmod', 'dense', chosen_lu_name]
         real(wp), parameter :: x_true(5) = [1.0_wp, 2.0_wp, 3.0_wp, 4.0_wp, 5.0_wp]
         integer :: i
 
@@ -543,8 +543,8 @@ contains
         class(linear_solver_type), allocatable :: solver
         type(csc_type) :: a
         real(wp) :: rhs(5)
-        character(len=7), parameter :: names(4) = [character(len=7) :: 'umfpack', 'klu', &
-            'cholmod', 'dense']
+        character(len=11), parameter :: names(5) = [character(len=11) :: 'umfpack', 'klu', &
+            'cholmod', 'dense', chosen_lu_name]
         integer :: i
 
         a = small_spd_matrix()
@@ -572,8 +572,8 @@ contains
         type(error_type), allocatable, intent(out) :: error
         class(linear_solver_type), allocatable :: solver
         ! 'cholmod+klu' checks the pattern itself before keeping it for the switch.
-        character(len=11), parameter :: names(5) = [character(len=11) :: 'umfpack', 'klu', &
-            'cholmod', 'dense', 'cholmod+klu']
+        character(len=11), parameter :: names(6) = [character(len=11) :: 'umfpack', 'klu', &
+            'cholmod', 'dense', 'cholmod+klu', chosen_lu_name]
         integer :: i
 
         do i = 1, size(names)
@@ -612,8 +612,8 @@ contains
         class(linear_solver_type), allocatable :: solver
         type(csc_type) :: a
         real(wp) :: rhs(4)
-        character(len=7), parameter :: names(4) = [character(len=7) :: 'umfpack', 'klu', &
-            'cholmod', 'dense']
+        character(len=11), parameter :: names(5) = [character(len=11) :: 'umfpack', 'klu', &
+            'cholmod', 'dense', chosen_lu_name]
         integer :: i
 
         a = small_spd_matrix()

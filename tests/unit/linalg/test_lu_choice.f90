@@ -28,8 +28,7 @@ contains
             new_unittest('the rule: flops per factor nonzero', test_rule), &
             new_unittest('a chain goes to KLU', test_chain), &
             new_unittest('a dense block goes to UMFPACK', test_dense), &
-            new_unittest('the same pattern, the same choice', test_same_pattern), &
-            new_unittest('calls out of order are errors', test_out_of_order) &
+            new_unittest('the same pattern, the same choice', test_same_pattern) &
             ]
     end subroutine collect_lu_choice
 
@@ -167,30 +166,5 @@ contains
         end do
         call solver%destroy()
     end subroutine test_same_pattern
-
-    subroutine test_out_of_order(error)
-        type(error_type), allocatable, intent(out) :: error
-        type(lu_choice_solver_type) :: solver
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
-        real(wp), allocatable :: values(:)
-        real(wp) :: rhs(10)
-        logical :: failed
-
-        rhs = 1.0_wp
-        call test_matrix(10, .false., col_ptr, row_index, values)
-        call solver%factor(values, error)
-        failed = allocated(error)
-        call check(error, failed, 'factor before analyse should fail')
-        if (allocated(error)) return
-        call solver%solve(rhs, error)
-        failed = allocated(error)
-        call check(error, failed, 'solve before factor should fail')
-        if (allocated(error)) return
-        call solver%analyse(10_ik, col_ptr, row_index, error)
-        if (allocated(error)) return
-        call solver%solve(rhs, error)
-        failed = allocated(error)
-        call check(error, failed, 'solve after analyse only should fail')
-    end subroutine test_out_of_order
 
 end module test_lu_choice
