@@ -29,7 +29,7 @@ module yarnfort_linalg_cholmod
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
-        procedure :: destroy
+        procedure :: release
         procedure :: get_name
         final :: finalize
     end type cholmod_solver_type
@@ -86,14 +86,13 @@ contains
         end if
     end subroutine solve_rhs
 
-    !> Free the CHOLMOD handle and the pattern copies (safe to call twice).
-    subroutine destroy(self)
+    !> Free the CHOLMOD handle.
+    subroutine release(self)
         class(cholmod_solver_type), intent(inout) :: self
 
         if (c_associated(self%handle)) call yarnfort_cholmod_free(self%handle)
         self%handle = c_null_ptr
-        call self%forget_pattern()
-    end subroutine destroy
+    end subroutine release
 
     pure function get_name(self) result(name)
         class(cholmod_solver_type), intent(in) :: self

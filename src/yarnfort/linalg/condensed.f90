@@ -49,7 +49,7 @@ module yarnfort_linalg_condensed
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
-        procedure :: destroy
+        procedure :: release
         procedure :: get_name
     end type condensed_solver_type
 
@@ -208,13 +208,12 @@ contains
         end do
     end subroutine find_candidate_entries
 
-    !> Free the reduced system's solver and every copy (safe to call twice).
-    subroutine destroy(self)
+    !> Free the reduced system's solver and the reduction.
+    subroutine release(self)
         class(condensed_solver_type), intent(inout) :: self
 
         if (allocated(self%inner)) call self%inner%destroy()
         self%inner_analysed = .false.
-        call self%forget_pattern()
         self%n_reduced = 0
         if (allocated(self%reduced)) deallocate(self%reduced)
         if (allocated(self%reduced_col_ptr)) deallocate(self%reduced_col_ptr)
@@ -225,7 +224,7 @@ contains
         if (allocated(self%candidate_entry)) deallocate(self%candidate_entry)
         if (allocated(self%candidate_row)) deallocate(self%candidate_row)
         if (allocated(self%values)) deallocate(self%values)
-    end subroutine destroy
+    end subroutine release
 
     pure function get_name(self) result(name)
         class(condensed_solver_type), intent(in) :: self

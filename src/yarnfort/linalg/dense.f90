@@ -47,7 +47,7 @@ module yarnfort_linalg_dense
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
-        procedure :: destroy
+        procedure :: release
         procedure :: get_name
     end type dense_solver_type
 
@@ -107,14 +107,13 @@ contains
         end if
     end subroutine solve_rhs
 
-    !> Free the dense matrix and the pattern copy (safe to call twice).
-    subroutine destroy(self)
+    !> Free the dense matrix.
+    subroutine release(self)
         class(dense_solver_type), intent(inout) :: self
 
-        call self%forget_pattern()
         if (allocated(self%lu)) deallocate(self%lu)
         if (allocated(self%pivots)) deallocate(self%pivots)
-    end subroutine destroy
+    end subroutine release
 
     pure function get_name(self) result(name)
         class(dense_solver_type), intent(in) :: self

@@ -4,7 +4,8 @@
 !> the pattern, the call sequence and the array sizes, keep the copy of the CSC pattern
 !> the libraries read again at factor time and the state (analysed, factored), and call
 !> the solver's own `analyse_pattern`, `factor_values` and `solve_rhs`, which hold only
-!> the library calls. Also the messages of a failed library call and of a status code.
+!> the library calls; `destroy` calls the solver's `release` and drops the pattern and
+!> the state. Also the messages of a failed library call and of a status code.
 module yarnfort_linalg_direct
     use, intrinsic :: iso_c_binding, only: c_long
     use yarnfort_kinds, only: wp, ik
@@ -28,6 +29,7 @@ module yarnfort_linalg_direct
         procedure :: analyse
         procedure :: factor
         procedure :: solve
+        procedure :: destroy
         !> The solver's analysis of the kept pattern (n, col_ptr, row_index are set); a
         !> failure destroys the solver.
         procedure(analyse_pattern_interface), deferred :: analyse_pattern
@@ -35,8 +37,8 @@ module yarnfort_linalg_direct
         procedure(factor_values_interface), deferred :: factor_values
         !> The solver's solve with the last factorisation (rhs of size n).
         procedure(solve_rhs_interface), deferred :: solve_rhs
-        !> Drop the pattern copy and the state (for `destroy`).
-        procedure :: forget_pattern
+        !> Free the solver's own handles and buffers (safe to call twice; for `destroy`).
+        procedure(release_interface), deferred :: release
         !> Set `error` to '<name>: <stage> failed: <reason>'.
         procedure :: fail
     end type direct_solver_type
@@ -61,6 +63,11 @@ module yarnfort_linalg_direct
             real(wp), intent(inout) :: rhs(:)
             type(error_type), allocatable, intent(out) :: error
         end subroutine solve_rhs_interface
+
+        subroutine release_interface(self)
+            import :: direct_solver_type
+            class(direct_solver_type), intent(inout) :: self
+        end subroutine release_interface
     end interface
 
 contains
@@ -116,14 +123,17 @@ contains
         call self%solve_rhs(rhs, error)
     end subroutine solve
 
-    subroutine forget_pattern(self)
+    !> Free the solver's handles and buffers, the pattern copy and the state (safe to call
+    !> twice).
+    subroutine destroy(self)
         class(direct_solver_type), intent(inout) :: self
 
+        call self%release()
         self%n = 0
         self%factored = .false.
         if (allocated(self%col_ptr)) deallocate(self%col_ptr)
         if (allocated(self%row_index)) deallocate(self%row_index)
-    end subroutine forget_pattern
+    end subroutine destroy
 
     subroutine fail(self, error, stage, reason)
         class(direct_solver_type), intent(in) :: self

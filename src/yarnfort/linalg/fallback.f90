@@ -21,7 +21,7 @@ module yarnfort_linalg_fallback
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
-        procedure :: destroy
+        procedure :: release
         procedure :: get_name
     end type fallback_solver_type
 
@@ -69,13 +69,12 @@ contains
         end if
     end subroutine solve_rhs
 
-    subroutine destroy(self)
+    subroutine release(self)
         class(fallback_solver_type), intent(inout) :: self
 
         if (allocated(self%primary)) call self%primary%destroy()
         if (allocated(self%secondary)) call self%secondary%destroy()
-        call self%forget_pattern()
-    end subroutine destroy
+    end subroutine release
 
     pure function get_name(self) result(name)
         class(fallback_solver_type), intent(in) :: self

@@ -50,7 +50,7 @@ module yarnfort_linalg_klu
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
-        procedure :: destroy
+        procedure :: release
         procedure :: get_name
         !> AMD's prediction of the factorisation's cost (yarnfort_linalg_lu_choice).
         procedure :: get_prediction
@@ -155,8 +155,8 @@ contains
         end if
     end subroutine solve_rhs
 
-    !> Free the Numeric and Symbolic objects and the pattern copies (safe to call twice).
-    subroutine destroy(self)
+    !> Free the Numeric and Symbolic objects.
+    subroutine release(self)
         class(klu_solver_type), intent(inout) :: self
         integer(c_long) :: ok
 
@@ -172,8 +172,7 @@ contains
         self%numeric = c_null_ptr
         self%symbolic = c_null_ptr
         self%symbolic_colamd = c_null_ptr
-        call self%forget_pattern()
-    end subroutine destroy
+    end subroutine release
 
     !> Flops of a factorisation and nonzeros of L + U that the AMD ordering of the last
     !> analysis predicts without pivoting (KLU's factors of the friction Jacobians never

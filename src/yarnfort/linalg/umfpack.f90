@@ -66,7 +66,7 @@ module yarnfort_linalg_umfpack
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
-        procedure :: destroy
+        procedure :: release
         procedure :: get_name
         final :: finalize
     end type umfpack_solver_type
@@ -141,19 +141,18 @@ contains
         end if
     end subroutine solve_rhs
 
-    !> Free the Numeric and Symbolic objects and the pattern copies (safe to call twice).
-    subroutine destroy(self)
+    !> Free the Numeric and Symbolic objects.
+    subroutine release(self)
         class(umfpack_solver_type), intent(inout) :: self
 
         if (c_associated(self%numeric)) call umfpack_dl_free_numeric(self%numeric)
         if (c_associated(self%symbolic)) call umfpack_dl_free_symbolic(self%symbolic)
         self%numeric = c_null_ptr
         self%symbolic = c_null_ptr
-        call self%forget_pattern()
         if (allocated(self%int_work)) deallocate(self%int_work)
         if (allocated(self%real_work)) deallocate(self%real_work)
         if (allocated(self%rhs_copy)) deallocate(self%rhs_copy)
-    end subroutine destroy
+    end subroutine release
 
     pure function get_memory(self) result(memory)
         class(umfpack_solver_type), intent(in) :: self

@@ -8,15 +8,19 @@ module yarnfort_material_law
 
     public :: force_law_type
 
-    !> Tension f(lambda) of a yarn, lambda = l/L0. Contract for every law:
-    !> f(lambda) = 0 and df/dlambda = 0 for lambda <= 1 (slack), f strictly increasing for
-    !> lambda > 1, f continuous with a continuous first derivative for lambda > 1.
+    !> Tension f(lambda) of a yarn, lambda = l/L0. f(lambda) = 0 and df/dlambda = 0 for
+    !> lambda <= 1 (slack), here for every law. Contract for each law's taut branch: f
+    !> strictly increasing for lambda > 1, continuous with a continuous first derivative.
     type, abstract :: force_law_type
     contains
         !> Tension and its derivative with respect to stretch.
-        procedure(get_force_interface), deferred :: get_force
+        procedure, non_overridable :: get_force
         !> Stored energy per unit reference length, integral from 1 to lambda of f.
-        procedure(get_energy_interface), deferred :: get_energy
+        procedure, non_overridable :: get_energy
+        !> The law's tension and derivative for lambda > 1 (called by get_force).
+        procedure(get_taut_force_interface), deferred :: get_taut_force
+        !> The law's energy for lambda > 1 (called by get_energy).
+        procedure(get_taut_energy_interface), deferred :: get_taut_energy
         !> A positive scale of df/dlambda near lambda = 1 (used to size regularisations).
         procedure(get_reference_stiffness_interface), deferred :: get_reference_stiffness
         !> The stretch at which the yarn carries a given tension (the law's inverse).
@@ -24,19 +28,19 @@ module yarnfort_material_law
     end type force_law_type
 
     abstract interface
-        pure subroutine get_force_interface(self, stretch, force, dforce)
+        pure subroutine get_taut_force_interface(self, stretch, force, dforce)
             import :: force_law_type, wp
             class(force_law_type), intent(in) :: self
             real(wp), intent(in) :: stretch
             real(wp), intent(out) :: force, dforce
-        end subroutine get_force_interface
+        end subroutine get_taut_force_interface
 
-        pure function get_energy_interface(self, stretch) result(energy)
+        pure function get_taut_energy_interface(self, stretch) result(energy)
             import :: force_law_type, wp
             class(force_law_type), intent(in) :: self
             real(wp), intent(in) :: stretch
             real(wp) :: energy
-        end function get_energy_interface
+        end function get_taut_energy_interface
 
         pure function get_reference_stiffness_interface(self) result(stiffness)
             import :: force_law_type, wp
@@ -46,6 +50,33 @@ module yarnfort_material_law
     end interface
 
 contains
+
+    !> Zero when slack (lambda <= 1), else the law's taut branch.
+    pure subroutine get_force(self, stretch, force, dforce)
+        class(force_law_type), intent(in) :: self
+        real(wp), intent(in) :: stretch
+        real(wp), intent(out) :: force, dforce
+
+        if (stretch <= 1.0_wp) then
+            force = 0.0_wp
+            dforce = 0.0_wp
+        else
+            call self%get_taut_force(stretch, force, dforce)
+        end if
+    end subroutine get_force
+
+    !> Zero when slack (lambda <= 1), else the law's taut branch.
+    pure function get_energy(self, stretch) result(energy)
+        class(force_law_type), intent(in) :: self
+        real(wp), intent(in) :: stretch
+        real(wp) :: energy
+
+        if (stretch <= 1.0_wp) then
+            energy = 0.0_wp
+        else
+            energy = self%get_taut_energy(stretch)
+        end if
+    end function get_energy
 
     !> Stretch lambda > 1 with f(lambda) = force > 0, by Newton's method safeguarded by
     !> bisection on a bracket grown from [1, 2]. `found` is false if no stretch up to

@@ -16,8 +16,8 @@ module yarnfort_material_linear
         !> Axial stiffness EA in N (tension per unit strain).
         real(wp) :: stiffness = 0.0_wp
     contains
-        procedure :: get_force
-        procedure :: get_energy
+        procedure :: get_taut_force
+        procedure :: get_taut_energy
         procedure :: get_reference_stiffness
     end type linear_law_type
 
@@ -42,33 +42,24 @@ contains
         self%stiffness = stiffness
     end subroutine new_linear_law
 
-    !> Tension EA*(lambda - 1) and its derivative EA for lambda > 1; zero when slack.
-    pure subroutine get_force(self, stretch, force, dforce)
+    !> Tension EA*(lambda - 1) and its derivative EA for lambda > 1.
+    pure subroutine get_taut_force(self, stretch, force, dforce)
         class(linear_law_type), intent(in) :: self
         real(wp), intent(in) :: stretch
         real(wp), intent(out) :: force, dforce
 
-        if (stretch <= 1.0_wp) then
-            force = 0.0_wp
-            dforce = 0.0_wp
-        else
-            force = self%stiffness * (stretch - 1.0_wp)
-            dforce = self%stiffness
-        end if
-    end subroutine get_force
+        force = self%stiffness * (stretch - 1.0_wp)
+        dforce = self%stiffness
+    end subroutine get_taut_force
 
     !> Energy per unit reference length EA*(lambda - 1)**2/2 for lambda > 1.
-    pure function get_energy(self, stretch) result(energy)
+    pure function get_taut_energy(self, stretch) result(energy)
         class(linear_law_type), intent(in) :: self
         real(wp), intent(in) :: stretch
         real(wp) :: energy
 
-        if (stretch <= 1.0_wp) then
-            energy = 0.0_wp
-        else
-            energy = 0.5_wp * self%stiffness * (stretch - 1.0_wp)**2
-        end if
-    end function get_energy
+        energy = 0.5_wp * self%stiffness * (stretch - 1.0_wp)**2
+    end function get_taut_energy
 
     !> The right-hand slope at lambda = 1, EA.
     pure function get_reference_stiffness(self) result(stiffness)

@@ -20,8 +20,8 @@ module yarnfort_material_neo_hookean
         !> Reference cross-section S1 = S(lambda = 1) in m**2.
         real(wp) :: area = 0.0_wp
     contains
-        procedure :: get_force
-        procedure :: get_energy
+        procedure :: get_taut_force
+        procedure :: get_taut_energy
         procedure :: get_reference_stiffness
     end type neo_hookean_law_type
 
@@ -57,37 +57,28 @@ contains
     end subroutine check_positive
 
     !> Tension S1*C*(lambda - lambda**(-2)) and its derivative S1*C*(1 + 2*lambda**(-3)).
-    pure subroutine get_force(self, stretch, force, dforce)
+    pure subroutine get_taut_force(self, stretch, force, dforce)
         class(neo_hookean_law_type), intent(in) :: self
         real(wp), intent(in) :: stretch
         real(wp), intent(out) :: force, dforce
         real(wp) :: scale
 
-        if (stretch <= 1.0_wp) then
-            force = 0.0_wp
-            dforce = 0.0_wp
-        else
-            scale = self%area * self%modulus
-            force = scale * (stretch - 1.0_wp / stretch**2)
-            dforce = scale * (1.0_wp + 2.0_wp / stretch**3)
-        end if
-    end subroutine get_force
+        scale = self%area * self%modulus
+        force = scale * (stretch - 1.0_wp / stretch**2)
+        dforce = scale * (1.0_wp + 2.0_wp / stretch**3)
+    end subroutine get_taut_force
 
     !> Energy per unit reference length, the integral of f from 1 to lambda:
     !> S1*C*((lambda**2 - 1)/2 + 1/lambda - 1) = S1*C*(lambda - 1)**2*(lambda + 2)/(2*lambda),
     !> evaluated in the factored form (no cancellation near lambda = 1).
-    pure function get_energy(self, stretch) result(energy)
+    pure function get_taut_energy(self, stretch) result(energy)
         class(neo_hookean_law_type), intent(in) :: self
         real(wp), intent(in) :: stretch
         real(wp) :: energy
 
-        if (stretch <= 1.0_wp) then
-            energy = 0.0_wp
-        else
-            energy = self%area * self%modulus * (stretch - 1.0_wp)**2 * (stretch + 2.0_wp) &
-                / (2.0_wp * stretch)
-        end if
-    end function get_energy
+        energy = self%area * self%modulus * (stretch - 1.0_wp)**2 * (stretch + 2.0_wp) &
+            / (2.0_wp * stretch)
+    end function get_taut_energy
 
     !> The right-hand slope at lambda = 1, 3*S1*C.
     pure function get_reference_stiffness(self) result(stiffness)

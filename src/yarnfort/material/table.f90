@@ -55,8 +55,8 @@ module yarnfort_material_table
         !> Floor of the end slopes as a fraction of the adjacent secant slope.
         real(wp) :: end_slope_ratio = default_end_slope_ratio
     contains
-        procedure :: get_force
-        procedure :: get_energy
+        procedure :: get_taut_force
+        procedure :: get_taut_energy
         procedure :: get_reference_stiffness
     end type table_law_type
 
@@ -142,19 +142,14 @@ contains
     end subroutine finish_table
 
     !> Tension and df/dlambda: the Hermite cubic of the interval holding the strain, the
-    !> linear extension beyond the last row, zero when slack.
-    pure subroutine get_force(self, stretch, force, dforce)
+    !> linear extension beyond the last row.
+    pure subroutine get_taut_force(self, stretch, force, dforce)
         class(table_law_type), intent(in) :: self
         real(wp), intent(in) :: stretch
         real(wp), intent(out) :: force, dforce
         real(wp) :: strain, width, secant, t
         integer :: k, n
 
-        if (stretch <= 1.0_wp) then
-            force = 0.0_wp
-            dforce = 0.0_wp
-            return
-        end if
         n = size(self%strain)
         strain = stretch - 1.0_wp
         if (strain >= self%strain(n)) then
@@ -173,21 +168,17 @@ contains
         dforce = 6.0_wp * secant * t * (1.0_wp - t) &
             + self%slope(k) * (1.0_wp - t) * (1.0_wp - 3.0_wp * t) &
             + self%slope(k + 1) * t * (3.0_wp * t - 2.0_wp)
-    end subroutine get_force
+    end subroutine get_taut_force
 
     !> Energy per unit reference length: the precomputed integral up to the knot below plus
     !> the closed-form integral of the Hermite cubic (or of the linear extension).
-    pure function get_energy(self, stretch) result(energy)
+    pure function get_taut_energy(self, stretch) result(energy)
         class(table_law_type), intent(in) :: self
         real(wp), intent(in) :: stretch
         real(wp) :: energy
         real(wp) :: strain, step
         integer :: k, n
 
-        if (stretch <= 1.0_wp) then
-            energy = 0.0_wp
-            return
-        end if
         n = size(self%strain)
         strain = stretch - 1.0_wp
         if (strain >= self%strain(n)) then
@@ -197,7 +188,7 @@ contains
         end if
         k = find_interval(self%strain, strain)
         energy = self%energy(k) + hermite_integral(self, k, strain - self%strain(k))
-    end function get_energy
+    end function get_taut_energy
 
     !> The right-hand slope df/dlambda at lambda = 1 (the first knot slope, > 0).
     pure function get_reference_stiffness(self) result(stiffness)

@@ -288,15 +288,16 @@ contains
         vtu%xml = vtu%xml // text // new_line('a')
     end subroutine add_text
 
-    !> The DataArray element of an array: inline ASCII values, or an offset into the
-    !> appended data (where the byte count and the bytes go, each base64-encoded).
-    subroutine add_array(vtu, type_name, label, components, n_tuples, field, bytes, ascii)
+    !> The DataArray element of an array: `values` inline as ASCII, or an offset into the
+    !> appended data (where the byte count and `bytes`, their binary form, go, each
+    !> base64-encoded).
+    subroutine add_array(vtu, type_name, label, components, n_tuples, field, bytes, values)
         type(vtu_builder_type), intent(inout) :: vtu
         character(len=*), intent(in) :: type_name, label
         integer, intent(in) :: components, n_tuples
         logical, intent(in) :: field
         integer(int8), intent(in) :: bytes(:)
-        character(len=*), intent(in) :: ascii
+        class(*), intent(in) :: values(:)
         character(len=:), allocatable :: attributes
 
         attributes = '<DataArray type="' // type_name // '" Name="' // label // '"'
@@ -305,7 +306,8 @@ contains
         if (field) attributes = attributes // ' NumberOfTuples="' &
             // format_integer(n_tuples) // '"'
         if (vtu%ascii) then
-            call add_text(vtu, attributes // ' format="ascii">' // ascii // '</DataArray>')
+            call add_text(vtu, attributes // ' format="ascii">' // format_values(values) &
+                // '</DataArray>')
         else
             call add_text(vtu, attributes // ' format="appended" offset="' &
                 // format_integer(len(vtu%appended)) // '"/>')
@@ -363,18 +365,9 @@ contains
         real(wp), intent(in) :: values(:)
         integer, intent(in) :: components
         logical, intent(in), optional :: field
-        character(len=:), allocatable :: text
-        integer :: status
 
-        if (vtu%ascii) then
-            allocate(character(len=25 * size(values) + 1) :: text)
-            write(text, '(*(1x, es24.16e3))', iostat=status) values
-            call add_array(vtu, 'Float64', label, components, size(values) / components, &
-                is_field(field), [integer(int8) :: ], trim(text))
-        else
-            call add_array(vtu, 'Float64', label, components, size(values) / components, &
-                is_field(field), transfer(values, [0_int8], 8 * size(values)), '')
-        end if
+        call add_array(vtu, 'Float64', label, components, size(values) / components, &
+            is_field(field), transfer(values, [0_int8], 8 * size(values)), values)
     end subroutine add_reals
 
     subroutine add_int32(vtu, label, values, field)
@@ -411,18 +404,26 @@ contains
         integer(int64), intent(in) :: values(:)
         integer(int8), intent(in) :: bytes(:)
         logical, intent(in), optional :: field
+
+        call add_array(vtu, type_name, label, 1, size(values), is_field(field), bytes, values)
+    end subroutine add_integers
+
+    !> The ASCII form of a DataArray: ' v1 v2 ...', reals as es24.16e3, integers as i0.
+    function format_values(values) result(text)
+        class(*), intent(in) :: values(:)
         character(len=:), allocatable :: text
         integer :: status
 
-        if (vtu%ascii) then
+        select type (values)
+        type is (real(wp))
+            allocate(character(len=25 * size(values) + 1) :: text)
+            write(text, '(*(1x, es24.16e3))', iostat=status) values
+        type is (integer(int64))
             allocate(character(len=21 * size(values) + 1) :: text)
             write(text, '(*(1x, i0))', iostat=status) values
-            call add_array(vtu, type_name, label, 1, size(values), is_field(field), &
-                [integer(int8) :: ], trim(text))
-        else
-            call add_array(vtu, type_name, label, 1, size(values), is_field(field), bytes, '')
-        end if
-    end subroutine add_integers
+        end select
+        text = trim(text)
+    end function format_values
 
     pure logical function is_field(field)
         logical, intent(in), optional :: field

@@ -111,13 +111,14 @@ contains
                 // 'element reference lengths')
             return
         end if
-        self%u = snapshot%u
-        self%u_trial = snapshot%u
         if (size(snapshot%factors) /= size(self%factors)) then
             call fatal_error(error, 'the restart file does not match the scene: other ' &
                 // 'load channels')
             return
         end if
+        ! Every check passed: a snapshot that does not fit leaves the stepper as it was.
+        self%u = snapshot%u
+        self%u_trial = snapshot%u
         self%factors = snapshot%factors
         self%factors_trial = snapshot%factors
     end subroutine restore_state
