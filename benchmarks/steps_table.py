@@ -83,6 +83,8 @@ def cells(row):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--trace', default=str(TRACE),
+                        help='steps_trace of this build (default: build/benchmarks)')
     parser.add_argument('--before', help='steps_trace built from the commit before')
     parser.add_argument('--also', nargs='*', default=[], metavar='NAME=PATH',
                         help='more builds of steps_trace to compare (a variant)')
@@ -91,7 +93,7 @@ def main():
     parser.add_argument('--paths', nargs='*', default=['loading', 'cycle'])
     parser.add_argument('--timeout', type=float, default=1800)
     args = parser.parse_args()
-    builds = [('after', TRACE)] + ([('before', pathlib.Path(args.before))]
+    builds = [('after', pathlib.Path(args.trace))] + ([('before', pathlib.Path(args.before))]
                                    if args.before else [])
     builds += [(name, pathlib.Path(path)) for name, path in
                (item.split('=', 1) for item in args.also)]

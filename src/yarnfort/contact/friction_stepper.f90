@@ -11,6 +11,9 @@
 !>   stick -> slip forward  if T_after  > T_crit(T_before, alpha) (beyond tolerance);
 !>   stick -> slip backward if T_before > T_crit(T_after, alpha);
 !>   slip -> stick if the flow increment of the step has the wrong sign.
+!> A step starts from the secant-predicted state with the stick passages that it takes
+!> across their limit slipping (predict_modes); each round after the first is a fast
+!> Newton solve (full steps only), and one that fails is retried with fewer new slips.
 !> A passage whose element would become shorter than min_length_ratio times its initial
 !> reference length locks at that length (stick), and may not slip that way again while
 !> the element keeps that length, in this step and the next ones. A passage that flips
@@ -206,7 +209,7 @@ contains
         integer, allocatable :: flips(:), good_mode(:), good_flips(:)
         logical, allocatable :: locked_forward(:), locked_backward(:)
         integer :: round, n_x, changed, cap, new_slips, outcome
-        logical :: have_good, guessed
+        logical :: have_good, guessed, full_retry
 
         associate(problem => self%full, scene => self%scene)
             n_x = scene%dofs%n_unknowns
@@ -214,10 +217,21 @@ contains
             problem%flow_target = self%flow
             unknowns = [self%u, self%flow]
             call predict(self, unknowns, outcome)
-            ! The loading turned: slipping passages start the step in stick (measured:
-            ! the last step's slip set first cost a failed or wasted solve, then a round).
-            guessed = outcome == reversed .and. any(self%mode_trial /= mode_stick)
-            if (guessed) self%mode_trial = mode_stick
+            guessed = .false.
+            select case (outcome)
+            case (predicted_state)
+                ! Stick passages that the predicted state takes across their limit start
+                ! the step slipping: a growing slip zone then costs no round per step.
+                call predict_modes(problem, [self%u, self%flow], self%factors, unknowns, &
+                    self%mode_trial, guessed, error)
+                if (allocated(error)) return
+            case (reversed)
+                ! The loading turned: slipping passages start the step in stick (measured:
+                ! the last step's slip set first cost a failed or wasted solve, then a
+                ! round).
+                guessed = any(self%mode_trial /= mode_stick)
+                self%mode_trial = mode_stick
+            end select
             allocate(flips(size(self%flow)), source=0)
             allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
                 source=.false.)
@@ -225,6 +239,7 @@ contains
             problem%locked = 0
             cap = huge(1)
             have_good = .false.
+            full_retry = .false.
             do round = 1, scene%solver%max_friction_iterations
                 problem%mode = self%mode_trial
                 ! The last step's active set, when it has no solution nearby, is cheaper to
@@ -232,9 +247,21 @@ contains
                 ! measured on a clamped 4 x 4 knit (stretch cycles to 2x), such failures
                 ! took 200-300 iterations each; solved fast (full steps only) the run
                 ! took 2591 Newton iterations instead of 4522 (same 81 steps), 1.15 s CPU
-                ! instead of 1.85 s. Fast solves of later rounds' guesses (several new
-                ! slips, with halving as the fallback) cut more steps: 156 steps, 2.4 s.
-                self%newton_full%quick = .not. have_good .and. any(self%mode_trial /= mode_stick)
+                ! instead of 1.85 s.
+                ! Later rounds are fast too, from a solved state: their new slips should
+                ! move it a little. Newton's fallbacks (line search, pseudo-transient) may
+                ! instead find a far solution of the set, which meets every stick/slip
+                ! condition and is not the continuation of the path. Measured on
+                ! inputs/knit3d.nml (1 x 1 cell, max_step 0.0125): where unloading turns
+                ! the loop's four passages back to slip at once, that set has a neutral
+                ! mode (the yarn running round the loop); 53 iterations took it 2e-4 m (a
+                ! fifth of the course spacing) along that mode and the answer left the
+                ! small-step limit by 15 % of the peak force for a third of the unloading
+                ! (benchmarks/steps_results.md, section 5). A fast round that fails is
+                ! retried with half its new slips from the solved state; one with a single
+                ! new slip or none is solved again with the fallbacks.
+                self%newton_full%quick = any(self%mode_trial /= mode_stick) .and. .not. full_retry
+                full_retry = .false.
                 call self%newton_full%solve(unknowns, stats, error)
                 iterations = iterations + stats%iterations
                 call record_solve(self%trace, stats, allocated(error))
@@ -244,7 +271,12 @@ contains
                     ! many, most violated first); without such a state, restart from
                     ! all-stick (the elastic problem, which has a solution).
                     if (have_good) then
-                        if (new_slips <= 1) return
+                        if (new_slips <= 1) then
+                            if (.not. self%newton_full%quick) return
+                            full_retry = .true.
+                            deallocate(error)
+                            cycle
+                        end if
                         cap = max(1, new_slips / 2)
                         deallocate(error)
                         unknowns = good_unknowns
@@ -560,19 +592,82 @@ contains
         end subroutine set_mode
     end subroutine update_active_set
 
+    !> Start modes of a step from its predicted `unknowns`: each stick passage that
+    !> fails the stick test there (and is not at its minimum length) slips, unless it
+    !> was already at its limit (within the dead band) in the `accepted` state, with
+    !> load factors `accepted_factors`. `changed`: some did.
+    !> A stick passage at its limit is often held there by equilibrium with slipping
+    !> neighbours (the heads of inputs/knit3d.nml by the sinkers: the two tensions are
+    !> equal at the node pair); its stick and slip are then both admissible, and slip
+    !> can close a neutral mode (singular Jacobian). Such passages are left to the
+    !> rounds, which slip them only when a solved state violates the stick test, as
+    !> they would without a prediction. Measured (benchmarks/steps_results.md, section
+    !> 5): without this exclusion the predicted start cut steps on the singular set,
+    !> and over the knit3d cycle it reached other branches, up to 36 % of the peak force
+    !> away from the small-step limit.
+    subroutine predict_modes(problem, accepted, accepted_factors, unknowns, mode, changed, &
+            error)
+        type(friction_problem_type), intent(inout) :: problem
+        real(wp), intent(in) :: accepted(:), accepted_factors(:), unknowns(:)
+        integer, intent(inout) :: mode(:)
+        logical, intent(out) :: changed
+        type(error_type), allocatable, intent(out) :: error
+        integer :: p, direction
+        real(wp) :: floor, measure
+        real(wp), allocatable :: trial_factors(:)
+        logical :: at_min_before, at_min_after
+        logical, allocatable :: at_limit(:)
+
+        changed = .false.
+        allocate(at_limit(size(mode)), source=.false.)
+        trial_factors = problem%factors
+        problem%factors = accepted_factors
+        call problem%update_state(accepted, error)
+        problem%factors = trial_factors
+        if (allocated(error)) return
+        floor = node_level_floor * problem%get_force_level()
+        do p = 1, size(mode)
+            if (mode(p) /= mode_stick) cycle
+            call get_slip_tendency(problem, p, floor, .false., .false., direction, measure, &
+                at_limit(p))
+        end do
+        call problem%update_state(unknowns, error)
+        if (allocated(error)) return
+        floor = node_level_floor * problem%get_force_level()
+        associate(scene => problem%scene, passages => problem%scene%passages)
+            do p = 1, size(mode)
+                if (mode(p) /= mode_stick .or. at_limit(p)) cycle
+                associate(before => passages%element_before(p), &
+                        after => passages%element_after(p))
+                    at_min_before = problem%length0(before) <= (scene%solver%min_length_ratio &
+                        + length_round_off) * scene%network%length0(before)
+                    at_min_after = problem%length0(after) <= (scene%solver%min_length_ratio &
+                        + length_round_off) * scene%network%length0(after)
+                end associate
+                call get_slip_tendency(problem, p, floor, at_min_before, at_min_after, &
+                    direction, measure)
+                if (direction == mode_stick) cycle
+                mode(p) = direction
+                changed = .true.
+            end do
+        end associate
+    end subroutine predict_modes
+
     !> Stick test of stick passage p at the state held in `problem` (update_state):
     !> `direction` is the way it starts to slip (mode_forward, mode_backward; not a
     !> locked one) and `measure` the relative excess of its high tension over the
     !> critical one, or `direction` is mode_stick. `floor`: node_level_floor times the
     !> scene's largest force.
     subroutine get_slip_tendency(problem, p, floor, locked_forward, locked_backward, &
-            direction, measure)
+            direction, measure, at_limit)
         type(friction_problem_type), intent(in) :: problem
         integer, intent(in) :: p
         real(wp), intent(in) :: floor
         logical, intent(in) :: locked_forward, locked_backward
         integer, intent(out) :: direction
         real(wp), intent(out) :: measure
+        !> The passage is within its dead band of the limit (either way).
+        logical, intent(out), optional :: at_limit
         real(wp) :: t_before, t_after, angle, critical, d1, d2, tol, band
         real(wp) :: noise_before, noise_after
 
@@ -590,6 +685,7 @@ contains
                 call law%get_critical_tension(t_before, angle, critical, d1, d2)
                 band = dead_band_factor * (scene%solver%residual_tolerance &
                     * max(t_before, t_after, floor) + noise_after + abs(d1) * noise_before)
+                if (present(at_limit)) at_limit = t_after >= critical * (1 - tol) - band
                 if (t_after > critical * (1 + tol) + band .and. .not. locked_forward) then
                     direction = mode_forward
                     measure = (t_after - critical) / max(critical + band, tiny(1.0_wp))
@@ -598,6 +694,8 @@ contains
                 call law%get_critical_tension(t_after, angle, critical, d1, d2)
                 band = dead_band_factor * (scene%solver%residual_tolerance &
                     * max(t_before, t_after, floor) + noise_before + abs(d1) * noise_after)
+                if (present(at_limit)) at_limit = at_limit &
+                    .or. t_before >= critical * (1 - tol) - band
                 if (t_before > critical * (1 + tol) + band .and. .not. locked_backward) then
                     direction = mode_backward
                     measure = (t_before - critical) / max(critical + band, tiny(1.0_wp))
@@ -776,5 +874,4 @@ contains
         if (associated(self%sliding)) deallocate(self%sliding)
         if (associated(self%elastic)) deallocate(self%elastic)
     end subroutine finalize
-
 end module yarnfort_contact_friction_stepper
