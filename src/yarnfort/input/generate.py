@@ -53,11 +53,9 @@ def fortran_value(var: Var, value: object) -> str:
 
 
 def fortran_default(var: Var) -> str:
-    if isinstance(var.default, list):
-        if len(set(map(str, var.default))) == 1:
-            return fortran_value(var, var.default[0])
-        return "[" + ", ".join(fortran_value(var, v) for v in var.default) + "]"
-    return fortran_value(var, var.default)
+    values = [fortran_value(var, v) for v in (var.default if isinstance(var.default, list)
+                                               else [var.default])]
+    return values[0] if len(set(values)) == 1 else "[" + ", ".join(values) + "]"
 
 
 def declaration(var: Var) -> str:
