@@ -124,10 +124,7 @@ contains
         character(len=*), intent(in) :: name
         integer :: k
 
-        is_assigned = .false.
-        do k = 1, size(sets)
-            if (sets(k)%name == name) is_assigned = .true.
-        end do
+        is_assigned = any([(sets(k)%name == name, k = 1, size(sets))])
     end function is_assigned
 
     !> For each entry of array `name` (at most `most`) up to the last one its assignments

@@ -459,29 +459,20 @@ def reference_table(group: Group) -> str:
     return "\n".join(rows)
 
 
-TABLE = re.compile(r"^\| variable \| type \| default \| unit \| meaning \|\n(?:\|.*\n)+",
-                   re.MULTILINE)
-HEADING = re.compile(r"^## `&(\w+)`", re.MULTILINE)
+#: A group's heading, the text up to its variable table (before the next heading), the table.
+SECTION = re.compile(r"^(## `&(\w+)`(?:(?!^## )[\s\S])*?)^\| variable \| type \| default \| "
+                     r"unit \| meaning \|\n(?:\|.*\n)+", re.MULTILINE)
 
 
 def with_tables(text: str) -> str:
     """REFERENCE.md with each group's variable table (the first after its heading)
     replaced by the generated one."""
     groups = {g.name: g for g in GROUPS}
-    out, position = [], 0
-    headings = list(HEADING.finditer(text))
-    missing = set(groups) - {h[1] for h in headings}
-    if missing:
-        raise SystemExit(f"REFERENCE.md has no section for {sorted(missing)}")
-    for heading in headings:
-        table = TABLE.search(text, heading.end())
-        if table is None:
-            raise SystemExit(f"REFERENCE.md: no variable table after &{heading[1]}")
-        out.append(text[position:table.start()])
-        out.append(reference_table(groups[heading[1]]) + "\n")
-        position = table.end()
-    out.append(text[position:])
-    return "".join(out)
+    found = [m[2] for m in SECTION.finditer(text)]
+    if sorted(found) != sorted(groups):
+        raise SystemExit(f"REFERENCE.md: no section or no variable table for "
+                         f"{sorted(set(groups) - set(found))} or a section twice")
+    return SECTION.sub(lambda m: m[1] + reference_table(groups[m[2]]) + "\n", text)
 
 
 def main(argv: list[str]) -> int:

@@ -198,15 +198,9 @@ contains
                 // '(each sets the reference lengths of the elements: give one)')
             return
         end if
-        if (size(yarn%length0) > 0) then
-            name = 'length0'
-            n_values = size(yarn%length0)
-        else if (size(yarn%stretch) > 0) then
-            name = 'stretch'
-            n_values = size(yarn%stretch)
-        else
-            return
-        end if
+        n_values = max(size(yarn%length0), size(yarn%stretch))
+        if (n_values == 0) return
+        name = trim(merge('length0', 'stretch', size(yarn%length0) > 0))
         n_elements = (size(yarn%nodes) - 1) * int(yarn%elements_per_segment, int64)
         if (n_values /= n_elements) then
             call fatal_error(error, label // ': ' // name // ' has ' &

@@ -344,10 +344,7 @@ contains
         character(len=*), intent(in) :: name
         integer :: n, k
 
-        n = 0
-        do k = 1, self%n_groups
-            if (self%groups(k)%name == name) n = n + 1
-        end do
+        n = count([(self%groups(k)%name == name, k = 1, self%n_groups)])
     end function count_group
 
     pure function find_group(self, name, occurrence) result(index)
