@@ -377,7 +377,7 @@ contains
         type(assignment_type), allocatable, intent(out) :: sets(:)
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: text, label, guess
-        integer :: k, n, j, m, g, paren
+        integer :: k, n, m, g, paren
         logical :: ok
 
         label = group_label(name, occurrence)
@@ -391,12 +391,8 @@ contains
                     n = n + 1
                     sets(n)%line = tokens(k)%line
                     ! Its values: the tokens up to the next name.
-                    j = k
-                    do while (j < size(tokens))
-                        if (tokens(j + 1)%is_name) exit
-                        j = j + 1
-                    end do
-                    allocate(sets(n)%values(j - k))
+                    allocate(sets(n)%values(findloc([tokens(k + 1:)%is_name, .true.], .true., &
+                        dim=1) - 1))
                     m = 0
                     ! The name in lower case without blanks, then without its subscript.
                     sets(n)%name = to_lower(remove_characters(text, ' ' // tab))
