@@ -148,13 +148,19 @@ def range_check(var: Var, value: str, variable: str) -> list[str]:
 
 
 def element_checks(var: Var) -> list[tuple[int, str]]:
-    """The range checks of every entry of `var` (scalar, fixed array or list)."""
+    """The range checks of every entry of `var` (scalar, fixed array or list; an
+    unallocated list has none)."""
     field = f"value%{var.name}"
     if not (var.size or var.is_list):
         return [(0, call) for call in range_check(var, field, f"'{var.name}'")]
     calls = range_check(var, f"{field}(i)", f"'{var.name}(' // format_integer(i) // ')'")
-    upper = var.size or f"size({field})"
-    return [(0, f"do i = 1, {upper}"), *[(1, c) for c in calls], (0, "end do")] if calls else []
+    if not calls:
+        return []
+    loop = [(0, f"do i = 1, {var.size or f'size({field})'}"), *[(1, c) for c in calls],
+            (0, "end do")]
+    if var.size:
+        return loop
+    return [(0, f"if (allocated({field})) then"), *[(d + 1, c) for d, c in loop], (0, "end if")]
 
 
 def choices_name(group: Group, var: Var) -> str:
@@ -204,7 +210,7 @@ def check_routine(group: Group) -> list[str]:
         steps.append((depth, line))
         if line.startswith("call check_"):
             steps.append((depth, "if (allocated(error)) return"))
-    while steps[-1][1].startswith("if (allocated"):
+    while steps[-1][1] == "if (allocated(error)) return":
         steps.pop()
     return fill("""
         !> The checks of &{name} that its description gives: ranges, choices and
