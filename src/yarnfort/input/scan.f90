@@ -43,7 +43,7 @@ module yarnfort_input_scan
     contains
         !> Number of occurrences of a group.
         procedure :: count_group
-        !> Index in `groups` of the k-th occurrence of a group (0 if there is none).
+        !> Index in `groups` of the k-th occurrence (k >= 1) of a group (0 if there is none).
         procedure :: find_group
         !> Text of a token.
         procedure :: token_text
@@ -351,18 +351,14 @@ contains
         class(namelist_scan_type), intent(in) :: self
         character(len=*), intent(in) :: name
         integer, intent(in) :: occurrence
-        integer :: index, k, n
+        integer :: index, n
 
-        index = 0
         n = 0
-        do k = 1, self%n_groups
-            if (self%groups(k)%name /= name) cycle
-            n = n + 1
-            if (n == occurrence) then
-                index = k
-                return
-            end if
+        do index = 1, self%n_groups
+            if (self%groups(index)%name == name) n = n + 1
+            if (n == occurrence) return
         end do
+        index = 0
     end function find_group
 
     !> The assignments of the `occurrence`-th group `name` (1 for a singleton), in text
