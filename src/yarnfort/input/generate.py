@@ -31,15 +31,10 @@ WIDTH = 96
 
 # ---------------------------------------------------------------- Fortran text helpers
 def fortran_real(value: float) -> str:
-    text = repr(float(value))
-    if "e" in text:
-        mantissa, exponent = text.split("e")
-        if "." not in mantissa:
-            mantissa += ".0"
-        text = f"{mantissa}e{int(exponent)}"
-    elif "." not in text:
-        text += ".0"
-    return text + "_wp"
+    mantissa, _, exponent = repr(float(value)).partition("e")
+    if "." not in mantissa:
+        mantissa += ".0"
+    return mantissa + (f"e{int(exponent)}" if exponent else "") + "_wp"
 
 
 def fortran_value(var: Var, value: object) -> str:
@@ -72,14 +67,7 @@ def wrap_statement(text: str, indent: str) -> list[str]:
     continuation lines."""
     if len(indent + text) <= WIDTH:
         return [indent + text]
-    breaks, quote = [], ""
-    for i, c in enumerate(text):
-        if quote:
-            quote = "" if c == quote else quote
-        elif c in "'\"":
-            quote = c
-        elif c == " ":
-            breaks.append(i)
+    breaks = [m.start() for m in re.finditer(r"'[^']*'|\"[^\"]*\"| ", text) if m[0] == " "]
     lines, start, first = [], 0, True
     while len(text) - start > WIDTH - len(indent) - (0 if first else 4):
         room = WIDTH - len(indent) - (0 if first else 4) - 2
@@ -484,25 +472,23 @@ def with_tables(text: str) -> str:
 def main(argv: list[str]) -> int:
     if len(argv) == 2 and argv[0] == "fortran":
         Path(argv[1]).write_text(fortran_module())
-        return 0
-    if argv == ["reference"]:
+    elif argv == ["reference"]:
         print("\n\n".join(f"## `&{g.name}`\n\n{reference_table(g)}" for g in GROUPS))
-        return 0
-    if len(argv) == 2 and argv[0] in ("check", "update"):
+    elif len(argv) == 2 and argv[0] in ("check", "update"):
         path = Path(argv[1])
         text = path.read_text()
         wanted = with_tables(text)
         if argv[0] == "update":
             path.write_text(wanted)
-            return 0
-        if wanted != text:
+        elif wanted != text:
             sys.stdout.writelines(difflib.unified_diff(
                 text.splitlines(True), wanted.splitlines(True), str(path),
                 "from variables.py"))
             return 1
-        return 0
-    print(__doc__, file=sys.stderr)
-    return 2
+    else:
+        print(__doc__, file=sys.stderr)
+        return 2
+    return 0
 
 
 if __name__ == "__main__":
