@@ -66,12 +66,9 @@ contains
         integer, intent(in) :: k
         character(len=:), allocatable :: label
 
-        if (len_trim(config%geometry%file) > 0) then
-            label = 'yarn #' // format_integer(k) // " of &geometry file '" &
-                // trim(config%geometry%file) // "'"
-        else
-            label = '&yarn #' // format_integer(k)
-        end if
+        label = '&yarn #' // format_integer(k)
+        if (len_trim(config%geometry%file) > 0) label = 'yarn #' // format_integer(k) &
+            // " of &geometry file '" // trim(config%geometry%file) // "'"
     end function yarn_label
 
     subroutine check_yarns(config, error)
@@ -306,11 +303,9 @@ contains
         type(config_type), intent(in) :: config
         character(len=:), allocatable :: source
 
-        if (len_trim(config%geometry%file) > 0) then
+        source = '&nodes'
+        if (len_trim(config%geometry%file) > 0) &
             source = "&geometry: file '" // trim(config%geometry%file) // "'"
-        else
-            source = '&nodes'
-        end if
     end function node_source
 
     !> Supports: names, fix letters, node ids, and at most one support per coordinate
