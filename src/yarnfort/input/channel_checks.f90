@@ -169,12 +169,10 @@ contains
         end if
         if (allocated(config%supports)) then
             do k = 1, size(config%supports)
-                associate(support => config%supports(k))
-                    call check_one("&support '" // trim(support%name) // "'", &
-                        support%channel, default_displacement_channel, &
-                        any(support%displacement /= 0.0_wp), 'displacement')
-                    if (allocated(error)) return
-                end associate
+                call check_one("&support '" // trim(config%supports(k)%name) // "'", &
+                    config%supports(k)%channel, default_displacement_channel, &
+                    any(config%supports(k)%displacement /= 0.0_wp), 'displacement')
+                if (allocated(error)) return
             end do
         end if
         call check_curve_columns(config, names, error)

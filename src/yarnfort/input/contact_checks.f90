@@ -28,7 +28,7 @@ contains
         !> `pair(a, b)`: the &contact of materials a and b (symmetric), or 0.
         integer, allocatable :: pair(:, :)
         integer :: c, i, a, b
-        character(len=:), allocatable :: label
+        character(len=:), allocatable :: label, variable
 
         if (.not. allocated(config%contacts)) return
         if (size(config%contacts) == 0) return
@@ -43,9 +43,18 @@ contains
                     if (allocated(error)) return
                     label = label // " (at = '" // trim(contact%at) // "')"
                 else
+                    ! Both materials set and defined.
                     do i = 1, 2
-                        call check_contact_material(error, label, i, contact%materials(i), &
-                            material_names)
+                        variable = 'materials(' // format_integer(i) // ')'
+                        if (len_trim(contact%materials(i)) == 0) then
+                            call fatal_error(error, label // ': ' // variable // ' is not set ' &
+                                // "(give the two yarn types, e.g. materials = '" &
+                                // trim(material_names(1)) // "', '" &
+                                // trim(material_names(size(material_names))) // "')")
+                            return
+                        end if
+                        call check_defined(error, label, variable, contact%materials(i), &
+                            material_names, 'defined by any &material', 'defined')
                         if (allocated(error)) return
                     end do
                     a = findloc(material_names, contact%materials(1), dim=1)
@@ -77,25 +86,6 @@ contains
         end do
         call check_contacts_complete(config, pair, error)
     end subroutine check_contacts
-
-    !> materials(i) of a &contact: set, and the name of a &material.
-    subroutine check_contact_material(error, label, i, name, material_names)
-        type(error_type), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: label, name
-        integer, intent(in) :: i
-        character(len=*), intent(in) :: material_names(:)
-        character(len=:), allocatable :: variable
-
-        variable = 'materials(' // format_integer(i) // ')'
-        if (len_trim(name) == 0) then
-            call fatal_error(error, label // ': ' // variable // ' is not set (give the ' &
-                // "two yarn types, e.g. materials = '" // trim(material_names(1)) // "', '" &
-                // trim(material_names(size(material_names))) // "')")
-            return
-        end if
-        call check_defined(error, label, variable, name, material_names, &
-            'defined by any &material', 'defined')
-    end subroutine check_contact_material
 
     !> With any &contact, every pair of yarn types meeting at a node needs one. A node
     !> meets when two different yarns list it (yarns of two types, or two of one type).

@@ -48,23 +48,13 @@ contains
         type(config_type), intent(in) :: config
         type(node_set_type), allocatable, intent(out) :: sets(:)
         integer, allocatable, intent(out), optional :: set_of(:)
-        integer :: n_obstacles, n_rings, s
+        integer :: s
 
-        n_obstacles = 0
-        n_rings = 0
-        if (allocated(config%obstacles)) n_obstacles = size(config%obstacles)
-        if (allocated(config%rings)) n_rings = size(config%rings)
-        allocate(sets(n_obstacles + n_rings))
-        do s = 1, n_obstacles
-            associate(obstacle => config%obstacles(s))
-                sets(s) = node_set_type('obstacle', s, obstacle%name, obstacle%nodes)
-            end associate
-        end do
-        do s = 1, n_rings
-            associate(ring => config%rings(s))
-                sets(n_obstacles + s) = node_set_type('ring', s, ring%name, ring%nodes)
-            end associate
-        end do
+        allocate(sets(0))
+        if (allocated(config%obstacles)) sets = [(node_set_type('obstacle', s, &
+            config%obstacles(s)%name, config%obstacles(s)%nodes), s = 1, size(config%obstacles))]
+        if (allocated(config%rings)) sets = [sets, (node_set_type('ring', s, &
+            config%rings(s)%name, config%rings(s)%nodes), s = 1, size(config%rings))]
         if (.not. present(set_of)) return
         allocate(set_of(size(config%node_positions, 2)), source=0)
         do s = 1, size(sets)

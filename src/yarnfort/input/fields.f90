@@ -8,9 +8,8 @@ module yarnfort_input_fields
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_text, only: to_lower, format_integer, format_real, join_names, closest_name, &
-        parse_integer, parse_real
-    use yarnfort_input_scan, only: namelist_scan_type, assignment_type, group_label
-    use yarnfort_text, only: string_type
+        parse_integer, parse_real, string_type
+    use yarnfort_input_scan, only: assignment_type, group_label
     implicit none
     private
 
@@ -124,10 +123,7 @@ contains
         character(len=*), intent(in) :: name
         integer :: k
 
-        is_assigned = .false.
-        do k = 1, size(sets)
-            if (sets(k)%name == name) is_assigned = .true.
-        end do
+        is_assigned = any([(sets(k)%name == name, k = 1, size(sets))])
     end function is_assigned
 
     !> For each entry of array `name` (at most `most`) up to the last one its assignments

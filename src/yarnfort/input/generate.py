@@ -31,15 +31,10 @@ WIDTH = 96
 
 # ---------------------------------------------------------------- Fortran text helpers
 def fortran_real(value: float) -> str:
-    text = repr(float(value))
-    if "e" in text:
-        mantissa, exponent = text.split("e")
-        if "." not in mantissa:
-            mantissa += ".0"
-        text = f"{mantissa}e{int(exponent)}"
-    elif "." not in text:
-        text += ".0"
-    return text + "_wp"
+    mantissa, _, exponent = repr(float(value)).partition("e")
+    if "." not in mantissa:
+        mantissa += ".0"
+    return mantissa + (f"e{int(exponent)}" if exponent else "") + "_wp"
 
 
 def fortran_value(var: Var, value: object) -> str:
@@ -53,11 +48,9 @@ def fortran_value(var: Var, value: object) -> str:
 
 
 def fortran_default(var: Var) -> str:
-    if isinstance(var.default, list):
-        if len(set(map(str, var.default))) == 1:
-            return fortran_value(var, var.default[0])
-        return "[" + ", ".join(fortran_value(var, v) for v in var.default) + "]"
-    return fortran_value(var, var.default)
+    values = [fortran_value(var, v) for v in (var.default if isinstance(var.default, list)
+                                               else [var.default])]
+    return values[0] if len(set(values)) == 1 else "[" + ", ".join(values) + "]"
 
 
 def declaration(var: Var) -> str:
@@ -74,14 +67,7 @@ def wrap_statement(text: str, indent: str) -> list[str]:
     continuation lines."""
     if len(indent + text) <= WIDTH:
         return [indent + text]
-    breaks, quote = [], ""
-    for i, c in enumerate(text):
-        if quote:
-            quote = "" if c == quote else quote
-        elif c in "'\"":
-            quote = c
-        elif c == " ":
-            breaks.append(i)
+    breaks = [m.start() for m in re.finditer(r"'[^']*'|\"[^\"]*\"| ", text) if m[0] == " "]
     lines, start, first = [], 0, True
     while len(text) - start > WIDTH - len(indent) - (0 if first else 4):
         room = WIDTH - len(indent) - (0 if first else 4) - 2
@@ -150,13 +136,19 @@ def range_check(var: Var, value: str, variable: str) -> list[str]:
 
 
 def element_checks(var: Var) -> list[tuple[int, str]]:
-    """The range checks of every entry of `var` (scalar, fixed array or list)."""
+    """The range checks of every entry of `var` (scalar, fixed array or list; an
+    unallocated list has none)."""
     field = f"value%{var.name}"
     if not (var.size or var.is_list):
         return [(0, call) for call in range_check(var, field, f"'{var.name}'")]
     calls = range_check(var, f"{field}(i)", f"'{var.name}(' // format_integer(i) // ')'")
-    upper = var.size or f"size({field})"
-    return [(0, f"do i = 1, {upper}"), *[(1, c) for c in calls], (0, "end do")] if calls else []
+    if not calls:
+        return []
+    loop = [(0, f"do i = 1, {var.size or f'size({field})'}"), *[(1, c) for c in calls],
+            (0, "end do")]
+    if var.size:
+        return loop
+    return [(0, f"if (allocated({field})) then"), *[(d + 1, c) for d, c in loop], (0, "end if")]
 
 
 def choices_name(group: Group, var: Var) -> str:
@@ -206,7 +198,7 @@ def check_routine(group: Group) -> list[str]:
         steps.append((depth, line))
         if line.startswith("call check_"):
             steps.append((depth, "if (allocated(error)) return"))
-    while steps[-1][1].startswith("if (allocated"):
+    while steps[-1][1] == "if (allocated(error)) return":
         steps.pop()
     return fill("""
         !> The checks of &{name} that its description gives: ranges, choices and
@@ -461,53 +453,42 @@ def reference_table(group: Group) -> str:
     return "\n".join(rows)
 
 
-TABLE = re.compile(r"^\| variable \| type \| default \| unit \| meaning \|\n(?:\|.*\n)+",
-                   re.MULTILINE)
-HEADING = re.compile(r"^## `&(\w+)`", re.MULTILINE)
+#: A group's heading, the text up to its variable table (before the next heading), the table.
+SECTION = re.compile(r"^(## `&(\w+)`(?:(?!^## )[\s\S])*?)^\| variable \| type \| default \| "
+                     r"unit \| meaning \|\n(?:\|.*\n)+", re.MULTILINE)
 
 
 def with_tables(text: str) -> str:
     """REFERENCE.md with each group's variable table (the first after its heading)
     replaced by the generated one."""
     groups = {g.name: g for g in GROUPS}
-    out, position = [], 0
-    headings = list(HEADING.finditer(text))
-    missing = set(groups) - {h[1] for h in headings}
-    if missing:
-        raise SystemExit(f"REFERENCE.md has no section for {sorted(missing)}")
-    for heading in headings:
-        table = TABLE.search(text, heading.end())
-        if table is None:
-            raise SystemExit(f"REFERENCE.md: no variable table after &{heading[1]}")
-        out.append(text[position:table.start()])
-        out.append(reference_table(groups[heading[1]]) + "\n")
-        position = table.end()
-    out.append(text[position:])
-    return "".join(out)
+    found = [m[2] for m in SECTION.finditer(text)]
+    if sorted(found) != sorted(groups):
+        raise SystemExit(f"REFERENCE.md: no section or no variable table for "
+                         f"{sorted(set(groups) - set(found))} or a section twice")
+    return SECTION.sub(lambda m: m[1] + reference_table(groups[m[2]]) + "\n", text)
 
 
 def main(argv: list[str]) -> int:
     if len(argv) == 2 and argv[0] == "fortran":
         Path(argv[1]).write_text(fortran_module())
-        return 0
-    if argv == ["reference"]:
+    elif argv == ["reference"]:
         print("\n\n".join(f"## `&{g.name}`\n\n{reference_table(g)}" for g in GROUPS))
-        return 0
-    if len(argv) == 2 and argv[0] in ("check", "update"):
+    elif len(argv) == 2 and argv[0] in ("check", "update"):
         path = Path(argv[1])
         text = path.read_text()
         wanted = with_tables(text)
         if argv[0] == "update":
             path.write_text(wanted)
-            return 0
-        if wanted != text:
+        elif wanted != text:
             sys.stdout.writelines(difflib.unified_diff(
                 text.splitlines(True), wanted.splitlines(True), str(path),
                 "from variables.py"))
             return 1
-        return 0
-    print(__doc__, file=sys.stderr)
-    return 2
+    else:
+        print(__doc__, file=sys.stderr)
+        return 2
+    return 0
 
 
 if __name__ == "__main__":

@@ -181,18 +181,17 @@ contains
         type(config_type), intent(out) :: config
         type(error_type), allocatable, intent(out) :: error
         logical, intent(in), optional :: from_working_directory
+        character(len=:), allocatable :: folder
         integer :: unit
 
         call open_to_read(path, "input file '" // path // "'", unit, error)
         if (allocated(error)) return
+        ! '' is the working directory.
+        folder = folder_of(path)
         if (present(from_working_directory)) then
-            if (from_working_directory) then
-                call read_config(unit, config, error)
-                close(unit)
-                return
-            end if
+            if (from_working_directory) folder = ''
         end if
-        call read_config(unit, config, error, folder_of(path))
+        call read_config(unit, config, error, folder)
         close(unit)
     end subroutine read_config_from_file
 

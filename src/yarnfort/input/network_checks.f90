@@ -66,12 +66,9 @@ contains
         integer, intent(in) :: k
         character(len=:), allocatable :: label
 
-        if (len_trim(config%geometry%file) > 0) then
-            label = 'yarn #' // format_integer(k) // " of &geometry file '" &
-                // trim(config%geometry%file) // "'"
-        else
-            label = '&yarn #' // format_integer(k)
-        end if
+        label = '&yarn #' // format_integer(k)
+        if (len_trim(config%geometry%file) > 0) label = 'yarn #' // format_integer(k) &
+            // " of &geometry file '" // trim(config%geometry%file) // "'"
     end function yarn_label
 
     subroutine check_yarns(config, error)
@@ -81,8 +78,6 @@ contains
         !> Elements and new nodes of the yarns so far (elements_per_segment may be large).
         integer(int64) :: n_elements, n_new_nodes
         logical, allocatable :: used(:)
-        !> The yarn with its unset per-element lists empty.
-        type(yarn_config_type) :: listed
         real(wp) :: scale
         character(len=:), allocatable :: label
         character(len=80) :: counts
@@ -109,9 +104,7 @@ contains
                 call check_defined(error, label, 'material', yarn%material, &
                     config%materials%name, 'defined by any &material', 'defined')
                 if (allocated(error)) return
-                ! Yarns of a geometry file or a generator may leave the lists unset.
-                listed = with_lists(yarn)
-                call check_yarn_variables(listed, label, error)
+                call check_yarn_variables(yarn, label, error)
                 if (allocated(error)) return
                 if (size(yarn%nodes) < 2) then
                     call fatal_error(error, label // ': nodes has ' &
@@ -119,7 +112,7 @@ contains
                         // ' node id(s); a yarn needs at least 2')
                     return
                 end if
-                call check_element_lengths(config, listed, label, error)
+                call check_element_lengths(config, yarn, label, error)
                 if (allocated(error)) return
                 n_elements = n_elements + (size(yarn%nodes) - 1) &
                     * int(yarn%elements_per_segment, int64)
@@ -170,17 +163,8 @@ contains
             // format_integer(i) // ' is on no yarn (a node off all yarns has no stiffness)')
     end subroutine check_yarns
 
-    !> A copy of `yarn` with its unset per-element lists empty.
-    function with_lists(yarn) result(copy)
-        type(yarn_config_type), intent(in) :: yarn
-        type(yarn_config_type) :: copy
-
-        copy = yarn
-        if (.not. allocated(copy%length0)) allocate(copy%length0(0))
-        if (.not. allocated(copy%stretch)) allocate(copy%stretch(0))
-    end function with_lists
-
-    !> Per-element reference lengths of a yarn (`length0` or `stretch`, both allocated):
+    !> Per-element reference lengths of a yarn (`length0` or `stretch`; yarns of a
+    !> geometry file or a generator may leave them unallocated):
     !> one value per element, not both, and not on a yarn whose material has a prestress
     !> (which would set the same lengths another way). Their ranges (> 0) are checked
     !> with the group.
@@ -190,23 +174,20 @@ contains
         character(len=*), intent(in) :: label
         type(error_type), allocatable, intent(out) :: error
         integer(int64) :: n_elements
-        integer :: n_values
+        integer :: n_values, n(2)
         character(len=:), allocatable :: name
 
-        if (size(yarn%length0) > 0 .and. size(yarn%stretch) > 0) then
+        n = 0
+        if (allocated(yarn%length0)) n(1) = size(yarn%length0)
+        if (allocated(yarn%stretch)) n(2) = size(yarn%stretch)
+        if (all(n > 0)) then
             call fatal_error(error, label // ': length0 and stretch are both given ' &
                 // '(each sets the reference lengths of the elements: give one)')
             return
         end if
-        if (size(yarn%length0) > 0) then
-            name = 'length0'
-            n_values = size(yarn%length0)
-        else if (size(yarn%stretch) > 0) then
-            name = 'stretch'
-            n_values = size(yarn%stretch)
-        else
-            return
-        end if
+        n_values = maxval(n)
+        if (n_values == 0) return
+        name = trim(merge('length0', 'stretch', n(1) > 0))
         n_elements = (size(yarn%nodes) - 1) * int(yarn%elements_per_segment, int64)
         if (n_values /= n_elements) then
             call fatal_error(error, label // ': ' // name // ' has ' &
@@ -322,11 +303,9 @@ contains
         type(config_type), intent(in) :: config
         character(len=:), allocatable :: source
 
-        if (len_trim(config%geometry%file) > 0) then
+        source = '&nodes'
+        if (len_trim(config%geometry%file) > 0) &
             source = "&geometry: file '" // trim(config%geometry%file) // "'"
-        else
-            source = '&nodes'
-        end if
     end function node_source
 
     !> Supports: names, fix letters, node ids, and at most one support per coordinate

@@ -43,7 +43,7 @@ module yarnfort_input_scan
     contains
         !> Number of occurrences of a group.
         procedure :: count_group
-        !> Index in `groups` of the k-th occurrence of a group (0 if there is none).
+        !> Index in `groups` of the k-th occurrence (k >= 1) of a group (0 if there is none).
         procedure :: find_group
         !> Text of a token.
         procedure :: token_text
@@ -344,28 +344,21 @@ contains
         character(len=*), intent(in) :: name
         integer :: n, k
 
-        n = 0
-        do k = 1, self%n_groups
-            if (self%groups(k)%name == name) n = n + 1
-        end do
+        n = count([(self%groups(k)%name == name, k = 1, self%n_groups)])
     end function count_group
 
     pure function find_group(self, name, occurrence) result(index)
         class(namelist_scan_type), intent(in) :: self
         character(len=*), intent(in) :: name
         integer, intent(in) :: occurrence
-        integer :: index, k, n
+        integer :: index, n
 
-        index = 0
         n = 0
-        do k = 1, self%n_groups
-            if (self%groups(k)%name /= name) cycle
-            n = n + 1
-            if (n == occurrence) then
-                index = k
-                return
-            end if
+        do index = 1, self%n_groups
+            if (self%groups(index)%name == name) n = n + 1
+            if (n == occurrence) return
         end do
+        index = 0
     end function find_group
 
     !> The assignments of the `occurrence`-th group `name` (1 for a singleton), in text
@@ -380,7 +373,7 @@ contains
         type(assignment_type), allocatable, intent(out) :: sets(:)
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: text, label, guess
-        integer :: k, n, j, m, g, paren
+        integer :: k, n, m, g, paren
         logical :: ok
 
         label = group_label(name, occurrence)
@@ -394,12 +387,8 @@ contains
                     n = n + 1
                     sets(n)%line = tokens(k)%line
                     ! Its values: the tokens up to the next name.
-                    j = k
-                    do while (j < size(tokens))
-                        if (tokens(j + 1)%is_name) exit
-                        j = j + 1
-                    end do
-                    allocate(sets(n)%values(j - k))
+                    allocate(sets(n)%values(findloc([tokens(k + 1:)%is_name, .true.], .true., &
+                        dim=1) - 1))
                     m = 0
                     ! The name in lower case without blanks, then without its subscript.
                     sets(n)%name = to_lower(remove_characters(text, ' ' // tab))
