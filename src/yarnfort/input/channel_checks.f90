@@ -223,7 +223,7 @@ contains
                     return
                 end if
             end if
-            j = load_number(stem)
+            j = load_number(stem, n_loads)
             if (j > 0 .and. any(suffixes(4:) == name(length - 2:))) then
                 call fatal_error(error, "curve.csv would have two columns '" // name &
                     // "' (the factor of channel " // name // ' and &load #' &
@@ -233,7 +233,7 @@ contains
         end do
         if (allocated(config%supports)) then
             do k = 1, size(config%supports)
-                j = load_number(trim(config%supports(k)%name))
+                j = load_number(trim(config%supports(k)%name), n_loads)
                 if (j > 0) then
                     call fatal_error(error, "curve.csv would have two columns '" &
                         // trim(config%supports(k)%name) // "_ux' (&support '" &
@@ -243,21 +243,23 @@ contains
                 end if
             end do
         end if
-    contains
-        !> k if `text` is load_column_prefix(k) of an existing &load, else 0.
-        integer function load_number(text)
-            character(len=*), intent(in) :: text
-            logical :: ok
-
-            load_number = 0
-            if (index(text, 'load_') /= 1) return
-            call parse_integer(text(6:), load_number, ok)
-            if (.not. ok .or. load_number < 1 .or. load_number > n_loads) then
-                load_number = 0
-            else if (load_column_prefix(load_number) /= text) then
-                load_number = 0          ! 'load_01' or 'load_+1' is no column name
-            end if
-        end function load_number
     end subroutine check_curve_columns
+
+    !> k if `text` is load_column_prefix(k) of one of n_loads loads, else 0. (A module
+    !> procedure: as an internal one it needed a trampoline, so an executable stack.)
+    integer function load_number(text, n_loads)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: n_loads
+        logical :: ok
+
+        load_number = 0
+        if (index(text, 'load_') /= 1) return
+        call parse_integer(text(6:), load_number, ok)
+        if (.not. ok .or. load_number < 1 .or. load_number > n_loads) then
+            load_number = 0
+        else if (load_column_prefix(load_number) /= text) then
+            load_number = 0          ! 'load_01' or 'load_+1' is no column name
+        end if
+    end function load_number
 
 end module yarnfort_input_channel_checks
