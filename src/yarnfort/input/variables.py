@@ -132,8 +132,9 @@ GROUPS = [
             presets={'fast': 'monolithic', 'balanced': 'monolithic', 'accurate': 'monolithic'},
             doc="Friction: `'monolithic'` solves positions and sliding together with a "
                 "stick/slip active set; `'staggered'` is the paper's two-step scheme (elastic "
-                'solve, then sliding), each step finished by monolithic solves once its '
-                'active set holds (the alternation alone converges slowly). Case-insensitive.'),
+                'solve, then sliding); a step that its first round does not solve is finished '
+                "by monolithic solves from that round's state (the alternation alone converges "
+                'slowly). Case-insensitive.'),
         Var('max_friction_iterations', 'integer', 200, range='>= 1',
             doc='Friction: most stick/slip active-set updates (monolithic) or elastic/sliding '
                 'alternations (staggered) per load step. A slip front advances by about one '
