@@ -20,13 +20,17 @@ contains
 
     !> CPU ms of residual + Jacobian (times(1)) and factorisation + solve (times(2)),
     !> the mean of repetitions filling about 0.3 s; `program_name` for a failure.
-    subroutine time_iteration(problem, solver, u, values, residual, times, program_name)
+    subroutine time_iteration(problem, solver, u, values, residual, times, program_name, &
+            failure)
         class(nonlinear_problem_type), intent(inout) :: problem
         class(linear_solver_type), intent(inout) :: solver
         real(wp), intent(in) :: u(:)
         real(wp), intent(inout) :: values(:), residual(:)
         real(wp), intent(out) :: times(2)
         character(len=*), intent(in) :: program_name
+        !> Where given, a failed factorisation or solve (a Jacobian singular at `u`, e.g.
+        !> with slack elements) comes back here instead of stopping the program.
+        type(error_type), allocatable, intent(out), optional :: failure
         type(error_type), allocatable :: error
         real(wp) :: t0, t1, t2
         integer :: repetitions
@@ -44,9 +48,12 @@ contains
             call cpu_time(t2)
             times(1) = times(1) + (t2 - t1)
             call solver%factor(values, error)
-            if (allocated(error)) call fail(program_name, error)
-            call solver%solve(residual, error)
-            if (allocated(error)) call fail(program_name, error)
+            if (.not. allocated(error)) call solver%solve(residual, error)
+            if (allocated(error)) then
+                if (.not. present(failure)) call fail(program_name, error)
+                call move_alloc(error, failure)
+                return
+            end if
             call cpu_time(t1)
             times(2) = times(2) + (t1 - t2)
             t2 = t1
