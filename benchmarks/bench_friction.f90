@@ -110,7 +110,7 @@ program bench_friction
     call get_command_argument(1, argument)
     if (trim(argument) == '--header') then
         write(output_unit, '(a)') '    scheme  unknowns  passages  steps  newton/step' // &
-            '  factor/step  ms/step  assembly_%  factor_%  solve_%  other_%  max_slipping' // &
+            '  factor/step     ms/step  assembly_%  factor_%  solve_%  other_%  max_slipping' // &
             '  peak_MiB  cpu_ms/step'
         stop
     end if
@@ -206,7 +206,7 @@ program bench_friction
         times(3, 4), times(3, 5), factorisations(3))
     associate(assembly => sum(times(:, 1:2)), factor => sum(times(:, 3:4)), &
             solve => sum(times(:, 5)))
-        write(output_unit, '(a10, i10, i10, i7, f13.2, f13.2, f9.2, 4f10.1, i14, f10.1, &
+        write(output_unit, '(a10, i10, i10, i7, f13.2, f13.2, f12.2, 4f10.1, i14, f10.1, &
             & f13.2)') &
             trim(scheme), scene%dofs%n_unknowns, scene%passages%size(), counter%steps, &
             real(counter%newton, wp) / counter%steps, &
