@@ -553,12 +553,8 @@ contains
                 select case (mode(p))
                 case (mode_stick)
                     ! An element locked at its minimum length in an earlier step stays so.
-                    if (problem%length0(before) <= min_before &
-                            + length_round_off * scene%network%length0(before)) &
-                        locked_forward(p) = .true.
-                    if (problem%length0(after) <= min_after &
-                            + length_round_off * scene%network%length0(after)) &
-                        locked_backward(p) = .true.
+                    if (is_at_min_length(problem, before)) locked_forward(p) = .true.
+                    if (is_at_min_length(problem, after)) locked_backward(p) = .true.
                     call get_slip_tendency(problem, p, floor, locked_forward(p), &
                         locked_backward(p), direction_p, measure)
                     if (direction_p /= mode_stick) call add_candidate(direction_p, measure)
@@ -638,7 +634,6 @@ contains
         integer :: p, direction
         real(wp) :: floor, measure
         real(wp), allocatable :: trial_factors(:)
-        logical :: at_min_before, at_min_after
         logical, allocatable :: at_limit(:)
 
         changed = .false.
@@ -657,24 +652,29 @@ contains
         call problem%update_state(unknowns, error)
         if (allocated(error)) return
         floor = node_level_floor * problem%get_force_level()
-        associate(scene => problem%scene, passages => problem%scene%passages)
+        associate(passages => problem%scene%passages)
             do p = 1, size(mode)
                 if (mode(p) /= mode_stick .or. at_limit(p)) cycle
-                associate(before => passages%element_before(p), &
-                        after => passages%element_after(p))
-                    at_min_before = problem%length0(before) <= (scene%solver%min_length_ratio &
-                        + length_round_off) * scene%network%length0(before)
-                    at_min_after = problem%length0(after) <= (scene%solver%min_length_ratio &
-                        + length_round_off) * scene%network%length0(after)
-                end associate
-                call get_slip_tendency(problem, p, floor, at_min_before, at_min_after, &
-                    direction, measure)
+                call get_slip_tendency(problem, p, floor, &
+                    is_at_min_length(problem, passages%element_before(p)), &
+                    is_at_min_length(problem, passages%element_after(p)), direction, measure)
                 if (direction == mode_stick) cycle
                 mode(p) = direction
                 changed = .true.
             end do
         end associate
     end subroutine predict_modes
+
+    !> Element e's reference length (in `problem`) is at its minimum, min_length_ratio
+    !> times its initial one, within rounding.
+    pure logical function is_at_min_length(problem, e)
+        type(friction_problem_type), intent(in) :: problem
+        integer, intent(in) :: e
+        associate(initial => problem%scene%network%length0(e))
+            is_at_min_length = problem%length0(e) <= problem%scene%solver%min_length_ratio &
+                * initial + length_round_off * initial
+        end associate
+    end function is_at_min_length
 
     !> Stick test of stick passage p at the state held in `problem` (update_state):
     !> `direction` is the way it starts to slip (mode_forward, mode_backward; not a
