@@ -543,7 +543,7 @@ def test_fuzz_full_run(executable, tmp_path, batch):
 
 #: Restart cases per batch, and batches.
 RESTART_BATCHES, RESTART_CASES_PER_BATCH = 2, 40
-#: Byte offsets and types of the header fields of restart.dat (format version 3, see
+#: Byte offsets and types of the header fields of restart.dat (format version 4, see
 #: src/yarnfort/output/restart.f90): after the 16-byte magic, the version and the
 #: 16-byte fingerprint come n_nodes, n_elements, n_unknowns, n_passages, step, knot
 #: (int32), time, next_step, previous_load (float64), the stepper (16 bytes),

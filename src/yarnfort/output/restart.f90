@@ -4,7 +4,7 @@
 !> restart.dat.tmp and renamed over restart.dat, so a run killed at any moment leaves
 !> either the previous complete file or the new one.
 !>
-!> Binary (unformatted stream, native byte order, full precision), version 3:
+!> Binary (unformatted stream, native byte order, full precision), version 4:
 !>     'yarnfort-restart' (16 characters), version (integer),
 !>     input fingerprint (16 characters),
 !>     n_nodes, n_elements, n_unknowns, n_passages, step, knot (integers),
@@ -13,6 +13,8 @@
 !>     factors(n_channels) (the load channels' factors), u(n_unknowns), u_old(n_unknowns),
 !>     length0(n_elements),
 !>     flow(n_passages), flow_old(n_passages) (reals), mode(n_passages) (integers),
+!>     load_older (real), have_older, held (integers 0 or 1), u_older(n_unknowns),
+!>     flow_older(n_passages) (reals),
 !>     'end-of-restart' (16 characters), then the checksum of every byte before it
 !>     (16 hex digits), so a file damaged after it was written is refused.
 !> Integers are default integers (4 bytes), reals 8 bytes.
@@ -37,7 +39,7 @@ module yarnfort_output_restart
     character(len=*), parameter :: restart_file_name = 'restart.dat'
     character(len=16), parameter :: magic = 'yarnfort-restart'
     character(len=16), parameter :: end_marker = 'end-of-restart'
-    integer, parameter :: format_version = 3
+    integer, parameter :: format_version = 4
     !> Most load channels a restart file may hold (&path channels has at most 8).
     integer, parameter :: max_restart_channels = 64
 
@@ -97,6 +99,10 @@ contains
                     write(unit, iostat=status, iomsg=message) [integer :: ]
                 end if
             end if
+            if (status == 0) write(unit, iostat=status, iomsg=message) s%load_older, &
+                merge(1, 0, s%have_older), merge(1, 0, s%held)
+            if (status == 0) call put_reals(s%u_older, s%n_unknowns)
+            if (status == 0) call put_reals(s%flow_older, s%n_passages)
             if (status == 0) write(unit, iostat=status, iomsg=message) end_marker
         end associate
         call close_new_file(unit, temporary, error, status, message)
@@ -147,7 +153,7 @@ contains
         character(len=16) :: header, marker, checksum
         character(len=32) :: text
         character(len=256) :: message
-        integer :: unit, status, version, have_old, n_channels
+        integer :: unit, status, version, have_old, n_channels, have_older, held
         integer(int64) :: file_size, position, expected
         logical :: exists
 
@@ -203,9 +209,9 @@ contains
             end if
             ! What follows must be exactly the arrays of these sizes and the end marker.
             inquire(unit=unit, size=file_size, pos=position)
-            expected = 8_int64 * (n_channels + 2_int64 * s%n_unknowns + s%n_elements &
-                + 2_int64 * s%n_passages) + 4_int64 * s%n_passages + len(end_marker) &
-                + len(checksum)
+            expected = 8_int64 * (n_channels + 3_int64 * s%n_unknowns + s%n_elements &
+                + 3_int64 * s%n_passages + 1) + 4_int64 * (s%n_passages + 2) &
+                + len(end_marker) + len(checksum)
             if (file_size - (position - 1) /= expected) then
                 close(unit)
                 write(text, '(i0)') file_size
@@ -218,6 +224,7 @@ contains
             allocate(s%factors(n_channels), s%u(s%n_unknowns), s%u_old(s%n_unknowns), &
                 s%length0(s%n_elements), &
                 s%flow(s%n_passages), s%flow_old(s%n_passages), s%mode(s%n_passages), &
+                s%u_older(s%n_unknowns), s%flow_older(s%n_passages), &
                 stat=status, errmsg=message)
             if (status /= 0) then
                 close(unit)
@@ -226,8 +233,18 @@ contains
                 return
             end if
             read(unit, iostat=status) s%factors, s%u, s%u_old, s%length0, s%flow, &
-                s%flow_old, s%mode, marker, checksum
+                s%flow_old, s%mode, s%load_older, have_older, held, s%u_older, &
+                s%flow_older, marker, checksum
             if (status == 0 .and. marker /= end_marker) status = -1
+            s%have_older = have_older == 1
+            s%held = held == 1
+            if (status == 0 .and. (have_older /= 0 .and. have_older /= 1 &
+                    .or. held /= 0 .and. held /= 1)) then
+                close(unit)
+                call fatal_error(error, "&control restart: '" // path // "' is damaged: " &
+                    // 'a size or flag field holds an impossible value')
+                return
+            end if
         end associate
         close(unit)
         if (status /= 0) then
@@ -362,6 +379,15 @@ contains
                     all(ieee_is_finite(snapshot%flow_old)))) then
                 call damaged('its previous state holds a value that is not a finite number')
                 return
+            end if
+            if (snapshot%have_older) then
+                if (.not. (ieee_is_finite(snapshot%load_older) .and. &
+                        all(ieee_is_finite(snapshot%u_older)) .and. &
+                        all(ieee_is_finite(snapshot%flow_older)))) then
+                    call damaged('its state before the previous one holds a value that is ' &
+                        // 'not a finite number')
+                    return
+                end if
             end if
             ! After step 0 the previous state is the step before: its time lies on the
             ! path before this one (and is its curve row's, checked with curve.csv), and

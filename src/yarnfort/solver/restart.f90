@@ -41,6 +41,12 @@ module yarnfort_solver_restart
         !> step's own time for step 0), so that load_old can be checked against the path.
         real(wp) :: time_old = 0.0_wp
         real(wp), allocatable :: u_old(:), flow_old(:)
+        !> Friction: the accepted state before that (position unknowns, flows, sum of the
+        !> factors) for the quadratic predictor, valid when `have_older`; `held`: the
+        !> active set held over the last step.
+        logical :: have_older = .false., held = .false.
+        real(wp) :: load_older = 0.0_wp
+        real(wp), allocatable :: u_older(:), flow_older(:)
     end type restart_type
 
 end module yarnfort_solver_restart
