@@ -214,7 +214,7 @@ contains
             problem%factors = self%factors_trial
             problem%flow_target = self%flow
             unknowns = [self%u, self%flow]
-            call predict(self, unknowns, outcome)
+            call predict(self, unknowns, outcome, quadratic=.true.)
             guessed = .false.
             select case (outcome)
             case (predicted_state)
@@ -293,7 +293,7 @@ contains
                         deallocate(error)
                         self%mode_trial = self%mode
                         unknowns = [self%u, self%flow]
-                        call predict(self, unknowns, outcome)
+                        call predict(self, unknowns, outcome, quadratic=.true.)
                         cycle
                     end if
                     if (all(self%mode_trial == mode_stick)) return
@@ -366,7 +366,7 @@ contains
                 real(wp), allocatable :: unknowns(:)
                 integer :: outcome
                 unknowns = [self%u, self%flow]
-                call predict(self, unknowns, outcome)
+                call predict(self, unknowns, outcome, quadratic=.false.)
                 if (outcome == reversed) self%mode_trial = mode_stick
                 self%u_trial = unknowns(1:size(self%u))
                 self%flow_trial = unknowns(size(self%u) + 1:)
@@ -759,10 +759,13 @@ contains
     !> 4 iterations. The unloading response is stiffer (all stick), but the positions
     !> follow the clamps nearly affinely either way.
     !> `outcome`: predicted_state, else reversed when the loading turned, else 0.
-    subroutine predict(self, unknowns, outcome)
+    subroutine predict(self, unknowns, outcome, quadratic)
         type(friction_stepper_type), intent(in) :: self
         real(wp), intent(inout) :: unknowns(:)
         integer, intent(out) :: outcome
+        !> The parabola may be used (not by the staggered scheme: its alternation took
+        !> 10.53 instead of 10.25 Newton iterations per step on inputs/knit_clamped.nml).
+        logical, intent(in) :: quadratic
         real(wp) :: ratio, load, load_now, w_older, w_old, w_now
         integer :: n_x
 
@@ -780,7 +783,7 @@ contains
         end if
         if (.not. (ratio > 0.0_wp .and. ratio <= 2.0_wp)) return
         outcome = predicted_state
-        if (self%have_older) then
+        if (self%have_older .and. quadratic) then
             if ((self%load_old - self%load_older) * (load_now - self%load_old) > 0.0_wp) then
                 ! Lagrange weights of the three states at the load of the step.
                 w_older = (load - self%load_old) * (load - load_now) &
