@@ -11,7 +11,8 @@
 !>   stick -> slip forward  if T_after  > T_crit(T_before, alpha) (beyond tolerance);
 !>   stick -> slip backward if T_before > T_crit(T_after, alpha);
 !>   slip -> stick if the flow increment of the step has the wrong sign.
-!> A step starts from the secant-predicted state with the stick passages that it takes
+!> A step starts from the predicted state (secant, or the parabola through three states of
+!> one active set; reversed secant across a turn) with the stick passages that it takes
 !> across their limit slipping (predict_modes); each round after the first is a fast
 !> Newton solve (full steps only), and one that fails is retried with fewer new slips.
 !> A passage whose element would become shorter than min_length_ratio times its initial
