@@ -178,6 +178,9 @@ contains
         self%u_trial = self%u
         self%flow_trial = self%flow
         self%mode_trial = self%mode
+        ! Written to restart files whether valid or not.
+        self%u_older = self%u
+        self%flow_older = self%flow
     end subroutine new_friction_stepper
 
     subroutine try_step(self, factors, stats, iterations, error)
@@ -891,13 +894,8 @@ contains
         snapshot%have_older = self%have_older
         snapshot%held = self%held
         snapshot%load_older = self%load_older
-        if (self%have_older) then
-            snapshot%u_older = self%u_older
-            snapshot%flow_older = self%flow_older
-        else
-            snapshot%u_older = self%u
-            snapshot%flow_older = self%flow
-        end if
+        snapshot%u_older = self%u_older
+        snapshot%flow_older = self%flow_older
         if (.not. allocated(snapshot%length0)) &
             allocate(snapshot%length0(self%scene%network%n_elements()))
         call self%scene%passages%get_length0(self%scene%network%length0, self%flow, &
