@@ -81,6 +81,21 @@ def capstan_limit_force(strains, w, c, depth):
     return np.array(expected)
 
 
+def assert_one_cycle_curve(curves, reference):
+    """Every curve of `curves` (runs of the cycle, time 0 to 2) has the force per width
+    of `reference` at each of its times, within SOLVED of the reference's peak."""
+    peak = np.max(np.abs(reference["force_per_width"]))
+    for key, curve in curves.items():
+        # the release is there (each run reaches time 2 with its steps)
+        assert curve["time"][-1] == pytest.approx(2.0, rel=ROUND_OFF)
+        common, mine, theirs = np.intersect1d(np.round(curve["time"], 9),
+                                              np.round(reference["time"], 9),
+                                              return_indices=True)
+        assert len(common) == len(curve["time"]), key  # coarser steps land on finer ones
+        assert np.max(np.abs(curve["force_per_width"][mine]
+                             - reference["force_per_width"][theirs])) <= SOLVED * peak, key
+
+
 def offset_pairs(position, period_y):
     """(head, foot) node pairs whose offset is (0, 0, d) (across the y period for the
     periodic cell's top course), in one state."""
@@ -229,17 +244,7 @@ def test_unloading_branch_does_not_depend_on_the_step(run_yarnfort, tmp_path):
                                     "output.vtk_every": 0},
                      tmp_path / f"cells{cells}_{step}")
         curves[cells, step] = read_curve(folder)
-    reference = curves[1, 0.00625]
-    peak = np.max(np.abs(reference["force_per_width"]))
-    for key, curve in curves.items():
-        # the release is there (each run reaches time 2 with its steps)
-        assert curve["time"][-1] == pytest.approx(2.0, rel=ROUND_OFF)
-        common, mine, theirs = np.intersect1d(np.round(curve["time"], 9),
-                                              np.round(reference["time"], 9),
-                                              return_indices=True)
-        assert len(common) == len(curve["time"]), key  # coarser steps land on finer ones
-        assert np.max(np.abs(curve["force_per_width"][mine]
-                             - reference["force_per_width"][theirs])) <= SOLVED * peak, key
+    assert_one_cycle_curve(curves, curves[1, 0.00625])
 
 
 def test_planar_4x2_cycle_does_not_depend_on_the_step(run_yarnfort, tmp_path):
@@ -269,11 +274,4 @@ def test_planar_4x2_cycle_does_not_depend_on_the_step(run_yarnfort, tmp_path):
     assert np.count_nonzero(loading) >= 0.9 / 0.0125
     expected = capstan_limit_force(reference["strain"][loading], *spacing, 0.0)
     assert np.max(np.abs(reference["force_per_width"][loading] - expected)) <= SOLVED * peak
-    for key, curve in curves.items():
-        assert curve["time"][-1] == pytest.approx(2.0, rel=ROUND_OFF)
-        common, mine, theirs = np.intersect1d(np.round(curve["time"], 9),
-                                              np.round(reference["time"], 9),
-                                              return_indices=True)
-        assert len(common) == len(curve["time"]), key  # coarser steps land on finer ones
-        assert np.max(np.abs(curve["force_per_width"][mine]
-                             - reference["force_per_width"][theirs])) <= SOLVED * peak, key
+    assert_one_cycle_curve(curves, reference)
