@@ -18,7 +18,8 @@
 !> reference length locks at that length (stick), and may not slip that way again while
 !> the element keeps that length, in this step and the next ones. A passage that flips
 !> more than max_flips times in one step is held in stick for the rest of the step
-!> (chatter damping); the count is reported.
+!> (chatter damping); the step fails if a held passage ends beyond its limit
+!> (check_damped).
 module yarnfort_contact_friction_stepper
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
