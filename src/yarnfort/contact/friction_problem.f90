@@ -30,6 +30,23 @@
 !> 9.6 factorisations per step against 2.5 for the active-set rounds, so the stepper's
 !> rounds (semismooth off) are the default. `locked` forbids a direction (minimum
 !> reference length reached, or chatter damping).
+!> Neutral modes: a set of slipping passages can let material run along a path without
+!> changing any tension (the yarn round a periodic cell, or a column of contact nodes
+!> sliding along a straight course whose heads and sinkers carry one tension); the
+!> Jacobian is then singular, the factorisation meets pivots of rounding size, and
+!> Newton's steps along the mode are set by rounding. Where it stops there is the same
+!> state of forces, but the flow increments, whose signs the stepper's active-set test
+!> reads, were arbitrary: passages were dropped at random, the rounds cycled, and on the
+!> planar 4 x 2 knit of inputs/knit3d.nml chatter damping ended steps beyond the limit
+!> (benchmarks/steps_results.md, section 7). So the tangent (never the residual) of
+!> each slip row gets neutral_shift times its largest flow derivative added to its own
+!> flow's entry, like the slack strings' spring: the converged answer is that of the
+!> exact law, and along a neutral mode the step now moves the flows as little as the
+!> shift allows instead of by rounding noise, so the solve keeps the flows of its start
+!> there (and the cell's symmetry). Relative 1e-12 is 1e4 times the rounding of a
+!> pivot and perturbs a regular step by 1e-12 of itself; 1e-8 (measured) was enough to
+!> let the stiff frictionless ring of test_defaults (EA = 1e6 times its load) stop at
+!> its residual tolerance 1e-7 away from the closed form instead of failing loudly.
 module yarnfort_contact_friction_problem
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -51,6 +68,9 @@ module yarnfort_contact_friction_problem
     !> Value of `locked` that holds a passage in stick (chatter damping).
     integer, parameter :: locked_both = 2
 
+    !> Shift of a slip row's own-flow derivative in the Jacobian (not the residual), in
+    !> units of the row's largest flow derivative (module notes: neutral modes).
+    real(wp), parameter :: neutral_shift = 1.0e-12_wp
     !> Smallest sin(gamma) used in the derivative of the wrap angle (see get_wrap_angle).
     real(wp), parameter :: min_sine = 1.0e-8_wp
     !> A slack string within this of stretch 1 sits at the kink of max(T, 0) (round-off
@@ -586,6 +606,8 @@ contains
                 end if
             end associate
             row = row / self%slip_weight(p)
+            ! Tangent only: neutral modes (module notes).
+            row(10) = row(10) + sign(neutral_shift * maxval(abs(row(10:12))), row(10))
             do k = 1, 12
                 slot = self%passage_slot(10, k, p)
                 if (slot /= 0) values(slot) = values(slot) + row(k)
