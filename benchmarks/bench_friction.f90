@@ -250,14 +250,19 @@ contains
         select type (linear => stepper%newton_full%linear)
         type is (condensed_solver_type)
             call measure_floor('klu', linear%n_reduced, linear%reduced_col_ptr, &
-                linear%reduced_row_index, values(linear%source), reduced, error)
+                linear%reduced_row_index, values(linear%source), reduced, error, &
+                with_metis=.true.)
             if (allocated(error)) call fail('bench_friction', error)
-            write(output_unit, '(a, i0, a, i0, a, f8.2, a, 2(es9.2, a, f8.2, a), a)', &
-                advance='no') &
+            write(output_unit, '(a, i0, a, i0, a, f8.2, a, 3(es9.2, a, f8.2, a), a, &
+                & 3(f9.2, a))', advance='no') &
                 'reduced: n ', linear%n_reduced, ' nnz ', size(linear%source), &
                 ' reductions/step ', real(linear%n_reductions, wp) / counter%steps, &
                 ' LU: klu-amd ', reduced%klu_lu, ' (', reduced%klu_ms, ' ms)  umfpack ', &
-                reduced%umfpack_lu, ' (', reduced%umfpack_ms, ' ms)', ' |'
+                reduced%umfpack_lu, ' (', reduced%umfpack_ms, ' ms)  umfpack-metis ', &
+                reduced%umfpack_metis_lu, ' (', reduced%umfpack_metis_ms, ' ms)', &
+                ' analyse ms: klu ', reduced%klu_analyse_ms, ' umfpack ', &
+                reduced%umfpack_analyse_ms, ' umfpack-metis ', &
+                reduced%umfpack_metis_analyse_ms, ' |'
             select type (choice => linear%inner)
             type is (lu_choice_solver_type)
                 write(output_unit, '(a, es9.2, a, es9.2, a, f8.1, a)', advance='no') &
