@@ -1,11 +1,14 @@
 ! SPDX-License-Identifier: MIT
 !> Sparse LU by KLU or UMFPACK, chosen for each pattern from the cost KLU's symbolic
 !> analysis (BTF + AMD) predicts, before any factorisation: the same pattern always gives
-!> the same choice. KLU factors column by column with sparse operations (Gilbert-Peierls),
-!> cheap per nonzero of the factors; UMFPACK assembles dense frontal matrices and factors
-!> them with the BLAS, dearer per nonzero but faster per flop. So the flops per factor
-!> nonzero decide: few on chain-like patterns (the woven nets' reduced friction systems),
-!> many where the factors fill in two dimensions (the knit's, or any net at 1e6 unknowns).
+!> the same choice. KLU factors column by column with sparse operations (Gilbert-Peierls):
+!> its time goes with the flops, at a high cost per flop. UMFPACK assembles dense frontal
+!> matrices and factors them with the BLAS: about 3x cheaper per flop, but it pays per
+!> column (its fronts) and per factor nonzero. So UMFPACK wins where the flops are many
+!> for the order and the factor nonzeros: where the factors fill in two dimensions with
+!> large fronts everywhere (the knits' reduced friction systems), not on the woven nets'
+!> chain-like systems, nor at 1e6 unknowns, where a few large separators hold the flops
+!> but most columns stay small.
 module yarnfort_linalg_lu_choice
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -15,17 +18,22 @@ module yarnfort_linalg_lu_choice
     implicit none
     private
 
-    public :: lu_choice_solver_type, prefers_umfpack, umfpack_min_flops_per_nonzero
+    public :: lu_choice_solver_type, prefers_umfpack
+    public :: umfpack_min_flops_per_nonzero, umfpack_min_flops_per_column
 
-    !> UMFPACK is chosen when KLU's predicted flops per nonzero of L + U reach this.
-    !> Measured on the reduced friction systems (benchmarks/results-lu-choice.md, CPU
-    !> time of UMFPACK's numeric factorisation over KLU's refactorisation, same matrix):
-    !> 6-9 at 6-11 flops per nonzero (woven nets, 1e3-1e4 unknowns), 2.0 at 32 (woven,
-    !> 1e5), 0.85-1.9 at 62-80 (knit, 20 x 20 loops), 0.37-0.73 at 119-165 (knit,
-    !> 40 x 40), 0.4-1.0 at 127 (woven, 1e6). Whole runs cross near 80-90, where the two
-    !> are within 10 %; the threshold sits above that because UMFPACK also costs memory
-    !> and system time (a new Numeric object, freshly mapped, at every factorisation).
-    real(wp), parameter :: umfpack_min_flops_per_nonzero = 100.0_wp
+    !> UMFPACK is chosen when KLU's predicted flops reach umfpack_min_flops_per_nonzero
+    !> times the predicted nonzeros of L + U plus umfpack_min_flops_per_column times the
+    !> order: where UMFPACK's predicted time is below KLU's. Fitted to CPU times of KLU's
+    !> refactorisation and UMFPACK's numeric factorisation of the same reduced friction
+    !> matrices (benchmarks/results-lu-choice.md: woven nets 1e5-1e6 unknowns, knits
+    !> 20 x 20 to 60 x 60 loops; within 20 % on every one): KLU 1.02 ns per flop + 0.36 us
+    !> per column, UMFPACK 0.27 ns per flop + 15 ns per factor nonzero + 3.2 us per
+    !> column. So UMFPACK pays when flops > 20 nonzeros + 3,800 columns (here 4,000). The
+    !> rule before, 100 flops per factor nonzero, chose UMFPACK on the woven 1e6 net (127 per
+    !> nonzero, 3,020 per column) where KLU is 1.27x faster, and KLU on the 30 x 30 knit
+    !> (92, 7,850 per column) where UMFPACK is 1.3x faster.
+    real(wp), parameter :: umfpack_min_flops_per_nonzero = 20.0_wp
+    real(wp), parameter :: umfpack_min_flops_per_column = 4000.0_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks
     !> the calls and keeps the pattern.
@@ -56,7 +64,8 @@ contains
         call klu%analyse(n, col_ptr, row_index, error)
         if (allocated(error)) return
         call klu%get_prediction(self%predicted_flops, self%predicted_nonzeros)
-        if (prefers_umfpack(self%predicted_flops, self%predicted_nonzeros)) then
+        if (prefers_umfpack(self%predicted_flops, self%predicted_nonzeros, &
+                real(n, wp))) then
             call klu%destroy()
             allocate(umfpack_solver_type :: self%chosen)
             call self%chosen%analyse(n, col_ptr, row_index, error)
@@ -65,13 +74,15 @@ contains
         end if
     end subroutine analyse
 
-    !> The rule: UMFPACK when the predicted flops per factor nonzero reach
-    !> umfpack_min_flops_per_nonzero.
-    pure function prefers_umfpack(flops, factor_nonzeros) result(umfpack)
-        real(wp), intent(in) :: flops, factor_nonzeros
+    !> The rule: UMFPACK when the predicted flops of a factorisation reach
+    !> umfpack_min_flops_per_nonzero per factor nonzero plus umfpack_min_flops_per_column
+    !> per column of the matrix (order n).
+    pure function prefers_umfpack(flops, factor_nonzeros, n) result(umfpack)
+        real(wp), intent(in) :: flops, factor_nonzeros, n
         logical :: umfpack
 
-        umfpack = flops >= umfpack_min_flops_per_nonzero * factor_nonzeros
+        umfpack = flops >= umfpack_min_flops_per_nonzero * factor_nonzeros &
+            + umfpack_min_flops_per_column * n
     end function prefers_umfpack
 
     subroutine factor(self, values, error)
