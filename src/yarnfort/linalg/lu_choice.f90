@@ -25,15 +25,14 @@ module yarnfort_linalg_lu_choice
     !> times the predicted nonzeros of L + U plus umfpack_min_flops_per_column times the
     !> order: where UMFPACK's predicted time is below KLU's. Fitted to CPU times of KLU's
     !> refactorisation and UMFPACK's numeric factorisation of the same reduced friction
-    !> matrices (benchmarks/results-lu-choice.md: woven nets 1e5-1e6 unknowns, knits
-    !> 20 x 20 to 60 x 60 loops; within 20 % on every one): KLU 1.02 ns per flop + 0.36 us
-    !> per column, UMFPACK 0.27 ns per flop + 15 ns per factor nonzero + 3.2 us per
-    !> column. So UMFPACK pays when flops > 20 nonzeros + 3,800 columns (here 4,000). The
-    !> rule before, 100 flops per factor nonzero, chose UMFPACK on the woven 1e6 net (127 per
-    !> nonzero, 3,020 per column) where KLU is 1.27x faster, and KLU on the 30 x 30 knit
-    !> (92, 7,850 per column) where UMFPACK is 1.3x faster.
-    real(wp), parameter :: umfpack_min_flops_per_nonzero = 20.0_wp
-    real(wp), parameter :: umfpack_min_flops_per_column = 4000.0_wp
+    !> matrices (benchmarks/results-lu-choice.md: woven nets 1e4-1e6 unknowns, knits
+    !> 20 x 20 to 60 x 60 loops; within 20 % on all but one of 11): KLU 1.03 ns per flop
+    !> + 0.32 us per column, UMFPACK 0.29 ns per flop + 19 ns per factor nonzero + 2.8 us
+    !> per column. The rule before, 100 flops per factor nonzero, chose UMFPACK on the
+    !> woven 1e6 net (127 per nonzero, 3,020 per column) where KLU is 1.27x faster, and
+    !> KLU on the 30 x 30 knit (92, 7,850 per column) where UMFPACK is 1.3x faster.
+    real(wp), parameter :: umfpack_min_flops_per_nonzero = 25.0_wp
+    real(wp), parameter :: umfpack_min_flops_per_column = 3300.0_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks
     !> the calls and keeps the pattern.

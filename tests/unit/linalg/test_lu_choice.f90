@@ -134,7 +134,7 @@ contains
     end subroutine test_chain
 
     !> A dense block of order n: about 2 n^3 / 3 flops on n^2 nonzeros, so n = 300 is
-    !> about 6 times the threshold (20 n^2 + 4000 n).
+    !> about 6 times the threshold (25 n^2 + 3300 n).
     subroutine test_dense(error)
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: name
