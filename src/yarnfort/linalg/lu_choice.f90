@@ -1,14 +1,11 @@
 ! SPDX-License-Identifier: MIT
 !> Sparse LU by KLU or UMFPACK, chosen for each pattern from the cost KLU's symbolic
 !> analysis (BTF + AMD) predicts, before any factorisation: the same pattern always gives
-!> the same choice. KLU factors column by column with sparse operations (Gilbert-Peierls):
-!> its time goes with the flops, at a high cost per flop. UMFPACK assembles dense frontal
-!> matrices and factors them with the BLAS: about 3x cheaper per flop, but it pays per
-!> column (its fronts) and per factor nonzero. So UMFPACK wins where the flops are many
-!> for the order and the factor nonzeros: where the factors fill in two dimensions with
-!> large fronts everywhere (the knits' reduced friction systems), not on the woven nets'
-!> chain-like systems, nor at 1e6 unknowns, where a few large separators hold the flops
-!> but most columns stay small.
+!> the same choice. KLU factors column by column with sparse operations (Gilbert-Peierls),
+!> cheap per nonzero of the factors; UMFPACK assembles dense frontal matrices and factors
+!> them with the BLAS, dearer per nonzero but faster per flop. So the flops per factor
+!> nonzero decide: few on chain-like patterns (the woven nets' reduced friction systems),
+!> many where the factors fill in two dimensions (the knit's, or any net at 1e6 unknowns).
 module yarnfort_linalg_lu_choice
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -18,21 +15,17 @@ module yarnfort_linalg_lu_choice
     implicit none
     private
 
-    public :: lu_choice_solver_type, prefers_umfpack
-    public :: umfpack_min_flops_per_nonzero, umfpack_min_flops_per_column
+    public :: lu_choice_solver_type, prefers_umfpack, umfpack_min_flops_per_nonzero
 
-    !> UMFPACK is chosen when KLU's predicted flops reach umfpack_min_flops_per_nonzero
-    !> times the predicted nonzeros of L + U plus umfpack_min_flops_per_column times the
-    !> order: where UMFPACK's predicted time is below KLU's. Fitted to CPU times of KLU's
-    !> refactorisation and UMFPACK's numeric factorisation of the same reduced friction
-    !> matrices (benchmarks/results-lu-choice.md: woven nets 1e4-1e6 unknowns, knits
-    !> 20 x 20 to 60 x 60 loops; within 20 % on all but one of 11): KLU 1.03 ns per flop
-    !> + 0.32 us per column, UMFPACK 0.29 ns per flop + 19 ns per factor nonzero + 2.8 us
-    !> per column. The rule before, 100 flops per factor nonzero, chose UMFPACK on the
-    !> woven 1e6 net (127 per nonzero, 3,020 per column) where KLU is 1.27x faster, and
-    !> KLU on the 30 x 30 knit (92, 7,850 per column) where UMFPACK is 1.3x faster.
-    real(wp), parameter :: umfpack_min_flops_per_nonzero = 25.0_wp
-    real(wp), parameter :: umfpack_min_flops_per_column = 3300.0_wp
+    !> UMFPACK is chosen when KLU's predicted flops per nonzero of L + U reach this.
+    !> Measured on the reduced friction systems (benchmarks/results-lu-choice.md, CPU
+    !> time of UMFPACK's numeric factorisation over KLU's refactorisation, same matrix):
+    !> 3-5 at 10-31 flops per nonzero (woven nets, 1e4-1e5 unknowns), 1.30 at 62 (knit,
+    !> 20 x 20 loops), 0.76 at 92 (30 x 30), 0.63 at 120 (40 x 40), 0.48 at 170
+    !> (60 x 60); at 127 (woven, 1e6) 1.27 and 0.94 in two runs, and a whole first load
+    !> step took 60 s with UMFPACK against 106 s with KLU. Whole knit runs crossed near
+    !> 80-90 before; 100 left the 30 x 30 knit on KLU.
+    real(wp), parameter :: umfpack_min_flops_per_nonzero = 80.0_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks
     !> the calls and keeps the pattern.
@@ -63,8 +56,7 @@ contains
         call klu%analyse(n, col_ptr, row_index, error)
         if (allocated(error)) return
         call klu%get_prediction(self%predicted_flops, self%predicted_nonzeros)
-        if (prefers_umfpack(self%predicted_flops, self%predicted_nonzeros, &
-                real(n, wp))) then
+        if (prefers_umfpack(self%predicted_flops, self%predicted_nonzeros)) then
             call klu%destroy()
             allocate(umfpack_solver_type :: self%chosen)
             call self%chosen%analyse(n, col_ptr, row_index, error)
@@ -73,15 +65,13 @@ contains
         end if
     end subroutine analyse
 
-    !> The rule: UMFPACK when the predicted flops of a factorisation reach
-    !> umfpack_min_flops_per_nonzero per factor nonzero plus umfpack_min_flops_per_column
-    !> per column of the matrix (order n).
-    pure function prefers_umfpack(flops, factor_nonzeros, n) result(umfpack)
-        real(wp), intent(in) :: flops, factor_nonzeros, n
+    !> The rule: UMFPACK when the predicted flops per factor nonzero reach
+    !> umfpack_min_flops_per_nonzero.
+    pure function prefers_umfpack(flops, factor_nonzeros) result(umfpack)
+        real(wp), intent(in) :: flops, factor_nonzeros
         logical :: umfpack
 
-        umfpack = flops >= umfpack_min_flops_per_nonzero * factor_nonzeros &
-            + umfpack_min_flops_per_column * n
+        umfpack = flops >= umfpack_min_flops_per_nonzero * factor_nonzeros
     end function prefers_umfpack
 
     subroutine factor(self, values, error)

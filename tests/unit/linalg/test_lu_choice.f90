@@ -8,7 +8,7 @@ module test_lu_choice
     use yarnfort_testing, only: unittest_type, new_unittest, check
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_lu_choice, only: lu_choice_solver_type, prefers_umfpack, &
-        umfpack_min_flops_per_nonzero, umfpack_min_flops_per_column
+        umfpack_min_flops_per_nonzero
     use yarnfort_linalg_factory, only: new_linear_solver, chosen_lu_name
     implicit none
     private
@@ -25,7 +25,7 @@ contains
         type(unittest_type), allocatable, intent(out) :: testsuite(:)
 
         testsuite = [ &
-            new_unittest('the rule: flops per factor nonzero and per column', test_rule), &
+            new_unittest('the rule: flops per factor nonzero', test_rule), &
             new_unittest('a chain goes to KLU', test_chain), &
             new_unittest('a dense block goes to UMFPACK', test_dense), &
             new_unittest('the same pattern, the same choice', test_same_pattern) &
@@ -34,19 +34,13 @@ contains
 
     subroutine test_rule(error)
         type(error_type), allocatable, intent(out) :: error
-        real(wp), parameter :: nonzeros = 1.0e5_wp, n = 2.0e4_wp
-        real(wp) :: threshold
+        real(wp), parameter :: nonzeros = 1.0e5_wp
 
-        threshold = umfpack_min_flops_per_nonzero * nonzeros + umfpack_min_flops_per_column * n
-        call check(error, prefers_umfpack(threshold, nonzeros, n), &
-            'at the threshold the rule should pick UMFPACK')
+        call check(error, prefers_umfpack(umfpack_min_flops_per_nonzero * nonzeros, &
+            nonzeros), 'at the threshold the rule should pick UMFPACK')
         if (allocated(error)) return
-        call check(error, .not. prefers_umfpack(0.99_wp * threshold, nonzeros, n), &
-            'below the threshold the rule should pick KLU')
-        if (allocated(error)) return
-        ! The same flops per factor nonzero on ten times the order: KLU.
-        call check(error, .not. prefers_umfpack(threshold, nonzeros, 10 * n), &
-            'a larger order at the same flops should pick KLU')
+        call check(error, .not. prefers_umfpack(0.99_wp * umfpack_min_flops_per_nonzero &
+            * nonzeros, nonzeros), 'below the threshold the rule should pick KLU')
     end subroutine test_rule
 
     !> An unsymmetric, diagonally dominant matrix of order n in CSC form: a tridiagonal
@@ -134,7 +128,7 @@ contains
     end subroutine test_chain
 
     !> A dense block of order n: about 2 n^3 / 3 flops on n^2 nonzeros, so n = 300 is
-    !> about 6 times the threshold (25 n^2 + 3300 n).
+    !> 2.5 times the threshold.
     subroutine test_dense(error)
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: name
