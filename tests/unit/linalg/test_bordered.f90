@@ -125,56 +125,45 @@ contains
 
     subroutine test_border(error)
         type(error_type), allocatable, intent(out) :: error
-        type(bordered_solver_type) :: solver
-        character(len=:), allocatable :: name
 
-        call new_bordered(solver, error)
-        if (allocated(error)) return
-        call solve_known(solver, order, .false., name, error)
-        if (allocated(error)) return
-        call check(error, index(name, 'bordered+') == 1, 'expected the border path, got ' &
-            // name)
+        call check_path(order, .false., order - n_leading, .true., error)
     end subroutine test_border
 
     subroutine test_wide_border(error)
         type(error_type), allocatable, intent(out) :: error
-        type(bordered_solver_type) :: solver
-        character(len=:), allocatable :: name
 
-        call new_bordered(solver, error)
-        if (allocated(error)) return
-        solver%max_border = order - n_leading - 1
-        call solve_known(solver, order, .false., name, error)
-        if (allocated(error)) return
-        call check(error, index(name, 'bordered') == 0, 'expected the general solver, got ' &
-            // name)
+        call check_path(order, .false., order - n_leading - 1, .false., error)
     end subroutine test_wide_border
 
     subroutine test_singular_leading(error)
         type(error_type), allocatable, intent(out) :: error
-        type(bordered_solver_type) :: solver
-        character(len=:), allocatable :: name
 
-        call new_bordered(solver, error)
-        if (allocated(error)) return
-        call solve_known(solver, order, .true., name, error)
-        if (allocated(error)) return
-        call check(error, index(name, 'bordered') == 0, 'expected the general solver, got ' &
-            // name)
+        call check_path(order, .true., order - n_leading, .false., error)
     end subroutine test_singular_leading
 
     subroutine test_no_border(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_path(n_leading, .false., 0, .true., error)
+    end subroutine test_no_border
+
+    !> Solve a known system of order n with at most max_border border unknowns; the path
+    !> taken should be the border one (border) or the general solver.
+    subroutine check_path(n, singular, max_border, border, error)
+        integer, intent(in) :: n, max_border
+        logical, intent(in) :: singular, border
         type(error_type), allocatable, intent(out) :: error
         type(bordered_solver_type) :: solver
         character(len=:), allocatable :: name
 
         call new_bordered(solver, error)
         if (allocated(error)) return
-        call solve_known(solver, n_leading, .false., name, error)
+        solver%max_border = max_border
+        call solve_known(solver, n, singular, name, error)
         if (allocated(error)) return
-        call check(error, index(name, 'bordered+') == 1, 'expected the border path, got ' &
-            // name)
-    end subroutine test_no_border
+        call check(error, (index(name, 'bordered+') == 1) .eqv. border, &
+            'unexpected path: ' // name)
+    end subroutine check_path
 
     !> The border changes (as the slipping flows do), K does not: right answers each time.
     subroutine test_new_pattern(error)
