@@ -24,7 +24,8 @@ module bench_floor
     use yarnfort_linalg_umfpack_binding, only: umfpack_control, umfpack_info, umfpack_irstep, &
         umfpack_prl, umfpack_a, umfpack_ok, umfpack_strategy_used, umfpack_dl_defaults, &
         umfpack_dl_symbolic, umfpack_dl_numeric, umfpack_dl_wsolve, &
-        umfpack_dl_free_symbolic, umfpack_dl_free_numeric, umfpack_lnz, umfpack_unz
+        umfpack_dl_free_symbolic, umfpack_dl_free_numeric, umfpack_lnz, umfpack_unz, &
+        umfpack_ordering, umfpack_ordering_metis
     use yarnfort_linalg_klu_binding, only: klu_l_common, klu_l_defaults, klu_l_analyze, &
         klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_free_symbolic, klu_l_free_numeric, &
         klu_l_numeric_sizes
@@ -57,6 +58,12 @@ module bench_floor
         real(wp) :: yarnfort_ms = -1.0_wp
         real(wp) :: umfpack_ms = -1.0_wp, umfpack_pattern_ms = -1.0_wp, klu_ms = -1.0_wp
         real(wp) :: klu_colamd_ms = -1.0_wp, klu_nobtf_ms = -1.0_wp, cholmod_ms = -1.0_wp
+        !> UMFPACK (values given) with METIS instead of its default AMD ordering
+        !> (with_metis), and the CPU ms of the symbolic analyses: KLU (AMD), UMFPACK (AMD,
+        !> METIS).
+        real(wp) :: umfpack_metis_ms = -1.0_wp, umfpack_metis_lu = 0.0_wp
+        real(wp) :: klu_analyse_ms = -1.0_wp, umfpack_analyse_ms = -1.0_wp
+        real(wp) :: umfpack_metis_analyse_ms = -1.0_wp
         !> Nonzeros of L of bare CHOLMOD (its analysis' count).
         real(wp) :: cholmod_lnz = 0.0_wp
         !> Nonzeros of L + U: UMFPACK analysed with the values, KLU with AMD and COLAMD.
@@ -76,7 +83,7 @@ contains
 
     !> Time `solver_name` and the bare libraries on the CSC matrix (0-based indices).
     subroutine measure_floor(solver_name, n, col_ptr, row_index, values, floor, error, &
-            with_klu)
+            with_klu, with_metis)
         character(len=*), intent(in) :: solver_name
         integer(ik), intent(in) :: n
         integer(ik), intent(in) :: col_ptr(:), row_index(:)
@@ -85,6 +92,8 @@ contains
         type(error_type), allocatable, intent(out) :: error
         !> Time bare KLU (default true).
         logical, intent(in), optional :: with_klu
+        !> Also time UMFPACK with the METIS ordering (default false).
+        logical, intent(in), optional :: with_metis
         class(linear_solver_type), allocatable :: solver
         real(wp), allocatable :: rhs(:)
         real(wp) :: start, first
@@ -115,12 +124,17 @@ contains
         floor%yarnfort_ms = 1e3_wp * (cpu_seconds() - start) / repetitions
         call solver%destroy()
 
-        call time_umfpack(.true., floor%umfpack_ms, floor%strategy, floor%umfpack_lu)
+        call time_umfpack(.true., floor%umfpack_ms, floor%strategy, floor%umfpack_lu, &
+            analyse_ms=floor%umfpack_analyse_ms)
         call time_umfpack(.false., floor%umfpack_pattern_ms, floor%strategy_pattern)
+        if (present(with_metis)) then
+            if (with_metis) call time_umfpack(.true., floor%umfpack_metis_ms, k, &
+                floor%umfpack_metis_lu, umfpack_ordering_metis, floor%umfpack_metis_analyse_ms)
+        end if
         klu = .true.
         if (present(with_klu)) klu = with_klu
         if (klu) then
-            call time_klu(0, 1, floor%klu_ms, floor%klu_lu)
+            call time_klu(0, 1, floor%klu_ms, floor%klu_lu, floor%klu_analyse_ms)
             call time_klu(1, 1, floor%klu_colamd_ms, floor%klu_colamd_lu)
             call time_klu(0, 0, floor%klu_nobtf_ms, floor%klu_nobtf_lu)
         end if
@@ -144,11 +158,14 @@ contains
                 int(target_seconds / max(seconds, 1e-6_wp))))
         end function count_repetitions
 
-        subroutine time_umfpack(with_values, ms, strategy, lu)
+        subroutine time_umfpack(with_values, ms, strategy, lu, ordering, analyse_ms)
             logical, intent(in) :: with_values
             real(wp), intent(out) :: ms
             integer, intent(out) :: strategy
             real(wp), intent(out), optional :: lu
+            !> Control(UMFPACK_ORDERING) (default: UMFPACK's own, AMD).
+            integer, intent(in), optional :: ordering
+            real(wp), intent(out), optional :: analyse_ms
             real(c_double) :: control(0:umfpack_control - 1), info(0:umfpack_info - 1)
             real(c_double), allocatable :: b(:), x(:), w(:)
             integer(c_long), allocatable :: wi(:)
@@ -164,6 +181,8 @@ contains
             call umfpack_dl_defaults(control)
             control(umfpack_irstep) = 0
             control(umfpack_prl) = 0
+            if (present(ordering)) control(umfpack_ordering) = real(ordering, c_double)
+            start = cpu_seconds()
             if (with_values) then
                 status = umfpack_dl_symbolic(int(n, c_long), int(n, c_long), col_ptr, &
                     row_index, values, symbolic, control, info)
@@ -172,6 +191,7 @@ contains
                     row_index, symbolic=symbolic, control=control, info=info)
             end if
             if (status /= umfpack_ok) return
+            if (present(analyse_ms)) analyse_ms = 1e3_wp * (cpu_seconds() - start)
             strategy = nint(info(umfpack_strategy_used))
             start = cpu_seconds()
             status = umfpack_dl_numeric(col_ptr, row_index, values, symbolic, numeric, &
@@ -196,9 +216,10 @@ contains
             call umfpack_dl_free_symbolic(symbolic)
         end subroutine time_umfpack
 
-        subroutine time_klu(ordering, btf, ms, lu)
+        subroutine time_klu(ordering, btf, ms, lu, analyse_ms)
             integer, intent(in) :: ordering, btf
             real(wp), intent(out) :: ms, lu
+            real(wp), intent(out), optional :: analyse_ms
             type(klu_l_common) :: common
             type(c_ptr) :: symbolic, numeric
             type(klu_l_numeric_sizes), pointer :: sizes
@@ -213,8 +234,10 @@ contains
             common%user_data = c_null_ptr
             common%ordering = ordering
             common%btf = btf
+            start = cpu_seconds()
             symbolic = klu_l_analyze(int(n, c_long), col_ptr, row_index, common)
             if (.not. c_associated(symbolic)) return
+            if (present(analyse_ms)) analyse_ms = 1e3_wp * (cpu_seconds() - start)
             start = cpu_seconds()
             numeric = klu_l_factor(col_ptr, row_index, values, symbolic, common)
             if (c_associated(numeric)) then

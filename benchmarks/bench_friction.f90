@@ -93,6 +93,7 @@ program bench_friction
     use yarnfort_linalg_factory, only: new_linear_solver
     use yarnfort_linalg_condensed, only: condensed_solver_type
     use yarnfort_linalg_lu_choice, only: lu_choice_solver_type
+    use yarnfort_linalg_bordered, only: bordered_solver_type
     use yarnfort_input_namelist, only: read_config_from_file, check_config
     implicit none
 
@@ -250,23 +251,26 @@ contains
         select type (linear => stepper%newton_full%linear)
         type is (condensed_solver_type)
             call measure_floor('klu', linear%n_reduced, linear%reduced_col_ptr, &
-                linear%reduced_row_index, values(linear%source), reduced, error)
+                linear%reduced_row_index, values(linear%source), reduced, error, &
+                with_metis=.true.)
             if (allocated(error)) call fail('bench_friction', error)
-            write(output_unit, '(a, i0, a, i0, a, f8.2, a, 2(es9.2, a, f8.2, a), a)', &
-                advance='no') &
+            write(output_unit, '(a, i0, a, i0, a, f8.2, a, 3(es9.2, a, f8.2, a), a, &
+                & 3(f9.2, a))', advance='no') &
                 'reduced: n ', linear%n_reduced, ' nnz ', size(linear%source), &
                 ' reductions/step ', real(linear%n_reductions, wp) / counter%steps, &
                 ' LU: klu-amd ', reduced%klu_lu, ' (', reduced%klu_ms, ' ms)  umfpack ', &
-                reduced%umfpack_lu, ' (', reduced%umfpack_ms, ' ms)', ' |'
-            select type (choice => linear%inner)
-            type is (lu_choice_solver_type)
-                write(output_unit, '(a, es9.2, a, es9.2, a, f8.1, a)', advance='no') &
-                    ' predicted flops ', choice%predicted_flops, ' LU ', &
-                    choice%predicted_nonzeros, ' flops/nonzero ', &
-                    choice%predicted_flops / max(1.0_wp, choice%predicted_nonzeros), &
-                    ' -> ' // choice%get_name()
+                reduced%umfpack_lu, ' (', reduced%umfpack_ms, ' ms)  umfpack-metis ', &
+                reduced%umfpack_metis_lu, ' (', reduced%umfpack_metis_ms, ' ms)', &
+                ' analyse ms: klu ', reduced%klu_analyse_ms, ' umfpack ', &
+                reduced%umfpack_analyse_ms, ' umfpack-metis ', &
+                reduced%umfpack_metis_analyse_ms, ' |'
+            select type (inner => linear%inner)
+            type is (bordered_solver_type)
+                ! The whole-matrix LU's prediction, if this pattern went to it.
+                write(output_unit, '(a)', advance='no') ' ' // inner%get_name()
+                if (.not. inner%use_border) call write_choice(inner%general)
             class default
-                write(output_unit, '(a)', advance='no') ' ' // choice%get_name()
+                call write_choice(inner)
             end select
             write(output_unit, '(a)') ''
         end select
@@ -297,6 +301,22 @@ contains
             ') | cpu ms/step ', 1e3_wp * cpu_total / counter%steps, ' = elastic x ', &
             1e3_wp * cpu_total / counter%steps / sum(elastic_ms)
     end subroutine write_iterations
+
+    !> KLU's prediction and the choice of a lu_choice solver, else the solver's name.
+    subroutine write_choice(solver)
+        class(linear_solver_type), intent(in) :: solver
+
+        select type (solver)
+        type is (lu_choice_solver_type)
+            write(output_unit, '(a, es9.2, a, es9.2, a, f8.1, a)', advance='no') &
+                ' predicted flops ', solver%predicted_flops, ' LU ', &
+                solver%predicted_nonzeros, ' flops/nonzero ', &
+                solver%predicted_flops / max(1.0_wp, solver%predicted_nonzeros), &
+                ' -> ' // solver%get_name()
+        class default
+            write(output_unit, '(a)', advance='no') ' ' // solver%get_name()
+        end select
+    end subroutine write_choice
 
     !> The `factors:` line (program notes).
     subroutine write_factors()

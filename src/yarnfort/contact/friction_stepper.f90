@@ -29,6 +29,7 @@ module yarnfort_contact_friction_stepper
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
         chosen_lu_name
     use yarnfort_linalg_condensed, only: condensed_solver_type
+    use yarnfort_linalg_bordered, only: bordered_solver_type
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
@@ -160,10 +161,23 @@ contains
         call new_friction_problem(self%full, scene, positions_frozen=.false.)
         block
             type(condensed_solver_type), allocatable :: condensed
-            ! Stick flows eliminated before factorising (yarnfort_linalg_condensed).
+            type(bordered_solver_type), allocatable :: bordered
+            ! Stick flows eliminated before factorising (yarnfort_linalg_condensed); with
+            ! the Cholesky default, the elastic block of the rest by `linear_name` and a
+            ! few slipping flows as its border (yarnfort_linalg_bordered).
             allocate(condensed)
-            call new_linear_solver(condensed%inner, full_name, error)
-            if (allocated(error)) return
+            if (full_name == chosen_lu_name) then
+                allocate(bordered)
+                bordered%n_leading = scene%dofs%n_unknowns
+                call new_linear_solver(bordered%leading, linear_name, error)
+                if (allocated(error)) return
+                call new_linear_solver(bordered%general, full_name, error)
+                if (allocated(error)) return
+                call move_alloc(bordered, condensed%inner)
+            else
+                call new_linear_solver(condensed%inner, full_name, error)
+                if (allocated(error)) return
+            end if
             condensed%first_candidate = scene%dofs%n_unknowns + 1
             call move_alloc(condensed, linear)
         end block

@@ -20,12 +20,12 @@ module yarnfort_linalg_lu_choice
     !> UMFPACK is chosen when KLU's predicted flops per nonzero of L + U reach this.
     !> Measured on the reduced friction systems (benchmarks/results-lu-choice.md, CPU
     !> time of UMFPACK's numeric factorisation over KLU's refactorisation, same matrix):
-    !> 6-9 at 6-11 flops per nonzero (woven nets, 1e3-1e4 unknowns), 2.0 at 32 (woven,
-    !> 1e5), 0.85-1.9 at 62-80 (knit, 20 x 20 loops), 0.37-0.73 at 119-165 (knit,
-    !> 40 x 40), 0.4-1.0 at 127 (woven, 1e6). Whole runs cross near 80-90, where the two
-    !> are within 10 %; the threshold sits above that because UMFPACK also costs memory
-    !> and system time (a new Numeric object, freshly mapped, at every factorisation).
-    real(wp), parameter :: umfpack_min_flops_per_nonzero = 100.0_wp
+    !> 3-5 at 10-31 flops per nonzero (woven nets, 1e4-1e5 unknowns), 1.30 at 62 (knit,
+    !> 20 x 20 loops), 0.76 at 92 (30 x 30), 0.63 at 120 (40 x 40), 0.48 at 170
+    !> (60 x 60); at 127 (woven, 1e6) 1.27 and 0.94 in two runs, and a whole first load
+    !> step took 60 s with UMFPACK against 106 s with KLU. Whole knit runs crossed near
+    !> 80-90 before; 100 left the 30 x 30 knit on KLU.
+    real(wp), parameter :: umfpack_min_flops_per_nonzero = 80.0_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks
     !> the calls and keeps the pattern.

@@ -11,6 +11,8 @@ module yarnfort_linalg_umfpack_binding
     public :: umfpack_size_of_unit, umfpack_numeric_size, umfpack_peak_memory, umfpack_lnz, &
         umfpack_unz, umfpack_strategy_used
     public :: umfpack_prl, umfpack_irstep, umfpack_status, umfpack_rcond
+    public :: umfpack_ordering, umfpack_ordering_amd, umfpack_ordering_metis
+    public :: umfpack_flops_estimate
     public :: umfpack_a
     public :: umfpack_ok, umfpack_warning_singular_matrix, umfpack_error_out_of_memory
     public :: umfpack_error_invalid_numeric_object, umfpack_error_invalid_symbolic_object
@@ -26,6 +28,10 @@ module yarnfort_linalg_umfpack_binding
 
     !> 0-based indices into Control: print level, maximum iterative refinement steps.
     integer, parameter :: umfpack_prl = 0, umfpack_irstep = 7
+    !> 0-based index into Control: the fill-reducing ordering, and two of its values
+    !> (AMD/COLAMD, UMFPACK's default; METIS, through CHOLMOD).
+    integer, parameter :: umfpack_ordering = 10
+    integer, parameter :: umfpack_ordering_amd = 1, umfpack_ordering_metis = 3
     !> 0-based indices into Info: status, reciprocal condition estimate.
     integer, parameter :: umfpack_status = 0, umfpack_rcond = 67
     !> 0-based indices into Info: bytes per Unit; size of the Numeric object and peak
@@ -35,6 +41,9 @@ module yarnfort_linalg_umfpack_binding
         umfpack_peak_memory = 41, umfpack_lnz = 43, umfpack_unz = 44
     !> 0-based index into Info: the strategy used (1 unsymmetric, 3 symmetric).
     integer, parameter :: umfpack_strategy_used = 18
+    !> 0-based index into Info: the flops of the factorisation that the symbolic
+    !> analysis predicts.
+    integer, parameter :: umfpack_flops_estimate = 22
 
     !> System to solve: A x = b.
     integer(c_long), parameter :: umfpack_a = 0

@@ -128,7 +128,7 @@ contains
     end subroutine test_chain
 
     !> A dense block of order n: about 2 n^3 / 3 flops on n^2 nonzeros, so n = 300 is
-    !> twice the threshold.
+    !> 2.5 times the threshold.
     subroutine test_dense(error)
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: name

@@ -1,0 +1,185 @@
+! SPDX-License-Identifier: MIT
+!> Unit tests of the bordered solver (yarnfort_linalg_bordered): a symmetric positive
+!> definite block K bordered by unsymmetric rows and columns, solved through the Schur
+!> complement, through the whole-matrix solver when the border is too wide, and through
+!> it too when K alone is singular; the analysis of K kept across patterns.
+module test_bordered
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type
+    use yarnfort_testing, only: unittest_type, new_unittest, check
+    use yarnfort_linalg_bordered, only: bordered_solver_type
+    use yarnfort_linalg_factory, only: new_linear_solver, chosen_lu_name
+    implicit none
+    private
+
+    public :: collect_bordered
+
+    !> Relative error of x accepted from a backward-stable solve of these small,
+    !> well-conditioned systems.
+    real(wp), parameter :: solution_tol = 1.0e5_wp * epsilon(1.0_wp)
+    !> Order of the matrix and of its leading block.
+    integer, parameter :: order = 9, n_leading = 6
+
+contains
+
+    subroutine collect_bordered(testsuite)
+        type(unittest_type), allocatable, intent(out) :: testsuite(:)
+
+        testsuite = [ &
+            new_unittest('border through the Schur complement', test_border), &
+            new_unittest('a wide border goes to the general solver', test_wide_border), &
+            new_unittest('a singular leading block goes to the general solver', &
+                test_singular_leading), &
+            new_unittest('no border: the leading block alone', test_no_border), &
+            new_unittest('a new pattern with the same leading block', test_new_pattern) &
+            ]
+    end subroutine collect_bordered
+
+    !> K symmetric positive definite (diagonally dominant, coupled neighbours), the border
+    !> unsymmetric and diagonally dominant; `singular` zeroes K's last row and column
+    !> (the border's columns and rows still reach that unknown).
+    function test_matrix(n, singular) result(a)
+        integer, intent(in) :: n
+        logical, intent(in) :: singular
+        real(wp) :: a(n, n)
+        integer :: i, j
+
+        a = 0.0_wp
+        do j = 1, n
+            do i = 1, n
+                if (i <= n_leading .and. j <= n_leading) then
+                    if (i == j) then
+                        a(i, j) = 4.0_wp + mod(i, 3)
+                    else if (abs(i - j) == 1) then
+                        a(i, j) = -1.0_wp
+                    end if
+                else if (i == j) then
+                    a(i, j) = 5.0_wp + mod(i, 2)
+                else
+                    a(i, j) = (0.25_wp + 0.125_wp * mod(i + 2 * j, 3)) &
+                        * merge(1.0_wp, -1.0_wp, i < j)
+                end if
+            end do
+        end do
+        if (singular) then
+            a(n_leading, 1:n_leading) = 0.0_wp
+            a(1:n_leading, n_leading) = 0.0_wp
+        end if
+    end function test_matrix
+
+    !> Every entry stored (zeros too).
+    subroutine to_csc(a, col_ptr, row_index, values)
+        real(wp), intent(in) :: a(:, :)
+        integer(ik), allocatable, intent(out) :: col_ptr(:), row_index(:)
+        real(wp), allocatable, intent(out) :: values(:)
+        integer :: i, j, n
+
+        n = size(a, 1)
+        allocate(col_ptr(n + 1), row_index(n * n), values(n * n))
+        col_ptr(1) = 0
+        do j = 1, n
+            do i = 1, n
+                row_index((j - 1) * n + i) = i - 1
+                values((j - 1) * n + i) = a(i, j)
+            end do
+            col_ptr(j + 1) = j * n
+        end do
+    end subroutine to_csc
+
+    subroutine new_bordered(solver, error)
+        type(bordered_solver_type), intent(out) :: solver
+        type(error_type), allocatable, intent(out) :: error
+
+        solver%n_leading = n_leading
+        call new_linear_solver(solver%leading, 'cholmod+klu', error)
+        if (allocated(error)) return
+        call new_linear_solver(solver%general, chosen_lu_name, error)
+    end subroutine new_bordered
+
+    !> Analyse, factor and solve A x = A x_known for a matrix of order n; `name` is the
+    !> path taken.
+    subroutine solve_known(solver, n, singular, name, error)
+        type(bordered_solver_type), intent(inout) :: solver
+        integer, intent(in) :: n
+        logical, intent(in) :: singular
+        character(len=:), allocatable, intent(out) :: name
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: a(:, :), values(:), x(:), rhs(:)
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        integer :: i
+
+        a = test_matrix(n, singular)
+        call to_csc(a, col_ptr, row_index, values)
+        call solver%analyse(int(n, ik), col_ptr, row_index, error)
+        if (allocated(error)) return
+        call solver%factor(values, error)
+        if (allocated(error)) return
+        name = solver%get_name()
+        x = [(real(mod(i, 5) - 2, wp) + 0.5_wp, i = 1, n)]
+        rhs = matmul(a, x)
+        call solver%solve(rhs, error)
+        if (allocated(error)) return
+        call check(error, maxval(abs(rhs - x)) <= solution_tol * maxval(abs(x)), &
+            name // ': solution differs from the known x')
+    end subroutine solve_known
+
+    subroutine test_border(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_path(order, .false., order - n_leading, .true., error)
+    end subroutine test_border
+
+    subroutine test_wide_border(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_path(order, .false., order - n_leading - 1, .false., error)
+    end subroutine test_wide_border
+
+    subroutine test_singular_leading(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_path(order, .true., order - n_leading, .false., error)
+    end subroutine test_singular_leading
+
+    subroutine test_no_border(error)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_path(n_leading, .false., 0, .true., error)
+    end subroutine test_no_border
+
+    !> Solve a known system of order n with at most max_border border unknowns; the path
+    !> taken should be the border one (border) or the general solver.
+    subroutine check_path(n, singular, max_border, border, error)
+        integer, intent(in) :: n, max_border
+        logical, intent(in) :: singular, border
+        type(error_type), allocatable, intent(out) :: error
+        type(bordered_solver_type) :: solver
+        character(len=:), allocatable :: name
+
+        call new_bordered(solver, error)
+        if (allocated(error)) return
+        solver%max_border = max_border
+        call solve_known(solver, n, singular, name, error)
+        if (allocated(error)) return
+        call check(error, (index(name, 'bordered+') == 1) .eqv. border, &
+            'unexpected path: ' // name)
+    end subroutine check_path
+
+    !> The border changes (as the slipping flows do), K does not: right answers each time.
+    subroutine test_new_pattern(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(bordered_solver_type) :: solver
+        character(len=:), allocatable :: name
+
+        call new_bordered(solver, error)
+        if (allocated(error)) return
+        call solve_known(solver, order, .false., name, error)
+        if (allocated(error)) return
+        call solve_known(solver, order - 1, .false., name, error)
+        if (allocated(error)) return
+        call solve_known(solver, order, .false., name, error)
+        if (allocated(error)) return
+        call check(error, solver%leading_analysed, 'the leading block should stay analysed')
+    end subroutine test_new_pattern
+
+end module test_bordered
