@@ -15,6 +15,8 @@
 !> one active set; reversed secant across a turn) with the stick passages that it takes
 !> across their limit slipping (predict_modes); each round after the first is a fast
 !> Newton solve (full steps only), and one that fails is retried with fewer new slips.
+!> When the step's first set fails with no new slip, its passages whose flows ran back
+!> in that solve stick and the set is solved again (stop_flowing_back).
 !> A passage whose element would become shorter than min_length_ratio times its initial
 !> reference length locks at that length (stick), and may not slip that way again while
 !> the element keeps that length, in this step and the next ones. A passage that flips
@@ -223,10 +225,10 @@ contains
         integer, intent(out) :: iterations
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: unknowns(:), good_unknowns(:)
-        integer, allocatable :: flips(:), good_mode(:), good_flips(:)
+        integer, allocatable :: flips(:), good_mode(:), good_flips(:), failed_mode(:)
         logical, allocatable :: locked_forward(:), locked_backward(:)
         integer :: round, n_x, changed, cap, new_slips, outcome
-        logical :: have_good, guessed, full_retry
+        logical :: have_good, guessed, full_retry, sign_tried, stopped
 
         associate(problem => self%full, scene => self%scene)
             n_x = scene%dofs%n_unknowns
@@ -257,6 +259,7 @@ contains
             cap = huge(1)
             have_good = .false.
             full_retry = .false.
+            sign_tried = .false.
             do round = 1, scene%solver%max_friction_iterations
                 problem%mode = self%mode_trial
                 ! The last step's active set, when it has no solution nearby, is cheaper to
@@ -283,6 +286,27 @@ contains
                 iterations = iterations + stats%iterations
                 call record_solve(self%trace, stats, allocated(error))
                 if (allocated(error)) then
+                    if (self%newton_full%quick .and. .not. (have_good .or. guessed &
+                        .or. sign_tried)) then
+                        ! The step's first set failed, with no new slip: where a set that
+                        ! slips as a whole must end (a periodic knit cell's passages at the
+                        ! end of the release), its neutral modes let the flows run off, and
+                        ! the passages that run back are those that stop. They stick and
+                        ! the set is solved again from the same start; the rounds then judge
+                        ! the result as any other. Measured (benchmarks/steps_results.md,
+                        ! section 8): inputs/knit3d.nml at t = 1.95 took 4 rounds and 25
+                        ! iterations through all-stick and halving, now 2 and 12; the planar
+                        ! 4 x 2 cell at max_step 0.05, 24 rounds and 122 iterations, now 2.
+                        sign_tried = .true.
+                        failed_mode = self%mode_trial
+                        call stop_flowing_back(self%newton_full%u(n_x + 1:), self%flow, &
+                            self%mode_trial, unknowns(n_x + 1:), stopped)
+                        if (stopped) then
+                            call record_changes(self%trace, failed_mode, self%mode_trial)
+                            deallocate(error)
+                            cycle
+                        end if
+                    end if
                     ! A fixed active set may have no solution nearby. Go back to the last
                     ! solved state and let fewer passages start slipping at once (half as
                     ! many, most violated first); without such a state, restart from
@@ -547,6 +571,33 @@ contains
         end associate
     end subroutine finish_monolithic
 
+    !> The slipping passages whose flow went back at `iterate` (the last iterate of a
+    !> failed solve) stick, with their flows (in `flow`) at the `accepted` values, if some
+    !> but not all of them did; `stopped`: they were changed.
+    subroutine stop_flowing_back(iterate, accepted, mode, flow, stopped)
+        real(wp), intent(in) :: iterate(:), accepted(:)
+        integer, intent(inout) :: mode(:)
+        real(wp), intent(inout) :: flow(:)
+        logical, intent(out) :: stopped
+        logical :: back(size(mode))
+
+        back = flows_back(mode, iterate - accepted)
+        stopped = any(back) .and. count(back) < count(mode /= mode_stick)
+        if (.not. stopped) return
+        where (back)
+            mode = mode_stick
+            flow = accepted
+        end where
+    end subroutine stop_flowing_back
+
+    !> A slipping passage (mode) whose flow `increment` has the wrong sign.
+    elemental logical function flows_back(mode, increment)
+        integer, intent(in) :: mode
+        real(wp), intent(in) :: increment
+        flows_back = (mode == mode_forward .and. increment < 0.0_wp) &
+            .or. (mode == mode_backward .and. increment > 0.0_wp)
+    end function flows_back
+
     !> Update the active set from the solved state held in `problem` (its update_state
     !> was called at the solution). `flow` are the solved flows, `accepted` those at the
     !> start of the step. Returns the number of passages whose mode changed.
@@ -589,7 +640,7 @@ contains
                         locked_backward(p), direction_p, measure)
                     if (direction_p /= mode_stick) call add_candidate(direction_p, measure)
                 case (mode_forward)
-                    if (increment < 0.0_wp) new_mode = mode_stick
+                    if (flows_back(mode(p), increment)) new_mode = mode_stick
                     ! Forward flow shortens the element before the node.
                     if (problem%length0(before) < min_before) then
                         new_mode = mode_stick
@@ -599,7 +650,7 @@ contains
                             - min_before) / passages%share(before)
                     end if
                 case (mode_backward)
-                    if (increment > 0.0_wp) new_mode = mode_stick
+                    if (flows_back(mode(p), increment)) new_mode = mode_stick
                     if (problem%length0(after) < min_after) then
                         new_mode = mode_stick
                         locked_backward(p) = .true.
