@@ -69,6 +69,9 @@ module yarnfort_contact_friction_stepper
     !> tensions at convergence (residual_tolerance times their level plus rounding).
     real(wp), parameter :: dead_band_factor = 10.0_wp
 
+    !> Chord steps after the first Newton step of a monolithic solve (newton_solver_type).
+    integer, parameter :: chord_steps = 3
+
     !> Outcomes of the predictor (predict).
     integer, parameter :: predicted_state = 1, reversed = -1
 
@@ -282,6 +285,8 @@ contains
                 ! new slip or none is solved again with the fallbacks.
                 self%newton_full%quick = any(self%mode_trial /= mode_stick) .and. .not. full_retry
                 full_retry = .false.
+                ! Chord steps in the step's first solve only (measured below at chord_steps).
+                self%newton_full%chord_steps = merge(chord_steps, 0, round == 1)
                 call self%newton_full%solve(unknowns, stats, error)
                 iterations = iterations + stats%iterations
                 call record_solve(self%trace, stats, allocated(error))
