@@ -120,6 +120,8 @@ module yarnfort_solver_newton
     contains
         !> Solve for unknowns u (in: initial guess, out: solution).
         procedure :: solve
+        !> One Newton step from u, without a convergence test.
+        procedure :: take_newton_step
         !> Timing and counters of assembly and linear algebra so far.
         procedure :: get_timings
         procedure :: destroy
@@ -398,57 +400,45 @@ contains
         logical, intent(out) :: converged
         type(error_type), allocatable, intent(out) :: error
         type(error_type), allocatable :: trial_error
-        real(wp), allocatable :: residual(:), step(:), trial(:), values(:), history(:)
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        real(wp), allocatable :: residual(:), step(:), kept(:), history(:)
         real(wp) :: f, f_trial
         integer :: k
 
         converged = .false.
-        associate(problem => self%problem%problem, n => size(u), &
-                tol => self%options%residual_tolerance)
-            allocate(col_ptr(n + 1), row_index(self%problem%nnz), values(self%problem%nnz))
-            call problem%copy_pattern(col_ptr, row_index)
-            call analyse_once(self, col_ptr, row_index, error)
+        associate(problem => self%problem%problem, tol => self%options%residual_tolerance)
+            call start_newton(self, u, error)
             if (allocated(error)) return
-            call problem%prepare_solve(u, error)
-            if (allocated(error)) return
-            allocate(residual(n), step(n))
-            self%u = u
-            call get_scaled_residual(self, self%u, residual, f, trial_error)
+            allocate(residual(size(u)), step(size(u)))
+            call get_scaled_residual(self, residual, f, trial_error)
             stats%residual_evaluations = stats%residual_evaluations + 1
             if (allocated(trial_error)) return
             history = [f]
             if (f > tol) then
-                call problem%evaluate_jacobian(self%u, values, trial_error)
-                if (.not. allocated(trial_error)) call self%linear%factor(values, trial_error)
+                call newton_step(self, residual, trial_error)
                 stats%jacobian_evaluations = stats%jacobian_evaluations + 1
                 if (allocated(trial_error)) return
-                step = -residual
-                call self%linear%solve(step, trial_error)
-                if (allocated(trial_error)) return
                 stats%iterations = stats%iterations + 1
-                trial = self%u + step
-                call get_scaled_residual(self, trial, residual, f, trial_error)
+                call get_scaled_residual(self, residual, f, trial_error)
                 stats%residual_evaluations = stats%residual_evaluations + 1
                 if (allocated(trial_error)) return
-                self%u = trial
                 history = [history, f]
                 do k = 1, self%chord_steps
                     if (f <= tol / 100) exit
                     step = -residual
                     call self%linear%solve(step, trial_error)
                     if (allocated(trial_error)) exit
-                    trial = self%u + step
-                    call get_scaled_residual(self, trial, residual, f_trial, trial_error)
+                    kept = self%u
+                    self%u = self%u + step
+                    call get_scaled_residual(self, residual, f_trial, trial_error)
                     stats%residual_evaluations = stats%residual_evaluations + 1
-                    if (allocated(trial_error)) exit
-                    if (.not. (f_trial <= f / 10)) exit
-                    self%u = trial
+                    if (allocated(trial_error) .or. .not. (f_trial <= f / 10)) then
+                        self%u = kept
+                        exit
+                    end if
                     f = f_trial
                     history = [history, f]
                 end do
             end if
-            ! Not converged: the caller goes on from the better of the start and here.
             if (f < history(1)) u = self%u
             if (.not. (f <= tol)) return
             call problem%check_solution(self%u, trial_error)
@@ -456,28 +446,79 @@ contains
             converged = .true.
             stats%residual_norm = f
             stats%residual_history = history
-            u = self%u
         end associate
     end subroutine solve_chord
 
-    !> The residual at v and its scaled max-norm with the row levels taken at v.
-    subroutine get_scaled_residual(self, v, residual, f, error)
+    !> u <- u + one Newton step of the exact law from u (no convergence test): the
+    !> direction a solve from u sets out in.
+    subroutine take_newton_step(self, u, error)
         class(newton_solver_type), intent(inout) :: self
-        real(wp), intent(in) :: v(:)
+        real(wp), intent(inout) :: u(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: residual(:)
+
+        associate(problem => self%problem%problem)
+            problem%spring = 0.0_wp
+            problem%tangent_spring = self%options%slack_stiffness
+            call start_newton(self, u, error)
+            if (allocated(error)) return
+            allocate(residual(size(u)))
+            call problem%evaluate_residual(self%u, residual, error)
+            if (allocated(error)) return
+            call newton_step(self, residual, error)
+            if (allocated(error)) return
+            u = self%u
+        end associate
+    end subroutine take_newton_step
+
+    !> Analyse the pattern (once), fix the problem's solve-wide weights at u, self%u = u.
+    subroutine start_newton(self, u, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        type(error_type), allocatable, intent(out) :: error
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+
+        allocate(col_ptr(size(u) + 1), row_index(self%problem%nnz))
+        call self%problem%problem%copy_pattern(col_ptr, row_index)
+        call analyse_once(self, col_ptr, row_index, error)
+        if (allocated(error)) return
+        call self%problem%problem%prepare_solve(u, error)
+        if (allocated(error)) return
+        self%u = u
+    end subroutine start_newton
+
+    !> self%u <- self%u - J(self%u)^-1 residual (the residual at self%u, whose state the
+    !> problem holds); the factors stay for chord steps.
+    subroutine newton_step(self, residual, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: residual(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: values(:), step(:)
+
+        allocate(values(self%problem%nnz))
+        call self%problem%problem%evaluate_jacobian(self%u, values, error)
+        if (allocated(error)) return
+        call self%linear%factor(values, error)
+        if (allocated(error)) return
+        step = -residual
+        call self%linear%solve(step, error)
+        if (allocated(error)) return
+        self%u = self%u + step
+    end subroutine newton_step
+
+    !> The residual at self%u and its scaled max-norm, the row levels taken there.
+    subroutine get_scaled_residual(self, residual, f, error)
+        class(newton_solver_type), intent(inout) :: self
         real(wp), intent(out) :: residual(:), f
         type(error_type), allocatable, intent(out) :: error
-        real(wp), allocatable :: kept(:)
 
         f = huge(1.0_wp)
-        kept = self%u
-        self%u = v
         call set_row_weights(self, .false., error)
-        self%u = kept
         if (allocated(error)) return
-        call self%problem%problem%evaluate_residual(v, residual, error)
+        call self%problem%problem%evaluate_residual(self%u, residual, error)
         if (allocated(error)) return
         if (.not. all(ieee_is_finite(residual))) then
-            call fatal_error(error, 'the residual is not a finite number')
+            call fatal_error(error, 'the residual is not a finite number (NaN or an overflow)')
             return
         end if
         f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
