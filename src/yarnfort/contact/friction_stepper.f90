@@ -70,7 +70,11 @@ module yarnfort_contact_friction_stepper
     !> tensions at convergence (residual_tolerance times their level plus rounding).
     real(wp), parameter :: dead_band_factor = 10.0_wp
 
-    !> Chord steps after the first Newton step of a monolithic solve (newton_solver_type).
+    !> Chord steps after the first Newton step of a step's first monolithic solve
+    !> (newton_solver_type%chord_steps). Measured (benchmarks/steps_results.md, section
+    !> 8), Newton iterations (factorisations) per step: inputs/knit_clamped.nml 4.42 ->
+    !> 3.65, woven 2,200 aligned 1.68 -> 1.18. In every round's solve instead, the planar
+    !> 4 x 2 periodic knit at max_step 0.05 cut a step at the end of the release.
     integer, parameter :: chord_steps = 3
 
     !> Outcomes of the predictor (predict).
@@ -287,7 +291,7 @@ contains
                 ! new slip or none is solved again with the fallbacks.
                 self%newton_full%quick = any(self%mode_trial /= mode_stick) .and. .not. full_retry
                 full_retry = .false.
-                ! Chord steps in the step's first solve only (measured below at chord_steps).
+                ! Chord steps in the step's first solve only (measured: chord_steps).
                 self%newton_full%chord_steps = merge(chord_steps, 0, round == 1)
                 start = unknowns
                 call self%newton_full%solve(unknowns, stats, error)
