@@ -422,7 +422,8 @@ contains
                 stats%residual_evaluations = stats%residual_evaluations + 1
                 if (allocated(trial_error)) return
                 history = [history, f]
-                do k = 1, self%chord_steps
+                ! The Newton step and the chord steps together within max_iterations.
+                do k = 1, min(self%chord_steps, self%options%max_iterations - 1)
                     if (f <= tol / 100) exit
                     step = -residual
                     call self%linear%solve(step, trial_error)
