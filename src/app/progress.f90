@@ -42,7 +42,12 @@ contains
         write(error_unit, '("  newton ", i3, "  residual ", es9.2, "  ", f8.3, " s")', &
             advance='no') state%newton_iterations, state%newton%residual_norm, state%wall_time
         if (state%n_passages > 0) then
-            write(error_unit, '("  slipping ", i0, "/", i0)') state%n_slipping, state%n_passages
+            write(error_unit, '("  slipping ", i0, "/", i0)', advance='no') state%n_slipping, &
+                state%n_passages
+            ! Passages held in stick by chatter damping: rare, so named only when present.
+            if (state%n_held > 0) write(error_unit, '("  held ", i0)', advance='no') &
+                state%n_held
+            write(error_unit, '()')
         else
             write(error_unit, '()')
         end if

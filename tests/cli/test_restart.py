@@ -25,8 +25,8 @@ VNET = (TOP / "inputs" / "vnet.nml").read_text()
 #: residual (below the tolerance, its digits are round-off).
 NOT_COMPARED = {"wall_time", "residual"}
 #: Counts that must agree exactly.
-INTEGER_COLUMNS = {"step", "direction", "slipping", "passages", "newton_iterations",
-                   "step_cuts"}
+INTEGER_COLUMNS = {"step", "direction", "slipping", "held", "passages",
+                   "newton_iterations", "step_cuts"}
 #: Largest difference allowed between the restarted and the uninterrupted curve,
 #: relative to the largest magnitude in the column. The restarted run repeats every
 #: operation of the uninterrupted one from the same bits, except that the linear

@@ -220,6 +220,7 @@ contains
         self%u_trial = self%u
         self%flow_trial = self%flow
         self%mode_trial = self%mode
+        self%n_damped = 0
         if (self%staggered) then
             call try_staggered(self, stats, iterations, error)
         else
@@ -495,6 +496,10 @@ contains
                 deallocate(level, noise)
                 if (residual_norm <= scene%solver%residual_tolerance &
                         .and. all(self%mode_trial == mode_before)) then
+                    ! The sliding solve's state is this one (positions u_trial, flows
+                    ! flow_trial): its held passages must be within their limit too.
+                    call check_damped(sliding, flips, locked_forward, locked_backward, error)
+                    if (allocated(error)) return
                     self%n_damped = count(flips > max_flips)
                     return
                 end if
@@ -1004,6 +1009,7 @@ contains
         call fill_step_state(self%scene, self%u, length0, self%factors, state, error)
         state%n_passages = size(self%mode)
         state%n_slipping = count(self%mode /= mode_stick)
+        state%n_held = self%n_damped
     end subroutine get_state
 
     !> Everything a step depends on besides the scene: the accepted state (whose flows

@@ -554,7 +554,13 @@ contains
         allocate(scene%passages%at_start(scene%network%n_elements()), source=0)
         allocate(scene%passages%at_end(scene%network%n_elements()), source=0)
         allocate(scene%passages%share(scene%network%n_elements()), source=1.0_wp)
-        allocate(yarn(0), at_node(0), before(0), after(0), laws(0))
+        ! At most every interior node of every yarn is a passage (filled below, trimmed
+        ! by store_passages; appending one at a time was quadratic: 20 s of the 29 s
+        ! set-up of the 100 x 100 knit, benchmarks/knit100.nml).
+        n_passages = sum([(max(size(config%yarns(y)%nodes) - 2, 0), y = 1, n_yarns)])
+        allocate(yarn(n_passages), at_node(n_passages), before(n_passages), &
+            after(n_passages), laws(n_passages))
+        n_passages = 0
         if (size(config%contacts) == 0) then
             call store_passages()
             return
@@ -606,7 +612,6 @@ contains
         ! other visit of the node (other yarns, or other passes of the same yarn); pairs
         ! without a &contact do not count. None: a plain shared node. Several different
         ! ones: an error (the law would depend on the order of the input).
-        n_passages = 0
         do y = 1, n_yarns
             do k = 2, size(config%yarns(y)%nodes) - 1
                 node = config%yarns(y)%nodes(k)
@@ -617,12 +622,12 @@ contains
                 ! The elements before and after the node along the yarn.
                 e = scene%network%yarn_first_element(y) - 1 &
                     + (k - 1) * config%yarns(y)%elements_per_segment
-                yarn = [yarn, y]
-                at_node = [at_node, node]
-                before = [before, e]
-                after = [after, e + 1]
-                laws = [laws, c]
                 n_passages = n_passages + 1
+                yarn(n_passages) = y
+                at_node(n_passages) = node
+                before(n_passages) = e
+                after(n_passages) = e + 1
+                laws(n_passages) = c
                 ! Every element of the segments before and after the node.
                 m = config%yarns(y)%elements_per_segment
                 scene%passages%at_end(e - m + 1:e) = n_passages
@@ -642,11 +647,11 @@ contains
     contains
         !> Hand the passages found (none without &contact groups) to the scene.
         subroutine store_passages()
-            scene%passages%yarn = yarn
-            scene%passages%node = at_node
-            scene%passages%element_before = before
-            scene%passages%element_after = after
-            scene%passages%law = laws
+            scene%passages%yarn = yarn(1:n_passages)
+            scene%passages%node = at_node(1:n_passages)
+            scene%passages%element_before = before(1:n_passages)
+            scene%passages%element_after = after(1:n_passages)
+            scene%passages%law = laws(1:n_passages)
         end subroutine store_passages
 
         !> The &contact of yarn y's k-th listed node (visits at `node`, a root), or 0.

@@ -29,6 +29,9 @@ module yarnfort_solver_stepper
         integer :: newton_iterations = 0
         !> Friction: passages that slipped in this step, and all sliding passages.
         integer :: n_slipping = 0, n_passages = 0
+        !> Friction: passages held in stick by chatter damping in this step (their mode
+        !> flipped too often; each ended within its limit, else the step failed).
+        integer :: n_held = 0
         !> 1 while the load factors grow, -1 while they shrink, 0 at rest.
         integer :: direction = 0
         !> Step cuts before this step converged, and its wall time in seconds.
