@@ -599,8 +599,8 @@ contains
     end subroutine finish_monolithic
 
     !> The slipping passages whose flow went back at `iterate` (a Newton step from the
-    !> start of a failed solve) stick, with their flows (in `flow`) at the `accepted` values, if some
-    !> but not all of them did; `stopped`: they were changed.
+    !> start of a failed solve) stick, with their flows (in `flow`) at the `accepted`
+    !> values, if some but not all of them did; `stopped`: they were changed.
     subroutine stop_flowing_back(iterate, accepted, mode, flow, stopped)
         real(wp), intent(in) :: iterate(:), accepted(:)
         integer, intent(inout) :: mode(:)
