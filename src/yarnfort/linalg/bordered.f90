@@ -43,6 +43,11 @@ module yarnfort_linalg_bordered
         !> and their values at the last factorisation.
         integer(ik), allocatable :: c_entry(:), c_row(:), c_column(:)
         real(wp), allocatable :: c_values(:)
+        !> Factorisations through the border and through `general` (any reason), the
+        !> border unknowns of all of them summed and their most, and the failed
+        !> factorisations of K: what the border limit is judged by (bench_friction).
+        integer :: n_border_factors = 0, n_general_factors = 0, n_leading_failures = 0
+        integer(ik) :: width_sum = 0, max_width = 0
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
@@ -153,15 +158,21 @@ contains
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
 
+        self%width_sum = self%width_sum + (self%n - self%n_leading)
+        self%max_width = max(self%max_width, self%n - self%n_leading)
         if (self%use_border) then
             call factor_border(self, values, error)
-            if (.not. allocated(error)) return
+            if (.not. allocated(error)) then
+                self%n_border_factors = self%n_border_factors + 1
+                return
+            end if
             deallocate(error)
             self%use_border = .false.
             call self%general%analyse(self%n, int(self%col_ptr, ik), int(self%row_index, ik), &
                 error)
             if (allocated(error)) return
         end if
+        self%n_general_factors = self%n_general_factors + 1
         call self%general%factor(values, error)
     end subroutine factor_values
 
@@ -173,14 +184,17 @@ contains
         integer(ik) :: m, c, k, j
 
         call self%leading%factor(values(self%source), error)
-        if (allocated(error)) return
+        if (allocated(error)) then
+            self%n_leading_failures = self%n_leading_failures + 1
+            return
+        end if
         m = self%n - self%n_leading
         if (m == 0) return
         if (allocated(self%coupling)) deallocate(self%coupling)
         allocate(self%coupling(self%n_leading, m), s(m, m))
         s = 0.0_wp
         self%coupling = 0.0_wp
-        ! B's and D's columns, then K^-1 B column by column.
+        ! B's and D's columns, then K^-1 B in one solve of m columns.
         do c = 1, m
             j = self%n_leading + c
             do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
@@ -190,9 +204,9 @@ contains
                     s(self%row_index(k) + 1 - self%n_leading, c) = values(k)
                 end if
             end do
-            call self%leading%solve(self%coupling(:, c), error)
-            if (allocated(error)) return
         end do
+        call self%leading%solve_columns(self%coupling, error)
+        if (allocated(error)) return
         self%c_values = values(self%c_entry)
         do k = 1, size(self%c_entry, kind=ik)
             s(self%c_row(k), :) = s(self%c_row(k), :) &
