@@ -265,6 +265,56 @@ contains
         end select
     end subroutine write_border_counts
 
+    !> The `border costs:` line: CPU ms of yarnfort's CHOLMOD factorisation of the elastic
+    !> Jacobian at the final state (the bordered solver's K) and of its solves, per
+    !> column, with 1, 8 and 32 columns at once (what each border unknown costs).
+    subroutine write_border_costs(n, col_ptr, row_index, values)
+        integer(ik), intent(in) :: n, col_ptr(:), row_index(:)
+        real(wp), intent(in) :: values(:)
+        integer, parameter :: widths(3) = [1, 8, 32]
+        real(wp), parameter :: target_seconds = 0.3_wp
+        class(linear_solver_type), allocatable :: solver
+        real(wp), allocatable :: rhs(:, :)
+        real(wp) :: factor_ms, column_ms(size(widths)), start, finish
+        integer :: k, repeats
+
+        call new_linear_solver(solver, 'cholmod', error)
+        if (allocated(error)) call fail('bench_friction', error)
+        call solver%analyse(n, col_ptr, row_index, error)
+        if (allocated(error)) call fail('bench_friction', error)
+        repeats = 0
+        call cpu_time(start)
+        finish = start
+        do while (finish - start < target_seconds .or. repeats == 0)
+            call solver%factor(values, error)
+            if (allocated(error)) then
+                write(output_unit, '(a)') 'border costs: ' // error%message
+                return
+            end if
+            repeats = repeats + 1
+            call cpu_time(finish)
+        end do
+        factor_ms = 1e3_wp * (finish - start) / repeats
+        do k = 1, size(widths)
+            allocate(rhs(n, widths(k)))
+            repeats = 0
+            call cpu_time(start)
+            finish = start
+            do while (finish - start < target_seconds .or. repeats == 0)
+                rhs = 1.0_wp
+                call solver%solve_columns(rhs, error)
+                if (allocated(error)) call fail('bench_friction', error)
+                repeats = repeats + 1
+                call cpu_time(finish)
+            end do
+            column_ms(k) = 1e3_wp * (finish - start) / (repeats * widths(k))
+            deallocate(rhs)
+        end do
+        write(output_unit, '(a, f0.3, a, 3(a, i0, a, f0.4, a))') 'border costs: K factor ', &
+            factor_ms, ' ms; solve per column', (' (', widths(k), ' at once) ', &
+            column_ms(k), ' ms', k = 1, size(widths))
+    end subroutine write_border_costs
+
     !> The `iteration:` line: CPU ms of one Newton iteration at the final state
     !> (residual, Jacobian, factorisation and solve with the solver the run used) of the
     !> monolithic friction problem and of the elastic problem of the same net (its
@@ -398,6 +448,7 @@ contains
         if (time_factors) then
             call measure_floor('cholmod', n_elastic, col_ptr, row_index, values, elastic, error)
             if (allocated(error)) call fail('bench_friction', error)
+            call write_border_costs(n_elastic, col_ptr, row_index, values)
         end if
         write(output_unit, '(a, i0, a, i0, a, 4(es9.2, a, f8.2, a), a, i0, a, i0, a, &
             & es9.2, a, f8.2, a, f8.2, a, 5(f5.1, a))') &

@@ -23,6 +23,8 @@ module yarnfort_linalg_bordered
     !> Most border unknowns handled through the Schur complement: each costs a solve with
     !> K's factors per factorisation and n_leading reals of memory.
     integer(ik), parameter :: default_max_border = 8
+    !> Most patterns sent to `general` after K failed to factor, before K is tried again.
+    integer, parameter :: max_skip_patterns = 16
 
     type, extends(direct_solver_type) :: bordered_solver_type
         !> Order of the symmetric leading block (set by the owner before analyse).
@@ -48,6 +50,10 @@ module yarnfort_linalg_bordered
         !> factorisations of K: what the border limit is judged by (bench_friction).
         integer :: n_border_factors = 0, n_general_factors = 0, n_leading_failures = 0
         integer(ik) :: width_sum = 0, max_width = 0
+        !> After K failed to factor (not positive definite), the next `skip_patterns`
+        !> patterns go to `general` without trying K again; the skip doubles with each
+        !> failure in a row (up to max_skip_patterns) and is reset when K factors.
+        integer :: skip_patterns = 0, next_skip = 1
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
@@ -71,6 +77,10 @@ contains
         end if
         m = self%n - self%n_leading
         self%use_border = self%n_leading > 0 .and. m >= 0 .and. m <= self%max_border
+        if (self%use_border .and. self%skip_patterns > 0) then
+            self%skip_patterns = self%skip_patterns - 1
+            self%use_border = .false.
+        end if
         if (.not. self%use_border) then
             call self%general%analyse(self%n, int(self%col_ptr, ik), int(self%row_index, ik), &
                 error)
@@ -186,8 +196,11 @@ contains
         call self%leading%factor(values(self%source), error)
         if (allocated(error)) then
             self%n_leading_failures = self%n_leading_failures + 1
+            self%skip_patterns = self%next_skip
+            self%next_skip = min(2 * self%next_skip, max_skip_patterns)
             return
         end if
+        self%next_skip = 1
         m = self%n - self%n_leading
         if (m == 0) return
         if (allocated(self%coupling)) deallocate(self%coupling)

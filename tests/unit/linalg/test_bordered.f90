@@ -37,7 +37,9 @@ contains
             new_unittest('several columns at once against one by one and dense', &
                 test_solve_columns), &
             new_unittest('the border against a dense solve of the whole matrix', &
-                test_border_against_dense) &
+                test_border_against_dense), &
+            new_unittest('a failed leading block is remembered for the next patterns', &
+                test_remembered_failure) &
             ]
     end subroutine collect_bordered
 
@@ -92,12 +94,19 @@ contains
         end do
     end subroutine to_csc
 
-    subroutine new_bordered(solver, error)
+    !> K by `leading_name` (default CHOLMOD falling back to KLU), the whole by KLU or
+    !> UMFPACK.
+    subroutine new_bordered(solver, error, leading_name)
         type(bordered_solver_type), intent(out) :: solver
         type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in), optional :: leading_name
 
         solver%n_leading = n_leading
-        call new_linear_solver(solver%leading, 'cholmod+klu', error)
+        if (present(leading_name)) then
+            call new_linear_solver(solver%leading, leading_name, error)
+        else
+            call new_linear_solver(solver%leading, 'cholmod+klu', error)
+        end if
         if (allocated(error)) return
         call new_linear_solver(solver%general, chosen_lu_name, error)
     end subroutine new_bordered
@@ -293,5 +302,29 @@ contains
             if (allocated(error)) return
         end do
     end subroutine test_border_against_dense
+
+    !> K by CHOLMOD alone, singular for five patterns, then regular: each pattern solved
+    !> right; K tried at the 1st, 3rd (after skipping one pattern) and 6th pattern (after
+    !> two; it factors there, and the border is used again).
+    subroutine test_remembered_failure(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(bordered_solver_type) :: solver
+        character(len=:), allocatable :: name
+        integer, parameter :: expected_failures(6) = [1, 1, 2, 2, 2, 2]
+        integer :: k
+
+        call new_bordered(solver, error, 'cholmod')
+        if (allocated(error)) return
+        do k = 1, size(expected_failures)
+            call solve_known(solver, order, k <= 5, name, error)
+            if (allocated(error)) return
+            call check(error, solver%n_leading_failures == expected_failures(k), &
+                'pattern ' // achar(iachar('0') + k) // ': unexpected count of K''s failures')
+            if (allocated(error)) return
+            call check(error, (index(name, 'bordered+') == 1) .eqv. (k == 6), &
+                'pattern ' // achar(iachar('0') + k) // ': unexpected path ' // name)
+            if (allocated(error)) return
+        end do
+    end subroutine test_remembered_failure
 
 end module test_bordered
