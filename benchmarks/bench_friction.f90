@@ -248,18 +248,20 @@ contains
 
     !> The `bordered:` line: the reduced systems' factorisations through the border and
     !> through the whole-matrix LU, their border unknowns (slipping flows; mean over all
-    !> factorisations and most), K's failed factorisations and K's solver at the end.
+    !> factorisations and most), K's failed factorisations, the patterns sent to the LU
+    !> after them without trying K, and K's solver at the end.
     subroutine write_border_counts()
         select type (linear => stepper%newton_full%linear)
         type is (condensed_solver_type)
             select type (inner => linear%inner)
             type is (bordered_solver_type)
-                write(output_unit, '(a, i0, a, i0, a, i0, a, f0.2, a, i0, a, i0, a)') &
+                write(output_unit, '(a, i0, a, i0, a, i0, a, f0.2, a, i0, a, i0, a, i0, a)') &
                     'bordered: limit ', inner%max_border, ' factorisations border ', &
                     inner%n_border_factors, ' general ', inner%n_general_factors, &
                     ' width mean ', real(inner%width_sum, wp) &
                     / max(1, inner%n_border_factors + inner%n_general_factors), ' max ', &
                     inner%max_width, ' leading failures ', inner%n_leading_failures, &
+                    ' skipped patterns ', inner%n_skipped_patterns, &
                     ' leading ' // inner%leading%get_name()
             end select
         end select

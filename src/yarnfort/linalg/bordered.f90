@@ -62,6 +62,8 @@ module yarnfort_linalg_bordered
         !> patterns go to `general` without trying K again; the skip doubles with each
         !> failure in a row (up to max_skip_patterns) and is reset when K factors.
         integer :: skip_patterns = 0, next_skip = 1
+        !> Patterns sent to `general` that way.
+        integer :: n_skipped_patterns = 0
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
@@ -87,6 +89,7 @@ contains
         self%use_border = self%n_leading > 0 .and. m >= 0 .and. m <= self%max_border
         if (self%use_border .and. self%skip_patterns > 0) then
             self%skip_patterns = self%skip_patterns - 1
+            self%n_skipped_patterns = self%n_skipped_patterns + 1
             self%use_border = .false.
         end if
         if (.not. self%use_border) then

@@ -116,12 +116,7 @@ contains
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
 
-        if (.not. self%factored) then
-            call fatal_error(error, self%get_name() &
-                // ': solve called without a valid factorisation')
-            return
-        end if
-        call check_array_size(self%get_name(), 'rhs', size(rhs, kind=ik), self%n, error)
+        call check_solve(self, size(rhs, kind=ik), error)
         if (allocated(error)) return
         call self%solve_rhs(rhs, error)
     end subroutine solve
@@ -132,16 +127,24 @@ contains
         real(wp), intent(inout) :: rhs(:, :)
         type(error_type), allocatable, intent(out) :: error
 
+        call check_solve(self, size(rhs, 1, kind=ik), error)
+        if (allocated(error) .or. size(rhs, 2) == 0) return
+        call self%solve_rhs_columns(rhs, error)
+    end subroutine solve_columns
+
+    !> A valid factorisation and a right-hand side of n rows.
+    subroutine check_solve(self, rows, error)
+        class(direct_solver_type), intent(in) :: self
+        integer(ik), intent(in) :: rows
+        type(error_type), allocatable, intent(out) :: error
+
         if (.not. self%factored) then
             call fatal_error(error, self%get_name() &
                 // ': solve called without a valid factorisation')
             return
         end if
-        call check_array_size(self%get_name(), 'rhs rows', size(rhs, 1, kind=ik), self%n, &
-            error)
-        if (allocated(error) .or. size(rhs, 2) == 0) return
-        call self%solve_rhs_columns(rhs, error)
-    end subroutine solve_columns
+        call check_array_size(self%get_name(), 'rhs', rows, self%n, error)
+    end subroutine check_solve
 
     subroutine solve_rhs_columns(self, rhs, error)
         class(direct_solver_type), intent(inout) :: self
