@@ -269,14 +269,14 @@ contains
 
     !> The `border costs:` line: CPU ms of yarnfort's CHOLMOD factorisation of the elastic
     !> Jacobian at the final state (the bordered solver's K) and of its solves, per
-    !> column, with 1, 8 and 32 columns at once (what each border unknown costs).
+    !> column, with 1, 8 and 32 columns at once (what each border unknown costs), and 4
+    !> at once followed by 1.
     subroutine write_border_costs(n, col_ptr, row_index, values)
         integer(ik), intent(in) :: n, col_ptr(:), row_index(:)
         real(wp), intent(in) :: values(:)
         integer, parameter :: widths(3) = [1, 8, 32]
         real(wp), parameter :: target_seconds = 0.3_wp
         class(linear_solver_type), allocatable :: solver
-        real(wp), allocatable :: rhs(:, :)
         real(wp) :: factor_ms, column_ms(size(widths)), start, finish
         integer :: k, repeats
 
@@ -298,22 +298,28 @@ contains
         end do
         factor_ms = 1e3_wp * (finish - start) / repeats
         do k = 1, size(widths)
-            allocate(rhs(n, widths(k)))
-            repeats = 0
-            call cpu_time(start)
-            finish = start
-            do while (finish - start < target_seconds .or. repeats == 0)
-                rhs = 1.0_wp
-                call solver%solve_columns(rhs, error)
-                if (allocated(error)) call fail('bench_friction', error)
-                repeats = repeats + 1
-                call cpu_time(finish)
-            end do
-            column_ms(k) = 1e3_wp * (finish - start) / (repeats * widths(k))
-            deallocate(rhs)
+            column_ms(k) = solve_ms(solver, n, widths(k), .false.)
         end do
-        ! 4 columns at once, then 1 (as the border's solve and a Newton step alternate).
-        allocate(rhs(n, 4))
+        write(output_unit, '(a, f0.3, a, 3(a, i0, a, f0.4, a), a, f0.4, a)') &
+            'border costs: K factor ', factor_ms, ' ms; solve per column', &
+            (' (', widths(k), ' at once) ', column_ms(k), ' ms', k = 1, size(widths)), &
+            ' (4 at once, then 1) ', solve_ms(solver, n, 4, .true.), ' ms'
+
+    end subroutine write_border_costs
+
+    !> CPU ms per column of `width` columns solved at once by `solver` (then one more
+    !> column alone, as the border's solve and a Newton step alternate, with `then_one`).
+    real(wp) function solve_ms(solver, n, width, then_one)
+        class(linear_solver_type), intent(inout) :: solver
+        integer(ik), intent(in) :: n
+        integer, intent(in) :: width
+        logical, intent(in) :: then_one
+        real(wp), parameter :: target_seconds = 0.3_wp
+        real(wp), allocatable :: rhs(:, :)
+        real(wp) :: start, finish
+        integer :: repeats
+
+        allocate(rhs(n, width))
         repeats = 0
         call cpu_time(start)
         finish = start
@@ -321,17 +327,13 @@ contains
             rhs = 1.0_wp
             call solver%solve_columns(rhs, error)
             if (allocated(error)) call fail('bench_friction', error)
-            call solver%solve(rhs(:, 1), error)
+            if (then_one) call solver%solve(rhs(:, 1), error)
             if (allocated(error)) call fail('bench_friction', error)
             repeats = repeats + 1
             call cpu_time(finish)
         end do
-        write(output_unit, '(a, f0.3, a, 3(a, i0, a, f0.4, a), a, f0.4, a)') &
-            'border costs: K factor ', factor_ms, ' ms; solve per column', &
-            (' (', widths(k), ' at once) ', column_ms(k), ' ms', k = 1, size(widths)), &
-            ' (4 at once, then 1) ', 1e3_wp * (finish - start) / (5 * repeats), ' ms'
-
-    end subroutine write_border_costs
+        solve_ms = 1e3_wp * (finish - start) / (repeats * (width + merge(1, 0, then_one)))
+    end function solve_ms
 
     !> The `iteration:` line: CPU ms of one Newton iteration at the final state
     !> (residual, Jacobian, factorisation and solve with the solver the run used) of the
