@@ -9,7 +9,7 @@
 !> 2-3x faster than an LU factors the bordered matrix (benchmarks/results-scale.md). The
 !> pattern of K does not change with the active set: its analysis is kept for the next
 !> pattern while that block stays the same. K^-1 B is one solve of m columns (CHOLMOD
-!> applies its dense blocks to all of them at once: 1.5-3.7x cheaper per column than m
+!> applies its dense blocks to all of them at once: 1.4-3.7x cheaper per column than m
 !> single solves). A K that fails to factor sends the next patterns to `general` without
 !> trying K (1, 2, 4, ... patterns while it keeps failing).
 module yarnfort_linalg_bordered
