@@ -42,7 +42,7 @@ end module bench_friction_counter
 !> Benchmark of a load/unload cycle with sliding on a generated crimped woven net.
 !>     bench_friction <crossings per side> <monolithic|staggered> [elements per segment
 !>                    [linear solver]] [--skewed] [--steps N] [--no-line-search]
-!>                    [--no-factor-times]
+!>                    [--no-factor-times] [--max-border M]
 !>     bench_friction --input <file.nml> <monolithic|staggered> [--steps N] ...
 !> --input: the scene of a namelist input (e.g. benchmarks/knit40.nml; relative file
 !> names in it are read from the working directory) instead of the woven net.
@@ -54,6 +54,7 @@ end module bench_friction_counter
 !> of 0.05 (N <= 20: loading only; for the largest nets). --no-line-search: Newton
 !> without KINSOL's line search. --no-factor-times: the `factors:` line without the
 !> timed factorisations (-1; they take longer than the run itself above 1e5 unknowns).
+!> --max-border M: the bordered solver's limit on slipping flows (default_max_border).
 !> Prints, for the whole cycle: unknowns, passages, load steps, Newton iterations and
 !> sparse factorisations per step, time per step, and the split of time between
 !> assembly, factorisation, solves and the rest; peak resident memory; process CPU time
@@ -103,7 +104,7 @@ program bench_friction
     type(counter_type) :: counter
     type(error_type), allocatable :: error
     real(wp) :: total, start, times(3, 5), cpu_start, cpu_total
-    integer :: side, per_segment, factorisations(3), n_positional, k, max_steps
+    integer :: side, per_segment, factorisations(3), n_positional, k, max_steps, max_border
     character(len=32) :: argument, scheme, positional(4)
     character(len=:), allocatable :: input_file
     logical :: skewed, line_search, time_factors
@@ -119,6 +120,7 @@ program bench_friction
     line_search = .true.
     time_factors = .true.
     max_steps = 0
+    max_border = -1
     n_positional = 0
     k = 0
     do while (k < command_argument_count())
@@ -136,6 +138,10 @@ program bench_friction
             allocate(character(len=4096) :: input_file)
             call get_command_argument(k, input_file)
             input_file = trim(input_file)
+        case ('--max-border')
+            k = k + 1
+            call get_command_argument(k, argument)
+            read(argument, *) max_border
         case ('--steps')
             k = k + 1
             call get_command_argument(k, argument)
@@ -190,6 +196,7 @@ program bench_friction
     if (allocated(error)) call fail('bench_friction', error)
     call new_friction_stepper(stepper, scene, get_linear_solver_name(scene), error)
     if (allocated(error)) call fail('bench_friction', error)
+    if (max_border >= 0) call set_max_border(max_border)
     call cpu_time(cpu_start)
     start = wall_time()
     call run_continuation(scene, stepper, counter, error)
@@ -216,6 +223,7 @@ program bench_friction
             100 * (total - assembly - factor - solve) / total, counter%max_slipping, &
             peak_memory_mib(), 1e3_wp * cpu_total / counter%steps
     end associate
+    call write_border_counts()
     if (associated(stepper%full)) call write_factors()
     ! Only where the run used its monolithic solver (a staggered run may never need its
     ! monolithic finish; its friction Jacobian was then never analysed).
@@ -224,6 +232,108 @@ program bench_friction
     end if
 
 contains
+
+    !> The bordered solver's limit (the monolithic solver's reduced systems).
+    subroutine set_max_border(limit)
+        integer, intent(in) :: limit
+
+        select type (linear => stepper%newton_full%linear)
+        type is (condensed_solver_type)
+            select type (inner => linear%inner)
+            type is (bordered_solver_type)
+                inner%max_border = limit
+            end select
+        end select
+    end subroutine set_max_border
+
+    !> The `bordered:` line: the reduced systems' factorisations through the border and
+    !> through the whole-matrix LU, their border unknowns (slipping flows; mean over all
+    !> factorisations and most), K's failed factorisations, the patterns sent to the LU
+    !> after them without trying K, and K's solver at the end.
+    subroutine write_border_counts()
+        select type (linear => stepper%newton_full%linear)
+        type is (condensed_solver_type)
+            select type (inner => linear%inner)
+            type is (bordered_solver_type)
+                write(output_unit, '(a, i0, a, i0, a, i0, a, f0.2, a, i0, a, i0, a, i0, a)') &
+                    'bordered: limit ', inner%max_border, ' factorisations border ', &
+                    inner%n_border_factors, ' general ', inner%n_general_factors, &
+                    ' width mean ', real(inner%width_sum, wp) &
+                    / max(1, inner%n_border_factors + inner%n_general_factors), ' max ', &
+                    inner%max_width, ' leading failures ', inner%n_leading_failures, &
+                    ' skipped patterns ', inner%n_skipped_patterns, &
+                    ' leading ' // inner%leading%get_name()
+            end select
+        end select
+    end subroutine write_border_counts
+
+    !> The `border costs:` line: CPU ms of yarnfort's CHOLMOD factorisation of the elastic
+    !> Jacobian at the final state (the bordered solver's K) and of its solves, per
+    !> column, with 1, 8 and 32 columns at once (what each border unknown costs), and 4
+    !> at once followed by 1.
+    subroutine write_border_costs(n, col_ptr, row_index, values)
+        integer(ik), intent(in) :: n, col_ptr(:), row_index(:)
+        real(wp), intent(in) :: values(:)
+        integer, parameter :: widths(3) = [1, 8, 32]
+        real(wp), parameter :: target_seconds = 0.3_wp
+        class(linear_solver_type), allocatable :: solver
+        real(wp) :: factor_ms, column_ms(size(widths)), start, finish
+        integer :: k, repeats
+
+        call new_linear_solver(solver, 'cholmod', error)
+        if (allocated(error)) call fail('bench_friction', error)
+        call solver%analyse(n, col_ptr, row_index, error)
+        if (allocated(error)) call fail('bench_friction', error)
+        repeats = 0
+        call cpu_time(start)
+        finish = start
+        do while (finish - start < target_seconds .or. repeats == 0)
+            call solver%factor(values, error)
+            if (allocated(error)) then
+                write(output_unit, '(a)') 'border costs: ' // error%message
+                return
+            end if
+            repeats = repeats + 1
+            call cpu_time(finish)
+        end do
+        factor_ms = 1e3_wp * (finish - start) / repeats
+        do k = 1, size(widths)
+            column_ms(k) = solve_ms(solver, n, widths(k), .false.)
+        end do
+        write(output_unit, '(a, f0.3, a, 3(a, i0, a, f0.4, a), a, f0.4, a)') &
+            'border costs: K factor ', factor_ms, ' ms; solve per column', &
+            (' (', widths(k), ' at once) ', column_ms(k), ' ms', k = 1, size(widths)), &
+            ' (4 at once, then 1) ', solve_ms(solver, n, 4, .true.), ' ms'
+
+    end subroutine write_border_costs
+
+    !> CPU ms per column of `width` columns solved at once by `solver` (then one more
+    !> column alone, as the border's solve and a Newton step alternate, with `then_one`).
+    real(wp) function solve_ms(solver, n, width, then_one)
+        class(linear_solver_type), intent(inout) :: solver
+        integer(ik), intent(in) :: n
+        integer, intent(in) :: width
+        logical, intent(in) :: then_one
+        real(wp), parameter :: target_seconds = 0.3_wp
+        real(wp), allocatable :: rhs(:, :)
+        real(wp) :: start, finish
+        integer :: repeats
+
+        allocate(rhs(n, width))
+        repeats = 0
+        call cpu_time(start)
+        finish = start
+        do while (finish - start < target_seconds .or. repeats == 0)
+            rhs = 1.0_wp
+            call solver%solve_columns(rhs, error)
+            if (allocated(error)) call fail('bench_friction', error)
+            if (then_one) call solver%solve(rhs(:, 1), error)
+            if (allocated(error)) call fail('bench_friction', error)
+            repeats = repeats + 1
+            call cpu_time(finish)
+        end do
+        solve_ms = 1e3_wp * (finish - start) / (repeats * (width + merge(1, 0, then_one)))
+    end function solve_ms
 
     !> The `iteration:` line: CPU ms of one Newton iteration at the final state
     !> (residual, Jacobian, factorisation and solve with the solver the run used) of the
@@ -358,6 +468,7 @@ contains
         if (time_factors) then
             call measure_floor('cholmod', n_elastic, col_ptr, row_index, values, elastic, error)
             if (allocated(error)) call fail('bench_friction', error)
+            call write_border_costs(n_elastic, col_ptr, row_index, values)
         end if
         write(output_unit, '(a, i0, a, i0, a, 4(es9.2, a, f8.2, a), a, i0, a, i0, a, &
             & es9.2, a, f8.2, a, f8.2, a, 5(f5.1, a))') &

@@ -5,6 +5,7 @@
     benchmarks/friction_table.py            # 1e3, 1e4, 1e5 and 1e6 unknowns
     benchmarks/friction_table.py --quick    # about 1e3 to 1e4 unknowns (a few minutes)
     benchmarks/friction_table.py --sides 6 22 --schemes monolithic
+    benchmarks/friction_table.py --bench /tmp/old/bench_friction --max-border 16
 
 build/benchmarks/bench_friction on crimped woven nets with 4 elements per segment, both
 schemes, on the aligned net and on the skewed one (--skewed: crossings moved by small
@@ -34,8 +35,10 @@ COLUMNS = ('scheme unknowns passages steps newton_per_step factor_per_step ms_pe
            'assembly_pct factor_pct solve_pct other_pct max_slipping peak_MiB cpu_ms_per_step').split()
 
 
-def run(side, scheme, skewed, steps, timeout):
-    command = [str(BENCH), str(side), scheme, '4']
+def run(side, scheme, skewed, steps, timeout, bench=BENCH, max_border=None):
+    command = [str(bench), str(side), scheme, '4']
+    if max_border is not None:
+        command += ['--max-border', str(max_border)]
     if skewed:
         command.append('--skewed')
     if steps:
@@ -56,6 +59,7 @@ def run(side, scheme, skewed, steps, timeout):
     row.update(zip(COLUMNS, main.split()))
     factors = next((line for line in lines if line.startswith('factors:')), '')
     row['factors'] = factors
+    row['bordered'] = next((line for line in lines if line.startswith('bordered:')), '')
     for key, pattern in (('lu_umfpack', r'umfpack +(\S+) \( *(\S+) ms\)'),
                          ('lu_klu', r'friction .*?klu-amd +(\S+) \( *(\S+) ms\)'),
                          ('cholmod', r'cholmod \( *(\S+) ms\)')):
@@ -96,10 +100,14 @@ def main():
                         help='load steps above --cycle-max (default %(default)s)')
     parser.add_argument('--timeout', type=float, default=None,
                         help='wall seconds per run (default: none)')
+    parser.add_argument('--bench', default=str(BENCH),
+                        help='bench_friction binary (e.g. a build of the commit before)')
+    parser.add_argument('--max-border', type=int, default=None,
+                        help="the bordered solver's limit (default: the build's)")
     args = parser.parse_args()
     sides = args.sides or (QUICK if args.quick else SIDES)
     subprocess.run([str(TOP / 'tools' / 'bootstrap')], stdin=subprocess.DEVNULL, check=True)
-    blas = subprocess.run(['ldd', str(BENCH)], capture_output=True, text=True).stdout
+    blas = subprocess.run(['ldd', args.bench], capture_output=True, text=True).stdout
     blas = re.search(r'libblas\.so\S* => (\S+)', blas)
     print('# Friction tables (benchmarks/friction_table.py '
           + ' '.join(sys.argv[1:]) + ')')
@@ -118,7 +126,8 @@ def main():
             for side in sides:
                 steps = args.steps if side > args.cycle_max else 0
                 print(f'# {net} {scheme} side {side} ...', file=sys.stderr, flush=True)
-                row = run(side, scheme, net == 'skewed', steps, args.timeout)
+                row = run(side, scheme, net == 'skewed', steps, args.timeout, args.bench,
+                          args.max_border)
                 row.update(net=net, scheme=scheme, side=side, cycle=not steps)
                 print(f'#   {row.get("failed") or row.get("ms_per_step") + " ms/step"}',
                       file=sys.stderr, flush=True)
@@ -161,6 +170,14 @@ def main():
               if timed else
               f'| {r["net"]} | {r["scheme"]} | {int(r["unknowns"]):,} | - | - | - | - '
               f'| {z[0]} % ({z[1]}, {z[2]}, {z[3]} %) | {z[4]} % |')
+    print()
+    print('Bordered solver of the reduced systems (`bordered:` line; border widths are the '
+          'slipping flows of each factorisation):')
+    print()
+    for r in rows:
+        if r.get('bordered'):
+            print(f'- {r["net"]} {r["scheme"]} {int(r["unknowns"]):,}: '
+                  + r['bordered'].removeprefix('bordered: '))
     print()
     print('Exponents (least-squares fit of CPU ms / step against unknowns, sizes run over '
           'the same kind of run; wall ms / step in brackets, which a loaded machine '

@@ -8,7 +8,10 @@
 !> load step of the woven net of 1e6 unknowns), and CHOLMOD factors the elastic tangent
 !> 2-3x faster than an LU factors the bordered matrix (benchmarks/results-scale.md). The
 !> pattern of K does not change with the active set: its analysis is kept for the next
-!> pattern while that block stays the same.
+!> pattern while that block stays the same. K^-1 B is one solve of m columns (CHOLMOD
+!> applies its dense blocks to all of them at once: 1.4-3.7x cheaper per column than m
+!> single solves). A K that fails to factor sends the next patterns to `general` without
+!> trying K (1, 2, 4, ... patterns while it keeps failing).
 module yarnfort_linalg_bordered
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -20,9 +23,16 @@ module yarnfort_linalg_bordered
 
     public :: bordered_solver_type, default_max_border
 
-    !> Most border unknowns handled through the Schur complement: each costs a solve with
-    !> K's factors per factorisation and n_leading reals of memory.
-    integer(ik), parameter :: default_max_border = 8
+    !> Most border unknowns handled through the Schur complement: each costs a column of
+    !> the solve with K's factors per factorisation and n_leading reals of memory. Set
+    !> from where the border stops paying (benchmarks/steps_results.md, h16t): (LU of the
+    !> whole + its analysis per pattern - CHOLMOD of K) / solve per column, CPU ms at the
+    !> final state: woven 2,200 unknowns ~5 (0.27 + 0.12 - 0.31 over 0.023), 10,120
+    !> aligned ~44 (5.65 + 1.1 - 2.28 over 0.10), skewed ~14 (4.52 + 1.0 - 3.62 over
+    !> 0.14), 96,600 ~22 (84.7 + 8 - 42.0 over 2.27), knit 40 x 40 ~100 (UMFPACK).
+    integer(ik), parameter :: default_max_border = 16
+    !> Most patterns sent to `general` after K failed to factor, before K is tried again.
+    integer, parameter :: max_skip_patterns = 16
 
     type, extends(direct_solver_type) :: bordered_solver_type
         !> Order of the symmetric leading block (set by the owner before analyse).
@@ -43,6 +53,17 @@ module yarnfort_linalg_bordered
         !> and their values at the last factorisation.
         integer(ik), allocatable :: c_entry(:), c_row(:), c_column(:)
         real(wp), allocatable :: c_values(:)
+        !> Factorisations through the border and through `general` (any reason), the
+        !> border unknowns of all of them summed and their most, and the failed
+        !> factorisations of K: what the border limit is judged by (bench_friction).
+        integer :: n_border_factors = 0, n_general_factors = 0, n_leading_failures = 0
+        integer(ik) :: width_sum = 0, max_width = 0
+        !> After K failed to factor (not positive definite), the next `skip_patterns`
+        !> patterns go to `general` without trying K again; the skip doubles with each
+        !> failure in a row (up to max_skip_patterns) and is reset when K factors.
+        integer :: skip_patterns = 0, next_skip = 1
+        !> Patterns sent to `general` that way.
+        integer :: n_skipped_patterns = 0
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
@@ -66,6 +87,11 @@ contains
         end if
         m = self%n - self%n_leading
         self%use_border = self%n_leading > 0 .and. m >= 0 .and. m <= self%max_border
+        if (self%use_border .and. self%skip_patterns > 0) then
+            self%skip_patterns = self%skip_patterns - 1
+            self%n_skipped_patterns = self%n_skipped_patterns + 1
+            self%use_border = .false.
+        end if
         if (.not. self%use_border) then
             call self%general%analyse(self%n, int(self%col_ptr, ik), int(self%row_index, ik), &
                 error)
@@ -153,15 +179,21 @@ contains
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
 
+        self%width_sum = self%width_sum + (self%n - self%n_leading)
+        self%max_width = max(self%max_width, self%n - self%n_leading)
         if (self%use_border) then
             call factor_border(self, values, error)
-            if (.not. allocated(error)) return
+            if (.not. allocated(error)) then
+                self%n_border_factors = self%n_border_factors + 1
+                return
+            end if
             deallocate(error)
             self%use_border = .false.
             call self%general%analyse(self%n, int(self%col_ptr, ik), int(self%row_index, ik), &
                 error)
             if (allocated(error)) return
         end if
+        self%n_general_factors = self%n_general_factors + 1
         call self%general%factor(values, error)
     end subroutine factor_values
 
@@ -173,14 +205,20 @@ contains
         integer(ik) :: m, c, k, j
 
         call self%leading%factor(values(self%source), error)
-        if (allocated(error)) return
+        if (allocated(error)) then
+            self%n_leading_failures = self%n_leading_failures + 1
+            self%skip_patterns = self%next_skip
+            self%next_skip = min(2 * self%next_skip, max_skip_patterns)
+            return
+        end if
+        self%next_skip = 1
         m = self%n - self%n_leading
         if (m == 0) return
         if (allocated(self%coupling)) deallocate(self%coupling)
         allocate(self%coupling(self%n_leading, m), s(m, m))
         s = 0.0_wp
         self%coupling = 0.0_wp
-        ! B's and D's columns, then K^-1 B column by column.
+        ! B's and D's columns, then K^-1 B in one solve of m columns.
         do c = 1, m
             j = self%n_leading + c
             do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
@@ -190,9 +228,9 @@ contains
                     s(self%row_index(k) + 1 - self%n_leading, c) = values(k)
                 end if
             end do
-            call self%leading%solve(self%coupling(:, c), error)
-            if (allocated(error)) return
         end do
+        call self%leading%solve_columns(self%coupling, error)
+        if (allocated(error)) return
         self%c_values = values(self%c_entry)
         do k = 1, size(self%c_entry, kind=ik)
             s(self%c_row(k), :) = s(self%c_row(k), :) &

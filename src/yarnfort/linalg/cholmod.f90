@@ -29,6 +29,7 @@ module yarnfort_linalg_cholmod
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
+        procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
         final :: finalize
@@ -80,11 +81,25 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_int) :: status
 
-        status = yarnfort_cholmod_solve(self%handle, self%n, rhs)
+        status = yarnfort_cholmod_solve(self%handle, self%n, 1_c_long, rhs)
         if (status < cholmod_ok) then
             call self%fail(error, 'solve', status_message(status))
         end if
     end subroutine solve_rhs
+
+    !> All columns in one CHOLMOD solve: the supernodal factor's dense blocks are applied
+    !> to the m columns together (BLAS 3) instead of m times to one.
+    subroutine solve_rhs_columns(self, rhs, error)
+        class(cholmod_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:, :)
+        type(error_type), allocatable, intent(out) :: error
+        integer(c_int) :: status
+
+        status = yarnfort_cholmod_solve(self%handle, self%n, size(rhs, 2, kind=c_long), rhs)
+        if (status < cholmod_ok) then
+            call self%fail(error, 'solve', status_message(status))
+        end if
+    end subroutine solve_rhs_columns
 
     !> Free the CHOLMOD handle.
     subroutine release(self)

@@ -55,12 +55,12 @@ module yarnfort_linalg_cholmod_binding
             integer(c_int) :: status
         end function yarnfort_cholmod_factorize
 
-        !> Overwrite rhs(1:n) with the solution of A x = rhs.
-        function yarnfort_cholmod_solve(handle, n, rhs) result(status) &
+        !> Overwrite rhs (n x ncol, column-major) with the solution of A X = rhs.
+        function yarnfort_cholmod_solve(handle, n, ncol, rhs) result(status) &
                 bind(C, name='yarnfort_cholmod_solve')
             import :: c_int, c_long, c_double, c_ptr
             type(c_ptr), value :: handle
-            integer(c_long), value :: n
+            integer(c_long), value :: n, ncol
             real(c_double), intent(inout) :: rhs(*)
             integer(c_int) :: status
         end function yarnfort_cholmod_solve

@@ -118,18 +118,20 @@ int yarnfort_cholmod_factorize(void *handle, SuiteSparse_long n, SuiteSparse_lon
     return h->common.status;
 }
 
-/* Solve A x = rhs and overwrite rhs; the solution and workspaces are allocated by the
- * first call and reused afterwards. */
-int yarnfort_cholmod_solve(void *handle, SuiteSparse_long n, double *rhs)
+/* Solve A X = RHS for ncol columns (RHS column-major, n x ncol) and overwrite RHS; the
+ * solution and workspaces are allocated by the first call and reused while ncol stays the
+ * same (several columns go through the supernodes' dense blocks together). */
+int yarnfort_cholmod_solve(void *handle, SuiteSparse_long n, SuiteSparse_long ncol,
+                           double *rhs)
 {
     yarnfort_cholmod *h = handle;
     cholmod_dense b;
     if (!h) return YARNFORT_CHOLMOD_NO_HANDLE;
-    if (!h->factor) return CHOLMOD_INVALID;
+    if (!h->factor || ncol < 1) return CHOLMOD_INVALID;
     memset(&b, 0, sizeof(b));
     b.nrow = (size_t) n;
-    b.ncol = 1;
-    b.nzmax = (size_t) n;
+    b.ncol = (size_t) ncol;
+    b.nzmax = (size_t) n * (size_t) ncol;
     b.d = (size_t) n;
     b.x = rhs;
     b.xtype = CHOLMOD_REAL;
@@ -139,6 +141,6 @@ int yarnfort_cholmod_solve(void *handle, SuiteSparse_long n, double *rhs)
                           &h->common)) {
         return h->common.status == CHOLMOD_OK ? CHOLMOD_INVALID : h->common.status;
     }
-    memcpy(rhs, h->x->x, (size_t) n * sizeof(double));
+    memcpy(rhs, h->x->x, (size_t) n * (size_t) ncol * sizeof(double));
     return h->common.status;
 }

@@ -29,6 +29,7 @@ module yarnfort_linalg_direct
         procedure :: analyse
         procedure :: factor
         procedure :: solve
+        procedure :: solve_columns
         procedure :: destroy
         !> The solver's analysis of the kept pattern (n, col_ptr, row_index are set); a
         !> failure destroys the solver.
@@ -37,6 +38,8 @@ module yarnfort_linalg_direct
         procedure(factor_values_interface), deferred :: factor_values
         !> The solver's solve with the last factorisation (rhs of size n).
         procedure(solve_rhs_interface), deferred :: solve_rhs
+        !> The solver's solve of several columns (n x m, m >= 1); by default column by column.
+        procedure :: solve_rhs_columns
         !> Free the solver's own handles and buffers (safe to call twice; for `destroy`).
         procedure(release_interface), deferred :: release
         !> Set `error` to '<name>: <stage> failed: <reason>'.
@@ -113,15 +116,47 @@ contains
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
 
+        call check_solve(self, size(rhs, kind=ik), error)
+        if (allocated(error)) return
+        call self%solve_rhs(rhs, error)
+    end subroutine solve
+
+    !> Overwrite each column of rhs with its solution, using the last factorisation.
+    subroutine solve_columns(self, rhs, error)
+        class(direct_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:, :)
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_solve(self, size(rhs, 1, kind=ik), error)
+        if (allocated(error) .or. size(rhs, 2) == 0) return
+        call self%solve_rhs_columns(rhs, error)
+    end subroutine solve_columns
+
+    !> A valid factorisation and a right-hand side of n rows.
+    subroutine check_solve(self, rows, error)
+        class(direct_solver_type), intent(in) :: self
+        integer(ik), intent(in) :: rows
+        type(error_type), allocatable, intent(out) :: error
+
         if (.not. self%factored) then
             call fatal_error(error, self%get_name() &
                 // ': solve called without a valid factorisation')
             return
         end if
-        call check_array_size(self%get_name(), 'rhs', size(rhs, kind=ik), self%n, error)
-        if (allocated(error)) return
-        call self%solve_rhs(rhs, error)
-    end subroutine solve
+        call check_array_size(self%get_name(), 'rhs', rows, self%n, error)
+    end subroutine check_solve
+
+    subroutine solve_rhs_columns(self, rhs, error)
+        class(direct_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:, :)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: c
+
+        do c = 1, size(rhs, 2)
+            call self%solve_rhs(rhs(:, c), error)
+            if (allocated(error)) return
+        end do
+    end subroutine solve_rhs_columns
 
     !> Free the solver's handles and buffers, the pattern copy and the state (safe to call
     !> twice).

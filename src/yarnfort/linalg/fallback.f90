@@ -21,6 +21,7 @@ module yarnfort_linalg_fallback
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
+        procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
     end type fallback_solver_type
@@ -68,6 +69,18 @@ contains
             call self%primary%solve(rhs, error)
         end if
     end subroutine solve_rhs
+
+    subroutine solve_rhs_columns(self, rhs, error)
+        class(fallback_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:, :)
+        type(error_type), allocatable, intent(out) :: error
+
+        if (self%switched) then
+            call self%secondary%solve_columns(rhs, error)
+        else
+            call self%primary%solve_columns(rhs, error)
+        end if
+    end subroutine solve_rhs_columns
 
     subroutine release(self)
         class(fallback_solver_type), intent(inout) :: self

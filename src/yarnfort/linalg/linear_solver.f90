@@ -22,6 +22,9 @@ module yarnfort_linalg_linear_solver
         procedure(factor_interface), deferred :: factor
         !> Overwrite rhs with the solution of A x = rhs using the last factorisation.
         procedure(solve_interface), deferred :: solve
+        !> Overwrite each column of rhs (n x m) with its solution; by default one `solve`
+        !> per column, a solver that solves several columns at once overrides it.
+        procedure :: solve_columns
         !> Free every handle and buffer (safe to call twice).
         procedure(destroy_interface), deferred :: destroy
         !> Short lowercase name, e.g. 'umfpack'.
@@ -62,5 +65,19 @@ module yarnfort_linalg_linear_solver
             character(len=:), allocatable :: name
         end function get_name_interface
     end interface
+
+contains
+
+    subroutine solve_columns(self, rhs, error)
+        class(linear_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:, :)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: c
+
+        do c = 1, size(rhs, 2)
+            call self%solve(rhs(:, c), error)
+            if (allocated(error)) return
+        end do
+    end subroutine solve_columns
 
 end module yarnfort_linalg_linear_solver
