@@ -29,7 +29,8 @@ module yarnfort_solver_newton
     use yarnfort_input_config, only: solver_config_type
     use yarnfort_solver_problem, only: nonlinear_problem_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc
+    use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc, &
+        analyse_counted, factor_counted, solve_counted
     use yarnfort_solver_timer, only: wall_time
     implicit none
     private
@@ -345,7 +346,7 @@ contains
                 ! Judge convergence by our own test on the final iterate, with its levels.
                 call set_row_weights(self, .false., error)
                 if (allocated(error)) return
-                call self%problem%problem%evaluate_residual(self%u, residual, error)
+                call residual_timed(self, self%u, residual, error)
                 if (allocated(error)) then
                     if (attempt == n_attempts) return
                     deallocate(error)
@@ -389,7 +390,8 @@ contains
         integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
         if (self%adapter%analysed) return
-        call self%linear%analyse(int(size(col_ptr) - 1, ik), col_ptr, row_index, error)
+        call analyse_counted(self%adapter, int(size(col_ptr) - 1, ik), col_ptr, row_index, &
+            error)
         if (allocated(error)) return
         self%adapter%analysed = .true.
     end subroutine analyse_once
@@ -433,7 +435,7 @@ contains
                 do k = 1, min(self%chord_steps, self%options%max_iterations - 1)
                     if (f <= tol / 100) exit
                     step = -residual
-                    call self%linear%solve(step, trial_error)
+                    call solve_counted(self%adapter, step, trial_error)
                     if (allocated(trial_error)) exit
                     kept = self%u
                     self%u = self%u + step
@@ -471,7 +473,7 @@ contains
             call start_newton(self, u, error)
             if (allocated(error)) return
             allocate(residual(size(u)))
-            call problem%evaluate_residual(self%u, residual, error)
+            call residual_timed(self, self%u, residual, error)
             if (allocated(error)) return
             call newton_step(self, residual, error)
             if (allocated(error)) return
@@ -504,15 +506,39 @@ contains
         real(wp), allocatable :: values(:), step(:)
 
         allocate(values(self%problem%nnz))
-        call self%problem%problem%evaluate_jacobian(self%u, values, error)
+        call jacobian_timed(self, self%u, values, error)
         if (allocated(error)) return
-        call self%linear%factor(values, error)
+        call factor_counted(self%adapter, values, error)
         if (allocated(error)) return
         step = -residual
-        call self%linear%solve(step, error)
+        call solve_counted(self%adapter, step, error)
         if (allocated(error)) return
         self%u = self%u + step
     end subroutine newton_step
+
+    !> The problem's residual at u, timed like KINSOL's calls (get_timings).
+    subroutine residual_timed(self, u, residual, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: residual(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: start
+        start = wall_time()
+        call self%problem%problem%evaluate_residual(u, residual, error)
+        self%problem%residual_time = self%problem%residual_time + (wall_time() - start)
+    end subroutine residual_timed
+
+    !> The problem's Jacobian values at u, timed like KINSOL's calls (get_timings).
+    subroutine jacobian_timed(self, u, values, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: start
+        start = wall_time()
+        call self%problem%problem%evaluate_jacobian(u, values, error)
+        self%problem%jacobian_time = self%problem%jacobian_time + (wall_time() - start)
+    end subroutine jacobian_timed
 
     !> The residual at self%u and its scaled max-norm, the row levels taken there.
     subroutine get_scaled_residual(self, residual, f, error)
@@ -523,7 +549,7 @@ contains
         f = huge(1.0_wp)
         call set_row_weights(self, .false., error)
         if (allocated(error)) return
-        call self%problem%problem%evaluate_residual(self%u, residual, error)
+        call residual_timed(self, self%u, residual, error)
         if (allocated(error)) return
         if (.not. all(ieee_is_finite(residual))) then
             call fatal_error(error, 'the residual is not a finite number (NaN or an overflow)')
@@ -575,25 +601,25 @@ contains
             shift = max(level, tiny(1.0_wp)) / problem%length_scale
             call set_row_weights(self, .false., error)
             if (allocated(error)) return
-            call problem%evaluate_residual(self%u, residual, error)
+            call residual_timed(self, self%u, residual, error)
             if (allocated(error)) return
             f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
             merit = norm2(residual * self%f_scale_data)
             mu = 1.0_wp
             do iteration = 1, transient_iterations * self%options%max_iterations
                 if (f <= self%options%residual_tolerance) exit
-                call problem%evaluate_jacobian(self%u, values, error)
+                call jacobian_timed(self, self%u, values, error)
                 if (allocated(error)) return
                 values(diagonal) = values(diagonal) + mu * shift
-                call self%linear%factor(values, trial_error)
+                call factor_counted(self%adapter, values, trial_error)
                 stats%jacobian_evaluations = stats%jacobian_evaluations + 1
                 if (.not. allocated(trial_error)) then
                     step = -residual
-                    call self%linear%solve(step, trial_error)
+                    call solve_counted(self%adapter, step, trial_error)
                 end if
                 if (.not. allocated(trial_error)) then
                     trial = self%u + step
-                    call problem%evaluate_residual(trial, residual, trial_error)
+                    call residual_timed(self, trial, residual, trial_error)
                     stats%residual_evaluations = stats%residual_evaluations + 1
                 end if
                 ! Accept a step that lowers the weighted 2-norm of the residual (a smooth
@@ -616,7 +642,7 @@ contains
                 else
                     mu = 10 * mu
                     if (mu > max_transient_shift) exit
-                    call problem%evaluate_residual(self%u, residual, error)
+                    call residual_timed(self, self%u, residual, error)
                     if (allocated(error)) return
                 end if
             end do

@@ -16,7 +16,8 @@ module yarnfort_solver_sunlinsol_adapter
     implicit none
     private
 
-    public :: adapter_type, new_sunlinsol_adapter, get_csc
+    public :: adapter_type, new_sunlinsol_adapter, get_csc, analyse_counted, &
+        factor_counted, solve_counted
 
     !> What the SUNLinearSolver's content points to.
     type :: adapter_type
@@ -68,10 +69,7 @@ contains
         call c_f_pointer(sunls%content, adapter)
         call get_csc(sunmat_a, n, nnz, col_ptr, row_index, values)
         if (.not. adapter%analysed .or. adapter%pattern_changed) then
-            start = wall_time()
-            call adapter%solver%analyse(n, col_ptr, row_index, adapter%error)
-            adapter%analyse_time = adapter%analyse_time + (wall_time() - start)
-            adapter%n_analyses = adapter%n_analyses + 1
+            call analyse_counted(adapter, n, col_ptr, row_index, adapter%error)
             if (allocated(adapter%error)) then
                 ierr = -1
                 return
@@ -79,10 +77,7 @@ contains
             adapter%analysed = .true.
             adapter%pattern_changed = .false.
         end if
-        start = wall_time()
-        call adapter%solver%factor(values, adapter%error)
-        adapter%factor_time = adapter%factor_time + (wall_time() - start)
-        adapter%n_factorisations = adapter%n_factorisations + 1
+        call factor_counted(adapter, values, adapter%error)
         ! A failed factorisation (e.g. singular) is recoverable for KINSOL: positive code.
         ierr = merge(1_c_int, 0_c_int, allocated(adapter%error))
     end function adapter_setup
@@ -101,13 +96,47 @@ contains
         call c_f_pointer(sunls%content, adapter)
         x => FN_VGetArrayPointer(sunvec_x)
         b => FN_VGetArrayPointer(sunvec_b)
-        start = wall_time()
         x = b
-        call adapter%solver%solve(x, adapter%error)
-        adapter%solve_time = adapter%solve_time + (wall_time() - start)
-        adapter%n_solves = adapter%n_solves + 1
+        call solve_counted(adapter, x, adapter%error)
         ierr = merge(1_c_int, 0_c_int, allocated(adapter%error))
     end function adapter_solve
+
+    !> Symbolic analysis by the adapter's solver, counted and timed.
+    subroutine analyse_counted(adapter, n, col_ptr, row_index, error)
+        type(adapter_type), intent(inout) :: adapter
+        integer(ik), intent(in) :: n, col_ptr(:), row_index(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: start
+        start = wall_time()
+        call adapter%solver%analyse(n, col_ptr, row_index, error)
+        adapter%analyse_time = adapter%analyse_time + (wall_time() - start)
+        adapter%n_analyses = adapter%n_analyses + 1
+    end subroutine analyse_counted
+
+    !> Numeric factorisation by the adapter's solver, counted and timed (for KINSOL's
+    !> setup and for the Newton steps yarnfort takes itself).
+    subroutine factor_counted(adapter, values, error)
+        type(adapter_type), intent(inout) :: adapter
+        real(wp), intent(in) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: start
+        start = wall_time()
+        call adapter%solver%factor(values, error)
+        adapter%factor_time = adapter%factor_time + (wall_time() - start)
+        adapter%n_factorisations = adapter%n_factorisations + 1
+    end subroutine factor_counted
+
+    !> x <- A^{-1} x with the last factorisation, counted and timed.
+    subroutine solve_counted(adapter, x, error)
+        type(adapter_type), intent(inout) :: adapter
+        real(wp), intent(inout) :: x(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: start
+        start = wall_time()
+        call adapter%solver%solve(x, error)
+        adapter%solve_time = adapter%solve_time + (wall_time() - start)
+        adapter%n_solves = adapter%n_solves + 1
+    end subroutine solve_counted
 
     !> Free the SUNLinearSolver shell; the adapter and its solver belong to the caller.
     integer(c_int) function adapter_free(sunls) result(ierr) bind(C)
