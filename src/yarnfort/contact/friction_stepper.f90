@@ -17,7 +17,8 @@
 !> Newton solve (full steps only), and one that fails is retried with fewer new slips.
 !> When the step's first set fails with no new slip, its passages whose flows the first
 !> Newton step sends back stick and the set is solved again (stop_flowing_back). The
-!> step's first solve starts with chord steps (newton_solver_type%chord_steps).
+!> step's first solve starts with chord steps (newton_solver_type%chord_steps), as do
+!> the staggered scheme's elastic and sliding solves.
 !> A passage whose element would become shorter than min_length_ratio times its initial
 !> reference length locks at that length (stick), and may not slip that way again while
 !> the element keeps that length, in this step and the next ones. A passage that flips
@@ -75,6 +76,10 @@ module yarnfort_contact_friction_stepper
     !> 8), Newton iterations (factorisations) per step: inputs/knit_clamped.nml 4.42 ->
     !> 3.65, woven 2,200 aligned 1.68 -> 1.18. In every round's solve instead, the planar
     !> 4 x 2 periodic knit at max_step 0.05 cut a step at the end of the release.
+    !> The staggered scheme's elastic and sliding solves take them too: woven 840 / 2,200 /
+    !> 10,120 aligned 3.30 / 4.43 / 6.72 -> 2.05 / 2.95 / 4.50 Newton iterations per step,
+    !> skewed 5.03 / 5.88 / 8.42 -> 3.32 / 4.10 / 5.88 (benchmarks/steps_trace), the
+    !> examples' curves with scheme = 'staggered' within 1.2e-10 of their largest force.
     integer, parameter :: chord_steps = 3
 
     !> Outcomes of the predictor (predict).
@@ -158,12 +163,14 @@ contains
                 call new_newton_solver(self%newton_elastic, self%elastic, linear, scene%solver, &
                     error)
                 if (allocated(error)) return
+                self%newton_elastic%chord_steps = chord_steps
             end if
             call new_friction_problem(self%sliding, scene, positions_frozen=.true.)
             call new_linear_solver(linear, general_name, error, unsymmetric=.true.)
             if (allocated(error)) return
             call new_newton_solver(self%newton_sliding, self%sliding, linear, scene%solver, error)
             if (allocated(error)) return
+            self%newton_sliding%chord_steps = chord_steps
         end if
         ! The monolithic problem: the whole solve, or the staggered scheme's finish of a
         ! step (finish_monolithic), which takes full Newton steps only.
