@@ -16,9 +16,8 @@
 !> across their limit slipping (predict_modes); each round after the first is a fast
 !> Newton solve (full steps only), and one that fails is retried with fewer new slips.
 !> When the step's first set fails with no new slip, its passages whose flows the first
-!> Newton step sends back stick and the set is solved again (stop_flowing_back). The
-!> step's first solve starts with chord steps (newton_solver_type%chord_steps), as do
-!> the staggered scheme's elastic and sliding solves.
+!> Newton step sends back stick and the set is solved again (stop_flowing_back). Every
+!> solve starts with chord steps (newton_solver_type%chord_steps), in both schemes.
 !> A passage whose element would become shorter than min_length_ratio times its initial
 !> reference length locks at that length (stick), and may not slip that way again while
 !> the element keeps that length, in this step and the next ones. A passage that flips
@@ -71,12 +70,13 @@ module yarnfort_contact_friction_stepper
     !> tensions at convergence (residual_tolerance times their level plus rounding).
     real(wp), parameter :: dead_band_factor = 10.0_wp
 
-    !> Chord steps after the first Newton step of a step's first monolithic solve
+    !> Chord steps after the first Newton step of every friction solve
     !> (newton_solver_type%chord_steps). Measured (benchmarks/steps_results.md, section
-    !> 8), Newton iterations (factorisations) per step: inputs/knit_clamped.nml 4.42 ->
-    !> 3.65, woven 2,200 aligned 1.68 -> 1.18. In every round's solve instead, the planar
-    !> 4 x 2 periodic knit at max_step 0.05 cut a step at the end of the release.
-    !> The staggered scheme's elastic and sliding solves take them too: woven 840 / 2,200 /
+    !> 8), Newton iterations (factorisations) per step, without -> in the first solve of
+    !> a step -> in every solve: inputs/knit_clamped.nml 4.42 -> 3.65 -> 3.27, woven
+    !> 2,200 aligned 1.68 -> 1.18 -> 1.13, 10,120 skewed 3.42 -> 2.48 -> 2.00, no step
+    !> cut in any of those runs. (Before stop_flowing_back, chord steps in every solve
+    !> made the planar 4 x 2 periodic knit at max_step 0.05 cut a step.) The staggered scheme's elastic and sliding solves take them too: woven 840 / 2,200 /
     !> 10,120 aligned 3.30 / 4.43 / 6.72 -> 2.05 / 2.95 / 4.50 Newton iterations per step,
     !> skewed 5.03 / 5.88 / 8.42 -> 3.32 / 4.10 / 5.88 (benchmarks/steps_trace), the
     !> examples' curves with scheme = 'staggered' within 1.2e-10 of their largest force.
@@ -300,7 +300,7 @@ contains
                 self%newton_full%quick = any(self%mode_trial /= mode_stick) .and. .not. full_retry
                 full_retry = .false.
                 ! Chord steps in the step's first solve only (measured: chord_steps).
-                self%newton_full%chord_steps = merge(chord_steps, 0, round == 1)
+                self%newton_full%chord_steps = chord_steps
                 start = unknowns
                 call self%newton_full%solve(unknowns, stats, error)
                 iterations = iterations + stats%iterations
