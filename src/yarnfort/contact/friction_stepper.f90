@@ -76,8 +76,9 @@ module yarnfort_contact_friction_stepper
     !> a step -> in every solve: inputs/knit_clamped.nml 4.42 -> 3.65 -> 3.27, woven
     !> 2,200 aligned 1.68 -> 1.18 -> 1.13, 10,120 skewed 3.42 -> 2.48 -> 2.00, no step
     !> cut in any of those runs. (Before stop_flowing_back, chord steps in every solve
-    !> made the planar 4 x 2 periodic knit at max_step 0.05 cut a step.) The staggered scheme's elastic and sliding solves take them too: woven 840 / 2,200 /
-    !> 10,120 aligned 3.30 / 4.43 / 6.72 -> 2.05 / 2.95 / 4.50 Newton iterations per step,
+    !> made the planar 4 x 2 periodic knit at max_step 0.05 cut a step.) The staggered
+    !> scheme's elastic and sliding solves take them too: woven 840 / 2,200 / 10,120
+    !> aligned 3.30 / 4.43 / 6.72 -> 2.05 / 2.95 / 4.50 Newton iterations per step,
     !> skewed 5.03 / 5.88 / 8.42 -> 3.32 / 4.10 / 5.88 (benchmarks/steps_trace), the
     !> examples' curves with scheme = 'staggered' within 1.2e-10 of their largest force.
     integer, parameter :: chord_steps = 3
@@ -201,6 +202,8 @@ contains
         call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)
         if (allocated(error)) return
         self%newton_full%quick = self%staggered
+        ! The staggered scheme's finish takes full Newton steps only (above).
+        if (.not. self%staggered) self%newton_full%chord_steps = chord_steps
         allocate(self%u(scene%dofs%n_unknowns))
         call scene%dofs%restrict(scene%network%position, self%u)
         allocate(self%flow(n_p), source=0.0_wp)
@@ -299,8 +302,6 @@ contains
                 ! new slip or none is solved again with the fallbacks.
                 self%newton_full%quick = any(self%mode_trial /= mode_stick) .and. .not. full_retry
                 full_retry = .false.
-                ! Chord steps in the step's first solve only (measured: chord_steps).
-                self%newton_full%chord_steps = chord_steps
                 start = unknowns
                 call self%newton_full%solve(unknowns, stats, error)
                 iterations = iterations + stats%iterations
