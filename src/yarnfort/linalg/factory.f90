@@ -77,8 +77,8 @@ contains
             block
                 type(fallback_solver_type), allocatable :: fallback
                 allocate(fallback)
-                allocate(cholmod_solver_type :: fallback%primary)
-                allocate(klu_solver_type :: fallback%secondary)
+                allocate(cholmod_solver_type :: fallback%active)
+                allocate(klu_solver_type :: fallback%general)
                 call move_alloc(fallback, solver)
             end block
         case default

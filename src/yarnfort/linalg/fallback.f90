@@ -12,10 +12,12 @@ module yarnfort_linalg_fallback
 
     public :: fallback_solver_type
 
-    !> The pattern (checked and kept by direct_solver_type) analyses the secondary solver
+    !> The pattern (checked and kept by direct_solver_type) analyses the general solver
     !> when switching.
     type, extends(direct_solver_type) :: fallback_solver_type
-        class(linear_solver_type), allocatable :: primary, secondary
+        !> The solver in use: the specialised one (set by the owner) until its first failed
+        !> factorisation, then the general one, moved here from `general` (set by the owner).
+        class(linear_solver_type), allocatable :: active, general
         logical :: switched = .false.
     contains
         procedure :: analyse_pattern
@@ -32,30 +34,24 @@ contains
         class(fallback_solver_type), intent(inout) :: self
         type(error_type), allocatable, intent(out) :: error
 
-        if (self%switched) then
-            call self%secondary%analyse(self%n, int(self%col_ptr, ik), &
-                int(self%row_index, ik), error)
-        else
-            call self%primary%analyse(self%n, int(self%col_ptr, ik), int(self%row_index, ik), &
-                error)
-        end if
+        call self%active%analyse(self%n, int(self%col_ptr, ik), int(self%row_index, ik), error)
     end subroutine analyse_pattern
 
+    !> On the first failure, switch to the general solver for good and factor with it.
     subroutine factor_values(self, values, error)
         class(fallback_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
 
-        if (.not. self%switched) then
-            call self%primary%factor(values, error)
-            if (.not. allocated(error)) return
-            deallocate(error)
-            self%switched = .true.
-            call self%primary%destroy()
-            call self%analyse_pattern(error)
-            if (allocated(error)) return
-        end if
-        call self%secondary%factor(values, error)
+        call self%active%factor(values, error)
+        if (self%switched .or. .not. allocated(error)) return
+        deallocate(error)
+        self%switched = .true.
+        call self%active%destroy()
+        call move_alloc(self%general, self%active)
+        call self%analyse_pattern(error)
+        if (allocated(error)) return
+        call self%active%factor(values, error)
     end subroutine factor_values
 
     subroutine solve_rhs(self, rhs, error)
@@ -63,11 +59,7 @@ contains
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
 
-        if (self%switched) then
-            call self%secondary%solve(rhs, error)
-        else
-            call self%primary%solve(rhs, error)
-        end if
+        call self%active%solve(rhs, error)
     end subroutine solve_rhs
 
     subroutine solve_rhs_columns(self, rhs, error)
@@ -75,27 +67,23 @@ contains
         real(wp), intent(inout) :: rhs(:, :)
         type(error_type), allocatable, intent(out) :: error
 
-        if (self%switched) then
-            call self%secondary%solve_columns(rhs, error)
-        else
-            call self%primary%solve_columns(rhs, error)
-        end if
+        call self%active%solve_columns(rhs, error)
     end subroutine solve_rhs_columns
 
     subroutine release(self)
         class(fallback_solver_type), intent(inout) :: self
 
-        if (allocated(self%primary)) call self%primary%destroy()
-        if (allocated(self%secondary)) call self%secondary%destroy()
+        if (allocated(self%active)) call self%active%destroy()
+        if (allocated(self%general)) call self%general%destroy()
     end subroutine release
 
     pure function get_name(self) result(name)
         class(fallback_solver_type), intent(in) :: self
         character(len=:), allocatable :: name
         if (self%switched) then
-            name = self%secondary%get_name()
+            name = self%active%get_name()
         else
-            name = self%primary%get_name() // ' (falls back to ' // self%secondary%get_name() &
+            name = self%active%get_name() // ' (falls back to ' // self%general%get_name() &
                 // ')'
         end if
     end function get_name
