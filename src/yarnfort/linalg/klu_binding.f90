@@ -102,24 +102,23 @@ module yarnfort_linalg_klu_binding
             type(klu_l_common), intent(inout) :: common
             integer(c_long) :: ok
         end function klu_l_rcond
-
-        !> Free and nullify the Symbolic object.
-        function klu_l_free_symbolic(symbolic, common) result(ok) &
-                bind(C, name='klu_l_free_symbolic')
-            import :: c_long, c_ptr, klu_l_common
-            type(c_ptr), intent(inout) :: symbolic
-            type(klu_l_common), intent(inout) :: common
-            integer(c_long) :: ok
-        end function klu_l_free_symbolic
-
-        !> Free and nullify the Numeric object.
-        function klu_l_free_numeric(numeric, common) result(ok) &
-                bind(C, name='klu_l_free_numeric')
-            import :: c_long, c_ptr, klu_l_common
-            type(c_ptr), intent(inout) :: numeric
-            type(klu_l_common), intent(inout) :: common
-            integer(c_long) :: ok
-        end function klu_l_free_numeric
     end interface
+
+    abstract interface
+        !> klu_l_free_symbolic and klu_l_free_numeric: free a Symbolic or Numeric object and
+        !> nullify the pointer; return TRUE/FALSE.
+        function klu_l_free_interface(object, common) result(ok) bind(C)
+            import :: c_long, c_ptr, klu_l_common
+            type(c_ptr), intent(inout) :: object
+            type(klu_l_common), intent(inout) :: common
+            integer(c_long) :: ok
+        end function klu_l_free_interface
+    end interface
+
+    !> Free and nullify the Symbolic object.
+    procedure(klu_l_free_interface), bind(C, name='klu_l_free_symbolic') :: &
+        klu_l_free_symbolic
+    !> Free and nullify the Numeric object.
+    procedure(klu_l_free_interface), bind(C, name='klu_l_free_numeric') :: klu_l_free_numeric
 
 end module yarnfort_linalg_klu_binding
