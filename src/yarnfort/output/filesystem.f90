@@ -57,18 +57,6 @@ module yarnfort_output_filesystem
             integer(c_int) :: status
         end function c_unlock_file
 
-        function c_sync_file(path) result(status) bind(C, name='yarnfort_sync_file')
-            import :: c_int, c_char
-            character(kind=c_char), intent(in) :: path(*)
-            integer(c_int) :: status
-        end function c_sync_file
-
-        function c_remove_file(path) result(status) bind(C, name='yarnfort_remove_file')
-            import :: c_int, c_char
-            character(kind=c_char), intent(in) :: path(*)
-            integer(c_int) :: status
-        end function c_remove_file
-
         subroutine ignore_file_size_signal() bind(C, name='yarnfort_ignore_file_size_signal')
         end subroutine ignore_file_size_signal
 
@@ -85,24 +73,35 @@ module yarnfort_output_filesystem
             integer(c_long_long) :: bytes
         end function c_file_size_limit
 
-        function c_file_size(path) result(bytes) bind(C, name='yarnfort_file_size')
-            import :: c_char, c_long_long
-            character(kind=c_char), intent(in) :: path(*)
-            integer(c_long_long) :: bytes
-        end function c_file_size
-
-        function c_free_space(path) result(bytes) bind(C, name='yarnfort_free_space')
-            import :: c_char, c_long_long
-            character(kind=c_char), intent(in) :: path(*)
-            integer(c_long_long) :: bytes
-        end function c_free_space
-
         subroutine c_last_error(text, length) bind(C, name='yarnfort_last_error')
             import :: c_int, c_char
             character(kind=c_char), intent(out) :: text(*)
             integer(c_int), value :: length
         end subroutine c_last_error
     end interface
+
+    abstract interface
+        !> yarnfort_sync_file, yarnfort_remove_file: 0 on success, -1 on failure (the
+        !> reason: c_last_error).
+        function path_status_interface(path) result(status) bind(C)
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: status
+        end function path_status_interface
+
+        !> yarnfort_file_size, yarnfort_free_space: bytes of the file, or free on its
+        !> device; -1 if it cannot be told.
+        function path_bytes_interface(path) result(bytes) bind(C)
+            import :: c_char, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long) :: bytes
+        end function path_bytes_interface
+    end interface
+
+    procedure(path_status_interface), bind(C, name='yarnfort_sync_file') :: c_sync_file
+    procedure(path_status_interface), bind(C, name='yarnfort_remove_file') :: c_remove_file
+    procedure(path_bytes_interface), bind(C, name='yarnfort_file_size') :: c_file_size
+    procedure(path_bytes_interface), bind(C, name='yarnfort_free_space') :: c_free_space
 
     !> Permissions of new folders (rwxr-xr-x before the umask).
     integer(c_int), parameter :: folder_mode = int(o'755', c_int)
@@ -143,9 +142,8 @@ contains
         character(len=*), intent(in) :: old, new
         type(error_type), allocatable, intent(out) :: error
 
-        if (c_rename(old // c_null_char, new // c_null_char) /= 0) &
-            call fatal_error(error, "cannot rename '" // old // "' to '" // new // "': " &
-                // get_reason())
+        call check_call(c_rename(old // c_null_char, new // c_null_char), &
+            "cannot rename '" // old // "' to '" // new // "'", error)
     end subroutine rename_file
 
     !> Remove the file `path`; a missing file is fine.
@@ -153,8 +151,8 @@ contains
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
 
-        if (c_remove_file(path // c_null_char) /= 0) &
-            call fatal_error(error, "cannot remove '" // path // "': " // get_reason())
+        call check_call(c_remove_file(path // c_null_char), "cannot remove '" // path // "'", &
+            error)
     end subroutine remove_file
 
     !> Flush the closed file `path` to its device (fsync), so that a rename after it
@@ -163,8 +161,8 @@ contains
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
 
-        if (c_sync_file(path // c_null_char) /= 0) &
-            call fatal_error(error, "cannot write '" // path // "' to disk: " // get_reason())
+        call check_call(c_sync_file(path // c_null_char), &
+            "cannot write '" // path // "' to disk", error)
     end subroutine sync_file
 
     !> Cut the (closed) file `path` back to `bytes` bytes, e.g. to drop a line that could
@@ -174,10 +172,19 @@ contains
         integer(8), intent(in) :: bytes
         type(error_type), allocatable, intent(out) :: error
 
-        if (c_truncate_file(path // c_null_char, int(bytes, c_long_long)) /= 0) &
-            call fatal_error(error, "cannot cut '" // path // "' back to its last whole " &
-                // 'line: ' // get_reason())
+        call check_call(c_truncate_file(path // c_null_char, int(bytes, c_long_long)), &
+            "cannot cut '" // path // "' back to its last whole line", error)
     end subroutine truncate_file
+
+    !> Fail with '<what>: <reason of the failed C call>' unless `status` (of a call
+    !> returning 0 on success) is 0.
+    subroutine check_call(status, what, error)
+        integer(c_int), intent(in) :: status
+        character(len=*), intent(in) :: what
+        type(error_type), allocatable, intent(out) :: error
+
+        if (status /= 0) call fatal_error(error, what // ': ' // get_reason())
+    end subroutine check_call
 
     !> Open the existing file `path` to append lines to it (`unit` = -1 on failure).
     subroutine open_append(unit, path, error)
@@ -190,10 +197,7 @@ contains
         message = ''
         open(newunit=unit, file=path, status='old', position='append', action='write', &
             iostat=status, iomsg=message)
-        if (status /= 0) then
-            unit = -1
-            call fatal_error(error, "cannot write '" // path // "': " // trim(message))
-        end if
+        call check_open(unit, path, status, message, error)
     end subroutine open_append
 
     !> Open `path` to write it anew (a file of that name is replaced): formatted lines, or
@@ -213,11 +217,22 @@ contains
         open(newunit=unit, file=path, access=merge('stream    ', 'sequential', bytes), &
             form=merge('unformatted', 'formatted  ', bytes), status='replace', action='write', &
             iostat=status, iomsg=message)
+        call check_open(unit, path, status, message, error)
+    end subroutine open_new_file
+
+    !> After an OPEN of `path` for writing with iostat `status` and iomsg `message`: on
+    !> failure `unit` = -1 and the error says why.
+    subroutine check_open(unit, path, status, message, error)
+        integer, intent(inout) :: unit
+        character(len=*), intent(in) :: path, message
+        integer, intent(in) :: status
+        type(error_type), allocatable, intent(out) :: error
+
         if (status /= 0) then
             unit = -1
             call fatal_error(error, "cannot write '" // path // "': " // trim(message))
         end if
-    end subroutine open_new_file
+    end subroutine check_open
 
     !> Close `unit`, on which the file `path` was written anew, after its last write
     !> (`status`, 0 if absent, and its iomsg `message`), checking that every byte reached
