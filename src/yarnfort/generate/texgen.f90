@@ -899,6 +899,8 @@ contains
         integer :: nx, ny, a, b, k, y, n, step(2), shift(2), node, first, last
         integer, allocatable :: id(:, :, :), chain(:), left(:), right(:), sides(:)
         integer, allocatable :: moved(:, :)
+        ! The gap-holders (links) and the copies between each one's follower and leader.
+        integer, allocatable :: gaps(:), gap_copies(:, :)
         logical, allocatable :: orphan(:, :, :)
         real(wp) :: offset(3)
         character(len=200) :: buffer
@@ -913,15 +915,18 @@ contains
         if (allocated(error)) return
         ! Gap-holders: the leader of the follower in copy (a, b) is in copy (a, b) + its
         ! lattice part; outside the sample both contact nodes go.
-        do k = 1, unit%n_links
-            associate(link => unit%links(k))
-                if (.not. link%gap) cycle
-                shift = lattice_part(link)
+        gaps = pack([(k, k = 1, unit%n_links)], unit%links(1:unit%n_links)%gap)
+        allocate(gap_copies(2, size(gaps)))
+        do k = 1, size(gaps)
+            gap_copies(:, k) = lattice_part(unit%links(gaps(k)))
+        end do
+        do k = 1, size(gaps)
+            associate(link => unit%links(gaps(k)), copies => gap_copies(:, k))
                 do b = 0, ny - 1
                     do a = 0, nx - 1
-                        if (.not. inside(a + shift(1), b + shift(2))) &
+                        if (.not. inside(a + copies(1), b + copies(2))) &
                             orphan(link%follower, a, b) = .true.
-                        if (.not. inside(a - shift(1), b - shift(2))) &
+                        if (.not. inside(a - copies(1), b - copies(2))) &
                             orphan(link%leader, a, b) = .true.
                     end do
                 end do
@@ -971,15 +976,13 @@ contains
                 end do
             end associate
         end do
-        do k = 1, unit%n_links
-            associate(link => unit%links(k))
-                if (.not. link%gap) cycle
-                shift = lattice_part(link)
+        do k = 1, size(gaps)
+            associate(link => unit%links(gaps(k)), copies => gap_copies(:, k))
                 do b = 0, ny - 1
                     do a = 0, nx - 1
                         if (orphan(link%follower, a, b)) cycle
                         call net%add_link(node_of(link%follower, a, b), node_of(link%leader, &
-                            a + shift(1), b + shift(2)), [0.0_wp, 0.0_wp, 0.0_wp], .true.)
+                            a + copies(1), b + copies(2)), [0.0_wp, 0.0_wp, 0.0_wp], .true.)
                     end do
                 end do
             end associate
