@@ -360,8 +360,7 @@ contains
                 // ' is not the sum of its load factors')
             return
         end if
-        if (.not. (all(ieee_is_finite(snapshot%u)) .and. all(ieee_is_finite(snapshot%flow)))) &
-                then
+        if (.not. finite_state(snapshot%u, snapshot%flow)) then
             call damaged('it holds a position or flow that is not a finite number')
             return
         end if
@@ -375,15 +374,13 @@ contains
         end if
         if (snapshot%have_old) then
             if (.not. (ieee_is_finite(snapshot%load_old) .and. &
-                    all(ieee_is_finite(snapshot%u_old)) .and. &
-                    all(ieee_is_finite(snapshot%flow_old)))) then
+                    finite_state(snapshot%u_old, snapshot%flow_old))) then
                 call damaged('its previous state holds a value that is not a finite number')
                 return
             end if
             if (snapshot%have_older) then
                 if (.not. (ieee_is_finite(snapshot%load_older) .and. &
-                        all(ieee_is_finite(snapshot%u_older)) .and. &
-                        all(ieee_is_finite(snapshot%flow_older)))) then
+                        finite_state(snapshot%u_older, snapshot%flow_older))) then
                     call damaged('its state before the previous one holds a value that is ' &
                         // 'not a finite number')
                     return
@@ -427,6 +424,12 @@ contains
             call fatal_error(error, "&control restart: '" // path // "' is damaged or not " &
                 // 'of this scene: ' // reason)
         end subroutine damaged
+
+        !> Every position (u) and flow of a stored state is a finite number.
+        pure logical function finite_state(u, flow)
+            real(wp), intent(in) :: u(:), flow(:)
+            finite_state = all(ieee_is_finite(u)) .and. all(ieee_is_finite(flow))
+        end function finite_state
     end subroutine check_restart
 
     !> Delete folder/restart.dat if there is one and it is a yarnfort restart file (a
