@@ -65,7 +65,6 @@ module yarnfort_output_writer
         !> Echo the effective input to folder/input.nml.
         procedure :: write_input
         procedure :: on_step
-        procedure :: on_cut
         procedure :: on_checkpoint
         !> Told the step and time a restart resumes after, before the files are opened.
         procedure :: on_resume
@@ -285,12 +284,6 @@ contains
             self%last_written = .false.
         end if
     end subroutine on_step
-
-    subroutine on_cut(self, time, step, reason)
-        class(output_writer_type), intent(inout) :: self
-        real(wp), intent(in) :: time, step
-        character(len=*), intent(in) :: reason
-    end subroutine on_cut
 
     !> The default: nothing to say.
     subroutine on_resume(self, step, time)

@@ -23,7 +23,8 @@ module yarnfort_solver_continuation
     type, abstract :: step_observer_type
     contains
         procedure(on_step_interface), deferred :: on_step
-        procedure(on_cut_interface), deferred :: on_cut
+        !> Told of every step cut (the time, the step tried and why it failed).
+        procedure :: on_cut
         !> Receives the restart snapshot of every converged step, after on_step.
         procedure :: on_checkpoint
     end type step_observer_type
@@ -36,13 +37,6 @@ module yarnfort_solver_continuation
             type(step_state_type), intent(in) :: state
             type(error_type), allocatable, intent(out) :: error
         end subroutine on_step_interface
-
-        subroutine on_cut_interface(self, time, step, reason)
-            import :: step_observer_type, wp
-            class(step_observer_type), intent(inout) :: self
-            real(wp), intent(in) :: time, step
-            character(len=*), intent(in) :: reason
-        end subroutine on_cut_interface
     end interface
 
     !> Pseudo-times closer than this (relative to the path length) are the same knot.
@@ -57,6 +51,13 @@ contains
         type(restart_type), intent(in) :: snapshot
         type(error_type), allocatable, intent(out) :: error
     end subroutine on_checkpoint
+
+    !> The default: cuts are not reported.
+    subroutine on_cut(self, time, step, reason)
+        class(step_observer_type), intent(inout) :: self
+        real(wp), intent(in) :: time, step
+        character(len=*), intent(in) :: reason
+    end subroutine on_cut
 
     !> Follow the scene's load path from its first knot to its last, or from the step
     !> of a `restart` snapshot on; stop early after `max_steps` converged load steps
