@@ -16,7 +16,7 @@ module yarnfort_linalg_bordered
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_direct, only: direct_solver_type, get_subpattern
     use yarnfort_linalg_dense, only: dense_solver_type
     implicit none
     private
@@ -116,33 +116,23 @@ contains
     subroutine analyse_leading(self, error)
         type(bordered_solver_type), intent(inout) :: self
         type(error_type), allocatable, intent(out) :: error
-        integer(ik), allocatable :: col_ptr(:), row_index(:), source(:)
-        integer(ik) :: j, k, kept
+        integer(ik), allocatable :: col_ptr(:), row_index(:), index(:)
+        integer(ik) :: j
 
-        allocate(col_ptr(self%n_leading + 1), row_index(size(self%row_index)), &
-            source(size(self%row_index)))
-        col_ptr(1) = 0
-        kept = 0
-        do j = 1, self%n_leading
-            do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
-                if (self%row_index(k) >= self%n_leading) cycle
-                kept = kept + 1
-                row_index(kept) = self%row_index(k)
-                source(kept) = k
-            end do
-            col_ptr(j + 1) = kept
-        end do
-        self%source = source(1:kept)
+        ! K: the leading rows and columns, numbered as in the whole matrix.
+        allocate(index(self%n), source=0_ik)
+        index(1:self%n_leading) = [(j, j = 1, self%n_leading)]
+        call get_subpattern(self%col_ptr, self%row_index, index, col_ptr, row_index, self%source)
         if (self%leading_analysed) then
-            if (size(self%leading_row_index) == kept) then
+            if (size(self%leading_row_index) == size(row_index)) then
                 if (all(self%leading_col_ptr == col_ptr) .and. &
-                    all(self%leading_row_index == row_index(1:kept))) return
+                    all(self%leading_row_index == row_index)) return
             end if
             call self%leading%destroy()
             self%leading_analysed = .false.
         end if
         self%leading_col_ptr = col_ptr
-        self%leading_row_index = row_index(1:kept)
+        self%leading_row_index = row_index
         call self%leading%analyse(self%n_leading, self%leading_col_ptr, &
             self%leading_row_index, error)
         self%leading_analysed = .not. allocated(error)

@@ -13,7 +13,7 @@ module yarnfort_linalg_condensed
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_direct, only: direct_solver_type, get_subpattern
     implicit none
     private
 
@@ -77,7 +77,7 @@ contains
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         logical, allocatable :: trivial(:)
-        integer(ik) :: j, k, i, m
+        integer(ik) :: j, k, m
 
         ! A candidate row is trivial when its only nonzero value is a nonzero diagonal.
         self%pivot = 0.0_wp
@@ -107,7 +107,6 @@ contains
         !> The reduced pattern: the stored entries whose row and column both stay.
         subroutine reduce(trivial)
             logical, intent(in) :: trivial(:)
-            integer(ik) :: kept
 
             m = 0
             do j = 1, self%n
@@ -119,26 +118,8 @@ contains
                 end if
             end do
             self%n_reduced = m
-            if (allocated(self%reduced_col_ptr)) deallocate(self%reduced_col_ptr)
-            if (allocated(self%reduced_row_index)) deallocate(self%reduced_row_index)
-            if (allocated(self%source)) deallocate(self%source)
-            allocate(self%reduced_col_ptr(m + 1), self%reduced_row_index(size(self%row_index)), &
-                self%source(size(self%row_index)))
-            self%reduced_col_ptr(1) = 0
-            kept = 0
-            do j = 1, self%n
-                if (trivial(j)) cycle
-                do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
-                    i = self%row_index(k) + 1
-                    if (trivial(i)) cycle
-                    kept = kept + 1
-                    self%reduced_row_index(kept) = self%reduced(i) - 1
-                    self%source(kept) = k
-                end do
-                self%reduced_col_ptr(self%reduced(j) + 1) = kept
-            end do
-            self%reduced_row_index = self%reduced_row_index(1:kept)
-            self%source = self%source(1:kept)
+            call get_subpattern(self%col_ptr, self%row_index, self%reduced, &
+                self%reduced_col_ptr, self%reduced_row_index, self%source)
             if (self%inner_analysed) call self%inner%destroy()
             self%inner_analysed = .false.
             self%n_reductions = self%n_reductions + 1

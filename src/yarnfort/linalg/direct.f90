@@ -15,7 +15,7 @@ module yarnfort_linalg_direct
     implicit none
     private
 
-    public :: direct_solver_type, describe_status
+    public :: direct_solver_type, describe_status, get_subpattern
 
     !> A linear solver that keeps the pattern (as 64-bit C arrays, what the libraries read).
     type, abstract, extends(linear_solver_type) :: direct_solver_type
@@ -169,6 +169,37 @@ contains
         if (allocated(self%col_ptr)) deallocate(self%col_ptr)
         if (allocated(self%row_index)) deallocate(self%row_index)
     end subroutine destroy
+
+    !> The pattern of the submatrix of a kept pattern (col_ptr, row_index) made of the rows
+    !> and columns j with index(j) > 0, numbered index(j) (1..m, increasing with j):
+    !> sub_col_ptr(m + 1) and 0-based sub_row_index, and for each of its entries the entry
+    !> (1-based) of the whole pattern it comes from. For solvers that hand part of the
+    !> matrix to another solver.
+    pure subroutine get_subpattern(col_ptr, row_index, index, sub_col_ptr, sub_row_index, &
+            source)
+        integer(c_long), intent(in) :: col_ptr(:), row_index(:)
+        integer(ik), intent(in) :: index(:)
+        integer(ik), allocatable, intent(out) :: sub_col_ptr(:), sub_row_index(:), source(:)
+        integer(ik) :: j, k, i, kept
+
+        allocate(sub_col_ptr(count(index > 0) + 1), sub_row_index(size(row_index)), &
+            source(size(row_index)))
+        sub_col_ptr(1) = 0
+        kept = 0
+        do j = 1, size(col_ptr, kind=ik) - 1
+            if (index(j) == 0) cycle
+            do k = col_ptr(j) + 1, col_ptr(j + 1)
+                i = row_index(k) + 1
+                if (index(i) == 0) cycle
+                kept = kept + 1
+                sub_row_index(kept) = index(i) - 1
+                source(kept) = k
+            end do
+            sub_col_ptr(index(j) + 1) = kept
+        end do
+        sub_row_index = sub_row_index(1:kept)
+        source = source(1:kept)
+    end subroutine get_subpattern
 
     subroutine fail(self, error, stage, reason)
         class(direct_solver_type), intent(in) :: self
