@@ -915,7 +915,10 @@ contains
         if (allocated(error)) return
         ! Gap-holders: the leader of the follower in copy (a, b) is in copy (a, b) + its
         ! lattice part; outside the sample both contact nodes go.
-        gaps = pack([(k, k = 1, unit%n_links)], unit%links(1:unit%n_links)%gap)
+        allocate(gaps(0))
+        do k = 1, unit%n_links
+            if (unit%links(k)%gap) gaps = [gaps, k]
+        end do
         allocate(gap_copies(2, size(gaps)))
         do k = 1, size(gaps)
             gap_copies(:, k) = lattice_part(unit%links(gaps(k)))
