@@ -123,6 +123,9 @@ module yarnfort_solver_newton
         procedure :: solve
         !> One Newton step from u, without a convergence test.
         procedure :: take_newton_step
+        !> The first Newton step and its chord steps only (no fallback): converged, or
+        !> the best iterate to judge before solving on.
+        procedure :: try_chord
         !> Timing and counters of assembly and linear algebra so far.
         procedure :: get_timings
         procedure :: destroy
@@ -450,14 +453,31 @@ contains
                 end do
             end if
             if (f < history(1)) u = self%u
+            stats%residual_norm = f
+            stats%residual_history = history
             if (.not. (f <= tol)) return
             call problem%check_solution(self%u, trial_error)
             if (allocated(trial_error)) return
             converged = .true.
-            stats%residual_norm = f
-            stats%residual_history = history
         end associate
     end subroutine solve_chord
+
+    !> The chord fast path of `solve` alone (solve_chord): `converged`, u is the
+    !> solution; else u is the best of its iterates (or the start), and the caller
+    !> decides whether to solve on (`solve` from u) or to change the problem first.
+    subroutine try_chord(self, u, stats, converged, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: u(:)
+        type(newton_stats_type), intent(out) :: stats
+        logical, intent(out) :: converged
+        type(error_type), allocatable, intent(out) :: error
+
+        associate(problem => self%problem%problem)
+            problem%spring = 0.0_wp
+            problem%tangent_spring = self%options%slack_stiffness
+            call solve_chord(self, u, stats, converged, error)
+        end associate
+    end subroutine try_chord
 
     !> u <- u + one Newton step of the exact law from u (no convergence test): the
     !> direction a solve from u sets out in.
