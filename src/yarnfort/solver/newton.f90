@@ -236,11 +236,13 @@ contains
     !> Solve from the initial guess u: with the exact law; if that fails and
     !> slack_stiffness > 0, predicted with the regularising spring and corrected with
     !> the exact law from the prediction (module notes). stats add up all attempts.
-    subroutine solve(self, u, stats, error)
+    subroutine solve(self, u, stats, error, after_chord)
         class(newton_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: u(:)
         type(newton_stats_type), intent(out) :: stats
         type(error_type), allocatable, intent(out) :: error
+        !> u is where try_chord left off: go on without another chord path.
+        logical, intent(in), optional :: after_chord
         type(error_type), allocatable :: exact_error
         real(wp), allocatable :: guess(:)
         real(wp) :: weight
@@ -248,7 +250,7 @@ contains
         associate(problem => self%problem%problem, spring => self%options%slack_stiffness)
             problem%spring = 0.0_wp
             problem%tangent_spring = spring
-            if (self%chord_steps > 0) then
+            if (self%chord_steps > 0 .and. .not. present_and_true(after_chord)) then
                 call solve_chord(self, u, stats, converged, error)
                 if (allocated(error) .or. converged) return
             end if
@@ -286,6 +288,12 @@ contains
             u = guess
         end associate
     contains
+        pure logical function present_and_true(flag)
+            logical, intent(in), optional :: flag
+            present_and_true = .false.
+            if (present(flag)) present_and_true = flag
+        end function present_and_true
+
         subroutine combine(later, link)
             type(error_type), intent(inout) :: later
             character(len=*), intent(in) :: link
