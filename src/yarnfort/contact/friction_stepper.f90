@@ -18,6 +18,8 @@
 !> When the step's first set fails with no new slip, its passages whose flows the first
 !> Newton step sends back stick and the set is solved again (stop_flowing_back). Every
 !> solve starts with chord steps (newton_solver_type%chord_steps), in both schemes.
+!> A monolithic round's set may be judged and changed before it is solved, at the
+!> chord path's iterate (provisional rounds, max_provisional_rounds).
 !> A passage whose element would become shorter than min_length_ratio times its initial
 !> reference length locks at that length (stick), and may not slip that way again while
 !> the element keeps that length, in this step and the next ones. A passage that flips
@@ -340,7 +342,9 @@ contains
                     provisional_rounds = max_provisional_rounds
                 if (provisional_rounds < max_provisional_rounds .and. .not. (full_retry &
                         .or. problem%semismooth)) then
-                    do pass = 1, provisional_passes
+                    ! Each pass is one Newton step: with the solve after them, within
+                    ! max_iterations (a solve's limit).
+                    do pass = 1, min(provisional_passes, scene%solver%max_iterations - 1)
                         call self%newton_full%try_chord(unknowns, stats, solved, step_error)
                         iterations = iterations + stats%iterations
                         call add_stats(stats, carried)
