@@ -123,6 +123,9 @@ module yarnfort_solver_newton
         procedure :: solve
         !> One Newton step from u, without a convergence test.
         procedure :: take_newton_step
+        !> The first Newton step and its chord steps only (no fallback): converged, or
+        !> the best iterate to judge before solving on.
+        procedure :: try_chord
         !> Timing and counters of assembly and linear algebra so far.
         procedure :: get_timings
         procedure :: destroy
@@ -233,11 +236,13 @@ contains
     !> Solve from the initial guess u: with the exact law; if that fails and
     !> slack_stiffness > 0, predicted with the regularising spring and corrected with
     !> the exact law from the prediction (module notes). stats add up all attempts.
-    subroutine solve(self, u, stats, error)
+    subroutine solve(self, u, stats, error, after_chord)
         class(newton_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: u(:)
         type(newton_stats_type), intent(out) :: stats
         type(error_type), allocatable, intent(out) :: error
+        !> u is where try_chord left off: go on without another chord path.
+        logical, intent(in), optional :: after_chord
         type(error_type), allocatable :: exact_error
         real(wp), allocatable :: guess(:)
         real(wp) :: weight
@@ -245,7 +250,7 @@ contains
         associate(problem => self%problem%problem, spring => self%options%slack_stiffness)
             problem%spring = 0.0_wp
             problem%tangent_spring = spring
-            if (self%chord_steps > 0) then
+            if (self%chord_steps > 0 .and. .not. present_and_true(after_chord)) then
                 call solve_chord(self, u, stats, converged, error)
                 if (allocated(error) .or. converged) return
             end if
@@ -283,6 +288,12 @@ contains
             u = guess
         end associate
     contains
+        pure logical function present_and_true(flag)
+            logical, intent(in), optional :: flag
+            present_and_true = .false.
+            if (present(flag)) present_and_true = flag
+        end function present_and_true
+
         subroutine combine(later, link)
             type(error_type), intent(inout) :: later
             character(len=*), intent(in) :: link
@@ -450,14 +461,31 @@ contains
                 end do
             end if
             if (f < history(1)) u = self%u
+            stats%residual_norm = f
+            stats%residual_history = history
             if (.not. (f <= tol)) return
             call problem%check_solution(self%u, trial_error)
             if (allocated(trial_error)) return
             converged = .true.
-            stats%residual_norm = f
-            stats%residual_history = history
         end associate
     end subroutine solve_chord
+
+    !> The chord fast path of `solve` alone (solve_chord): `converged`, u is the
+    !> solution; else u is the best of its iterates (or the start), and the caller
+    !> decides whether to solve on (`solve` from u) or to change the problem first.
+    subroutine try_chord(self, u, stats, converged, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: u(:)
+        type(newton_stats_type), intent(out) :: stats
+        logical, intent(out) :: converged
+        type(error_type), allocatable, intent(out) :: error
+
+        associate(problem => self%problem%problem)
+            problem%spring = 0.0_wp
+            problem%tangent_spring = self%options%slack_stiffness
+            call solve_chord(self, u, stats, converged, error)
+        end associate
+    end subroutine try_chord
 
     !> u <- u + one Newton step of the exact law from u (no convergence test): the
     !> direction a solve from u sets out in.
