@@ -64,7 +64,6 @@ contains
         integer(c_int64_t), pointer :: col_ptr(:), row_index(:)
         real(c_double), pointer :: values(:)
         integer(ik) :: n, nnz
-        real(wp) :: start
 
         call c_f_pointer(sunls%content, adapter)
         call get_csc(sunmat_a, n, nnz, col_ptr, row_index, values)
@@ -91,7 +90,6 @@ contains
         real(c_double), value :: tol
         type(adapter_type), pointer :: adapter
         real(c_double), pointer :: x(:), b(:)
-        real(wp) :: start
 
         call c_f_pointer(sunls%content, adapter)
         x => FN_VGetArrayPointer(sunvec_x)
