@@ -141,6 +141,8 @@ module yarnfort_contact_friction_stepper
         real(wp), allocatable :: u_older(:), flow_older(:)
         real(wp) :: load_older = 0.0_wp
         logical :: have_older = .false., held = .false.
+        !> The accepted state is the initial one (no load step accepted since).
+        logical :: from_initial = .false.
         !> Passages held in stick by chatter damping in the last step.
         integer :: n_damped = 0
         !> The current step's trace (since the last accept) and the last accepted one's.
@@ -299,6 +301,13 @@ contains
                 ! round).
                 guessed = any(self%mode_trial /= mode_stick)
                 self%mode_trial = mode_stick
+            case default
+                ! The first load step from the initial state (no predictor): all-stick, the
+                ! elastic trial, and the rounds let the slip zone in. Measured
+                ! (benchmarks/steps_results.md, section 11): step 1 of the 8 x 8 clamped
+                ! knit (default edge threads) took 27 Newton iterations instead of 30 from
+                ! the initial state's slip set; no other scene changed.
+                if (self%from_initial) self%mode_trial = mode_stick
             end select
             allocate(flips(size(self%flow)), source=0)
             allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
@@ -370,6 +379,21 @@ contains
                     end if
                 end if
                 full_retry = .false.
+                if (guessed .and. .not. (have_good .or. solved) .and. chorded) then
+                    ! A guessed start set (predict_modes, or stick at a turn) whose first
+                    ! Newton step raised the scaled residual is given up without KINSOL;
+                    ! the last step's set from the predicted state follows (below).
+                    ! Measured (benchmarks/steps_results.md, section 11; Newton iterations
+                    ! per step): the 8 x 4 twill of tests/verification/test_texgen.py
+                    ! built-in / TexGen 3.85 / 3.95 -> 2.85 / 2.65, inputs/belt.nml 3.12
+                    ! -> 2.77, the 8 x 8 clamped knit 3.90 -> 3.60 (step 2: the set
+                    ! predicted from the unloaded state took 7 iterations to fail).
+                    if (first_step_rose(carried)) then
+                        call fatal_error(error, 'the guessed active set diverges')
+                        stats = carried
+                        solved = .true.
+                    end if
+                end if
                 if (.not. solved) then
                     call self%newton_full%solve(unknowns, stats, error, after_chord=chorded)
                     iterations = iterations + stats%iterations
@@ -433,7 +457,13 @@ contains
                     end if
                     if (guessed) then
                         ! The guessed start failed: the last step's active set instead.
+                        ! That restart is no fallback state, so its rounds may be
+                        ! provisional. Measured (benchmarks/steps_results.md, section 11):
+                        ! the 8 x 8 clamped knit 4.10 -> 3.90 Newton iterations per step
+                        ! (loading), the built-in twill 3.95 -> 3.85, inputs/belt.nml 3.20
+                        ! -> 3.12, no scene worse.
                         guessed = .false.
+                        failed_before = self%trace%failed_solves
                         deallocate(error)
                         self%mode_trial = self%mode
                         unknowns = [self%u, self%flow]
@@ -508,6 +538,15 @@ contains
             new_slips = trial_new_slips
         end subroutine judge_provisional
     end subroutine try_monolithic
+
+    !> The first Newton step of a solve (chord path, `stats`) raised the scaled residual.
+    pure logical function first_step_rose(stats)
+        type(newton_stats_type), intent(in) :: stats
+        first_step_rose = .false.
+        if (.not. allocated(stats%residual_history)) return
+        if (size(stats%residual_history) < 2) return
+        first_step_rose = stats%residual_history(2) > stats%residual_history(1)
+    end function first_step_rose
 
     !> Add the counts of `earlier` (the provisional part of one round) to `stats`.
     pure subroutine add_stats(stats, earlier)
@@ -1126,6 +1165,7 @@ contains
             self%flow_older = self%flow_old
             self%load_older = self%load_old
         end if
+        self%from_initial = .not. self%have_old
         self%u_old = self%u
         self%flow_old = self%flow
         self%load_old = sum(self%factors)
