@@ -13,13 +13,16 @@
 !>   slip -> stick if the flow increment of the step has the wrong sign.
 !> A step starts from the predicted state (secant, or the parabola through three states of
 !> one active set; reversed secant across a turn) with the stick passages that it takes
-!> across their limit slipping (predict_modes); each round after the first is a fast
+!> across their limit slipping (predict_modes), or all-stick when it is the first load
+!> step from the initial state; a guessed start set whose first Newton step raises the
+!> residual gives way at once to the last step's set. Each round after the first is a fast
 !> Newton solve (full steps only), and one that fails is retried with fewer new slips.
 !> When the step's first set fails with no new slip, its passages whose flows the first
 !> Newton step sends back stick and the set is solved again (stop_flowing_back). Every
 !> solve starts with chord steps (newton_solver_type%chord_steps), in both schemes.
 !> A monolithic round's set may be judged and changed before it is solved, at the
-!> chord path's iterate (provisional rounds, max_provisional_rounds).
+!> chord path's iterate (provisional rounds, max_provisional_rounds); after a solved state,
+!> an iterate that does not contract is judged for its stops only.
 !> A passage whose element would become shorter than min_length_ratio times its initial
 !> reference length locks at that length (stick), and may not slip that way again while
 !> the element keeps that length, in this step and the next ones. A passage that flips
