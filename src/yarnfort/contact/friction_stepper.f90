@@ -13,13 +13,16 @@
 !>   slip -> stick if the flow increment of the step has the wrong sign.
 !> A step starts from the predicted state (secant, or the parabola through three states of
 !> one active set; reversed secant across a turn) with the stick passages that it takes
-!> across their limit slipping (predict_modes); each round after the first is a fast
+!> across their limit slipping (predict_modes), or all-stick when it is the first load
+!> step from the initial state; a guessed start set whose first Newton step raises the
+!> residual gives way at once to the last step's set. Each round after the first is a fast
 !> Newton solve (full steps only), and one that fails is retried with fewer new slips.
 !> When the step's first set fails with no new slip, its passages whose flows the first
 !> Newton step sends back stick and the set is solved again (stop_flowing_back). Every
 !> solve starts with chord steps (newton_solver_type%chord_steps), in both schemes.
 !> A monolithic round's set may be judged and changed before it is solved, at the
-!> chord path's iterate (provisional rounds, max_provisional_rounds).
+!> chord path's iterate (provisional rounds, max_provisional_rounds); after a solved state,
+!> an iterate that does not contract is judged for its stops only.
 !> A passage whose element would become shorter than min_length_ratio times its initial
 !> reference length locks at that length (stick), and may not slip that way again while
 !> the element keeps that length, in this step and the next ones. A passage that flips
@@ -141,6 +144,8 @@ module yarnfort_contact_friction_stepper
         real(wp), allocatable :: u_older(:), flow_older(:)
         real(wp) :: load_older = 0.0_wp
         logical :: have_older = .false., held = .false.
+        !> The accepted state is the initial one (no load step accepted since).
+        logical :: from_initial = .false.
         !> Passages held in stick by chatter damping in the last step.
         integer :: n_damped = 0
         !> The current step's trace (since the last accept) and the last accepted one's.
@@ -299,6 +304,13 @@ contains
                 ! round).
                 guessed = any(self%mode_trial /= mode_stick)
                 self%mode_trial = mode_stick
+            case default
+                ! The first load step from the initial state (no predictor): all-stick, the
+                ! elastic trial, and the rounds let the slip zone in. Measured
+                ! (benchmarks/steps_results.md, section 11): step 1 of the 8 x 8 clamped
+                ! knit (default edge threads) took 27 Newton iterations instead of 30 from
+                ! the initial state's slip set; no other scene changed.
+                if (self%from_initial) self%mode_trial = mode_stick
             end select
             allocate(flips(size(self%flow)), source=0)
             allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
@@ -353,7 +365,21 @@ contains
                         if (allocated(step_error) .or. solved) exit
                         if (.not. allocated(stats%residual_history)) exit
                         if (.not. (stats%residual_norm <= provisional_contraction &
-                            * stats%residual_history(1))) exit
+                            * stats%residual_history(1))) then
+                            ! Not contracting, in a round after a solved state: its stops
+                            ! only (the first Newton step sends their flows back, as in
+                            ! stop_flowing_back), no new slips. Measured
+                            ! (benchmarks/steps_results.md, section 11): the 8 x 8 clamped
+                            ! knit, step 1 from rest 27 -> 13 Newton iterations (224 new
+                            ! slips at the elastic trial, 100 of them stop), loading 3.60 ->
+                            ! 2.90 per step, cycle 3.12 -> 2.77; no other scene changed.
+                            if (pass == 1 .and. have_good) then
+                                call judge_provisional(problem, unknowns(n_x + 1:), &
+                                    stats%residual_norm, changed, 0)
+                                moved = changed > 0
+                            end if
+                            exit
+                        end if
                         call judge_provisional(problem, unknowns(n_x + 1:), &
                             stats%residual_norm, changed)
                         moved = changed > 0
@@ -370,6 +396,21 @@ contains
                     end if
                 end if
                 full_retry = .false.
+                if (guessed .and. .not. (have_good .or. solved) .and. chorded) then
+                    ! A guessed start set (predict_modes, or stick at a turn) whose first
+                    ! Newton step raised the scaled residual is given up without KINSOL;
+                    ! the last step's set from the predicted state follows (below).
+                    ! Measured (benchmarks/steps_results.md, section 11; Newton iterations
+                    ! per step): the 8 x 4 twill of tests/verification/test_texgen.py
+                    ! built-in / TexGen 3.85 / 3.95 -> 2.85 / 2.65, inputs/belt.nml 3.12
+                    ! -> 2.77, the 8 x 8 clamped knit 3.90 -> 3.60 (step 2: the set
+                    ! predicted from the unloaded state took 7 iterations to fail).
+                    if (first_step_rose(carried)) then
+                        call fatal_error(error, 'the guessed active set diverges')
+                        stats = carried
+                        solved = .true.
+                    end if
+                end if
                 if (.not. solved) then
                     call self%newton_full%solve(unknowns, stats, error, after_chord=chorded)
                     iterations = iterations + stats%iterations
@@ -433,7 +474,13 @@ contains
                     end if
                     if (guessed) then
                         ! The guessed start failed: the last step's active set instead.
+                        ! That restart is no fallback state, so its rounds may be
+                        ! provisional. Measured (benchmarks/steps_results.md, section 11):
+                        ! the 8 x 8 clamped knit 4.10 -> 3.90 Newton iterations per step
+                        ! (loading), the built-in twill 3.95 -> 3.85, inputs/belt.nml 3.20
+                        ! -> 3.12, no scene worse.
                         guessed = .false.
+                        failed_before = self%trace%failed_solves
                         deallocate(error)
                         self%mode_trial = self%mode
                         unknowns = [self%u, self%flow]
@@ -473,15 +520,18 @@ contains
     contains
         !> The active set judged at a provisional iterate (flows `flow`) as at a solved
         !> state; kept, with the rounds' bookkeeping, only if it changed (`changed`).
-        subroutine judge_provisional(problem, flow, residual, changed)
+        subroutine judge_provisional(problem, flow, residual, changed, cap_here)
             type(friction_problem_type), intent(inout) :: problem
             real(wp), intent(in) :: flow(:), residual
             integer, intent(out) :: changed
+            !> At most this many new slips (default: the rounds' cap); when given, the
+            !> count of the last new slips (for halving) stays.
+            integer, intent(in), optional :: cap_here
             integer, allocatable :: trial_mode(:), trial_flips(:), saved_locked(:)
             logical, allocatable :: trial_forward(:), trial_backward(:)
             real(wp), allocatable :: saved_target(:)
             type(error_type), allocatable :: state_error
-            integer :: trial_new_slips
+            integer :: trial_new_slips, max_new_slips
 
             changed = 0
             call problem%update_state(unknowns, state_error)
@@ -492,8 +542,10 @@ contains
             trial_backward = locked_backward
             saved_locked = problem%locked
             saved_target = problem%flow_target
+            max_new_slips = cap
+            if (present(cap_here)) max_new_slips = cap_here
             call update_active_set(problem, flow, self%flow, trial_mode, trial_flips, &
-                trial_forward, trial_backward, changed, cap, &
+                trial_forward, trial_backward, changed, max_new_slips, &
                 trial_new_slips, residual)
             if (changed == 0) then
                 problem%locked = saved_locked
@@ -505,9 +557,18 @@ contains
             flips = trial_flips
             locked_forward = trial_forward
             locked_backward = trial_backward
-            new_slips = trial_new_slips
+            if (.not. present(cap_here)) new_slips = trial_new_slips
         end subroutine judge_provisional
     end subroutine try_monolithic
+
+    !> The first Newton step of a solve (chord path, `stats`) raised the scaled residual.
+    pure logical function first_step_rose(stats)
+        type(newton_stats_type), intent(in) :: stats
+        first_step_rose = .false.
+        if (.not. allocated(stats%residual_history)) return
+        if (size(stats%residual_history) < 2) return
+        first_step_rose = stats%residual_history(2) > stats%residual_history(1)
+    end function first_step_rose
 
     !> Add the counts of `earlier` (the provisional part of one round) to `stats`.
     pure subroutine add_stats(stats, earlier)
@@ -1126,6 +1187,7 @@ contains
             self%flow_older = self%flow_old
             self%load_older = self%load_old
         end if
+        self%from_initial = .not. self%have_old
         self%u_old = self%u
         self%flow_old = self%flow
         self%load_old = sum(self%factors)
