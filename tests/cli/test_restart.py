@@ -9,6 +9,7 @@ import csv
 import os
 import signal
 import subprocess
+import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -258,3 +259,41 @@ def test_max_steps_must_not_be_negative(run_yarnfort, tmp_path):
     run = run_yarnfort(with_output(VNET, "out", control="max_steps = -1"))
     assert run.returncode == 2
     assert "&control: max_steps = -1 must be >= 0" in run.stderr
+
+
+def test_restart_from_the_initial_state(run_yarnfort, tmp_path):
+    """A run killed during its first load step leaves the restart file of step 0 (the
+    initial state). The restarted run must take the first load step as the
+    uninterrupted one does (all-stick from the initial state, not from its slip set):
+    the same Newton iterations and curve. The scene is inputs/knit_clamped.nml as a
+    24 x 12 strip, whose initial state has 72 slipping passages (measured: from that
+    slip set the first step took 60 Newton iterations instead of 17)."""
+    text = (TOP / "inputs" / "knit_clamped.nml").read_text()
+    assert "cells = 8, 4 " in text
+    text = text.replace("cells = 8, 4 ", "cells = 24, 12 ")
+    full_folder, parts_folder = tmp_path / "full", tmp_path / "parts"
+    full = run_yarnfort(with_output(text, str(full_folder), control="max_steps = 2"), cwd=TOP)
+    assert full.returncode == 0, full.stderr
+    assert int(read_rows(full_folder)[0]["slipping"]) > 0, "the initial state must slip"
+    restart_file = parts_folder / "restart.dat"
+    for _ in range(5):
+        # Kill as soon as the restart file of step 0 is there (the first load step takes
+        # about 0.2 s); try again should the kill come after step 1.
+        process = subprocess.Popen([str(EXECUTABLE)], cwd=TOP, text=True,
+                                   stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)
+        process.stdin.write(with_output(text, str(parts_folder), control="max_steps = 2"))
+        process.stdin.close()
+        while not restart_file.exists() and process.poll() is None:
+            time.sleep(0.002)
+        process.kill()
+        process.wait()
+        if [r["step"] for r in read_rows(parts_folder)] == ["0"]:
+            break
+    else:
+        pytest.fail("the run could not be stopped during its first load step")
+    again = run_yarnfort(with_output(text, str(parts_folder),
+                                     control="max_steps = 2, restart = .true."), cwd=TOP)
+    assert again.returncode == 0, again.stderr
+    assert "restarting after step 0" in again.stderr
+    compare_curves(read_rows(full_folder), read_rows(parts_folder))

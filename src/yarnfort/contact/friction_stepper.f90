@@ -1288,6 +1288,10 @@ contains
         self%load_older = snapshot%load_older
         self%u_older = snapshot%u_older
         self%flow_older = snapshot%flow_older
+        ! Restarted from the initial state: its first load step starts all-stick, as in
+        ! the run that wrote the file (a 48 x 24 clamped knit's step 1 from the initial
+        ! state's slip set took 625 Newton iterations instead of 25).
+        self%from_initial = snapshot%step == 0
         self%factors_trial = self%factors
         self%u_trial = self%u
         self%flow_trial = self%flow
