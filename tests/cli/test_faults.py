@@ -529,6 +529,16 @@ def test_non_finite_position_in_restart_is_refused(tmp_path, value):
     assert "a position or flow that is not a finite number" in proc.stderr
 
 
+@pytest.mark.parametrize("value", [float("inf"), float("nan")])
+def test_non_finite_previous_load_in_restart_is_refused(tmp_path, value):
+    """The load of the state before the last converged one is damaged."""
+    assert run(with_output(CAPSTAN, "out", control="max_steps = 5"), tmp_path).returncode == 0
+    patch(tmp_path / "out" / "restart.dat", "load_old", "<d", value)
+    proc = run(with_output(CAPSTAN, "out", control="restart = .true."), tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert "its previous state holds a value that is not a finite number" in proc.stderr
+
+
 # ------------------------------------------------------------------ memory
 
 def test_geometry_file_larger_than_memory(tmp_path):

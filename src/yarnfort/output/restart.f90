@@ -360,7 +360,7 @@ contains
                 // ' is not the sum of its load factors')
             return
         end if
-        if (.not. finite_state(snapshot%u, snapshot%flow)) then
+        if (.not. finite_state(snapshot%previous_load, snapshot%u, snapshot%flow)) then
             call damaged('it holds a position or flow that is not a finite number')
             return
         end if
@@ -373,14 +373,13 @@ contains
             return
         end if
         if (snapshot%have_old) then
-            if (.not. (ieee_is_finite(snapshot%load_old) .and. &
-                    finite_state(snapshot%u_old, snapshot%flow_old))) then
+            if (.not. finite_state(snapshot%load_old, snapshot%u_old, snapshot%flow_old)) then
                 call damaged('its previous state holds a value that is not a finite number')
                 return
             end if
             if (snapshot%have_older) then
-                if (.not. (ieee_is_finite(snapshot%load_older) .and. &
-                        finite_state(snapshot%u_older, snapshot%flow_older))) then
+                if (.not. finite_state(snapshot%load_older, snapshot%u_older, &
+                        snapshot%flow_older)) then
                     call damaged('its state before the previous one holds a value that is ' &
                         // 'not a finite number')
                     return
@@ -425,10 +424,11 @@ contains
                 // 'of this scene: ' // reason)
         end subroutine damaged
 
-        !> Every position (u) and flow of a stored state is a finite number.
-        pure logical function finite_state(u, flow)
-            real(wp), intent(in) :: u(:), flow(:)
-            finite_state = all(ieee_is_finite(u)) .and. all(ieee_is_finite(flow))
+        !> The load, every position (u) and every flow of a stored state are finite numbers.
+        pure logical function finite_state(load, u, flow)
+            real(wp), intent(in) :: load, u(:), flow(:)
+            finite_state = ieee_is_finite(load) .and. all(ieee_is_finite(u)) &
+                .and. all(ieee_is_finite(flow))
         end function finite_state
     end subroutine check_restart
 
