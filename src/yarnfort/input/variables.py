@@ -24,6 +24,27 @@ from descriptors import Group, Var
 GAP_FACTOR = ('The gap factor as a piecewise-linear function of the displacement factor p_disp '
               "(constant beyond the end knots): the holders' length is gap * factor (paper "
               'Fig. 13b). `gap_factor_p_disp` increasing; factors positive.')
+#: A name that other groups or columns refer to.
+NAME_RULE = 'Required and unique. One word of letters, digits, `_`, `-`, `.`.'
+#: The nodes of a named node set.
+NODE_SET = 'At least one node id, each in 1..n_nodes, no repeats'
+#: The optional long-format files of &output follow curve.csv.
+LIKE_CURVE = ('Written, flushed and resumed on restart like `curve.csv` (a restart with it '
+              'needs the file of the first run; one without it deletes the file).')
+
+
+def sliding_node_group(name: str, doc: str, name_doc: str, nodes_doc: str) -> Group:
+    """&obstacle or &ring (nodes that yarns slide through): name_doc and nodes_doc end the
+    docs of its variables `name` and `nodes`."""
+    return Group(name, 'repeatable', doc, [
+        Var('name', 'character', '', length='name_length',
+            doc='Required and unique among `&obstacle`, `&ring` and `&support` names. One word '
+                'of letters, digits, `_`, `-`, `.`. `&contact at` names it' + name_doc),
+        Var('nodes', 'integer', None, shape='list',
+            doc=f'{NODE_SET}, each passed through (not ended at) by every yarn that lists it. '
+                + nodes_doc),
+    ])
+
 
 GROUPS = [
     Group('control', 'singleton',
@@ -157,8 +178,7 @@ GROUPS = [
     Group('material', 'repeatable',
           'One yarn type and its force law (one group per yarn type).', [
         Var('name', 'character', '', length='name_length',
-            doc='Required and unique. One word of letters, digits, `_`, `-`, `.`. `&yarn` and '
-                'the geometry file refer to it (case-sensitive).'),
+            doc=f'{NAME_RULE} `&yarn` and the geometry file refer to it (case-sensitive).'),
         Var('law', 'character', '', length=16, lower=True,
             choices=['linear', 'neo_hookean', 'table'], selects=True,
             doc='Required (case-insensitive).'),
@@ -378,10 +398,9 @@ GROUPS = [
     Group('support', 'repeatable',
           'A named set of nodes whose listed components are prescribed.', [
         Var('name', 'character', '', length='name_length',
-            doc='Required and unique. One word of letters, digits, `_`, `-`, `.`. Names the '
-                "support's reaction-force columns in the curve CSV."),
+            doc=f"{NAME_RULE} Names the support's reaction-force columns in the curve CSV."),
         Var('nodes', 'integer', None, shape='list',
-            doc='At least one node id, each in 1..n_nodes, no repeats.'),
+            doc=f'{NODE_SET}.'),
         Var('fix', 'character', 'xyz', length=3, lower=True,
             doc='The prescribed components: one or more of `x`, `y`, `z`, each once '
                 '(case-insensitive).'),
@@ -399,7 +418,7 @@ GROUPS = [
     Group('load', 'repeatable',
           'A force P (N) at load factor p_force = 1 on each listed node.', [
         Var('nodes', 'integer', None, shape='list',
-            doc='At least one node id, each in 1..n_nodes, no repeats.'),
+            doc=f'{NODE_SET}.'),
         Var('force', 'real', [0.0, 0.0, 0.0], shape=3, unit='N', range='finite',
             doc='Force P on each listed node at load factor p_force = 1. Applied force = '
                 'p_force(t) * P. A nonzero component on a coordinate that a support prescribes '
@@ -450,9 +469,7 @@ GROUPS = [
                 'converged step, in long format (columns `step,support,node,rx,ry,rz`; one row '
                 'per node of each `&support` set, in the order the set lists them; N, the force '
                 'the support applies on the net; 0 for a component the set does not fix). The '
-                'rows of a set add up to its columns of `curve.csv`. Written, flushed and '
-                'resumed on restart like `curve.csv` (a restart with it needs the file of the '
-                'first run; one without it deletes the file).'),
+                'rows of a set add up to its columns of `curve.csv`. ' + LIKE_CURVE),
         Var('contact_state', 'logical', True,
             doc='Write `contacts.csv` when the scene has sliding passages (a yarn through a '
                 'contact node with a friction law): per converged step and passage, in long '
@@ -463,36 +480,21 @@ GROUPS = [
                 'the element after / before the node) or `locked` (stuck because the element '
                 'on its low-tension side is at its minimum length, see `&solver '
                 'min_length_ratio`); tensions in N (clipped at 0), critical_tension = '
-                'T_crit(tension_min, wrap_angle), wrap_angle in rad. Written, flushed and '
-                'resumed on restart like `curve.csv` (a restart with it needs the file of the '
-                'first run; one without it deletes the file).'),
+                'T_crit(tension_min, wrap_angle), wrap_angle in rad. ' + LIKE_CURVE),
         Var('residual_history', 'logical', False,
             doc='Also print, per step, the scaled residual of every Newton iterate, max '
                 '\\|F_i\\| / (level_i + noise_i / residual_tolerance) (see `&solver '
                 'residual_tolerance`; converged at <= residual_tolerance), to see the '
                 'convergence rate.'),
     ]),
-    Group('obstacle', 'repeatable',
-          'Fixed obstacles (pins, guides, capstan pegs): nodes at a prescribed position that '
-          'yarns slide through.', [
-        Var('name', 'character', '', length='name_length',
-            doc='Required and unique among `&obstacle`, `&ring` and `&support` names. One word '
-                'of letters, digits, `_`, `-`, `.`. `&contact at` names it; it also names the '
-                "reaction-force columns of the coordinates it holds (as a `&support`'s)."),
-        Var('nodes', 'integer', None, shape='list',
-            doc='At least one node id, each in 1..n_nodes, no repeats, each passed through '
-                '(not ended at) by every yarn that lists it. Every coordinate of these nodes '
-                'that no `&support` prescribes is held at its initial position; a `&support` '
-                'that lists the node moves it (a moving pin).'),
-    ]),
-    Group('ring', 'repeatable',
-          'Free rings: nodes of free position that yarns slide through.', [
-        Var('name', 'character', '', length='name_length',
-            doc='Required and unique among `&obstacle`, `&ring` and `&support` names. One word '
-                'of letters, digits, `_`, `-`, `.`. `&contact at` names it.'),
-        Var('nodes', 'integer', None, shape='list',
-            doc='At least one node id, each in 1..n_nodes, no repeats, each passed through '
-                '(not ended at) by every yarn that lists it. The position is free; a `&load` '
-                'on the node is the force applied to the ring.'),
-    ]),
+    sliding_node_group(
+        'obstacle', 'Fixed obstacles (pins, guides, capstan pegs): nodes at a prescribed '
+        'position that yarns slide through.',
+        "; it also names the reaction-force columns of the coordinates it holds (as a "
+        "`&support`'s).",
+        'Every coordinate of these nodes that no `&support` prescribes is held at its initial '
+        'position; a `&support` that lists the node moves it (a moving pin).'),
+    sliding_node_group(
+        'ring', 'Free rings: nodes of free position that yarns slide through.', '.',
+        'The position is free; a `&load` on the node is the force applied to the ring.'),
 ]
