@@ -33,6 +33,16 @@ LIKE_CURVE = ('Written, flushed and resumed on restart like `curve.csv` (a resta
               'needs the file of the first run; one without it deletes the file).')
 
 
+def channel_var(group: str, scaled: str, default: str) -> Var:
+    """The `channel` of &support or &load: the load channel that scales `scaled`."""
+    return Var('channel', 'character', '', length='name_length',
+               default_doc=f"`''` (`'{default}'`)",
+               doc=f'The load channel whose factor scales `{scaled}`: a name of `&path '
+                   f"channels`, or `'p_force'` / `'p_disp'` without them ('' is `'{default}'`). "
+                   f'With `&path channels`, a {group} with a nonzero {scaled} must name one. '
+                   'See *Load channels* below.')
+
+
 def sliding_node_group(name: str, doc: str, name_doc: str, nodes_doc: str) -> Group:
     """&obstacle or &ring (nodes that yarns slide through): name_doc and nodes_doc end the
     docs of its variables `name` and `nodes`."""
@@ -408,12 +418,7 @@ GROUPS = [
             doc='Displacement D at load factor p_disp = 1, per component. Prescribed position = '
                 'initial position + p_disp(t) * D. A nonzero component outside `fix` is an '
                 'error.'),
-        Var('channel', 'character', '', length='name_length',
-            default_doc="`''` (`'p_disp'`)",
-            doc='The load channel whose factor scales `displacement`: a name of `&path '
-                "channels`, or `'p_force'` / `'p_disp'` without them ('' is `'p_disp'`). With "
-                '`&path channels`, a support with a nonzero displacement must name one. See '
-                '*Load channels* below.'),
+        channel_var('support', 'displacement', 'p_disp'),
     ]),
     Group('load', 'repeatable',
           'A force P (N) at load factor p_force = 1 on each listed node.', [
@@ -423,12 +428,7 @@ GROUPS = [
             doc='Force P on each listed node at load factor p_force = 1. Applied force = '
                 'p_force(t) * P. A nonzero component on a coordinate that a support prescribes '
                 'is an error.'),
-        Var('channel', 'character', '', length='name_length',
-            default_doc="`''` (`'p_force'`)",
-            doc='The load channel whose factor scales `force`: a name of `&path channels`, or '
-                "`'p_force'` / `'p_disp'` without them ('' is `'p_force'`). With `&path "
-                'channels`, a load with a nonzero force must name one. See *Load channels* '
-                'below.'),
+        channel_var('load', 'force', 'p_force'),
     ]),
     Group('path', 'singleton',
           'The load path as knots over pseudo-time, linear in between.', [
