@@ -372,7 +372,7 @@ contains
                     do pass = 1, min(provisional_passes, scene%solver%max_iterations - 1)
                         call self%newton_full%try_chord(unknowns, stats, solved, step_error)
                         iterations = iterations + stats%iterations
-                        call add_stats(stats, carried)
+                        call stats%add_earlier(carried)
                         carried = stats
                         chorded = .not. allocated(step_error)
                         if (allocated(step_error) .or. solved) exit
@@ -430,7 +430,7 @@ contains
                 if (.not. solved) then
                     call self%newton_full%solve(unknowns, stats, error, after_chord=chorded)
                     iterations = iterations + stats%iterations
-                    call add_stats(stats, carried)
+                    call stats%add_earlier(carried)
                 end if
                 call record_solve(self%trace, stats, allocated(error))
                 if (allocated(error)) then
@@ -585,23 +585,6 @@ contains
         if (size(stats%residual_history) < 2) return
         first_step_rose = stats%residual_history(2) > stats%residual_history(1)
     end function first_step_rose
-
-    !> Add the counts of `earlier` (the provisional part of one round) to `stats`.
-    pure subroutine add_stats(stats, earlier)
-        type(newton_stats_type), intent(inout) :: stats
-        type(newton_stats_type), intent(in) :: earlier
-        stats%iterations = stats%iterations + earlier%iterations
-        stats%residual_evaluations = stats%residual_evaluations + earlier%residual_evaluations
-        stats%jacobian_evaluations = stats%jacobian_evaluations + earlier%jacobian_evaluations
-        if (allocated(earlier%residual_history)) then
-            if (allocated(stats%residual_history)) then
-                stats%residual_history = [earlier%residual_history, stats%residual_history]
-            else
-                stats%residual_history = earlier%residual_history
-            end if
-        end if
-    end subroutine add_stats
-
     !> A step of the staggered scheme from the secant-predicted state: rounds of an
     !> elastic solve and a sliding solve (whose own active set settles first), with
     !> Aitken relaxation of the flows. A round that ends at equilibrium with its active set

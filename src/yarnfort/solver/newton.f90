@@ -76,6 +76,8 @@ module yarnfort_solver_newton
         real(wp) :: residual_norm = huge(1.0_wp)
         !> KINSOL's return flag.
         integer :: flag = 0
+    contains
+        procedure :: add_earlier => add_earlier_stats
     end type newton_stats_type
 
     !> What KINSOL's callbacks see through their user-data pointer.
@@ -133,6 +135,23 @@ module yarnfort_solver_newton
     end type newton_solver_type
 
 contains
+
+    !> Add the counts of `earlier` (an earlier part of the same solve, such as the
+    !> provisional passes of a friction round) to these, its residuals first.
+    pure subroutine add_earlier_stats(stats, earlier)
+        class(newton_stats_type), intent(inout) :: stats
+        type(newton_stats_type), intent(in) :: earlier
+        stats%iterations = stats%iterations + earlier%iterations
+        stats%residual_evaluations = stats%residual_evaluations + earlier%residual_evaluations
+        stats%jacobian_evaluations = stats%jacobian_evaluations + earlier%jacobian_evaluations
+        if (allocated(earlier%residual_history)) then
+            if (allocated(stats%residual_history)) then
+                stats%residual_history = [earlier%residual_history, stats%residual_history]
+            else
+                stats%residual_history = earlier%residual_history
+            end if
+        end if
+    end subroutine add_earlier_stats
 
     !> Set up KINSOL for `problem` (which must outlive the solver) with `linear` as the
     !> linear solver (ownership passes to the Newton solver) and the &solver options.
