@@ -9,6 +9,17 @@
 !> bounds, which is what makes the friction Jacobian's factors dense (benchmarks/
 !> results-friction-factor.md); with the stick flows gone the reduced system is the
 !> elastic tangent plus the slipping flows.
+!> With more than `superset_above` kept candidates (the inner solver then factors the
+!> whole reduced matrix, not a border) the reduction keeps a superset: the candidates
+!> that must stay and their neighbours in the pattern up to `superset_reach` steps (the
+!> flows of the passages next to a slipping one along its yarn), and the next sets are
+!> solved with that reduction while they fit in it and it is at most twice what they
+!> would keep. A kept trivial row is only
+!> not eliminated (still exact); what it saves is the inner solver's analysis and full
+!> factorisation, which a new pattern costs and a refactorisation does not (woven net
+!> of 96,600 unknowns: KLU analysis 18 ms + full factorisation 68 ms against a
+!> refactorisation 31 ms; 50 reductions in its 60-step cycle, see
+!> benchmarks/results-issue16-run7.md).
 module yarnfort_linalg_condensed
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -45,6 +56,19 @@ module yarnfort_linalg_condensed
         logical :: inner_analysed = .false.
         !> Analyses of the reduced system so far (each set of eliminated unknowns).
         integer :: n_reductions = 0
+        !> Above this many kept candidates the reduction keeps a superset (module notes);
+        !> at or below it, exactly the non-trivial rows (the default: the bordered
+        !> solver's border limit, below which a new set costs no new analysis).
+        integer(ik) :: superset_above = 16
+        !> How far the superset reaches: candidates within this many steps of a
+        !> non-trivial row in the pattern (along a yarn, the flows of the passages next
+        !> to a slipping one). Woven cycle of 96,600 unknowns, new analyses per cycle for
+        !> reach 0 / 1 / 2 / 4 / 6: aligned 50 / 29 / 21 / - / -, skewed 95 / 76 / 65 /
+        !> 53 / 43, CPU ms per step going down 5-15 % with the reach
+        !> (benchmarks/results-issue16-run7.md).
+        integer :: superset_reach = 4
+        !> Column of each of candidate_entry (its row is candidate_row): the neighbours.
+        integer(ik), allocatable :: candidate_column(:)
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
@@ -71,7 +95,7 @@ contains
     end subroutine analyse_pattern
 
     !> Find the trivial rows of these values, reduce (analysing the reduced pattern
-    !> again if the set changed) and factor the reduced matrix.
+    !> again if the kept set changes: choose_reduction) and factor the reduced matrix.
     subroutine factor_values(self, values, error)
         class(condensed_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
@@ -90,8 +114,7 @@ contains
                 trivial(self%candidate_row(k)) = .false.
         end do
         where (.not. trivial) self%pivot = 0.0_wp
-        if (self%n_reductions == 0 .or. any(trivial .neqv. (self%reduced == 0))) &
-            call reduce(trivial)
+        call choose_reduction()
         self%values = values(self%col_ptr(self%first_candidate) + 1:size(self%row_index))
         if (self%n_reduced > 0) then
             if (.not. self%inner_analysed) then
@@ -104,13 +127,47 @@ contains
             if (allocated(error)) return
         end if
     contains
+        !> Reduce again when a row that must stay was eliminated, or when the kept set
+        !> differs from the one wanted (exactly the non-trivial rows up to superset_above
+        !> of them; above, those and their neighbours, reused while at most twice that).
+        subroutine choose_reduction()
+            logical, allocatable :: wanted(:), reached(:)
+            integer(ik) :: n_wanted, n_kept
+            integer :: sweep
+
+            allocate(wanted(self%n))
+            wanted = .not. trivial
+            if (count(wanted(self%first_candidate:), kind=ik) > self%superset_above) then
+                do sweep = 1, self%superset_reach
+                    allocate(reached, source=wanted)
+                    do k = 1, size(self%candidate_entry, kind=ik)
+                        if (self%candidate_column(k) < self%first_candidate) cycle
+                        if (wanted(self%candidate_row(k))) &
+                            reached(self%candidate_column(k)) = .true.
+                        if (wanted(self%candidate_column(k))) &
+                            reached(self%candidate_row(k)) = .true.
+                    end do
+                    call move_alloc(reached, wanted)
+                end do
+                if (self%n_reductions > 0) then
+                    n_wanted = count(wanted(self%first_candidate:), kind=ik)
+                    n_kept = count(self%reduced(self%first_candidate:) /= 0, kind=ik)
+                    if (.not. any(.not. trivial .and. self%reduced == 0) &
+                        .and. n_kept <= 2 * n_wanted) return
+                end if
+            else if (self%n_reductions > 0) then
+                if (.not. any(wanted .neqv. (self%reduced /= 0))) return
+            end if
+            call reduce(.not. wanted)
+        end subroutine choose_reduction
+
         !> The reduced pattern: the stored entries whose row and column both stay.
-        subroutine reduce(trivial)
-            logical, intent(in) :: trivial(:)
+        subroutine reduce(eliminated)
+            logical, intent(in) :: eliminated(:)
 
             m = 0
             do j = 1, self%n
-                if (trivial(j)) then
+                if (eliminated(j)) then
                     self%reduced(j) = 0
                 else
                     m = m + 1
@@ -176,7 +233,8 @@ contains
                 end if
             end do
         end do
-        allocate(self%candidate_entry(count), self%candidate_row(count))
+        allocate(self%candidate_entry(count), self%candidate_row(count), &
+            self%candidate_column(count))
         count = 0
         do j = 1, self%n
             do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
@@ -185,6 +243,7 @@ contains
                 count = count + 1
                 self%candidate_entry(count) = k
                 self%candidate_row(count) = i
+                self%candidate_column(count) = j
             end do
         end do
     end subroutine find_candidate_entries
@@ -204,6 +263,7 @@ contains
         if (allocated(self%diagonal)) deallocate(self%diagonal)
         if (allocated(self%candidate_entry)) deallocate(self%candidate_entry)
         if (allocated(self%candidate_row)) deallocate(self%candidate_row)
+        if (allocated(self%candidate_column)) deallocate(self%candidate_column)
         if (allocated(self%values)) deallocate(self%values)
     end subroutine release
 
