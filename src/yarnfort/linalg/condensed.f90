@@ -13,8 +13,8 @@
 !> whole reduced matrix, not a border) the reduction keeps a superset: the candidates
 !> that must stay and their neighbours in the pattern up to `superset_reach` steps (the
 !> flows of the passages next to a slipping one along its yarn), and the next sets are
-!> solved with that reduction while they fit in it and it is at most twice what they
-!> would keep. A kept trivial row is only
+!> solved with that reduction while they fit in it; the trivial rows kept are at most
+!> `superset_fraction` of the coordinates. A kept trivial row is only
 !> not eliminated (still exact); what it saves is the inner solver's analysis and full
 !> factorisation, which a new pattern costs and a refactorisation does not (woven net
 !> of 96,600 unknowns: KLU analysis 18 ms + full factorisation 68 ms against a
@@ -67,6 +67,11 @@ module yarnfort_linalg_condensed
         !> 53 / 43, CPU ms per step going down 5-15 % with the reach
         !> (benchmarks/results-issue16-run7.md).
         integer :: superset_reach = 4
+        !> Most trivial rows kept, as a fraction of the unknowns before first_candidate
+        !> (the coordinates): a kept stick flow costs the factors what a slipping one
+        !> does, so a net where much slips (the clamped 100 x 100 knit, 39,600 of 79,600
+        !> passages) gets the exact set (without this bound: 122.7 -> 160.5 s CPU).
+        real(wp) :: superset_fraction = 0.02_wp
         !> Column of each of candidate_entry (its row is candidate_row): the neighbours.
         integer(ik), allocatable :: candidate_column(:)
     contains
@@ -129,15 +134,18 @@ contains
     contains
         !> Reduce again when a row that must stay was eliminated, or when the kept set
         !> differs from the one wanted (exactly the non-trivial rows up to superset_above
-        !> of them; above, those and their neighbours, reused while at most twice that).
+        !> of them; above, those and their neighbours, reused while it holds them and
+        !> at most max_extra trivial rows besides).
         subroutine choose_reduction()
             logical, allocatable :: wanted(:), reached(:)
-            integer(ik) :: n_wanted, n_kept
+            integer(ik) :: n_must, n_kept, max_extra
             integer :: sweep
 
             allocate(wanted(self%n))
             wanted = .not. trivial
-            if (count(wanted(self%first_candidate:), kind=ik) > self%superset_above) then
+            n_must = count(wanted(self%first_candidate:), kind=ik)
+            max_extra = int(self%superset_fraction * (self%first_candidate - 1), ik)
+            if (n_must > self%superset_above) then
                 do sweep = 1, self%superset_reach
                     allocate(reached, source=wanted)
                     do k = 1, size(self%candidate_entry, kind=ik)
@@ -149,11 +157,13 @@ contains
                     end do
                     call move_alloc(reached, wanted)
                 end do
+                ! Too many neighbours (a large part of the flows slips): the exact set.
+                if (count(wanted(self%first_candidate:), kind=ik) - n_must > max_extra) &
+                    wanted = .not. trivial
                 if (self%n_reductions > 0) then
-                    n_wanted = count(wanted(self%first_candidate:), kind=ik)
                     n_kept = count(self%reduced(self%first_candidate:) /= 0, kind=ik)
                     if (.not. any(.not. trivial .and. self%reduced == 0) &
-                        .and. n_kept <= 2 * n_wanted) return
+                        .and. n_kept - n_must <= max_extra) return
                 end if
             else if (self%n_reductions > 0) then
                 if (.not. any(wanted .neqv. (self%reduced /= 0))) return

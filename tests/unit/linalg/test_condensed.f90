@@ -145,9 +145,10 @@ contains
     end subroutine test_changed_set
 
     !> Above superset_above kept rows, the neighbours of a non-trivial row stay too (in
-    !> this dense pattern every candidate is a neighbour of every other), trivial rows
-    !> kept are solved exactly, and a set that fits in the kept one needs no new
-    !> reduction; at or below superset_above the reduction is exact again.
+    !> this dense pattern every candidate is a neighbour of every other) when
+    !> superset_fraction leaves room, trivial rows kept are solved exactly, and a set
+    !> that fits in the kept one needs no new reduction; at or below superset_above, or
+    !> without room, the reduction is exact.
     subroutine test_superset(error)
         type(error_type), allocatable, intent(out) :: error
         type(condensed_solver_type) :: solver
@@ -155,6 +156,7 @@ contains
         call new_analysed(solver, first_candidate, error)
         if (allocated(error)) return
         solver%superset_above = 0
+        solver%superset_fraction = 1.0_wp
         call check_solve(solver, test_matrix([.true., .false., .true.]), 'row 7 slips', error)
         if (allocated(error)) return
         call check(error, solver%n_reductions == 1 .and. solver%n_reduced == order, &
@@ -169,6 +171,17 @@ contains
         if (allocated(error)) return
         call check(error, solver%n_reductions == 2 .and. solver%n_reduced == order - 3, &
             'no slipping row: every candidate should be eliminated')
+        if (allocated(error)) return
+        ! No trivial row may be kept: the exact set.
+        call new_analysed(solver, first_candidate, error)
+        if (allocated(error)) return
+        solver%superset_above = 0
+        solver%superset_fraction = 0.0_wp
+        call check_solve(solver, test_matrix([.true., .false., .true.]), &
+            'row 7 slips, no superset', error)
+        if (allocated(error)) return
+        call check(error, solver%n_reduced == order - 2, &
+            'without room for trivial rows only row 7 of the candidates should be kept')
     end subroutine test_superset
 
     subroutine test_none_eliminated(error)
