@@ -14,12 +14,13 @@
 !> that must stay and their neighbours in the pattern up to `superset_reach` steps (the
 !> flows of the passages next to a slipping one along its yarn), and the next sets are
 !> solved with that reduction while they fit in it; the trivial rows kept are at most
-!> `superset_fraction` of the coordinates. A kept trivial row is only
-!> not eliminated (still exact); what it saves is the inner solver's analysis and full
+!> `superset_fraction` of the coordinates. A kept trivial row is only not eliminated
+!> (the solve stays exact); what it saves is the inner solver's analysis and full
 !> factorisation, which a new pattern costs and a refactorisation does not (woven net
 !> of 96,600 unknowns: KLU analysis 18 ms + full factorisation 68 ms against a
-!> refactorisation 31 ms; 50 reductions in its 60-step cycle, see
-!> benchmarks/results-issue16-run7.md).
+!> refactorisation 31 ms; new analyses per 60-step cycle 50 -> 15 aligned, 131 -> 52
+!> skewed, CPU per step -15 % and -17 %, at 963,600 unknowns -26 %; the answers the
+!> same to 3e-15 of the peak force: benchmarks/results-issue16-run7.md).
 module yarnfort_linalg_condensed
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -62,9 +63,9 @@ module yarnfort_linalg_condensed
         integer(ik) :: superset_above = 16
         !> How far the superset reaches: candidates within this many steps of a
         !> non-trivial row in the pattern (along a yarn, the flows of the passages next
-        !> to a slipping one). Woven cycle of 96,600 unknowns, new analyses per cycle for
-        !> reach 0 / 1 / 2 / 4 / 6: aligned 50 / 29 / 21 / - / -, skewed 95 / 76 / 65 /
-        !> 53 / 43, CPU ms per step going down 5-15 % with the reach
+        !> to a slipping one). Skewed woven cycle of 96,600 unknowns, without the bound
+        !> superset_fraction: new analyses per cycle 131 before, 76 / 65 / 57 / 53 / 43
+        !> for reach 1 / 2 / 3 / 4 / 6, CPU per step 419 -> 389 / 364 / 355 / 355 / 341 ms
         !> (benchmarks/results-issue16-run7.md).
         integer :: superset_reach = 4
         !> Most trivial rows kept, as a fraction of the unknowns before first_candidate
