@@ -9,6 +9,18 @@
 !> bounds, which is what makes the friction Jacobian's factors dense (benchmarks/
 !> results-friction-factor.md); with the stick flows gone the reduced system is the
 !> elastic tangent plus the slipping flows.
+!> With more than `superset_above` kept candidates (the inner solver then factors the
+!> whole reduced matrix, not a border) the reduction keeps a superset: the candidates
+!> that must stay and their neighbours in the pattern up to `superset_reach` steps (the
+!> flows of the passages next to a slipping one along its yarn), and the next sets are
+!> solved with that reduction while they fit in it; the trivial rows kept are at most
+!> `superset_fraction` of the coordinates. A kept trivial row is only not eliminated
+!> (the solve stays exact); what it saves is the inner solver's analysis and full
+!> factorisation, which a new pattern costs and a refactorisation does not (woven net
+!> of 96,600 unknowns: KLU analysis 18 ms + full factorisation 68 ms against a
+!> refactorisation 31 ms; new analyses per 60-step cycle 50 -> 15 aligned, 131 -> 52
+!> skewed, CPU per step -15 % and -17 %, at 963,600 unknowns -26 %; the answers the
+!> same to 3e-15 of the peak force: benchmarks/results-issue16-run7.md).
 module yarnfort_linalg_condensed
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -45,6 +57,24 @@ module yarnfort_linalg_condensed
         logical :: inner_analysed = .false.
         !> Analyses of the reduced system so far (each set of eliminated unknowns).
         integer :: n_reductions = 0
+        !> Above this many kept candidates the reduction keeps a superset (module notes);
+        !> at or below it, exactly the non-trivial rows (the default: the bordered
+        !> solver's border limit, below which a new set costs no new analysis).
+        integer(ik) :: superset_above = 16
+        !> How far the superset reaches: candidates within this many steps of a
+        !> non-trivial row in the pattern (along a yarn, the flows of the passages next
+        !> to a slipping one). Skewed woven cycle of 96,600 unknowns, without the bound
+        !> superset_fraction: new analyses per cycle 131 before, 76 / 65 / 57 / 53 / 43
+        !> for reach 1 / 2 / 3 / 4 / 6, CPU per step 419 -> 389 / 364 / 355 / 355 / 341 ms
+        !> (benchmarks/results-issue16-run7.md).
+        integer :: superset_reach = 4
+        !> Most trivial rows kept, as a fraction of the unknowns before first_candidate
+        !> (the coordinates): a kept stick flow costs the factors what a slipping one
+        !> does, so a net where much slips (the clamped 100 x 100 knit, 39,600 of 79,600
+        !> passages) gets the exact set (without this bound: 122.7 -> 160.5 s CPU).
+        real(wp) :: superset_fraction = 0.02_wp
+        !> Column of each of candidate_entry (its row is candidate_row): the neighbours.
+        integer(ik), allocatable :: candidate_column(:)
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
@@ -71,7 +101,7 @@ contains
     end subroutine analyse_pattern
 
     !> Find the trivial rows of these values, reduce (analysing the reduced pattern
-    !> again if the set changed) and factor the reduced matrix.
+    !> again if the kept set changes: choose_reduction) and factor the reduced matrix.
     subroutine factor_values(self, values, error)
         class(condensed_solver_type), intent(inout) :: self
         real(wp), intent(in) :: values(:)
@@ -90,8 +120,7 @@ contains
                 trivial(self%candidate_row(k)) = .false.
         end do
         where (.not. trivial) self%pivot = 0.0_wp
-        if (self%n_reductions == 0 .or. any(trivial .neqv. (self%reduced == 0))) &
-            call reduce(trivial)
+        call choose_reduction()
         self%values = values(self%col_ptr(self%first_candidate) + 1:size(self%row_index))
         if (self%n_reduced > 0) then
             if (.not. self%inner_analysed) then
@@ -104,13 +133,52 @@ contains
             if (allocated(error)) return
         end if
     contains
+        !> Reduce again when a row that must stay was eliminated, or when the kept set
+        !> differs from the one wanted (exactly the non-trivial rows up to superset_above
+        !> of them; above, those and their neighbours, reused while it holds them and
+        !> at most max_extra trivial rows besides).
+        subroutine choose_reduction()
+            logical, allocatable :: wanted(:), reached(:)
+            integer(ik) :: n_must, n_kept, max_extra
+            integer :: sweep
+
+            allocate(wanted(self%n))
+            wanted = .not. trivial
+            n_must = count(wanted(self%first_candidate:), kind=ik)
+            max_extra = int(self%superset_fraction * (self%first_candidate - 1), ik)
+            if (n_must > self%superset_above) then
+                do sweep = 1, self%superset_reach
+                    allocate(reached, source=wanted)
+                    do k = 1, size(self%candidate_entry, kind=ik)
+                        if (self%candidate_column(k) < self%first_candidate) cycle
+                        if (wanted(self%candidate_row(k))) &
+                            reached(self%candidate_column(k)) = .true.
+                        if (wanted(self%candidate_column(k))) &
+                            reached(self%candidate_row(k)) = .true.
+                    end do
+                    call move_alloc(reached, wanted)
+                end do
+                ! Too many neighbours (a large part of the flows slips): the exact set.
+                if (count(wanted(self%first_candidate:), kind=ik) - n_must > max_extra) &
+                    wanted = .not. trivial
+                if (self%n_reductions > 0) then
+                    n_kept = count(self%reduced(self%first_candidate:) /= 0, kind=ik)
+                    if (.not. any(.not. trivial .and. self%reduced == 0) &
+                        .and. n_kept - n_must <= max_extra) return
+                end if
+            else if (self%n_reductions > 0) then
+                if (.not. any(wanted .neqv. (self%reduced /= 0))) return
+            end if
+            call reduce(.not. wanted)
+        end subroutine choose_reduction
+
         !> The reduced pattern: the stored entries whose row and column both stay.
-        subroutine reduce(trivial)
-            logical, intent(in) :: trivial(:)
+        subroutine reduce(eliminated)
+            logical, intent(in) :: eliminated(:)
 
             m = 0
             do j = 1, self%n
-                if (trivial(j)) then
+                if (eliminated(j)) then
                     self%reduced(j) = 0
                 else
                     m = m + 1
@@ -176,7 +244,8 @@ contains
                 end if
             end do
         end do
-        allocate(self%candidate_entry(count), self%candidate_row(count))
+        allocate(self%candidate_entry(count), self%candidate_row(count), &
+            self%candidate_column(count))
         count = 0
         do j = 1, self%n
             do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
@@ -185,6 +254,7 @@ contains
                 count = count + 1
                 self%candidate_entry(count) = k
                 self%candidate_row(count) = i
+                self%candidate_column(count) = j
             end do
         end do
     end subroutine find_candidate_entries
@@ -204,6 +274,7 @@ contains
         if (allocated(self%diagonal)) deallocate(self%diagonal)
         if (allocated(self%candidate_entry)) deallocate(self%candidate_entry)
         if (allocated(self%candidate_row)) deallocate(self%candidate_row)
+        if (allocated(self%candidate_column)) deallocate(self%candidate_column)
         if (allocated(self%values)) deallocate(self%values)
     end subroutine release
 

@@ -27,6 +27,7 @@ contains
         testsuite = [ &
             new_unittest('stick rows eliminated, the rest solved', test_eliminated), &
             new_unittest('a changed set is reduced again', test_changed_set), &
+            new_unittest('a superset reduction is kept while the set fits', test_superset), &
             new_unittest('no row eliminated', test_none_eliminated), &
             new_unittest('every row eliminated', test_all_eliminated), &
             new_unittest('a zero candidate row is a singular matrix', test_singular), &
@@ -142,6 +143,46 @@ contains
         call check(error, solver%n_reductions == 2 .and. solver%n_reduced == order - 1, &
             'the new set should be reduced again, one unknown eliminated')
     end subroutine test_changed_set
+
+    !> Above superset_above kept rows, the neighbours of a non-trivial row stay too (in
+    !> this dense pattern every candidate is a neighbour of every other) when
+    !> superset_fraction leaves room, trivial rows kept are solved exactly, and a set
+    !> that fits in the kept one needs no new reduction; at or below superset_above, or
+    !> without room, the reduction is exact.
+    subroutine test_superset(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(condensed_solver_type) :: solver
+
+        call new_analysed(solver, first_candidate, error)
+        if (allocated(error)) return
+        solver%superset_above = 0
+        solver%superset_fraction = 1.0_wp
+        call check_solve(solver, test_matrix([.true., .false., .true.]), 'row 7 slips', error)
+        if (allocated(error)) return
+        call check(error, solver%n_reductions == 1 .and. solver%n_reduced == order, &
+            'the neighbours of row 7 (rows 6 and 8) should be kept')
+        if (allocated(error)) return
+        call check_solve(solver, test_matrix([.false., .true., .true.]), 'row 6 slips', error)
+        if (allocated(error)) return
+        call check(error, solver%n_reductions == 1, &
+            'a set within the kept one should not be reduced again')
+        if (allocated(error)) return
+        call check_solve(solver, test_matrix([.true., .true., .true.]), 'all stick', error)
+        if (allocated(error)) return
+        call check(error, solver%n_reductions == 2 .and. solver%n_reduced == order - 3, &
+            'no slipping row: every candidate should be eliminated')
+        if (allocated(error)) return
+        ! No trivial row may be kept: the exact set.
+        call new_analysed(solver, first_candidate, error)
+        if (allocated(error)) return
+        solver%superset_above = 0
+        solver%superset_fraction = 0.0_wp
+        call check_solve(solver, test_matrix([.true., .false., .true.]), &
+            'row 7 slips, no superset', error)
+        if (allocated(error)) return
+        call check(error, solver%n_reduced == order - 2, &
+            'without room for trivial rows only row 7 of the candidates should be kept')
+    end subroutine test_superset
 
     subroutine test_none_eliminated(error)
         type(error_type), allocatable, intent(out) :: error
