@@ -24,12 +24,14 @@ contains
     !> element reference lengths length0. `spring`: weight of the regularising spring
     !> (get_truss_tension) of a Newton predictor; absent or 0 for the exact law.
     subroutine assemble_internal_force(scene, x, length0, internal, tension, stretch, error, &
-            spring)
+            spring, rounding)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(out) :: internal(:), tension(:), stretch(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(in), optional :: spring
+        !> Each tension's rounding error (get_tension_rounding), for the row levels.
+        real(wp), intent(out), optional :: rounding(:)
         integer :: e, n1, n2
         real(wp) :: force(3), weight
 
@@ -39,8 +41,13 @@ contains
         do e = 1, scene%network%n_elements()
             n1 = scene%network%element_nodes(1, e)
             n2 = scene%network%element_nodes(2, e)
-            call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
-                force, error)
+            if (present(rounding)) then
+                call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
+                    force, error, rounding=rounding(e))
+            else
+                call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
+                    force, error)
+            end if
             if (allocated(error)) return
             if (.not. ieee_is_finite(tension(e))) then
                 call overflow(e, stretch(e))
@@ -137,7 +144,7 @@ contains
     !> with `block`, its tangent; `spring`, `tangent_spring` as there) at node positions x,
     !> after checking that it has not degenerated to a point.
     subroutine get_element_response(scene, x, length0, e, spring, tension, stretch, force, &
-            error, block, tangent_spring)
+            error, block, tangent_spring, rounding)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:)
         integer, intent(in) :: e
@@ -146,6 +153,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(out), optional :: block(3, 3)
         real(wp), intent(in), optional :: tangent_spring
+        real(wp), intent(out), optional :: rounding
         real(wp) :: length
         character(len=160) :: buffer
 
@@ -159,7 +167,7 @@ contains
                 return
             end if
             call get_truss_response(scene%laws(scene%network%element_material(e))%law, spring, &
-                length0(e), x1, x2, tension, stretch, force, block, tangent_spring)
+                length0(e), x1, x2, tension, stretch, force, block, tangent_spring, rounding)
         end associate
     end subroutine get_element_response
 

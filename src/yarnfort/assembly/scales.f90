@@ -7,20 +7,17 @@
 module yarnfort_assembly_scales
     use yarnfort_kinds, only: wp
     use yarnfort_scene_scene, only: scene_type, get_node_force_scale
-    use yarnfort_assembly_truss, only: get_truss_tension
+    use yarnfort_assembly_truss, only: get_truss_tension, get_tension_rounding
     use yarnfort_material_law, only: force_law_type
     implicit none
     private
 
-    public :: get_node_force_levels, get_unknown_levels, get_tension_with_noise, node_level_floor
+    public :: get_node_force_levels, gather_node_force_levels, get_unknown_levels
+    public :: get_tension_with_noise, node_level_floor
 
     !> A node where no force meets (a slack region) is judged against this fraction of
     !> the largest force of the scene.
     real(wp), parameter :: node_level_floor = 1.0e-6_wp
-    !> Rounding of one element force, in units of eps * (|T| + r dT/dlambda) where
-    !> r = (|x1| + |x2| + l) / L0: the tension is computed from lambda = l/L0, and l
-    !> from coordinate differences that carry the rounding of the coordinates.
-    real(wp), parameter :: rounding_factor = 8.0_wp
 
 contains
 
@@ -35,18 +32,35 @@ contains
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:), factors(:), spring
         real(wp), intent(out) :: level(:), noise(:), max_force
+        real(wp), allocatable :: tension(:), rounding(:)
+        integer :: e
+
+        allocate(tension(scene%network%n_elements()), rounding(scene%network%n_elements()))
+        do e = 1, scene%network%n_elements()
+            associate(nodes => scene%network%element_nodes(:, e))
+                call get_tension_with_noise(scene%laws(scene%network%element_material(e))%law, &
+                    spring, x(:, nodes(1)), x(:, nodes(2)), length0(e), tension(e), rounding(e))
+            end associate
+        end do
+        call gather_node_force_levels(scene, tension, rounding, factors, level, noise, max_force)
+    end subroutine get_node_force_levels
+
+    !> The same from each element's tension and its rounding error, where these are at
+    !> hand (assemble_internal_force gives them with the internal force).
+    pure subroutine gather_node_force_levels(scene, tension, rounding, factors, level, noise, &
+            max_force)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: tension(:), rounding(:), factors(:)
+        real(wp), intent(out) :: level(:), noise(:), max_force
         integer :: e, n, k
-        real(wp) :: tension, rounding
 
         level = 0.0_wp
         noise = 0.0_wp
         do e = 1, scene%network%n_elements()
             associate(nodes => scene%network%element_nodes(:, e))
-                call get_tension_with_noise(scene%laws(scene%network%element_material(e))%law, &
-                    spring, x(:, nodes(1)), x(:, nodes(2)), length0(e), tension, rounding)
                 do k = 1, 2
-                    level(nodes(k)) = max(level(nodes(k)), abs(tension))
-                    noise(nodes(k)) = noise(nodes(k)) + rounding
+                    level(nodes(k)) = max(level(nodes(k)), abs(tension(e)))
+                    noise(nodes(k)) = noise(nodes(k)) + rounding(e)
                 end do
             end associate
         end do
@@ -55,26 +69,19 @@ contains
         end do
         max_force = maxval([0.0_wp, level])
         level = max(level, node_level_floor * max_force)
-    end subroutine get_node_force_levels
+    end subroutine gather_node_force_levels
 
-    !> Tension of an element with nodes at x1, x2 and its rounding error: the tension is
-    !> computed from lambda = l/L0, and l from coordinate differences, which carry the
-    !> rounding of the coordinates: noise = rounding_factor * eps * (|T| + r |dT/dlambda|)
-    !> with r = (|x1| + |x2| + l) / L0. A string within that rounding of stretch 1 (the
-    !> kink of the tension-only law) counts with the slope of its taut side.
+    !> Tension of an element with nodes at x1, x2 and its rounding error
+    !> (get_tension_rounding).
     pure subroutine get_tension_with_noise(law, spring, x1, x2, length0, tension, noise)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: spring, x1(3), x2(3), length0
         real(wp), intent(out) :: tension, noise
-        real(wp) :: length, stretch, dtension, r
+        real(wp) :: length, dtension
 
         length = norm2(x2 - x1)
-        stretch = length / length0
-        call get_truss_tension(law, spring, stretch, tension, dtension)
-        r = (norm2(x1) + norm2(x2) + length) / length0
-        if (dtension == 0.0_wp .and. stretch > 1.0_wp - rounding_factor * epsilon(1.0_wp) * r) &
-            dtension = law%get_reference_stiffness()
-        noise = rounding_factor * epsilon(1.0_wp) * (abs(tension) + r * abs(dtension))
+        call get_truss_tension(law, spring, length / length0, tension, dtension)
+        noise = get_tension_rounding(law, x1, x2, length, length0, tension, dtension)
     end subroutine get_tension_with_noise
 
     !> The levels of the equilibrium rows (one per unknown coordinate) from the node

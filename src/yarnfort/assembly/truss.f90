@@ -6,10 +6,14 @@ module yarnfort_assembly_truss
     implicit none
     private
 
-    public :: get_truss_tension, get_truss_response, slack_rest_stretch
+    public :: get_truss_tension, get_truss_response, get_tension_rounding, slack_rest_stretch
 
     !> Rest stretch of the regularising spring (see get_truss_tension).
     real(wp), parameter :: slack_rest_stretch = 0.5_wp
+    !> Rounding of one element force, in units of eps * (|T| + r dT/dlambda) where
+    !> r = (|x1| + |x2| + l) / L0: the tension is computed from lambda = l/L0, and l
+    !> from coordinate differences that carry the rounding of the coordinates.
+    real(wp), parameter :: rounding_factor = 8.0_wp
 
 contains
 
@@ -44,13 +48,15 @@ contains
     !> length, k (I - c c^T) / (2 l) + k c c^T / L0 with k = tangent_spring * k_ref: the
     !> force is unchanged, so a Newton step keeps a regular matrix while the converged
     !> state is that of the exact law.
+    !> `rounding`: the rounding error of the tension (get_tension_rounding).
     pure subroutine get_truss_response(law, spring, length0, x1, x2, &
-            tension, stretch, force, block, tangent_spring)
+            tension, stretch, force, block, tangent_spring, rounding)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: spring, length0, x1(3), x2(3)
         real(wp), intent(out) :: tension, stretch, force(3)
         real(wp), intent(out), optional :: block(3, 3)
         real(wp), intent(in), optional :: tangent_spring
+        real(wp), intent(out), optional :: rounding
         real(wp) :: d(3), length, c(3), dtension, transverse, axial, k_tangent
         integer :: k
 
@@ -58,6 +64,8 @@ contains
         length = norm2(d)
         stretch = length / length0
         call get_truss_tension(law, spring, stretch, tension, dtension)
+        if (present(rounding)) rounding = get_tension_rounding(law, x1, x2, length, length0, &
+            tension, dtension)
         if (length > 0.0_wp) then
             c = d / length
         else
@@ -80,5 +88,23 @@ contains
             end do
         end if
     end subroutine get_truss_response
+
+    !> Rounding error of the tension of an element with nodes at x1, x2 (length l,
+    !> reference length L0), computed as get_truss_tension gives tension and dtension:
+    !> rounding_factor * eps * (|T| + r |dT/dlambda|), r = (|x1| + |x2| + l) / L0. A
+    !> string within that rounding of stretch 1 (the kink of the tension-only law)
+    !> counts with the slope of its taut side.
+    pure real(wp) function get_tension_rounding(law, x1, x2, length, length0, tension, &
+            dtension) result(rounding)
+        class(force_law_type), intent(in) :: law
+        real(wp), intent(in) :: x1(3), x2(3), length, length0, tension, dtension
+        real(wp) :: r, slope
+
+        r = (norm2(x1) + norm2(x2) + length) / length0
+        slope = dtension
+        if (dtension == 0.0_wp .and. length / length0 > 1.0_wp - rounding_factor &
+                * epsilon(1.0_wp) * r) slope = law%get_reference_stiffness()
+        rounding = rounding_factor * epsilon(1.0_wp) * (abs(tension) + r * abs(slope))
+    end function get_tension_rounding
 
 end module yarnfort_assembly_truss

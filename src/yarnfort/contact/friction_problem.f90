@@ -54,8 +54,8 @@ module yarnfort_contact_friction_problem
     use yarnfort_assembly_truss, only: get_truss_tension
     use yarnfort_assembly_pattern, only: build_clique_pattern
     use yarnfort_assembly_assemble, only: assemble_internal_force, add_element_tangents
-    use yarnfort_assembly_scales, only: get_node_force_levels, get_unknown_levels, &
-        get_tension_with_noise, node_level_floor
+    use yarnfort_assembly_scales, only: gather_node_force_levels, get_unknown_levels, &
+        node_level_floor
     use yarnfort_contact_geometry, only: get_wrap_angle
     use yarnfort_solver_problem, only: nonlinear_problem_type
     implicit none
@@ -105,6 +105,8 @@ module yarnfort_contact_friction_problem
         integer, allocatable :: element_clique(:, :), passage_clique(:, :)
         !> Work arrays.
         real(wp), allocatable :: x(:, :), length0(:), internal(:), tension(:), stretch(:)
+        !> Rounding error of each element's tension at that state (the row levels' noise).
+        real(wp), allocatable :: rounding(:)
         !> What the work arrays were last computed from (update_state): the unknowns, the
         !> frozen positions, the load factors and the spring weight. A solve asks for the
         !> same state several times (initial guess, row levels, the last iterate, the
@@ -156,7 +158,7 @@ contains
         allocate(self%u_frozen(self%n_x), source=0.0_wp)
         allocate(self%x(3, scene%network%n_nodes()), self%length0(n_elements))
         allocate(self%internal(3 * scene%network%n_nodes()))
-        allocate(self%tension(n_elements), self%stretch(n_elements))
+        allocate(self%tension(n_elements), self%stretch(n_elements), self%rounding(n_elements))
 
         allocate(self%element_clique(8, n_elements), source=0)
         do e = 1, n_elements
@@ -310,7 +312,7 @@ contains
                     self%length0)
             end if
             call assemble_internal_force(scene, self%x, self%length0, self%internal, &
-                self%tension, self%stretch, error, self%spring)
+                self%tension, self%stretch, error, self%spring, self%rounding)
         end associate
         if (allocated(error)) return
         self%state_valid = size(u) == self%get_size()
@@ -441,7 +443,12 @@ contains
         call self%update_state(u, error)
         if (allocated(error)) return
         allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
-        call get_node_force_levels(self%scene, self%x, self%length0, self%factors, self%spring, &
+        ! From the tensions and their rounding at this state (update_state), not evaluated
+        ! again (that second loop over the elements took 6-8 % of a woven cycle's CPU at
+        ! 96,600 unknowns, benchmarks/results-issue16-run7.md section 1). Measured, CPU
+        ! per cycle step, same run: woven 10,120 unknowns 9.94 -> 8.99 ms, 96,600 180.4 ->
+        ! 167.9 ms; the same counts, forces bitwise equal on 47 scenes.
+        call gather_node_force_levels(self%scene, self%tension, self%rounding, self%factors, &
             node_level, node_noise, max_force)
         row = 0
         if (.not. self%positions_frozen) then
@@ -476,15 +483,10 @@ contains
     end subroutine get_row_levels
 
     !> Rounding error of element e's tension at the state of the last update_state.
-    real(wp) function get_element_noise(self, e) result(noise)
+    pure real(wp) function get_element_noise(self, e) result(noise)
         class(friction_problem_type), intent(in) :: self
         integer, intent(in) :: e
-        real(wp) :: tension
-        associate(nodes => self%scene%network%element_nodes(:, e))
-            call get_tension_with_noise(self%scene%laws(self%scene%network%element_material(e))%law, &
-                self%spring, self%x(:, nodes(1)), self%x(:, nodes(2)), self%length0(e), &
-                tension, noise)
-        end associate
+        noise = self%rounding(e)
     end function get_element_noise
 
     subroutine evaluate_residual(self, u, residual, error)
