@@ -520,23 +520,19 @@ def test_previous_time_and_load_changed_together_are_refused(tmp_path):
 
 
 @pytest.mark.parametrize("value", [float("inf"), float("nan")])
-def test_non_finite_position_in_restart_is_refused(tmp_path, value):
-    """The V-net has two position unknowns; the first one is damaged."""
-    assert run(with_output(VNET, "out", control="max_steps = 3"), tmp_path).returncode == 0
-    patch(tmp_path / "out" / "restart.dat", "u", "<d", value)
-    proc = run(with_output(VNET, "out", control="restart = .true."), tmp_path)
+@pytest.mark.parametrize("scene, steps, field, message", [
+    # The V-net has two position unknowns; the first one is damaged.
+    (VNET, 3, "u", "a position or flow that is not a finite number"),
+    # The load of the state before the last converged one is damaged.
+    (CAPSTAN, 5, "load_old", "its previous state holds a value that is not a finite number"),
+], ids=["position", "previous_load"])
+def test_non_finite_value_in_restart_is_refused(tmp_path, value, scene, steps, field, message):
+    control = f"max_steps = {steps}"
+    assert run(with_output(scene, "out", control=control), tmp_path).returncode == 0
+    patch(tmp_path / "out" / "restart.dat", field, "<d", value)
+    proc = run(with_output(scene, "out", control="restart = .true."), tmp_path)
     assert proc.returncode == 2, proc.stderr
-    assert "a position or flow that is not a finite number" in proc.stderr
-
-
-@pytest.mark.parametrize("value", [float("inf"), float("nan")])
-def test_non_finite_previous_load_in_restart_is_refused(tmp_path, value):
-    """The load of the state before the last converged one is damaged."""
-    assert run(with_output(CAPSTAN, "out", control="max_steps = 5"), tmp_path).returncode == 0
-    patch(tmp_path / "out" / "restart.dat", "load_old", "<d", value)
-    proc = run(with_output(CAPSTAN, "out", control="restart = .true."), tmp_path)
-    assert proc.returncode == 2, proc.stderr
-    assert "its previous state holds a value that is not a finite number" in proc.stderr
+    assert message in proc.stderr
 
 
 # ------------------------------------------------------------------ memory

@@ -13,7 +13,7 @@ module yarnfort_assembly_scales
     private
 
     public :: get_node_force_levels, gather_node_force_levels, get_unknown_levels
-    public :: get_tension_with_noise, node_level_floor
+    public :: node_level_floor
 
     !> A node where no force meets (a slack region) is judged against this fraction of
     !> the largest force of the scene.
@@ -25,7 +25,7 @@ contains
     !> level(n) = max(largest |tension| of the elements at n, |applied force at n|),
     !> floored at node_level_floor * the largest such force of the scene (max_force);
     !> noise(n) = the rounding error of the residual at n (sum over its elements of
-    !> rounding_factor * eps * (|T| + lambda dT/dlambda)). `spring` as in
+    !> get_tension_rounding). `spring` as in
     !> get_truss_tension. With no force anywhere (max_force = 0) every level is 0.
     pure subroutine get_node_force_levels(scene, x, length0, factors, spring, level, noise, &
             max_force)
