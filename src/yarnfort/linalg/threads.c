@@ -11,6 +11,9 @@
  * The OpenMP and OpenBLAS entry points are looked up in the running process (dlsym), so
  * nothing here needs them at link time and a reference BLAS is left alone.
  *
+ * - The libraries' OpenMP regions, once limited, run on the calling thread without
+ *   libgomp's team machinery (GOMP_parallel below).
+ *
  * OpenBLAS (pthreads build) starts its worker threads when it is loaded, one per core
  * but the caller's, and each spins (sched_yield) for 2^28 TSC cycles, about 0.1 s, before
  * it sleeps; openblas_set_num_threads starts them again if they were stopped. On this
@@ -26,12 +29,17 @@
 #include <stdlib.h>
 
 typedef void (*set_int_function)(int);
+typedef void (*region_body)(void *);
+typedef void (*parallel_function)(region_body, void *, unsigned, unsigned);
 
 /* Bits of the result: OpenMP regions limited, OpenBLAS threads set. */
 #define YARNFORT_THREADS_OPENMP 1
 #define YARNFORT_THREADS_OPENBLAS 2
 
 static int applied = -1;
+
+/* Regions run here on the calling thread (a count for the tests). */
+static long serial_regions = 0;
 
 /* The user's OPENBLAS_NUM_THREADS decides OpenBLAS's threads. */
 static int blas_left_to_user(void)
@@ -74,4 +82,40 @@ int yarnfort_apply_thread_policy(int library_openmp, int blas_threads)
         }
     }
     return applied;
+}
+
+/*
+ * libgomp's entry point for `#pragma omp parallel` (GCC 4.9 on), defined here so that
+ * the libraries bind to it: the dynamic linker looks in the executable (or in the module
+ * that holds this library) before libgomp. Debian's CHOLMOD (the only user: it imports
+ * GOMP_parallel, omp_get_num_threads and omp_get_thread_num and nothing else) enters a
+ * region two or three times per supernode, `if` clause or not, and libgomp makes a team
+ * of one for each, ending with a futex wake: 49,000 system calls in one run of the
+ * 8 x 8 knit cell of benchmarks/steps_table.py. With the regions limited (the policy
+ * above) the body runs here on the calling thread, where omp_get_num_threads() is 1 and
+ * omp_get_thread_num() 0, as in a team of one: the same work, in the same order.
+ * Measured (benchmarks/results-blas-threads.md, CPU): CHOLMOD's factorisation 0.78x /
+ * 0.81x on the cable nets of 1e4 / 1e5 unknowns, an elastic Newton iteration of the
+ * 8 x 8 knit cell 0.65x; the woven nets' factors, with few rows per supernode, as before.
+ * Otherwise (the user's OMP_THREAD_LIMIT, or before the policy) libgomp's own runs.
+ */
+void GOMP_parallel(region_body body, void *data, unsigned num_threads, unsigned flags)
+{
+    static parallel_function next = NULL;
+    if (applied >= 0 && (applied & YARNFORT_THREADS_OPENMP)) {
+        serial_regions++;
+        body(data);
+        return;
+    }
+    if (!next) next = (parallel_function) dlsym(RTLD_NEXT, "GOMP_parallel");
+    if (!next) {
+        body(data);
+        return;
+    }
+    next(body, data, num_threads, flags);
+}
+
+long yarnfort_serial_regions(void)
+{
+    return serial_regions;
 }

@@ -8,14 +8,18 @@
 !> - OpenBLAS (pthreads build) with 1 or 2 threads: 8.5 / 35 against 9.3 / 32 ms, equal
 !>   within the noise of a shared machine; one thread, which never competes with other
 !>   processes for the cores.
+!> - With the regions limited, Debian's CHOLMOD still entered libgomp two or three times
+!>   per supernode for a team of one (a futex system call each); its regions now run on
+!>   the calling thread (threads.c, GOMP_parallel): factorisation 0.78x / 0.81x on the
+!>   cable nets of 1e4 / 1e5 unknowns, an elastic iteration of the 8 x 8 knit cell 0.65x.
 !> The policy is applied once per process, at the first linear solver; OMP_THREAD_LIMIT
 !> and OPENBLAS_NUM_THREADS set by the user take precedence (threads.c).
 module yarnfort_linalg_threads
-    use, intrinsic :: iso_c_binding, only: c_int
+    use, intrinsic :: iso_c_binding, only: c_int, c_long
     implicit none
     private
 
-    public :: apply_thread_policy, library_openmp, blas_threads
+    public :: apply_thread_policy, library_openmp, blas_threads, count_serial_regions
 
     !> Let the libraries' own OpenMP regions run in parallel.
     logical, parameter :: library_openmp = .false.
@@ -23,6 +27,10 @@ module yarnfort_linalg_threads
     integer, parameter :: blas_threads = 1
 
     interface
+        function yarnfort_serial_regions() result(count) bind(C, name='yarnfort_serial_regions')
+            import :: c_long
+            integer(c_long) :: count
+        end function yarnfort_serial_regions
         function yarnfort_apply_thread_policy(openmp, threads) result(applied) &
                 bind(C, name='yarnfort_apply_thread_policy')
             import :: c_int
@@ -45,5 +53,10 @@ contains
         if (present(openmp_limited)) openmp_limited = iand(applied, 1_c_int) /= 0
         if (present(blas_set)) blas_set = iand(applied, 2_c_int) /= 0
     end subroutine apply_thread_policy
+
+    !> OpenMP regions of the libraries run on the calling thread so far (threads.c).
+    integer function count_serial_regions()
+        count_serial_regions = int(yarnfort_serial_regions())
+    end function count_serial_regions
 
 end module yarnfort_linalg_threads

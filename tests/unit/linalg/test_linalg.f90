@@ -11,7 +11,7 @@ module test_linalg
         klu_max_order, chosen_lu_name
     use yarnfort_linalg_klu, only: klu_solver_type
     use yarnfort_linalg_umfpack, only: umfpack_solver_type, umfpack_memory_type
-    use yarnfort_linalg_threads, only: apply_thread_policy
+    use yarnfort_linalg_threads, only: apply_thread_policy, count_serial_regions
     implicit none
     private
 
@@ -86,7 +86,9 @@ contains
             new_unittest('factory rejects an unknown name', test_factory_unknown), &
             new_unittest('default solver follows the measured table', test_default_rule), &
             new_unittest('umfpack analyses with the values', test_umfpack_strategy), &
-            new_unittest('thread policy applied once', test_thread_policy_once) &
+            new_unittest('thread policy applied once', test_thread_policy_once), &
+            new_unittest('limited OpenMP regions run on the calling thread', &
+                test_serial_regions) &
             ]
     end subroutine collect_linalg
 
@@ -736,6 +738,31 @@ contains
         call check(error, openmp_first .eqv. openmp_again .and. (blas_first .eqv. blas_again), &
             'the thread policy reported different actions on a second call')
     end subroutine test_thread_policy_once
+
+    !> With the regions limited, CHOLMOD's supernodal factorisation (a 2D Laplacian of
+    !> 14,400 unknowns is supernodal) enters its OpenMP regions through threads.c's
+    !> GOMP_parallel and still solves; with the user's OMP_THREAD_LIMIT, libgomp's runs.
+    subroutine test_serial_regions(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(csc_type) :: a
+        real(wp), allocatable :: x_true(:), x(:)
+        logical :: openmp_limited, blas_set
+        integer :: before
+
+        call apply_thread_policy(openmp_limited, blas_set)
+        a = laplacian_2d(120)
+        x_true = random_vector(a%n, random_seed + 3)
+        before = count_serial_regions()
+        call check_known_solution('cholmod', 'Laplacian 120 x 120', a, x_true, error, x)
+        if (allocated(error)) return
+        if (openmp_limited) then
+            call check(error, count_serial_regions() > before, 'CHOLMOD''s OpenMP regions ' &
+                // 'did not run through yarnfort''s GOMP_parallel')
+        else
+            call check(error, count_serial_regions() == before, 'OpenMP regions ran on ' &
+                // 'the calling thread although the policy left them to libgomp')
+        end if
+    end subroutine test_serial_regions
 
     ! ---- helpers: solving and checking ---------------------------------------------------
 
