@@ -22,7 +22,8 @@ static double cpu_seconds(void)
 
 int bench_cholmod_time(SuiteSparse_long n, SuiteSparse_long *col_ptr,
                        SuiteSparse_long *row_index, double *values, double target_seconds,
-                       int max_repetitions, double *ms, double *lnz)
+                       int max_repetitions, double supernodal_switch, double *ms,
+                       double *lnz)
 {
     cholmod_common common;
     cholmod_sparse a;
@@ -35,6 +36,7 @@ int bench_cholmod_time(SuiteSparse_long n, SuiteSparse_long *col_ptr,
     *lnz = 0.0;
     if (!cholmod_l_start(&common)) return -1;
     common.print = 0;
+    common.supernodal_switch = supernodal_switch;
     memset(&a, 0, sizeof(a));
     a.nrow = a.ncol = (size_t) n;
     a.nzmax = (size_t) col_ptr[n];

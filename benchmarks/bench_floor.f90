@@ -10,7 +10,7 @@
 !>   klu_l_factor, with KLU's AMD ordering (its default) and with COLAMD;
 !> - bare CHOLMOD (only where the solver named is 'cholmod' or 'cholmod+klu', i.e. the
 !>   matrix is symmetric positive definite): cholmod_l_factorize + cholmod_l_solve after
-!>   cholmod_l_analyze, its defaults (bench_cholmod.c).
+!>   cholmod_l_analyze, its defaults but yarnfort's supernodal switch (bench_cholmod.c).
 !> Also the nonzeros of the factors (L + U) of each.
 !> Times are process CPU times (cpu_time): everything here runs on one thread, and on a
 !> machine shared with other work the CPU time of a run moves far less than its wall time.
@@ -21,6 +21,7 @@ module bench_floor
     use yarnfort_error, only: error_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
+    use yarnfort_linalg_cholmod, only: supernodal_switch
     use yarnfort_linalg_umfpack_binding, only: umfpack_control, umfpack_info, umfpack_irstep, &
         umfpack_prl, umfpack_a, umfpack_ok, umfpack_strategy_used, umfpack_dl_defaults, &
         umfpack_dl_symbolic, umfpack_dl_numeric, umfpack_dl_wsolve, &
@@ -37,13 +38,15 @@ module bench_floor
     interface
         !> bench_cholmod.c
         function bench_cholmod_time(n, col_ptr, row_index, values, target_seconds, &
-                max_repetitions, ms, lnz) result(status) bind(C, name='bench_cholmod_time')
+                max_repetitions, supernodal_switch, ms, lnz) result(status) &
+                bind(C, name='bench_cholmod_time')
             import :: c_long, c_double, c_int
             integer(c_long), value :: n
             integer(c_long), intent(in) :: col_ptr(*), row_index(*)
             real(c_double), intent(in) :: values(*)
             real(c_double), value :: target_seconds
             integer(c_int), value :: max_repetitions
+            real(c_double), value :: supernodal_switch
             real(c_double), intent(out) :: ms, lnz
             integer(c_int) :: status
         end function bench_cholmod_time
@@ -142,8 +145,8 @@ contains
             block
                 real(c_double) :: ms, lnz
                 if (bench_cholmod_time(int(n, c_long), col_ptr, row_index, values, &
-                        real(target_seconds, c_double), int(max_repetitions, c_int), ms, &
-                        lnz) == 0) then
+                        real(target_seconds, c_double), int(max_repetitions, c_int), &
+                        real(supernodal_switch, c_double), ms, lnz) == 0) then
                     floor%cholmod_ms = ms
                     floor%cholmod_lnz = lnz
                 end if

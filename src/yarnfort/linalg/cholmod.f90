@@ -5,7 +5,8 @@
 !> entries below the diagonal are ignored. A matrix that is not positive definite gives
 !> an error value saying so, and the caller may fall back to UMFPACK.
 module yarnfort_linalg_cholmod
-    use, intrinsic :: iso_c_binding, only: c_int, c_long, c_ptr, c_null_ptr, c_associated
+    use, intrinsic :: iso_c_binding, only: c_int, c_long, c_double, c_ptr, c_null_ptr, &
+        c_associated
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_direct, only: direct_solver_type, describe_status
@@ -18,7 +19,16 @@ module yarnfort_linalg_cholmod
     implicit none
     private
 
-    public :: cholmod_solver_type
+    public :: cholmod_solver_type, supernodal_switch
+
+    !> Supernodal factor (dense blocks, BLAS) where the analysis predicts at least this
+    !> many flops per nonzero of L, else simplicial (CHOLMOD's default: 40). Measured
+    !> (benchmarks/results-blas-threads.md; CPU, supernodal over simplicial): cable nets
+    !> of bench_newton 0.91 / 0.77 / 0.62 / 0.37 at 22 / 29 / 37 / 45 flops per nonzero
+    !> (factorisation); woven nets 1.31 / 1.26 / 1.07 at 7 / 12 / 23 and about 1 at 34
+    !> (96,600 unknowns; whole elastic iteration). The switch was worth 40 while every
+    !> supernode paid libgomp's team of one (threads.c).
+    real(wp), parameter :: supernodal_switch = 25.0_wp
 
     !> CHOLMOD solver. Owns a C handle: never copy an analysed object by assignment.
     type, extends(direct_solver_type) :: cholmod_solver_type
@@ -43,7 +53,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer(c_int) :: status
 
-        self%handle = yarnfort_cholmod_create()
+        self%handle = yarnfort_cholmod_create(real(supernodal_switch, c_double))
         if (.not. c_associated(self%handle)) then
             call fatal_error(error, 'cholmod: could not start CHOLMOD (cholmod_l_start)')
             return

@@ -21,9 +21,12 @@ module yarnfort_linalg_cholmod_binding
     integer(c_int), parameter :: cholmod_no_handle = -100
 
     interface
-        !> New handle (CHOLMOD started, print level 0, LL' factor); NULL on failure.
-        function yarnfort_cholmod_create() result(handle) bind(C, name='yarnfort_cholmod_create')
-            import :: c_ptr
+        !> New handle (CHOLMOD started, print level 0, LL' factor, supernodal from
+        !> `supernodal_switch` flops per nonzero of L); NULL on failure.
+        function yarnfort_cholmod_create(supernodal_switch) result(handle) &
+                bind(C, name='yarnfort_cholmod_create')
+            import :: c_ptr, c_double
+            real(c_double), value :: supernodal_switch
             type(c_ptr) :: handle
         end function yarnfort_cholmod_create
 

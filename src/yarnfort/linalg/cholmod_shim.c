@@ -50,8 +50,10 @@ static cholmod_sparse wrap_sparse(SuiteSparse_long n, SuiteSparse_long *col_ptr,
 }
 
 /* New handle with CHOLMOD started, silent, and set to compute LL' (LDL', the simplicial
- * default, would factorise indefinite matrices without reporting them). NULL on failure. */
-void *yarnfort_cholmod_create(void)
+ * default, would factorise indefinite matrices without reporting them); the factor is
+ * supernodal where the analysis predicts at least `supernodal_switch` flops per nonzero
+ * of L, else simplicial. NULL on failure. */
+void *yarnfort_cholmod_create(double supernodal_switch)
 {
     yarnfort_cholmod *h = calloc(1, sizeof(*h));
     if (!h) return NULL;
@@ -61,6 +63,7 @@ void *yarnfort_cholmod_create(void)
     }
     h->common.print = 0;
     h->common.final_ll = 1;
+    h->common.supernodal_switch = supernodal_switch;
     return h;
 }
 
