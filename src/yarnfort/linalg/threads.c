@@ -5,14 +5,12 @@
  * - OpenMP regions inside the libraries (Debian's CHOLMOD asks for a fixed 4 threads in
  *   its supernodal factorisation, a num_threads clause that OMP_NUM_THREADS does not
  *   override) run on one thread: max-active-levels is set to 0, unless the user set
- *   OMP_THREAD_LIMIT;
+ *   OMP_THREAD_LIMIT; once limited, they run on the calling thread without libgomp's
+ *   team machinery (GOMP_parallel below);
  * - OpenBLAS, when it is the BLAS in use, gets the given number of threads, unless the
  *   user set OPENBLAS_NUM_THREADS.
  * The OpenMP and OpenBLAS entry points are looked up in the running process (dlsym), so
  * nothing here needs them at link time and a reference BLAS is left alone.
- *
- * - The libraries' OpenMP regions, once limited, run on the calling thread without
- *   libgomp's team machinery (GOMP_parallel below).
  *
  * OpenBLAS (pthreads build) starts its worker threads when it is loaded, one per core
  * but the caller's, and each spins (sched_yield) for 2^28 TSC cycles, about 0.1 s, before
@@ -94,9 +92,10 @@ int yarnfort_apply_thread_policy(int library_openmp, int blas_threads)
  * 8 x 8 knit cell of benchmarks/steps_table.py. With the regions limited (the policy
  * above) the body runs here on the calling thread, where omp_get_num_threads() is 1 and
  * omp_get_thread_num() 0, as in a team of one: the same work, in the same order.
- * Measured (benchmarks/results-blas-threads.md, CPU): CHOLMOD's factorisation 0.78x /
- * 0.81x on the cable nets of 1e4 / 1e5 unknowns, an elastic Newton iteration of the
- * 8 x 8 knit cell 0.65x; the woven nets' factors, with few rows per supernode, as before.
+ * Measured (benchmarks/results-blas-threads.md, CPU): CHOLMOD's factorisation 0.76x /
+ * 0.81x on the cable nets of 1e4 / 1e5 unknowns on an idle machine (0.56x / 0.63x with
+ * the cores busy), an elastic Newton iteration of the 8 x 8 knit cell 0.59-0.65x; the
+ * woven nets' factors, with few rows per supernode, as before.
  * Otherwise (the user's OMP_THREAD_LIMIT, or before the policy) libgomp's own runs.
  */
 void GOMP_parallel(region_body body, void *data, unsigned num_threads, unsigned flags)

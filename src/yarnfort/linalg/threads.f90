@@ -10,8 +10,9 @@
 !>   processes for the cores.
 !> - With the regions limited, Debian's CHOLMOD still entered libgomp two or three times
 !>   per supernode for a team of one (a futex system call each); its regions now run on
-!>   the calling thread (threads.c, GOMP_parallel): factorisation 0.78x / 0.81x on the
-!>   cable nets of 1e4 / 1e5 unknowns, an elastic iteration of the 8 x 8 knit cell 0.65x.
+!>   the calling thread (threads.c, GOMP_parallel): factorisation 0.76x / 0.81x on the
+!>   cable nets of 1e4 / 1e5 unknowns (idle machine), an elastic iteration of the 8 x 8
+!>   knit cell 0.59-0.65x.
 !> The policy is applied once per process, at the first linear solver; OMP_THREAD_LIMIT
 !> and OPENBLAS_NUM_THREADS set by the user take precedence (threads.c).
 module yarnfort_linalg_threads
