@@ -12,6 +12,7 @@ module yarnfort_linalg_factory
     use yarnfort_linalg_fallback, only: fallback_solver_type
     use yarnfort_linalg_lu_choice, only: lu_choice_solver_type
     use yarnfort_linalg_threads, only: apply_thread_policy
+    use yarnfort_linalg_heap, only: apply_heap_policy
     use yarnfort_text, only: to_lower
     implicit none
     private
@@ -47,7 +48,8 @@ contains
 
     !> Allocate `solver` as the solver called `name` ('umfpack', 'klu', 'cholmod' or
     !> 'dense'; case and surrounding blanks are ignored). Any old solver is destroyed.
-    !> The first call applies the thread policy of yarnfort_linalg_threads.
+    !> The first call applies the thread policy of yarnfort_linalg_threads and the heap
+    !> policy of yarnfort_linalg_heap.
     subroutine new_linear_solver(solver, name, error, unsymmetric)
         class(linear_solver_type), allocatable, intent(out) :: solver
         character(len=*), intent(in) :: name
@@ -57,6 +59,7 @@ contains
         logical, intent(in), optional :: unsymmetric
 
         call apply_thread_policy()
+        call apply_heap_policy()
         select case (to_lower(trim(adjustl(name))))
         case ('umfpack')
             allocate(umfpack_solver_type :: solver)

@@ -3,6 +3,7 @@
 !> linear_solver_type, and of the factory.
 module test_linalg
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
+    use, intrinsic :: iso_c_binding, only: c_size_t
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_testing, only: unittest_type, new_unittest, check
@@ -12,10 +13,25 @@ module test_linalg
     use yarnfort_linalg_klu, only: klu_solver_type
     use yarnfort_linalg_umfpack, only: umfpack_solver_type, umfpack_memory_type
     use yarnfort_linalg_threads, only: apply_thread_policy, count_serial_regions
+    use yarnfort_linalg_heap, only: apply_heap_policy
     implicit none
     private
 
     public :: collect_linalg
+
+    !> glibc's malloc statistics (struct mallinfo2, malloc.h): hblkhd is the bytes in
+    !> blocks malloc mapped on their own.
+    type, bind(C) :: mallinfo2_type
+        integer(c_size_t) :: arena, ordblks, smblks, hblks, hblkhd, usmblks, fsmblks, &
+            uordblks, fordblks, keepcost
+    end type mallinfo2_type
+
+    interface
+        function mallinfo2() result(info) bind(C, name='mallinfo2')
+            import :: mallinfo2_type
+            type(mallinfo2_type) :: info
+        end function mallinfo2
+    end interface
 
     !> Relative residual ||A x - b|| / ||b|| accepted from a backward-stable direct solve.
     real(wp), parameter :: residual_tol = 1000 * epsilon(1.0_wp)
@@ -88,7 +104,8 @@ contains
             new_unittest('umfpack analyses with the values', test_umfpack_strategy), &
             new_unittest('thread policy applied once', test_thread_policy_once), &
             new_unittest('limited OpenMP regions run on the calling thread', &
-                test_serial_regions) &
+                test_serial_regions), &
+            new_unittest('heap policy: large blocks from the heap', test_heap_policy) &
             ]
     end subroutine collect_linalg
 
@@ -763,6 +780,28 @@ contains
                 // 'the calling thread although the policy left them to libgomp')
         end if
     end subroutine test_serial_regions
+
+    !> With the heap policy in force (glibc, no malloc tuning by the user), a block of
+    !> 64 MiB, twice glibc's largest mmap threshold, comes from the heap, not from a
+    !> mapping of its own; a second call reports the same.
+    subroutine test_heap_policy(error)
+        type(error_type), allocatable, intent(out) :: error
+        logical :: applied, applied_again
+        real(wp), allocatable :: block(:)
+        type(mallinfo2_type) :: before, with_block
+
+        call apply_heap_policy(applied)
+        call apply_heap_policy(applied_again)
+        call check(error, applied .eqv. applied_again, &
+            'the heap policy reported a different state on a second call')
+        if (allocated(error) .or. .not. applied) return
+        before = mallinfo2()
+        allocate(block(8 * 1024 * 1024))
+        block(1) = 1.0_wp
+        with_block = mallinfo2()
+        call check(error, with_block%hblkhd - before%hblkhd < 64 * 1024 * 1024, &
+            'a block of 64 MiB was mapped on its own')
+    end subroutine test_heap_policy
 
     ! ---- helpers: solving and checking ---------------------------------------------------
 
