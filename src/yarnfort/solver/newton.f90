@@ -53,9 +53,9 @@ module yarnfort_solver_newton
     integer, parameter :: max_update_steps = 8
     !> try_row_update gives up at once (one residual evaluation) above this scaled
     !> residual at its start. Measured (benchmarks/steps_results.md, section 13): of the
-    !> updates tried on inputs/knit_clamped.nml and the 10,120 woven nets, 13 of the 16
-    !> that started above 1e-2 failed at their first chord step (each a Jacobian
-    !> evaluation and one solve per row wasted), 7 of the 82 below; without this
+    !> updates tried on inputs/knit_clamped.nml, inputs/belt.nml and the 10,120 woven
+    !> nets, 8 of the 13 that started above 1e-2 failed at their first chord step (each
+    !> a Jacobian evaluation and one solve per row wasted), 7 of the 77 below; without this
     !> limit the 8 x 8 clamped knit took 10.20 instead of 9.85 residual evaluations per
     !> load step (2.45 instead of 2.50 Newton iterations) and more CPU.
     real(wp), parameter :: max_update_start = 1.0e-2_wp
@@ -589,7 +589,6 @@ contains
                     do e = int(col_ptr(j)) + 1, int(col_ptr(j + 1))
                         a = slot(row_index(e) + 1)
                         if (a == 0) cycle
-                        if (values(e) == self%kept_values(e)) cycle
                         n_entries = n_entries + 1
                         entry_slot = [entry_slot, a]
                         entry_column = [entry_column, j]
