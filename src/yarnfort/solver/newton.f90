@@ -55,9 +55,9 @@ module yarnfort_solver_newton
     !> residual at its start. Measured (benchmarks/steps_results.md, section 13): of the
     !> updates tried on inputs/knit_clamped.nml, inputs/belt.nml and the 10,120 woven
     !> nets, 8 of the 13 that started above 1e-2 failed at their first chord step (each
-    !> a Jacobian evaluation and one solve per row wasted), 7 of the 77 below; without this
-    !> limit the 8 x 8 clamped knit took 10.20 instead of 9.85 residual evaluations per
-    !> load step (2.45 instead of 2.50 Newton iterations) and more CPU.
+    !> a Jacobian evaluation and one solve per row wasted), 7 of the 77 below; without
+    !> this limit the 8 x 8 clamped knit took 10.20 instead of 9.85 residual evaluations
+    !> per load step (2.45 instead of 2.50 Newton iterations) and more CPU.
     real(wp), parameter :: max_update_start = 1.0e-2_wp
     !> Iterations of the pseudo-transient fallback, in units of max_iterations.
     integer, parameter :: transient_iterations = 4
@@ -733,6 +733,8 @@ contains
         call self%problem%problem%copy_pattern(col_ptr, row_index)
         call analyse_once(self, col_ptr, row_index, error)
         if (allocated(error)) return
+        ! New row weights (prepare_solve): the kept factors no longer match them.
+        self%kept_factorisation = -1
         call self%problem%problem%prepare_solve(u, error)
         if (allocated(error)) return
         self%u = u
