@@ -380,8 +380,8 @@ contains
                 ! aligned 1.72 -> 1.40, skewed 2.75 -> 1.68; clamped knits 8 x 8 (loading)
                 ! default 2.60 -> 2.50, taut 1.90 -> 1.80, rollers 2.15 -> 1.95,
                 ! inputs/knit_clamped.nml 2.20 -> 2.12; periodic cells equal; residual
-                ! evaluations per step up to +8 % (skewed 10,120 6.97 -> 7.40); same
-                ! steps, forces within 1e-12 of the peak on 28 scenes.
+                ! evaluations per step up to +11 % (8 x 8 default cycle 9.40 -> 10.43);
+                ! same steps, forces within 1e-12 of the peak on 28 scenes.
                 if (round > 1 .and. allocated(factored_mode) .and. .not. (full_retry &
                         .or. problem%semismooth)) then
                     call self%newton_full%try_row_update(unknowns, n_x + pack(passage_index, &
