@@ -29,6 +29,7 @@ module yarnfort_solver_newton
     use yarnfort_input_config, only: solver_config_type
     use yarnfort_solver_problem, only: nonlinear_problem_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_dense, only: dense_solver_type
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc, &
         analyse_counted, factor_counted, solve_counted
     use yarnfort_solver_timer, only: wall_time
@@ -550,8 +551,9 @@ contains
         type(error_type), allocatable :: trial_error
         real(wp), allocatable :: residual(:), step(:), kept(:), history(:), values(:)
         real(wp), allocatable :: z(:, :), capacity(:, :), y(:), entry_value(:)
-        integer, allocatable :: slot(:), entry_slot(:), entry_column(:), pivots(:)
+        integer, allocatable :: slot(:), entry_slot(:), entry_column(:)
         integer(ik), allocatable :: col_ptr(:), row_index(:)
+        type(dense_solver_type) :: correction
         integer :: k, n_rows, j, e, n_entries, a, b, i
         real(wp) :: f, f_trial
 
@@ -583,21 +585,22 @@ contains
                 do a = 1, n_rows
                     slot(rows(a)) = a
                 end do
-                n_entries = 0
-                allocate(entry_slot(0), entry_column(0), entry_value(0))
+                n_entries = count(slot(row_index + 1) > 0)
+                allocate(entry_slot(n_entries), entry_column(n_entries), entry_value(n_entries))
+                i = 0
                 do j = 1, n
                     do e = int(col_ptr(j)) + 1, int(col_ptr(j + 1))
                         a = slot(row_index(e) + 1)
                         if (a == 0) cycle
-                        n_entries = n_entries + 1
-                        entry_slot = [entry_slot, a]
-                        entry_column = [entry_column, j]
-                        entry_value = [entry_value, values(e) - self%kept_values(e)]
+                        i = i + 1
+                        entry_slot(i) = a
+                        entry_column(i) = j
+                        entry_value(i) = values(e) - self%kept_values(e)
                     end do
                 end do
                 deallocate(values)
                 ! Z = J^-1 U (U: the unit columns of the rows), C = I + V Z.
-                allocate(z(n, n_rows), capacity(n_rows, n_rows), pivots(n_rows), y(n_rows))
+                allocate(z(n, n_rows), capacity(n_rows, n_rows), y(n_rows))
                 do a = 1, n_rows
                     z(:, a) = 0.0_wp
                     z(rows(a), a) = 1.0_wp
@@ -612,7 +615,10 @@ contains
                     capacity(entry_slot(i), :) = capacity(entry_slot(i), :) &
                         + entry_value(i) * z(entry_column(i), :)
                 end do
-                call factor_dense(capacity, pivots, trial_error)
+                call correction%analyse(int(n_rows, ik), [(int(a, ik) * n_rows, a = 0, n_rows)], &
+                    [((int(i, ik), i = 0, n_rows - 1), a = 1, n_rows)], trial_error)
+                if (allocated(trial_error)) return
+                call correction%factor(reshape(capacity, [n_rows * n_rows]), trial_error)
                 if (allocated(trial_error)) return
                 do k = 1, max_update_steps
                     if (f <= tol / 100) exit
@@ -624,7 +630,8 @@ contains
                         y(entry_slot(i)) = y(entry_slot(i)) &
                             + entry_value(i) * step(entry_column(i))
                     end do
-                    call solve_dense(capacity, pivots, y)
+                    call correction%solve(y, trial_error)
+                    if (allocated(trial_error)) exit
                     do b = 1, n_rows
                         step = step - y(b) * z(:, b)
                     end do
@@ -649,56 +656,6 @@ contains
             converged = .true.
         end associate
     end subroutine try_row_update
-
-    !> LU factors with partial pivoting of a small dense matrix, in place.
-    pure subroutine factor_dense(a, pivots, error)
-        real(wp), intent(inout) :: a(:, :)
-        integer, intent(out) :: pivots(:)
-        type(error_type), allocatable, intent(out) :: error
-        integer :: j, p, n
-        real(wp), allocatable :: row(:)
-        n = size(a, 1)
-        do j = 1, n
-            p = j - 1 + maxloc(abs(a(j:, j)), dim=1)
-            pivots(j) = p
-            if (.not. (abs(a(p, j)) > 0.0_wp)) then
-                allocate(error)
-                error%message = 'singular row update'
-                return
-            end if
-            if (p /= j) then
-                row = a(j, :)
-                a(j, :) = a(p, :)
-                a(p, :) = row
-            end if
-            a(j + 1:, j) = a(j + 1:, j) / a(j, j)
-            a(j + 1:, j + 1:) = a(j + 1:, j + 1:) &
-                - matmul(a(j + 1:, j:j), a(j:j, j + 1:))
-        end do
-    end subroutine factor_dense
-
-    !> x <- A^-1 x with the factors of factor_dense.
-    pure subroutine solve_dense(a, pivots, x)
-        real(wp), intent(in) :: a(:, :)
-        integer, intent(in) :: pivots(:)
-        real(wp), intent(inout) :: x(:)
-        integer :: j, n
-        real(wp) :: t
-        n = size(a, 1)
-        do j = 1, n
-            if (pivots(j) /= j) then
-                t = x(j)
-                x(j) = x(pivots(j))
-                x(pivots(j)) = t
-            end if
-        end do
-        do j = 2, n
-            x(j) = x(j) - dot_product(a(j, 1:j - 1), x(1:j - 1))
-        end do
-        do j = n, 1, -1
-            x(j) = (x(j) - dot_product(a(j, j + 1:), x(j + 1:))) / a(j, j)
-        end do
-    end subroutine solve_dense
 
     !> u <- u + one Newton step of the exact law from u (no convergence test): the
     !> direction a solve from u sets out in.
