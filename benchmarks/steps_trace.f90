@@ -87,7 +87,9 @@ end module steps_trace_observer
 !> step, rounds per step, residual evaluations per step, stick -> slip and slip ->
 !> stick changes per step, CPU ms per step (the continuation alone), CPU ms of one
 !> elastic Newton iteration of the same net at the final state (its default linear
-!> solver) and the ratio of the two.
+!> solver) and the ratio of the two. Then one `timings` line: Jacobian evaluations and
+!> factorisations per step, and the monolithic solver's wall ms per step in residual
+!> and Jacobian assembly, analysis, factorisation and solves (step 0 included).
 program steps_trace
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use yarnfort_kinds, only: wp
@@ -173,4 +175,19 @@ program steps_trace
             t%iterations / n, t%rounds / n, t%residual_evaluations / n, t%to_slip / n, &
             t%to_stick / n, per_step, elastic_ms, per_step / elastic_ms
     end associate
+    ! Where the monolithic solver's time goes, per load step (wall ms, step 0 and the
+    ! elastic iteration's timing apart from it are included: small).
+    block
+        real(wp) :: residual_time, jacobian_time, analyse_time, factor_time, solve_time
+        integer :: n_factorisations
+        call stepper%newton_full%get_timings(residual_time, jacobian_time, analyse_time, &
+            factor_time, solve_time, n_factorisations)
+        associate(n => real(max(observer%steps, 1), wp), t => observer%total)
+            write(output_unit, '(a, 2f9.2, 5f9.2)') 'timings jacobians/step ' &
+                // 'factorisations/step, wall ms/step: residual jacobian analyse factor ' &
+                // 'solve', t%jacobian_evaluations / n, n_factorisations / n, &
+                1e3_wp * [residual_time, jacobian_time, analyse_time, factor_time, &
+                solve_time] / n
+        end associate
+    end block
 end program steps_trace

@@ -29,6 +29,7 @@ module yarnfort_solver_newton
     use yarnfort_input_config, only: solver_config_type
     use yarnfort_solver_problem, only: nonlinear_problem_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_dense, only: dense_solver_type
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc, &
         analyse_counted, factor_counted, solve_counted
     use yarnfort_solver_timer, only: wall_time
@@ -46,6 +47,19 @@ module yarnfort_solver_newton
     !> the full steps jump to 4e3 times the initial residual and wander there for all
     !> max_iterations (200 iterations wasted before the line search took 11).
     integer, parameter :: full_step_patience = 5
+    !> Most rows that try_row_update replaces (it stores as many vectors of the order
+    !> of the system).
+    integer, parameter :: max_update_rows = 16
+    !> Most chord steps of try_row_update (each cuts the residual tenfold).
+    integer, parameter :: max_update_steps = 8
+    !> try_row_update gives up at once (one residual evaluation) above this scaled
+    !> residual at its start. Measured (benchmarks/steps_results.md, section 13): of the
+    !> updates tried on inputs/knit_clamped.nml, inputs/belt.nml and the 10,120 woven
+    !> nets, 8 of the 13 that started above 1e-2 failed at their first chord step (each
+    !> a Jacobian evaluation and one solve per row wasted), 7 of the 77 below; without
+    !> this limit the 8 x 8 clamped knit took 10.20 instead of 9.85 residual evaluations
+    !> per load step (2.45 instead of 2.50 Newton iterations) and more CPU.
+    real(wp), parameter :: max_update_start = 1.0e-2_wp
     !> Iterations of the pseudo-transient fallback, in units of max_iterations.
     integer, parameter :: transient_iterations = 4
     !> The fallback gives up when its shift exceeds this multiple of the row levels per
@@ -120,6 +134,11 @@ module yarnfort_solver_newton
         logical :: quick = .false.
         !> Chord steps after the first Newton step of a solve (solve_chord); 0: none.
         integer :: chord_steps = 0
+        !> The Jacobian values of the last Newton step (newton_step) and the linear
+        !> solver's factorisation count just after it: while that count holds, its
+        !> factors are still the linear solver's (try_row_update).
+        real(wp), allocatable :: kept_values(:)
+        integer :: kept_factorisation = -1
     contains
         !> Solve for unknowns u (in: initial guess, out: solution).
         procedure :: solve
@@ -128,6 +147,9 @@ module yarnfort_solver_newton
         !> The first Newton step and its chord steps only (no fallback): converged, or
         !> the best iterate to judge before solving on.
         procedure :: try_chord
+        !> Chord steps of a problem whose rows `rows` changed since the last Newton step,
+        !> with that step's factors and a low-rank correction (no factorisation).
+        procedure :: try_row_update
         !> Timing and counters of assembly and linear algebra so far.
         procedure :: get_timings
         procedure :: destroy
@@ -335,6 +357,8 @@ contains
         logical :: converged
         character(len=200) :: buffer
 
+        ! KINSOL's factors and prepare_solve's weights are not those of newton_step.
+        self%kept_factorisation = -1
         ! Full Newton steps first; with line_search, a failed attempt is repeated from
         ! the initial guess with KINSOL's line search (back-tracking where needed only).
         n_attempts = merge(2, 1, self%options%line_search .and. .not. self%quick)
@@ -506,6 +530,133 @@ contains
         end associate
     end subroutine try_chord
 
+    !> Chord steps from u for a problem that differs from the one of the last Newton
+    !> step (newton_step) in its rows `rows` only (a friction step's active-set round:
+    !> passages turned stick or slip), while the linear solver still holds that step's
+    !> factors: the kept Jacobian with those rows replaced by the new ones at u, solved
+    !> by the Sherman-Morrison-Woodbury formula (size(rows) solves with the kept factors
+    !> and a dense system of that order), without a factorisation. The rows keep the
+    !> weights of that solve (no prepare_solve). Steps go on while each cuts the scaled
+    !> residual tenfold, to 1 % of the tolerance, as in solve_chord; `converged`: u is
+    !> the solution, else u is the best iterate (or the start) and the caller solves on
+    !> as usual. Nothing is tried (converged false, no evaluation) without kept factors
+    !> or with more than max_update_rows rows.
+    subroutine try_row_update(self, u, rows, stats, converged, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: u(:)
+        integer, intent(in) :: rows(:)
+        type(newton_stats_type), intent(out) :: stats
+        logical, intent(out) :: converged
+        type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: trial_error
+        real(wp), allocatable :: residual(:), step(:), kept(:), history(:), values(:)
+        real(wp), allocatable :: z(:, :), capacity(:, :), y(:), entry_value(:)
+        integer, allocatable :: slot(:), entry_slot(:), entry_column(:)
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
+        type(dense_solver_type) :: correction
+        integer :: k, n_rows, j, e, n_entries, a, b, i
+        real(wp) :: f, f_trial
+
+        converged = .false.
+        n_rows = size(rows)
+        if (n_rows == 0 .or. n_rows > max_update_rows) return
+        if (self%kept_factorisation /= self%adapter%n_factorisations) return
+        if (.not. allocated(self%kept_values)) return
+        associate(problem => self%problem%problem, tol => self%options%residual_tolerance, &
+                n => size(u))
+            self%u = u
+            allocate(residual(n), step(n))
+            call get_scaled_residual(self, residual, f, trial_error)
+            stats%residual_evaluations = stats%residual_evaluations + 1
+            if (allocated(trial_error)) return
+            history = [f]
+            stats%residual_norm = f
+            stats%residual_history = history
+            if (f > max_update_start) return
+            if (f > tol / 100) then
+                ! The new rows (Jacobian at u) less the kept ones: V, a few entries per row.
+                allocate(values(self%problem%nnz))
+                call jacobian_timed(self, self%u, values, trial_error)
+                stats%jacobian_evaluations = stats%jacobian_evaluations + 1
+                if (allocated(trial_error)) return
+                allocate(col_ptr(n + 1), row_index(self%problem%nnz))
+                call problem%copy_pattern(col_ptr, row_index)
+                allocate(slot(n), source=0)
+                do a = 1, n_rows
+                    slot(rows(a)) = a
+                end do
+                n_entries = count(slot(row_index + 1) > 0)
+                allocate(entry_slot(n_entries), entry_column(n_entries), entry_value(n_entries))
+                i = 0
+                do j = 1, n
+                    do e = int(col_ptr(j)) + 1, int(col_ptr(j + 1))
+                        a = slot(row_index(e) + 1)
+                        if (a == 0) cycle
+                        i = i + 1
+                        entry_slot(i) = a
+                        entry_column(i) = j
+                        entry_value(i) = values(e) - self%kept_values(e)
+                    end do
+                end do
+                deallocate(values)
+                ! Z = J^-1 U (U: the unit columns of the rows), C = I + V Z.
+                allocate(z(n, n_rows), capacity(n_rows, n_rows), y(n_rows))
+                do a = 1, n_rows
+                    z(:, a) = 0.0_wp
+                    z(rows(a), a) = 1.0_wp
+                    call solve_counted(self%adapter, z(:, a), trial_error)
+                    if (allocated(trial_error)) return
+                end do
+                capacity = 0.0_wp
+                do a = 1, n_rows
+                    capacity(a, a) = 1.0_wp
+                end do
+                do i = 1, n_entries
+                    capacity(entry_slot(i), :) = capacity(entry_slot(i), :) &
+                        + entry_value(i) * z(entry_column(i), :)
+                end do
+                call correction%analyse(int(n_rows, ik), [(int(a, ik) * n_rows, a = 0, n_rows)], &
+                    [((int(i, ik), i = 0, n_rows - 1), a = 1, n_rows)], trial_error)
+                if (allocated(trial_error)) return
+                call correction%factor(reshape(capacity, [n_rows * n_rows]), trial_error)
+                if (allocated(trial_error)) return
+                do k = 1, max_update_steps
+                    if (f <= tol / 100) exit
+                    step = -residual
+                    call solve_counted(self%adapter, step, trial_error)
+                    if (allocated(trial_error)) exit
+                    y = 0.0_wp
+                    do i = 1, n_entries
+                        y(entry_slot(i)) = y(entry_slot(i)) &
+                            + entry_value(i) * step(entry_column(i))
+                    end do
+                    call correction%solve(y, trial_error)
+                    if (allocated(trial_error)) exit
+                    do b = 1, n_rows
+                        step = step - y(b) * z(:, b)
+                    end do
+                    kept = self%u
+                    self%u = self%u + step
+                    call get_scaled_residual(self, residual, f_trial, trial_error)
+                    stats%residual_evaluations = stats%residual_evaluations + 1
+                    if (allocated(trial_error) .or. .not. (f_trial <= f / 10)) then
+                        self%u = kept
+                        exit
+                    end if
+                    f = f_trial
+                    history = [history, f]
+                end do
+            end if
+            if (f < history(1)) u = self%u
+            stats%residual_norm = f
+            stats%residual_history = history
+            if (.not. (f <= tol)) return
+            call problem%check_solution(self%u, trial_error)
+            if (allocated(trial_error)) return
+            converged = .true.
+        end associate
+    end subroutine try_row_update
+
     !> u <- u + one Newton step of the exact law from u (no convergence test): the
     !> direction a solve from u sets out in.
     subroutine take_newton_step(self, u, error)
@@ -539,6 +690,8 @@ contains
         call self%problem%problem%copy_pattern(col_ptr, row_index)
         call analyse_once(self, col_ptr, row_index, error)
         if (allocated(error)) return
+        ! New row weights (prepare_solve): the kept factors no longer match them.
+        self%kept_factorisation = -1
         call self%problem%problem%prepare_solve(u, error)
         if (allocated(error)) return
         self%u = u
@@ -557,6 +710,8 @@ contains
         if (allocated(error)) return
         call factor_counted(self%adapter, values, error)
         if (allocated(error)) return
+        call move_alloc(values, self%kept_values)
+        self%kept_factorisation = self%adapter%n_factorisations
         step = -residual
         call solve_counted(self%adapter, step, error)
         if (allocated(error)) return
