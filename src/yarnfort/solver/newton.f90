@@ -463,9 +463,10 @@ contains
         logical, intent(out) :: converged
         type(error_type), allocatable, intent(out) :: error
         type(error_type), allocatable :: trial_error
-        real(wp), allocatable :: residual(:), step(:), kept(:), history(:)
-        real(wp) :: f, f_trial
+        real(wp), allocatable :: residual(:), step(:), history(:)
+        real(wp) :: f
         integer :: k
+        logical :: accepted
 
         converged = .false.
         associate(problem => self%problem%problem, tol => self%options%residual_tolerance)
@@ -491,27 +492,60 @@ contains
                     step = -residual
                     call solve_counted(self%adapter, step, trial_error)
                     if (allocated(trial_error)) exit
-                    kept = self%u
-                    self%u = self%u + step
-                    call get_scaled_residual(self, residual, f_trial, trial_error)
-                    stats%residual_evaluations = stats%residual_evaluations + 1
-                    if (allocated(trial_error) .or. .not. (f_trial <= f / 10)) then
-                        self%u = kept
-                        exit
-                    end if
-                    f = f_trial
-                    history = [history, f]
+                    call take_chord_step(self, step, residual, f, history, stats, accepted)
+                    if (.not. accepted) exit
                 end do
             end if
-            if (f < history(1)) u = self%u
-            stats%residual_norm = f
-            stats%residual_history = history
-            if (.not. (f <= tol)) return
-            call problem%check_solution(self%u, trial_error)
-            if (allocated(trial_error)) return
-            converged = .true.
+            call finish_chord(self, u, f, history, stats, converged)
         end associate
     end subroutine solve_chord
+
+    !> self%u + step replaces self%u if it cuts the scaled residual tenfold (`accepted`;
+    !> residual, f and history then follow it), else self%u stays.
+    subroutine take_chord_step(self, step, residual, f, history, stats, accepted)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(in) :: step(:)
+        real(wp), intent(inout) :: residual(:), f
+        real(wp), allocatable, intent(inout) :: history(:)
+        type(newton_stats_type), intent(inout) :: stats
+        logical, intent(out) :: accepted
+        type(error_type), allocatable :: trial_error
+        real(wp), allocatable :: kept(:)
+        real(wp) :: f_trial
+
+        kept = self%u
+        self%u = self%u + step
+        call get_scaled_residual(self, residual, f_trial, trial_error)
+        stats%residual_evaluations = stats%residual_evaluations + 1
+        accepted = .not. allocated(trial_error)
+        if (accepted) accepted = f_trial <= f / 10
+        if (.not. accepted) then
+            self%u = kept
+            return
+        end if
+        f = f_trial
+        history = [history, f]
+    end subroutine take_chord_step
+
+    !> The end of a chord path at self%u with scaled residual f: u takes it if it is the
+    !> best iterate, stats its residuals; `converged` where f is within the tolerance
+    !> and the problem accepts the solution.
+    subroutine finish_chord(self, u, f, history, stats, converged)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: u(:)
+        real(wp), intent(in) :: f, history(:)
+        type(newton_stats_type), intent(inout) :: stats
+        logical, intent(out) :: converged
+        type(error_type), allocatable :: trial_error
+
+        if (f < history(1)) u = self%u
+        stats%residual_norm = f
+        stats%residual_history = history
+        converged = .false.
+        if (.not. (f <= self%options%residual_tolerance)) return
+        call self%problem%problem%check_solution(self%u, trial_error)
+        converged = .not. allocated(trial_error)
+    end subroutine finish_chord
 
     !> The chord fast path of `solve` alone (solve_chord): `converged`, u is the
     !> solution; else u is the best of its iterates (or the start), and the caller
@@ -549,13 +583,14 @@ contains
         logical, intent(out) :: converged
         type(error_type), allocatable, intent(out) :: error
         type(error_type), allocatable :: trial_error
-        real(wp), allocatable :: residual(:), step(:), kept(:), history(:), values(:)
+        real(wp), allocatable :: residual(:), step(:), history(:), values(:)
         real(wp), allocatable :: z(:, :), capacity(:, :), y(:), entry_value(:)
         integer, allocatable :: slot(:), entry_slot(:), entry_column(:)
         integer(ik), allocatable :: col_ptr(:), row_index(:)
         type(dense_solver_type) :: correction
         integer :: k, n_rows, j, e, n_entries, a, b, i
-        real(wp) :: f, f_trial
+        real(wp) :: f
+        logical :: accepted
 
         converged = .false.
         n_rows = size(rows)
@@ -635,25 +670,11 @@ contains
                     do b = 1, n_rows
                         step = step - y(b) * z(:, b)
                     end do
-                    kept = self%u
-                    self%u = self%u + step
-                    call get_scaled_residual(self, residual, f_trial, trial_error)
-                    stats%residual_evaluations = stats%residual_evaluations + 1
-                    if (allocated(trial_error) .or. .not. (f_trial <= f / 10)) then
-                        self%u = kept
-                        exit
-                    end if
-                    f = f_trial
-                    history = [history, f]
+                    call take_chord_step(self, step, residual, f, history, stats, accepted)
+                    if (.not. accepted) exit
                 end do
             end if
-            if (f < history(1)) u = self%u
-            stats%residual_norm = f
-            stats%residual_history = history
-            if (.not. (f <= tol)) return
-            call problem%check_solution(self%u, trial_error)
-            if (allocated(trial_error)) return
-            converged = .true.
+            call finish_chord(self, u, f, history, stats, converged)
         end associate
     end subroutine try_row_update
 
