@@ -7,9 +7,8 @@ module test_row_update
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     use yarnfort_testing, only: unittest_type, new_unittest, check, check_close
-    use yarnfort_input_config, only: config_type
     use yarnfort_scene_scene, only: scene_type
-    use yarnfort_scene_builder, only: new_scene
+    use two_pegs_scene, only: make_scene
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
@@ -29,49 +28,6 @@ contains
             new_unittest('slip_solved_with_kept_factors', test_slip), &
             new_unittest('nothing_tried_after_other_factors', test_other_factors) ]
     end subroutine collect_row_update
-
-    !> A yarn A-C-E-B (two elements per segment) passing two contact nodes C and E, each
-    !> also the end of a peg anchored at D1, D2; A, B, D1, D2 fixed, A and B pulled along
-    !> x (the scene of tests/unit/contact).
-    subroutine make_scene(scene, error)
-        type(scene_type), intent(out) :: scene
-        type(error_type), allocatable, intent(out) :: error
-        type(config_type) :: config
-
-        config%node_positions = reshape([-1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, -0.3_wp, 0.1_wp, &
-            0.8_wp, -0.2_wp, -0.1_wp, 1.5_wp, 0.2_wp, 0.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, &
-            0.8_wp, -1.0_wp, 0.3_wp], [3, 6])
-        allocate(config%materials(2))
-        config%materials(1)%name = 'yarn'
-        config%materials(1)%law = 'neo_hookean'
-        config%materials(1)%modulus = 1.0e6_wp
-        config%materials(1)%area = 1.0e-5_wp
-        config%materials(2)%name = 'peg'
-        config%materials(2)%law = 'linear'
-        config%materials(2)%stiffness = 20.0_wp
-        allocate(config%yarns(3))
-        config%yarns(1)%material = 'yarn'
-        config%yarns(1)%nodes = [1, 2, 3, 4]
-        config%yarns(1)%elements_per_segment = 2
-        config%yarns(2)%material = 'peg'
-        config%yarns(2)%nodes = [2, 5]
-        config%yarns(3)%material = 'peg'
-        config%yarns(3)%nodes = [3, 6]
-        allocate(config%supports(1))
-        config%supports(1)%name = 'fixed'
-        config%supports(1)%nodes = [1, 4, 5, 6]
-        config%supports(1)%displacement = [0.1_wp, 0.0_wp, 0.0_wp]
-        allocate(config%loads(0))
-        allocate(config%contacts(1))
-        config%contacts(1)%materials = [character(len=64) :: 'yarn', 'peg']
-        config%contacts(1)%law = 'adhesion'
-        config%contacts(1)%friction_coefficient = 0.3_wp
-        config%contacts(1)%adhesion = 0.05_wp
-        config%path%time = [0.0_wp, 1.0_wp]
-        config%path%p_force = [0.0_wp, 0.0_wp]
-        config%path%p_disp = [0.0_wp, 1.0_wp]
-        call new_scene(scene, config, error)
-    end subroutine make_scene
 
     !> The scene's friction problem at half the displacement, all stick, solved; a
     !> Newton solver with chord steps (as the friction stepper's) and the unknowns `u`.
