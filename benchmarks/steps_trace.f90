@@ -87,9 +87,10 @@ end module steps_trace_observer
 !> step, rounds per step, residual evaluations per step, stick -> slip and slip ->
 !> stick changes per step, CPU ms per step (the continuation alone), CPU ms of one
 !> elastic Newton iteration of the same net at the final state (its default linear
-!> solver) and the ratio of the two. Then one `timings` line: Jacobian evaluations and
-!> factorisations per step, and the monolithic solver's wall ms per step in residual
-!> and Jacobian assembly, analysis, factorisation and solves (step 0 included).
+!> solver) and the ratio of the two. Then one `timings` line: Jacobian evaluations,
+!> factorisations and linear solves per step, and the monolithic solver's wall ms per
+!> step in residual and Jacobian assembly, analysis, factorisation and solves (step 0
+!> included).
 program steps_trace
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use yarnfort_kinds, only: wp
@@ -179,13 +180,14 @@ program steps_trace
     ! elastic iteration's timing apart from it are included: small).
     block
         real(wp) :: residual_time, jacobian_time, analyse_time, factor_time, solve_time
-        integer :: n_factorisations
+        integer :: n_factorisations, n_solves
         call stepper%newton_full%get_timings(residual_time, jacobian_time, analyse_time, &
-            factor_time, solve_time, n_factorisations)
+            factor_time, solve_time, n_factorisations, n_solves)
         associate(n => real(max(observer%steps, 1), wp), t => observer%total)
-            write(output_unit, '(a, 2f9.2, 5f9.2)') 'timings jacobians/step ' &
-                // 'factorisations/step, wall ms/step: residual jacobian analyse factor ' &
-                // 'solve', t%jacobian_evaluations / n, n_factorisations / n, &
+            write(output_unit, '(a, 3f9.2, 5f9.2)') 'timings jacobians/step ' &
+                // 'factorisations/step solves/step, wall ms/step: residual jacobian ' &
+                // 'analyse factor solve', t%jacobian_evaluations / n, &
+                n_factorisations / n, n_solves / n, &
                 1e3_wp * [residual_time, jacobian_time, analyse_time, factor_time, &
                 solve_time] / n
         end associate

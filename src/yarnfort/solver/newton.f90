@@ -1003,11 +1003,12 @@ contains
 
     !> Accumulated figures: assembly (residual, Jacobian) and linear algebra times.
     subroutine get_timings(self, residual_time, jacobian_time, analyse_time, factor_time, &
-            solve_time, n_factorisations)
+            solve_time, n_factorisations, n_solves)
         class(newton_solver_type), intent(in) :: self
         real(wp), intent(out) :: residual_time, jacobian_time, analyse_time, factor_time
         real(wp), intent(out) :: solve_time
         integer, intent(out) :: n_factorisations
+        integer, intent(out), optional :: n_solves
         if (.not. associated(self%problem)) then
             residual_time = 0.0_wp
             jacobian_time = 0.0_wp
@@ -1015,6 +1016,7 @@ contains
             factor_time = 0.0_wp
             solve_time = 0.0_wp
             n_factorisations = 0
+            if (present(n_solves)) n_solves = 0
             return
         end if
         residual_time = self%problem%residual_time
@@ -1023,6 +1025,7 @@ contains
         factor_time = self%adapter%factor_time
         solve_time = self%adapter%solve_time
         n_factorisations = self%adapter%n_factorisations
+        if (present(n_solves)) n_solves = self%adapter%n_solves
     end subroutine get_timings
 
     subroutine destroy(self)
