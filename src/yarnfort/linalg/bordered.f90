@@ -68,6 +68,7 @@ module yarnfort_linalg_bordered
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
+        procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
     end type bordered_solver_type
@@ -253,6 +254,37 @@ contains
         rhs(1:nl) = rhs(1:nl) - matmul(self%coupling, y)
         rhs(nl + 1:) = y
     end subroutine solve_rhs
+
+    !> The same for several columns: K^-1 of all of them in one `solve_columns`, the
+    !> Schur complement's solve of all of them, then each column's correction as in
+    !> solve_rhs (the same arithmetic).
+    subroutine solve_rhs_columns(self, rhs, error)
+        class(bordered_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:, :)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: y(:, :)
+        integer(ik) :: k, nl
+        integer :: c
+
+        if (.not. self%use_border) then
+            call self%general%solve_columns(rhs, error)
+            return
+        end if
+        nl = self%n_leading
+        call self%leading%solve_columns(rhs(1:nl, :), error)
+        if (allocated(error) .or. self%n == nl) return
+        y = rhs(nl + 1:, :)
+        do k = 1, size(self%c_entry, kind=ik)
+            y(self%c_row(k), :) = y(self%c_row(k), :) &
+                - self%c_values(k) * rhs(self%c_column(k), :)
+        end do
+        call self%schur%solve_columns(y, error)
+        if (allocated(error)) return
+        do c = 1, size(rhs, 2)
+            rhs(1:nl, c) = rhs(1:nl, c) - matmul(self%coupling, y(:, c))
+        end do
+        rhs(nl + 1:, :) = y
+    end subroutine solve_rhs_columns
 
     !> Free the general solver and the border; the analysis of K is kept for the next
     !> pattern (freed with the object).

@@ -45,6 +45,11 @@ module yarnfort_linalg_condensed
         integer(ik), allocatable :: reduced(:)
         integer(ik), allocatable :: reduced_col_ptr(:), reduced_row_index(:), source(:)
         integer(ik) :: n_reduced = 0
+        !> The unknown of each reduced one, and the eliminated unknowns (increasing): what
+        !> `solve` gathers and scatters.
+        integer(ik), allocatable :: kept(:), eliminated(:)
+        !> The reduced right-hand sides of `solve` (kept between calls).
+        real(wp), allocatable :: part(:, :)
         !> Diagonal of each eliminated unknown's row (0 for the others).
         real(wp), allocatable :: pivot(:)
         !> Entry of each candidate's diagonal (0 if not stored), and the off-diagonal
@@ -79,6 +84,7 @@ module yarnfort_linalg_condensed
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
+        procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
     end type condensed_solver_type
@@ -186,6 +192,8 @@ contains
                 end if
             end do
             self%n_reduced = m
+            self%kept = pack([(j, j = 1, self%n)], .not. eliminated)
+            self%eliminated = pack([(j, j = 1, self%n)], eliminated)
             call get_subpattern(self%col_ptr, self%row_index, self%reduced, &
                 self%reduced_col_ptr, self%reduced_row_index, self%source)
             if (self%inner_analysed) call self%inner%destroy()
@@ -200,29 +208,57 @@ contains
         class(condensed_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
-        real(wp), allocatable :: part(:)
-        integer(ik) :: j, k, i, offset
+
+        call solve_condensed(self, size(rhs, kind=ik), 1_ik, rhs, error)
+    end subroutine solve_rhs
+
+    !> The same for several columns: the elimination for all of them, then one
+    !> `solve_columns` of the reduced system.
+    subroutine solve_rhs_columns(self, rhs, error)
+        class(condensed_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:, :)
+        type(error_type), allocatable, intent(out) :: error
+
+        call solve_condensed(self, size(rhs, 1, kind=ik), size(rhs, 2, kind=ik), rhs, error)
+    end subroutine solve_rhs_columns
+
+    !> Both solves on n x m columns (each column's arithmetic that of a single solve).
+    subroutine solve_condensed(self, n, m, rhs, error)
+        type(condensed_solver_type), intent(inout) :: self
+        integer(ik), intent(in) :: n, m
+        real(wp), intent(inout) :: rhs(n, m)
+        type(error_type), allocatable, intent(out) :: error
+        integer(ik) :: j, k, i, e, c, offset
 
         offset = self%col_ptr(self%first_candidate)
-        do j = self%first_candidate, self%n
-            if (self%reduced(j) /= 0) cycle
-            rhs(j) = rhs(j) / self%pivot(j)
+        do e = 1, size(self%eliminated, kind=ik)
+            j = self%eliminated(e)
+            rhs(j, :) = rhs(j, :) / self%pivot(j)
             do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
                 i = self%row_index(k) + 1
-                if (self%reduced(i) /= 0) rhs(i) = rhs(i) - self%values(k - offset) * rhs(j)
+                if (self%reduced(i) /= 0) &
+                    rhs(i, :) = rhs(i, :) - self%values(k - offset) * rhs(j, :)
             end do
         end do
         if (self%n_reduced == 0) return
-        allocate(part(self%n_reduced))
-        do j = 1, self%n
-            if (self%reduced(j) /= 0) part(self%reduced(j)) = rhs(j)
+        if (allocated(self%part)) then
+            if (size(self%part, 1, kind=ik) /= self%n_reduced &
+                .or. size(self%part, 2, kind=ik) < m) deallocate(self%part)
+        end if
+        if (.not. allocated(self%part)) allocate(self%part(self%n_reduced, m))
+        do c = 1, m
+            self%part(:, c) = rhs(self%kept, c)
         end do
-        call self%inner%solve(part, error)
+        if (m == 1) then
+            call self%inner%solve(self%part(:, 1), error)
+        else
+            call self%inner%solve_columns(self%part(:, 1:m), error)
+        end if
         if (allocated(error)) return
-        do j = 1, self%n
-            if (self%reduced(j) /= 0) rhs(j) = part(self%reduced(j))
+        do c = 1, m
+            rhs(self%kept, c) = self%part(:, c)
         end do
-    end subroutine solve_rhs
+    end subroutine solve_condensed
 
     !> The diagonal entries of the candidate columns and the off-diagonal entries of the
     !> candidate rows (first_candidate clipped to 1..n + 1).
@@ -267,6 +303,9 @@ contains
         self%inner_analysed = .false.
         self%n_reduced = 0
         if (allocated(self%reduced)) deallocate(self%reduced)
+        if (allocated(self%kept)) deallocate(self%kept)
+        if (allocated(self%eliminated)) deallocate(self%eliminated)
+        if (allocated(self%part)) deallocate(self%part)
         if (allocated(self%reduced_col_ptr)) deallocate(self%reduced_col_ptr)
         if (allocated(self%reduced_row_index)) deallocate(self%reduced_row_index)
         if (allocated(self%source)) deallocate(self%source)

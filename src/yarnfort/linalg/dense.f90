@@ -47,6 +47,7 @@ module yarnfort_linalg_dense
         procedure :: analyse_pattern
         procedure :: factor_values
         procedure :: solve_rhs
+        procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
     end type dense_solver_type
@@ -106,6 +107,21 @@ contains
                 // format_integer(int(-info, ik)))
         end if
     end subroutine solve_rhs
+
+    !> Overwrite each column of rhs with its solution (one dgetrs for all of them).
+    subroutine solve_rhs_columns(self, rhs, error)
+        class(dense_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:, :)
+        type(error_type), allocatable, intent(out) :: error
+        integer :: info, n
+
+        n = int(self%n)
+        call dgetrs('N', n, size(rhs, 2), self%lu, n, self%pivots, rhs, n, info)
+        if (info /= 0) then
+            call fatal_error(error, 'dense: dgetrs rejected argument ' &
+                // format_integer(int(-info, ik)))
+        end if
+    end subroutine solve_rhs_columns
 
     !> Free the dense matrix.
     subroutine release(self)

@@ -37,6 +37,7 @@ module yarnfort_linalg_lu_choice
         procedure :: analyse
         procedure :: factor
         procedure :: solve
+        procedure :: solve_columns
         procedure :: destroy
         procedure :: get_name
     end type lu_choice_solver_type
@@ -93,6 +94,16 @@ contains
         if (allocated(error)) return
         call self%chosen%solve(rhs, error)
     end subroutine solve
+
+    subroutine solve_columns(self, rhs, error)
+        class(lu_choice_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:, :)
+        type(error_type), allocatable, intent(out) :: error
+
+        call require_solver(self, 'solve called without a valid factorisation', error)
+        if (allocated(error)) return
+        call self%chosen%solve_columns(rhs, error)
+    end subroutine solve_columns
 
     !> An error with `message` if no solver was chosen yet (no successful `analyse`).
     subroutine require_solver(self, message, error)

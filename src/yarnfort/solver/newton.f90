@@ -31,7 +31,7 @@ module yarnfort_solver_newton
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_dense, only: dense_solver_type
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc, &
-        analyse_counted, factor_counted, solve_counted
+        analyse_counted, factor_counted, solve_counted, solve_columns_counted
     use yarnfort_solver_timer, only: wall_time
     implicit none
     private
@@ -636,12 +636,12 @@ contains
                 deallocate(values)
                 ! Z = J^-1 U (U: the unit columns of the rows), C = I + V Z.
                 allocate(z(n, n_rows), capacity(n_rows, n_rows), y(n_rows))
+                z = 0.0_wp
                 do a = 1, n_rows
-                    z(:, a) = 0.0_wp
                     z(rows(a), a) = 1.0_wp
-                    call solve_counted(self%adapter, z(:, a), trial_error)
-                    if (allocated(trial_error)) return
                 end do
+                call solve_columns_counted(self%adapter, z, trial_error)
+                if (allocated(trial_error)) return
                 capacity = 0.0_wp
                 do a = 1, n_rows
                     capacity(a, a) = 1.0_wp
