@@ -71,8 +71,7 @@ contains
         integer(c_int) :: status
         integer(c_long) :: minor
 
-        status = yarnfort_cholmod_factorize(self%handle, self%n, self%col_ptr, &
-            self%row_index, values, minor)
+        status = yarnfort_cholmod_factorize(self%handle, self%n, values, minor)
         if (status == cholmod_ok .or. status == cholmod_dsmall) then
             return
         else if (status == cholmod_not_posdef) then

@@ -46,13 +46,13 @@ module yarnfort_linalg_cholmod_binding
             integer(c_int) :: status
         end function yarnfort_cholmod_analyze
 
-        !> Numeric LL' factorisation; minor is the 0-based failed column, or n.
-        function yarnfort_cholmod_factorize(handle, n, col_ptr, row_index, values, minor) &
+        !> Numeric LL' factorisation of the values of the analysed pattern; minor is the
+        !> 0-based failed column in the fill-reducing order, or n.
+        function yarnfort_cholmod_factorize(handle, n, values, minor) &
                 result(status) bind(C, name='yarnfort_cholmod_factorize')
             import :: c_int, c_long, c_double, c_ptr
             type(c_ptr), value :: handle
             integer(c_long), value :: n
-            integer(c_long), intent(in) :: col_ptr(*), row_index(*)
             real(c_double), intent(in) :: values(*)
             integer(c_long), intent(out) :: minor
             integer(c_int) :: status

@@ -37,9 +37,6 @@ typedef struct {
     int stype;                 /* triangle of PAP' that is stored: 1 upper, -1 lower */
     SuiteSparse_long *p_col_ptr, *p_row_index;  /* that triangle's pattern */
     SuiteSparse_long *source;  /* for each of its entries, the entry of A it takes */
-    double *p_values;          /* its values at the last factorisation */
-    double *work;              /* permuted right-hand sides (n x work_columns) */
-    SuiteSparse_long work_columns;
 } yarnfort_cholmod;
 
 /* Status returned when the handle itself is missing or cannot be allocated. */
@@ -96,11 +93,7 @@ static void free_analysis(yarnfort_cholmod *h)
     free(h->p_col_ptr);
     free(h->p_row_index);
     free(h->source);
-    free(h->p_values);
-    free(h->work);
     h->perm = h->p_col_ptr = h->p_row_index = h->source = NULL;
-    h->p_values = h->work = NULL;
-    h->work_columns = 0;
     h->n = 0;
 }
 
@@ -114,81 +107,75 @@ void yarnfort_cholmod_free(void *handle)
     free(h);
 }
 
+/* Row and column in the stored triangle of PAP' of entry (i, j) of A. */
+static void place(const yarnfort_cholmod *h, const SuiteSparse_long *inverse,
+                  SuiteSparse_long i, SuiteSparse_long j, SuiteSparse_long *row,
+                  SuiteSparse_long *column)
+{
+    SuiteSparse_long low = inverse[i], high = inverse[j];
+    if (low > high) {
+        SuiteSparse_long swap = low;
+        low = high;
+        high = swap;
+    }
+    *row = h->stype > 0 ? low : high;
+    *column = h->stype > 0 ? high : low;
+}
+
 /* The stored triangle of PAP' (h->stype) from the upper triangle of A (col_ptr,
  * row_index), rows sorted within each column, and for each entry the entry of A it
  * takes. 0 or CHOLMOD_OUT_OF_MEMORY. */
 static int permute_pattern(yarnfort_cholmod *h, const SuiteSparse_long *col_ptr,
                            const SuiteSparse_long *row_index)
 {
-    SuiteSparse_long n = h->n, j, e, k, nnz = 0;
-    SuiteSparse_long *inverse = malloc((size_t) n * sizeof(*inverse));
-    SuiteSparse_long *next = malloc((size_t) (n + 1) * sizeof(*next));
-    SuiteSparse_long *by_row_ptr = NULL, *by_row = NULL, *by_row_column = NULL;
+    SuiteSparse_long n = h->n, most = col_ptr[n] > 0 ? col_ptr[n] : 1;
+    SuiteSparse_long j, e, k, nnz = 0;
+    SuiteSparse_long *inverse = malloc((size_t) (n > 0 ? n : 1) * sizeof(*inverse));
+    SuiteSparse_long *row = malloc((size_t) most * sizeof(*row));
+    SuiteSparse_long *column = malloc((size_t) most * sizeof(*column));
+    SuiteSparse_long *entry = malloc((size_t) most * sizeof(*entry));
+    SuiteSparse_long *row_ptr = calloc((size_t) n + 1, sizeof(*row_ptr));
+    SuiteSparse_long *by_row = malloc((size_t) most * sizeof(*by_row));
     int status = CHOLMOD_OUT_OF_MEMORY;
 
     h->p_col_ptr = calloc((size_t) n + 1, sizeof(*h->p_col_ptr));
-    if (!inverse || !next || !h->p_col_ptr) goto done;
+    h->p_row_index = malloc((size_t) most * sizeof(*h->p_row_index));
+    h->source = malloc((size_t) most * sizeof(*h->source));
+    if (!inverse || !row || !column || !entry || !row_ptr || !by_row || !h->p_col_ptr
+        || !h->p_row_index || !h->source) goto done;
     for (k = 0; k < n; k++) inverse[h->perm[k]] = k;
-    /* Count the entries of each column of the triangle. */
+    /* The upper triangle's entries, placed, and the counts per row and per column. */
     for (j = 0; j < n; j++) {
         for (e = col_ptr[j]; e < col_ptr[j + 1]; e++) {
-            SuiteSparse_long i = row_index[e], pi, pj;
-            if (i > j) continue;
-            pi = inverse[i];
-            pj = inverse[j];
-            h->p_col_ptr[(h->stype > 0 ? (pi > pj ? pi : pj) : (pi < pj ? pi : pj)) + 1]++;
+            if (row_index[e] > j) continue;
+            place(h, inverse, row_index[e], j, &row[nnz], &column[nnz]);
+            entry[nnz] = e;
+            row_ptr[row[nnz] + 1]++;
+            h->p_col_ptr[column[nnz] + 1]++;
             nnz++;
         }
     }
-    for (k = 0; k < n; k++) h->p_col_ptr[k + 1] += h->p_col_ptr[k];
-    h->p_row_index = malloc((size_t) (nnz > 0 ? nnz : 1) * sizeof(*h->p_row_index));
-    h->source = malloc((size_t) (nnz > 0 ? nnz : 1) * sizeof(*h->source));
-    h->p_values = malloc((size_t) (nnz > 0 ? nnz : 1) * sizeof(*h->p_values));
-    /* Sorted rows: first bucket the entries by their row in the triangle (a counting
-     * sort), then deal them out to their columns in row order. */
-    by_row_ptr = calloc((size_t) n + 1, sizeof(*by_row_ptr));
-    by_row = malloc((size_t) (nnz > 0 ? nnz : 1) * sizeof(*by_row));
-    by_row_column = malloc((size_t) (nnz > 0 ? nnz : 1) * sizeof(*by_row_column));
-    if (!h->p_row_index || !h->source || !h->p_values || !by_row_ptr || !by_row
-        || !by_row_column) goto done;
-    for (j = 0; j < n; j++) {
-        for (e = col_ptr[j]; e < col_ptr[j + 1]; e++) {
-            SuiteSparse_long i = row_index[e], pi, pj;
-            if (i > j) continue;
-            pi = inverse[i];
-            pj = inverse[j];
-            by_row_ptr[(h->stype > 0 ? (pi < pj ? pi : pj) : (pi > pj ? pi : pj)) + 1]++;
-        }
-    }
-    for (k = 0; k < n; k++) by_row_ptr[k + 1] += by_row_ptr[k];
-    memcpy(next, by_row_ptr, (size_t) (n + 1) * sizeof(*next));
-    for (j = 0; j < n; j++) {
-        for (e = col_ptr[j]; e < col_ptr[j + 1]; e++) {
-            SuiteSparse_long i = row_index[e], pi, pj;
-            if (i > j) continue;
-            pi = inverse[i];
-            pj = inverse[j];
-            k = next[h->stype > 0 ? (pi < pj ? pi : pj) : (pi > pj ? pi : pj)]++;
-            by_row[k] = e;
-            by_row_column[k] = h->stype > 0 ? (pi > pj ? pi : pj) : (pi < pj ? pi : pj);
-        }
-    }
-    memcpy(next, h->p_col_ptr, (size_t) (n + 1) * sizeof(*next));
     for (k = 0; k < n; k++) {
-        for (e = by_row_ptr[k]; e < by_row_ptr[k + 1]; e++) {
-            SuiteSparse_long column = by_row_column[e];
-            h->p_row_index[next[column]] = k;
-            h->source[next[column]] = by_row[e];
-            next[column]++;
-        }
+        row_ptr[k + 1] += row_ptr[k];
+        h->p_col_ptr[k + 1] += h->p_col_ptr[k];
+    }
+    /* Sorted rows: the entries bucketed by row (a counting sort), then dealt out to their
+     * columns in row order. */
+    for (k = 0; k < nnz; k++) by_row[row_ptr[row[k]]++] = k;
+    memcpy(row_ptr, h->p_col_ptr, (size_t) (n + 1) * sizeof(*row_ptr));
+    for (e = 0; e < nnz; e++) {
+        k = by_row[e];
+        h->p_row_index[row_ptr[column[k]]] = row[k];
+        h->source[row_ptr[column[k]]++] = entry[k];
     }
     status = 0;
 done:
     free(inverse);
-    free(next);
-    free(by_row_ptr);
+    free(row);
+    free(column);
+    free(entry);
+    free(row_ptr);
     free(by_row);
-    free(by_row_column);
     return status;
 }
 
@@ -244,30 +231,34 @@ int yarnfort_cholmod_analyze(void *handle, SuiteSparse_long n, SuiteSparse_long 
     return h->common.status;
 }
 
-/* Numeric LL' factorisation; on CHOLMOD_NOT_POSDEF *minor is the failed column
- * (0-based), else n. */
-int yarnfort_cholmod_factorize(void *handle, SuiteSparse_long n, SuiteSparse_long *col_ptr,
-                               SuiteSparse_long *row_index, double *values,
+/* Numeric LL' factorisation of A (its values in the order of the analysed pattern); on
+ * CHOLMOD_NOT_POSDEF *minor is the failed column of PAP' (0-based), else n. */
+int yarnfort_cholmod_factorize(void *handle, SuiteSparse_long n, double *values,
                                SuiteSparse_long *minor)
 {
     yarnfort_cholmod *h = handle;
     cholmod_sparse a;
+    double *permuted;
+    SuiteSparse_long k, nnz;
+    int status;
     *minor = n;
     if (!h) return YARNFORT_CHOLMOD_NO_HANDLE;
     if (!h->factor || n != h->n) return CHOLMOD_INVALID;
-    (void) col_ptr;
-    (void) row_index;
-    for (SuiteSparse_long k = 0; k < h->p_col_ptr[n]; k++) h->p_values[k] = values[h->source[k]];
-    a = wrap_sparse(n, h->p_col_ptr, h->p_row_index, h->p_values, h->stype);
+    /* The values of PAP' for this factorisation only (as CHOLMOD's own transposes were). */
+    nnz = h->p_col_ptr[n];
+    permuted = malloc((size_t) (nnz > 0 ? nnz : 1) * sizeof(*permuted));
+    if (!permuted) return CHOLMOD_OUT_OF_MEMORY;
+    for (k = 0; k < nnz; k++) permuted[k] = values[h->source[k]];
+    a = wrap_sparse(n, h->p_col_ptr, h->p_row_index, permuted, h->stype);
     h->common.status = CHOLMOD_OK;
     if (!cholmod_l_factorize(&a, h->factor, &h->common) && h->common.status == CHOLMOD_OK) {
-        return CHOLMOD_INVALID;
+        h->common.status = CHOLMOD_INVALID;
     }
+    free(permuted);
+    status = h->common.status;
     *minor = (SuiteSparse_long) h->factor->minor;
-    if (h->common.status == CHOLMOD_OK && h->factor->minor < (size_t) n) {
-        return CHOLMOD_NOT_POSDEF;
-    }
-    return h->common.status;
+    if (status == CHOLMOD_OK && h->factor->minor < (size_t) n) return CHOLMOD_NOT_POSDEF;
+    return status;
 }
 
 /* Solve A X = RHS for ncol columns (RHS column-major, n x ncol) and overwrite RHS; the
@@ -278,32 +269,34 @@ int yarnfort_cholmod_solve(void *handle, SuiteSparse_long n, SuiteSparse_long nc
 {
     yarnfort_cholmod *h = handle;
     cholmod_dense b;
+    double *permuted;
     SuiteSparse_long c, k;
+    int status;
     if (!h) return YARNFORT_CHOLMOD_NO_HANDLE;
     if (!h->factor || ncol < 1 || n != h->n) return CHOLMOD_INVALID;
-    if (ncol != h->work_columns) {
-        free(h->work);
-        h->work = malloc((size_t) (n > 0 ? n : 1) * (size_t) ncol * sizeof(*h->work));
-        h->work_columns = h->work ? ncol : 0;
-        if (!h->work) return CHOLMOD_OUT_OF_MEMORY;
-    }
-    /* P rhs, solved with the factor of PAP', then P' x. */
+    /* P rhs, solved with the factor of PAP', then P' x; P rhs for this solve only (n x
+     * ncol: kept, 16 columns at 963,600 unknowns would hold 123 MB for the run). */
+    permuted = malloc((size_t) (n > 0 ? n : 1) * (size_t) ncol * sizeof(*permuted));
+    if (!permuted) return CHOLMOD_OUT_OF_MEMORY;
     for (c = 0; c < ncol; c++) {
-        for (k = 0; k < n; k++) h->work[c * n + k] = rhs[c * n + h->perm[k]];
+        for (k = 0; k < n; k++) permuted[c * n + k] = rhs[c * n + h->perm[k]];
     }
     memset(&b, 0, sizeof(b));
     b.nrow = (size_t) n;
     b.ncol = (size_t) ncol;
     b.nzmax = (size_t) n * (size_t) ncol;
     b.d = (size_t) n;
-    b.x = h->work;
+    b.x = permuted;
     b.xtype = CHOLMOD_REAL;
     b.dtype = CHOLMOD_DOUBLE;
     h->common.status = CHOLMOD_OK;
     if (!cholmod_l_solve2(CHOLMOD_A, h->factor, &b, NULL, &h->x, NULL, &h->y, &h->e,
                           &h->common)) {
-        return h->common.status == CHOLMOD_OK ? CHOLMOD_INVALID : h->common.status;
+        status = h->common.status == CHOLMOD_OK ? CHOLMOD_INVALID : h->common.status;
+        free(permuted);
+        return status;
     }
+    free(permuted);
     for (c = 0; c < ncol; c++) {
         const double *x = (const double *) h->x->x + c * n;
         for (k = 0; k < n; k++) rhs[c * n + h->perm[k]] = x[k];
