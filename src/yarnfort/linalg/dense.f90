@@ -98,14 +98,8 @@ contains
         class(dense_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
-        integer :: info, n
 
-        n = int(self%n)
-        call dgetrs('N', n, 1, self%lu, n, self%pivots, rhs, n, info)
-        if (info /= 0) then
-            call fatal_error(error, 'dense: dgetrs rejected argument ' &
-                // format_integer(int(-info, ik)))
-        end if
+        call solve_lu(self, 1, rhs, error)
     end subroutine solve_rhs
 
     !> Overwrite each column of rhs with its solution (one dgetrs for all of them).
@@ -113,15 +107,25 @@ contains
         class(dense_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:, :)
         type(error_type), allocatable, intent(out) :: error
+
+        call solve_lu(self, size(rhs, 2), rhs, error)
+    end subroutine solve_rhs_columns
+
+    !> The nrhs columns of rhs (n x nrhs) overwritten with their solutions by dgetrs.
+    subroutine solve_lu(self, nrhs, rhs, error)
+        type(dense_solver_type), intent(in) :: self
+        integer, intent(in) :: nrhs
+        real(wp), intent(inout) :: rhs(self%n, nrhs)
+        type(error_type), allocatable, intent(out) :: error
         integer :: info, n
 
         n = int(self%n)
-        call dgetrs('N', n, size(rhs, 2), self%lu, n, self%pivots, rhs, n, info)
+        call dgetrs('N', n, nrhs, self%lu, n, self%pivots, rhs, n, info)
         if (info /= 0) then
             call fatal_error(error, 'dense: dgetrs rejected argument ' &
                 // format_integer(int(-info, ik)))
         end if
-    end subroutine solve_rhs_columns
+    end subroutine solve_lu
 
     !> Free the dense matrix.
     subroutine release(self)
