@@ -65,6 +65,7 @@ def fabric_material(name: str, default_doc: str, doc: str) -> Var:
     """A yarn type of &fabric: the name of a `&material`."""
     return Var(name, 'character', '', length='name_length', default_doc=default_doc, doc=doc)
 
+
 def channel_var(group: str, scaled: str, default: str) -> Var:
     """The `channel` of &support or &load: the load channel that scales `scaled`."""
     return Var('channel', 'character', '', length='name_length',
