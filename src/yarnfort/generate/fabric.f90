@@ -310,12 +310,9 @@ contains
         subroutine require_choice(error, variable, value, choices)
             type(error_type), allocatable, intent(out) :: error
             character(len=*), intent(in) :: variable, value, choices(:)
-            integer :: n
             if (any(choices == value)) return
-            n = size(choices)
             call fatal_error(error, label // variable // " = '" // trim(value) &
-                // "' is unknown (use " // join_names(choices(:n - 1), '') // ' or ' &
-                // trim(choices(n)) // ')')
+                // "' is unknown (use " // join_names(choices, '', ' or ') // ')')
         end subroutine require_choice
 
         !> At least one cell each way, and not too many in all.
