@@ -375,16 +375,22 @@ contains
         end do
     end function closest_name
 
-    !> Names joined as 'a, b, c', each with an optional prefix (e.g. '&').
-    pure function join_names(names, prefix) result(joined)
+    !> Names joined as 'a, b, c', each with an optional prefix (e.g. '&'); with `last`
+    !> (e.g. ' or '), that joins the last two: 'a, b or c'.
+    pure function join_names(names, prefix, last) result(joined)
         character(len=*), intent(in) :: names(:)
         character(len=*), intent(in) :: prefix
+        character(len=*), intent(in), optional :: last
         character(len=:), allocatable :: joined
         integer :: i
 
         joined = ''
         do i = 1, size(names)
-            if (i > 1) joined = joined // ', '
+            if (i > 1 .and. i == size(names) .and. present(last)) then
+                joined = joined // last
+            else if (i > 1) then
+                joined = joined // ', '
+            end if
             joined = joined // prefix // trim(names(i))
         end do
     end function join_names

@@ -6,11 +6,14 @@ module yarnfort_generate_fabric
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, fabric_config_type
+    use yarnfort_input_groups, only: fabric_kind_choices, fabric_boundary_choices, &
+        fabric_sides_choices
+    use yarnfort_input_fields, only: check_range
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_knit, only: generate_knit
     use yarnfort_generate_woven, only: generate_woven
     use yarnfort_generate_texgen, only: generate_texgen
-    use yarnfort_text, only: resolve_path, join_names
+    use yarnfort_text, only: resolve_path, join_names, format_real, format_integer
     implicit none
     private
 
@@ -57,14 +60,11 @@ contains
         integer :: k
 
         associate(fabric => config%fabric)
-            call require_choice(error, 'kind', fabric%kind, [character(len=6) :: 'knit', &
-                'plain', 'twill', 'texgen'])
+            call require_choice(error, 'kind', fabric%kind, fabric_kind_choices)
             if (allocated(error)) return
-            call require_choice(error, 'boundary', fabric%boundary, [character(len=8) :: &
-                'periodic', 'clamped'])
+            call require_choice(error, 'boundary', fabric%boundary, fabric_boundary_choices)
             if (allocated(error)) return
-            call require_choice(error, 'sides', fabric%sides, [character(len=7) :: 'free', &
-                'rollers'])
+            call require_choice(error, 'sides', fabric%sides, fabric_sides_choices)
             if (allocated(error)) return
             if (fabric%kind == 'texgen') then
                 call require_range(error, 'strain', fabric%strain, -0.9_wp, 100.0_wp)
@@ -178,14 +178,14 @@ contains
             end if
         end associate
     contains
+        !> A finite real in [low, high] (the message by the input's generic range check).
         subroutine require_range(error, variable, value, low, high)
             type(error_type), allocatable, intent(out) :: error
             character(len=*), intent(in) :: variable
             real(wp), intent(in) :: value, low, high
-            if (value >= low .and. value <= high) return
-            write(buffer, '(a, a, " = ", g0, " must lie in [", g0, ", ", g0, "]")') &
-                label, variable, value, low, high
-            call fatal_error(error, trim(buffer))
+            call check_range(error, '&fabric', variable, value, value >= low .and. &
+                value <= high, 'must lie in [' // format_real(low) // ', ' &
+                // format_real(high) // ']')
         end subroutine require_range
 
         !> An integer in [low, high], or at least `low` without `high`.
@@ -195,15 +195,13 @@ contains
             integer, intent(in) :: value, low
             integer, intent(in), optional :: high
             if (present(high)) then
-                if (value >= low .and. value <= high) return
-                write(buffer, '(a, a, " = ", i0, " must lie in [", i0, ", ", i0, "]")') &
-                    label, variable, value, low, high
+                call check_range(error, '&fabric', variable, value, value >= low .and. &
+                    value <= high, 'must lie in [' // format_integer(low) // ', ' &
+                    // format_integer(high) // ']')
             else
-                if (value >= low) return
-                write(buffer, '(a, a, " = ", i0, " must be at least ", i0)') label, variable, &
-                    value, low
+                call check_range(error, '&fabric', variable, value, value >= low, &
+                    'must be at least ' // format_integer(low))
             end if
-            call fatal_error(error, trim(buffer))
         end subroutine require_count
 
         subroutine require_material(error, variable, name, required)
@@ -312,12 +310,9 @@ contains
         subroutine require_choice(error, variable, value, choices)
             type(error_type), allocatable, intent(out) :: error
             character(len=*), intent(in) :: variable, value, choices(:)
-            integer :: n
             if (any(choices == value)) return
-            n = size(choices)
             call fatal_error(error, label // variable // " = '" // trim(value) &
-                // "' is unknown (use " // join_names(choices(:n - 1), '') // ' or ' &
-                // trim(choices(n)) // ')')
+                // "' is unknown (use " // join_names(choices, '', ' or ') // ')')
         end subroutine require_choice
 
         !> At least one cell each way, and not too many in all.

@@ -16,11 +16,11 @@ module yarnfort_input_namelist
         read_control_groups, read_solver_groups, read_material_groups, read_contact_groups, &
         read_fabric_groups, read_nodes_groups, read_geometry_groups, read_yarn_groups, &
         read_support_groups, read_load_groups, read_path_groups, read_output_groups, &
-        read_obstacle_groups, read_ring_groups
+        read_obstacle_groups, read_ring_groups, fabric_kind_choices
     use yarnfort_input_fields, only: max_list, max_coordinates
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
     use yarnfort_input_geometry, only: read_geometry_file
-    use yarnfort_text, only: format_integer, folder_of, resolve_path, open_to_read
+    use yarnfort_text, only: format_integer, folder_of, resolve_path, open_to_read, join_names
     use yarnfort_input_validate, only: check_config
     use yarnfort_generate_fabric, only: generate_fabric
     implicit none
@@ -129,7 +129,8 @@ contains
         if (.not. allocated(error)) call read_fabric_groups(scan, config%fabric, error)
         if (allocated(error)) return
         if (scan%count_group('fabric') > 0 .and. len_trim(config%fabric%kind) == 0) then
-            call post_read_error(error, scan, 'fabric', 'kind is required (knit, plain or twill)')
+            call post_read_error(error, scan, 'fabric', 'kind is required (' &
+                // join_names(fabric_kind_choices, '', ' or ') // ')')
             return
         end if
         call read_nodes_groups(scan, nodes, error)

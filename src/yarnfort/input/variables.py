@@ -33,6 +33,39 @@ LIKE_CURVE = ('Written, flushed and resumed on restart like `curve.csv` (a resta
               'needs the file of the first run; one without it deletes the file).')
 
 
+
+def law_parameter(name: str, unit: str, range: str, laws: list[str], doc: str,
+                  **extra: object) -> Var:
+    """A real parameter of the laws `laws` of the group's selecting variable; -1 means
+    not set (required for those laws, an error for the others)."""
+    return Var(name, 'real', -1.0, unit=unit, range=range, laws=laws,
+               default_doc='`-1` (not set)', doc=doc, **extra)  # type: ignore[arg-type]
+
+
+def node_set(doc: str) -> Var:
+    """The `nodes` of a named node set (&support, &load, &obstacle, &ring)."""
+    return Var('nodes', 'integer', None, shape='list', doc=f'{NODE_SET}{doc}')
+
+
+def knot_list(name: str, unit: str, default_doc: str | None, doc: str) -> Var:
+    """A list of &path given knot by knot: finite values."""
+    return Var(name, 'real', None, shape='list', unit=unit, range='finite',
+               default_doc=default_doc, doc=doc)
+
+
+def fabric_vars(*variables: Var) -> list[Var]:
+    """The variables of &fabric: checked by the fabric module (range and choices are
+    documentation only)."""
+    for var in variables:
+        var.checked_by = 'fabric'
+    return list(variables)
+
+
+def fabric_material(name: str, default_doc: str, doc: str) -> Var:
+    """A yarn type of &fabric: the name of a `&material`."""
+    return Var(name, 'character', '', length='name_length', default_doc=default_doc, doc=doc)
+
+
 def channel_var(group: str, scaled: str, default: str) -> Var:
     """The `channel` of &support or &load: the load channel that scales `scaled`."""
     return Var('channel', 'character', '', length='name_length',
@@ -50,9 +83,8 @@ def sliding_node_group(name: str, doc: str, name_doc: str, nodes_doc: str) -> Gr
         Var('name', 'character', '', length='name_length',
             doc='Required and unique among `&obstacle`, `&ring` and `&support` names. One word '
                 'of letters, digits, `_`, `-`, `.`. `&contact at` names it' + name_doc),
-        Var('nodes', 'integer', None, shape='list',
-            doc=f'{NODE_SET}, each passed through (not ended at) by every yarn that lists it. '
-                + nodes_doc),
+        node_set(', each passed through (not ended at) by every yarn that lists it. '
+                 + nodes_doc),
     ])
 
 
@@ -192,15 +224,10 @@ GROUPS = [
         Var('law', 'character', '', length=16, lower=True,
             choices=['linear', 'neo_hookean', 'table'], selects=True,
             doc='Required (case-insensitive).'),
-        Var('stiffness', 'real', -1.0, unit='N', range='> 0', laws=['linear'],
-            default_doc='`-1` (not set)',
-            doc='`linear`: EA.'),
-        Var('modulus', 'real', -1.0, unit='Pa', range='> 0', laws=['neo_hookean'],
-            default_doc='`-1` (not set)',
-            doc='`neo_hookean`: modulus C.'),
-        Var('area', 'real', -1.0, unit='m^2', range='> 0', laws=['neo_hookean'],
-            default_doc='`-1` (not set)',
-            doc='`neo_hookean`: undeformed cross-section S(1).'),
+        law_parameter('stiffness', 'N', '> 0', ['linear'], '`linear`: EA.'),
+        law_parameter('modulus', 'Pa', '> 0', ['neo_hookean'], '`neo_hookean`: modulus C.'),
+        law_parameter('area', 'm^2', '> 0', ['neo_hookean'],
+                      '`neo_hookean`: undeformed cross-section S(1).'),
         Var('table_file', 'character', '', length='path_length', adjust=False, laws=['table'],
             doc='`table`: CSV file of (strain, force in N). The material code reads it. A '
                 "relative name is taken relative to the input file's folder (the working "
@@ -222,18 +249,17 @@ GROUPS = [
             choices=['bonded', 'coulomb', 'adhesion', 'decaying_adhesion', 'general'],
             selects=True,
             doc='Required (case-insensitive).'),
-        Var('friction_coefficient', 'real', -1.0, unit='1', range='>= 0',
-            laws=['coulomb', 'adhesion', 'decaying_adhesion'], default_doc='`-1` (not set)',
-            doc='Friction coefficient mu. Every law but `bonded` and `general`.'),
-        Var('adhesion', 'real', -1.0, unit='N', range='>= 0',
-            laws=['adhesion', 'decaying_adhesion'], default_doc='`-1` (not set)',
-            doc='Adhesion beta (per radian of wrap angle). `adhesion` and `decaying_adhesion`.'),
-        Var('decay_start', 'real', -1.0, unit='N', range='>= 0', laws=['decaying_adhesion'],
-            default_doc='`-1` (not set)',
-            doc='Tension w_d where the adhesion starts to decay. `decaying_adhesion`.'),
-        Var('decay_end', 'real', -1.0, unit='N', range='>= 0', laws=['decaying_adhesion'],
-            default_doc='`-1` (not set)', type_doc='real > `decay_start`',
-            doc='Tension s_d where the adhesion has vanished. `decaying_adhesion`.'),
+        law_parameter('friction_coefficient', '1', '>= 0',
+                      ['coulomb', 'adhesion', 'decaying_adhesion'],
+                      'Friction coefficient mu. Every law but `bonded` and `general`.'),
+        law_parameter('adhesion', 'N', '>= 0', ['adhesion', 'decaying_adhesion'],
+                      'Adhesion beta (per radian of wrap angle). `adhesion` and '
+                      '`decaying_adhesion`.'),
+        law_parameter('decay_start', 'N', '>= 0', ['decaying_adhesion'],
+                      'Tension w_d where the adhesion starts to decay. `decaying_adhesion`.'),
+        law_parameter('decay_end', 'N', '>= 0', ['decaying_adhesion'],
+                      'Tension s_d where the adhesion has vanished. `decaying_adhesion`.',
+                      type_doc='real > `decay_start`'),
         Var('rate_table', 'character', '', length='path_length', adjust=False, laws=['general'],
             default_doc="`''` (none)",
             doc='`general`: CSV file of (T in N, g in N/rad), the rate of the general law T\' = '
@@ -250,34 +276,33 @@ GROUPS = [
     ]),
     Group('fabric', 'singleton',
           'A generated fabric (knitted with inlay, or woven) instead of &nodes, &yarn and '
-          '&support groups.', [
+          '&support groups.', fabric_vars(
         Var('kind', 'character', '', length=16, lower=True,
-            choices=['knit', 'plain', 'twill', 'texgen'],
-            checked_by='fabric', default_doc='required',
+            choices=['knit', 'plain', 'twill', 'texgen'], default_doc='required',
             doc="`'knit'` (weft-knitted single jersey, optional inlay), `'plain'` (plain weave), "
                 "`'twill'` (2/2 twill) or `'texgen'` (a periodic cell, or a clamped sample of "
                 "copies of it, from a TexGen model file, "
                 '`texgen_file`).'),
-        Var('cells', 'integer', [4, 4], shape=2, range='>= 1', checked_by='fabric',
+        Var('cells', 'integer', [4, 4], shape=2, range='>= 1',
             doc='Repeats along x and y: wales x courses (knit); weft yarns (crossings along x) x '
                 'warp yarns (woven). A periodic plain weave needs even counts, a periodic twill '
                 'multiples of 4. TexGen: copies of the cell in a clamped sample (not used for '
                 'a periodic cell).'),
-        Var('spacing', 'real', [-1.0, -1.0], shape=2, unit='m', range='> 0', checked_by='fabric',
+        Var('spacing', 'real', [-1.0, -1.0], shape=2, unit='m', range='> 0',
             default_doc='required',
             doc='Repeat spacing along x and y: wale and course spacing (knit); weft and warp '
                 'yarn spacing (woven).'),
         Var('boundary', 'character', 'periodic', length=16, lower=True,
-            choices=['periodic', 'clamped'], checked_by='fabric',
+            choices=['periodic', 'clamped'],
             doc="`'periodic'`: a unit cell whose edge nodes are tied to the opposite edge (paper "
                 'eq. 53), stretched by the macroscopic strain below; one node (`anchor`) is held '
                 "against rigid translation. `'clamped'`: a finite sample, yarn ends at x = 0 "
                 'held (`left`), those at the right edge pulled (`right`); for `texgen`, '
                 '`cells` copies of the cell.'),
-        Var('strain', 'real', 1.0, unit='1', range='[-0.9, 100]', checked_by='fabric',
+        Var('strain', 'real', 1.0, unit='1', range='[-0.9, 100]',
             doc='Engineering strain along x at p_disp = 1 (`1.0` stretches to twice the length). '
                 "Periodic: of the cell's x period; clamped: of the sample's length."),
-        Var('lateral_strain', 'real', 0.0, unit='1', range='[-0.9, 100]', checked_by='fabric',
+        Var('lateral_strain', 'real', 0.0, unit='1', range='[-0.9, 100]',
             doc='Periodic: engineering strain of the y period at p_disp = 1, prescribed. Give '
                 'the measured lateral contraction if you know it; 0 holds the height. The height '
                 'cannot be left free: a string network has no resistance to lateral compaction, '
@@ -287,14 +312,13 @@ GROUPS = [
                 "step 0, and the knit cell's initial state did not converge. For free lateral "
                 "contraction, use a clamped sample with `sides = 'free'`."),
         Var('sides', 'character', 'free', length=16, lower=True, choices=['free', 'rollers'],
-            checked_by='fabric',
             doc="Clamped: `'free'` side edges or `'rollers'`. Woven: rollers hold the weft ends "
                 'in y and z (a selvedge); free weft ends of pre-stressed weft yarns cannot carry '
                 'their tension, so woven strips need rollers. Knit: rollers hold the contacts of '
                 'the first and last course in y. With free sides a cast-on and a bind-off '
                 'thread close the first and the last course (`edge_material`; see *Clamped '
                 'knit edges* below).'),
-        Var('elements_per_segment', 'integer', 1, range='>= 1', checked_by='fabric',
+        Var('elements_per_segment', 'integer', 1, range='>= 1',
             doc='Elements per yarn segment between generated nodes. A string under tension is '
                 'straight between contacts, so 1 is exact: `verification/fabrics` finds 2, 4 and '
                 '8 give the same curve to 2e-14. More only cost time, most with sliding, where a '
@@ -302,57 +326,45 @@ GROUPS = [
                 'sparse factors. Measured on `benchmarks/bench_friction` (woven net, 578 '
                 'passages): 132 ms per load step with 4 elements per segment against 29 ms with '
                 '1.'),
-        Var('knit_material', 'character', '', length='name_length', checked_by='fabric',
-            default_doc='required (knit)',
-            doc='Yarn type of the loops.'),
-        Var('head_width', 'real', 0.5, unit='1', range='[0.05, 0.95]', checked_by='fabric',
+        fabric_material('knit_material', 'required (knit)', 'Yarn type of the loops.'),
+        Var('head_width', 'real', 0.5, unit='1', range='[0.05, 0.95]',
             doc="Knit: width of a loop's head, as a fraction of the wale spacing. The loops are "
                 'polygons through their contacts (a string under tension is straight between '
                 'contacts): a loop is 2*spacing(2) + spacing(1) long.'),
-        Var('inlay_material', 'character', '', length='name_length', checked_by='fabric',
-            default_doc="`''` (no inlay)",
-            doc='Knit: yarn type of the inlay.'),
-        Var('inlay_every', 'integer', 1, range='>= 1', checked_by='fabric',
+        fabric_material('inlay_material', "`''` (no inlay)", 'Knit: yarn type of the inlay.'),
+        Var('inlay_every', 'integer', 1, range='>= 1',
             doc='Knit: an inlay in every inlay_every-th course (0, k, 2k, ...).'),
-        Var('inlay_offset', 'real', 0.5, unit='1', range='[0.05, 0.95]', checked_by='fabric',
+        Var('inlay_offset', 'real', 0.5, unit='1', range='[0.05, 0.95]',
             doc='Knit: height of the inlay above its course line, as a fraction of the course '
                 'spacing.'),
-        Var('warp_material', 'character', '', length='name_length', checked_by='fabric',
-            default_doc='required (woven)',
-            doc='Woven: yarn types along x (warp, the loaded direction) and along y (weft).'),
-        Var('weft_material', 'character', '', length='name_length', checked_by='fabric',
-            default_doc='required (woven)',
-            doc='Woven: yarn types along x (warp, the loaded direction) and along y (weft).'),
-        Var('gap', 'real', -1.0, unit='m', checked_by='fabric',
+        *[fabric_material(name, 'required (woven)', 'Woven: yarn types along x (warp, the '
+                          'loaded direction) and along y (weft).')
+          for name in ('warp_material', 'weft_material')],
+        Var('gap', 'real', -1.0, unit='m',
             default_doc='required (woven, knit with inlay)',
             type_doc='real, 0 < gap < min(spacing)',
             doc='Gap-holder length: distance between the axes of the two yarns at a crossing.'),
-        Var('gap_factor_p_disp', 'real', None, shape='list', unit='1', checked_by='fabric',
-            default_doc='empty (factor 1)',
-            doc=GAP_FACTOR),
-        Var('gap_factor', 'real', None, shape='list', unit='1', checked_by='fabric',
-            default_doc='empty (factor 1)',
-            doc=GAP_FACTOR),
+        *[Var(name, 'real', None, shape='list', unit='1', default_doc='empty (factor 1)',
+              doc=GAP_FACTOR) for name in ('gap_factor_p_disp', 'gap_factor')],
         Var('texgen_file', 'character', '', length='path_length', adjust=False,
-            checked_by='fabric', default_doc='required (texgen)',
+            default_doc='required (texgen)',
             doc="TexGen: the model file (`.tg3`, TexGen's XML), relative to the input file's "
                 'folder (the working directory for stdin). Read without TexGen: one textile, '
                 'periodic yarns with repeats along x and y (the cell), master nodes, '
                 'interpolation, section width and height, GeometryScale. See *TexGen import* '
                 'below.'),
         Var('texgen_materials', 'character', '', length='name_length', shape=64,
-            checked_by='fabric', default_doc='required (texgen)',
+            default_doc='required (texgen)',
             doc="TexGen: the `&material` of TexGen's yarn 0, 1, 2, ... (by index); yarns "
                 'beyond the last name given take that one, so one name serves all yarns.'),
         Var('texgen_contact_tolerance', 'real', 0.05, unit='1', range='[0, 1]',
-            checked_by='fabric',
             doc='TexGen: two yarns are in contact where their centre lines come within (1 + '
                 'this) times the sum of their half thicknesses (TexGen yarns that touch are '
                 'exactly that far apart, up to its interpolation).'),
-        Var('texgen_samples', 'integer', 16, range='[2, 1000]', checked_by='fabric',
+        Var('texgen_samples', 'integer', 16, range='[2, 1000]',
             doc='TexGen: points per master-node span of the sampled centre lines on which '
                 'contacts are searched.'),
-        Var('knit_depth', 'real', 0.0, unit='m', checked_by='fabric',
+        Var('knit_depth', 'real', 0.0, unit='m',
             type_doc='real, 0 <= knit_depth < min(spacing)',
             doc="Knit: 0 makes the planar knit (a loop's head and the feet of the loop above "
                 'share one node). A positive value makes it three-dimensional: the feet and '
@@ -360,12 +372,11 @@ GROUPS = [
                 'between them, and each loop contact has a node on either yarn joined by a '
                 'gap-holder of this length (the distance between the yarn axes: the yarn '
                 'thickness). See *Three-dimensional knit* below.'),
-        Var('edge_material', 'character', '', length='name_length', checked_by='fabric',
-            default_doc='`knit_material`',
+        fabric_material('edge_material', '`knit_material`',
             doc="Knit, clamped with `sides = 'free'`: yarn type of the cast-on and bind-off "
                 'threads that close the first and the last course (see *Clamped knit edges* '
                 'below).'),
-    ]),
+    )),
     Group('nodes', 'singleton',
           'Node coordinates (node ids 1..n in list order).', [
         Var('xyz', 'real', None, shape='list', max='max_coordinates', unit='m',
@@ -409,8 +420,7 @@ GROUPS = [
           'A named set of nodes whose listed components are prescribed.', [
         Var('name', 'character', '', length='name_length',
             doc=f"{NAME_RULE} Names the support's reaction-force columns in the curve CSV."),
-        Var('nodes', 'integer', None, shape='list',
-            doc=f'{NODE_SET}.'),
+        node_set('.'),
         Var('fix', 'character', 'xyz', length=3, lower=True,
             doc='The prescribed components: one or more of `x`, `y`, `z`, each once '
                 '(case-insensitive).'),
@@ -422,8 +432,7 @@ GROUPS = [
     ]),
     Group('load', 'repeatable',
           'A force P (N) at load factor p_force = 1 on each listed node.', [
-        Var('nodes', 'integer', None, shape='list',
-            doc=f'{NODE_SET}.'),
+        node_set('.'),
         Var('force', 'real', [0.0, 0.0, 0.0], shape=3, unit='N', range='finite',
             doc='Force P on each listed node at load factor p_force = 1. Applied force = '
                 'p_force(t) * P. A nonzero component on a coordinate that a support prescribes '
@@ -432,12 +441,11 @@ GROUPS = [
     ]),
     Group('path', 'singleton',
           'The load path as knots over pseudo-time, linear in between.', [
-        Var('time', 'real', None, shape='list', unit='pseudo-time', range='finite',
-            doc='At least 2 knots, strictly increasing.'),
-        Var('p_force', 'real', None, shape='list', unit='1', range='finite', default_doc='zeros',
-            doc='Force factor at each knot (scales every `&load` force).'),
-        Var('p_disp', 'real', None, shape='list', unit='1', range='finite', default_doc='zeros',
-            doc='Displacement factor at each knot (scales every `&support` displacement).'),
+        knot_list('time', 'pseudo-time', None, 'At least 2 knots, strictly increasing.'),
+        knot_list('p_force', '1', 'zeros',
+                  'Force factor at each knot (scales every `&load` force).'),
+        knot_list('p_disp', '1', 'zeros',
+                  'Displacement factor at each knot (scales every `&support` displacement).'),
         Var('channels', 'character', '', length='name_length', shape=8,
             default_doc="none (`'p_force'`, `'p_disp'`)", type_doc='character(64) x 8',
             doc='Names of independent load channels (at most 8), each one word of letters, '
@@ -445,11 +453,10 @@ GROUPS = [
                 'Each `&load` and `&support` names the channel that scales it. Given, the '
                 'factors come from `factors` and `p_force`, `p_disp` may not be set. Not with '
                 '`&fabric`.'),
-        Var('factors', 'real', None, shape='list', unit='1', range='finite',
-            default_doc='none',
-            doc='With `channels`: the factor of every channel at every knot, one row per knot '
-                '(the values of the channels in the order of `channels`), so n_knots * '
-                'n_channels values.'),
+        knot_list('factors', '1', 'none',
+                  'With `channels`: the factor of every channel at every knot, one row per '
+                  'knot (the values of the channels in the order of `channels`), so n_knots * '
+                  'n_channels values.'),
     ]),
     Group('output', 'singleton',
           'Where and what to write.', [
