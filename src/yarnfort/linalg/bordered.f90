@@ -67,7 +67,6 @@ module yarnfort_linalg_bordered
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
-        procedure :: solve_rhs
         procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
@@ -230,65 +229,35 @@ contains
         call self%schur%factor(reshape(s, [m * m]), error)
     end subroutine factor_border
 
-    subroutine solve_rhs(self, rhs, error)
-        class(bordered_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:)
-        type(error_type), allocatable, intent(out) :: error
-
-        call solve_bordered(self, size(rhs, kind=ik), 1_ik, rhs, error)
-    end subroutine solve_rhs
-
-    !> The same for several columns: K^-1 of all of them in one `solve_columns` and the
-    !> Schur complement's solve of all of them.
+    !> z = K^-1 r1, y = S^-1 (r2 - C z), x = z - K^-1 B y, for the m columns of rhs (each
+    !> column's arithmetic that of a single solve): K^-1 of all of them in one
+    !> `solve_columns` and the Schur complement's solve of all of them.
     subroutine solve_rhs_columns(self, rhs, error)
         class(bordered_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:, :)
-        type(error_type), allocatable, intent(out) :: error
-
-        call solve_bordered(self, size(rhs, 1, kind=ik), size(rhs, 2, kind=ik), rhs, error)
-    end subroutine solve_rhs_columns
-
-    !> z = K^-1 r1, y = S^-1 (r2 - C z), x = z - K^-1 B y, for the m columns of rhs (each
-    !> column's arithmetic that of a single solve).
-    subroutine solve_bordered(self, n, m, rhs, error)
-        type(bordered_solver_type), intent(inout) :: self
-        integer(ik), intent(in) :: n, m
-        real(wp), intent(inout) :: rhs(n, m)
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: y(:, :)
         integer(ik) :: k, nl, c
 
         if (.not. self%use_border) then
-            if (m == 1) then
-                call self%general%solve(rhs(:, 1), error)
-            else
-                call self%general%solve_columns(rhs, error)
-            end if
+            call self%general%solve_columns(rhs, error)
             return
         end if
         nl = self%n_leading
-        if (m == 1) then
-            call self%leading%solve(rhs(1:nl, 1), error)
-        else
-            call self%leading%solve_columns(rhs(1:nl, :), error)
-        end if
+        call self%leading%solve_columns(rhs(1:nl, :), error)
         if (allocated(error) .or. self%n == nl) return
         y = rhs(nl + 1:, :)
         do k = 1, size(self%c_entry, kind=ik)
             y(self%c_row(k), :) = y(self%c_row(k), :) &
                 - self%c_values(k) * rhs(self%c_column(k), :)
         end do
-        if (m == 1) then
-            call self%schur%solve(y(:, 1), error)
-        else
-            call self%schur%solve_columns(y, error)
-        end if
+        call self%schur%solve_columns(y, error)
         if (allocated(error)) return
-        do c = 1, m
+        do c = 1, size(rhs, 2)
             rhs(1:nl, c) = rhs(1:nl, c) - matmul(self%coupling, y(:, c))
         end do
         rhs(nl + 1:, :) = y
-    end subroutine solve_bordered
+    end subroutine solve_rhs_columns
 
     !> Free the general solver and the border; the analysis of K is kept for the next
     !> pattern (freed with the object).

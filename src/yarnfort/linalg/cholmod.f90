@@ -38,7 +38,6 @@ module yarnfort_linalg_cholmod
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
-        procedure :: solve_rhs
         procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
@@ -83,21 +82,9 @@ contains
         end if
     end subroutine factor_values
 
-    !> Overwrite rhs with the solution (workspaces allocated once, by the first solve).
-    subroutine solve_rhs(self, rhs, error)
-        class(cholmod_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:)
-        type(error_type), allocatable, intent(out) :: error
-        integer(c_int) :: status
-
-        status = yarnfort_cholmod_solve(self%handle, self%n, 1_c_long, rhs)
-        if (status < cholmod_ok) then
-            call self%fail(error, 'solve', status_message(status))
-        end if
-    end subroutine solve_rhs
-
     !> All columns in one CHOLMOD solve: the supernodal factor's dense blocks are applied
-    !> to the m columns together (BLAS 3) instead of m times to one.
+    !> to the m columns together (BLAS 3) instead of m times to one (workspaces allocated
+    !> by the first solve, again when m changes).
     subroutine solve_rhs_columns(self, rhs, error)
         class(cholmod_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:, :)

@@ -81,7 +81,6 @@ module yarnfort_linalg_condensed
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
-        procedure :: solve_rhs
         procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
@@ -201,30 +200,12 @@ contains
     end subroutine factor_values
 
     !> Eliminated unknowns from their rows, their columns moved to the right-hand side,
-    !> then the reduced system.
-    subroutine solve_rhs(self, rhs, error)
-        class(condensed_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:)
-        type(error_type), allocatable, intent(out) :: error
-
-        call solve_condensed(self, size(rhs, kind=ik), 1_ik, rhs, error)
-    end subroutine solve_rhs
-
-    !> The same for several columns: the elimination for all of them, then one
-    !> `solve_columns` of the reduced system.
+    !> then the reduced system: the elimination for all m columns, then one
+    !> `solve_columns` of the reduced system (each column's arithmetic that of a single
+    !> solve).
     subroutine solve_rhs_columns(self, rhs, error)
         class(condensed_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:, :)
-        type(error_type), allocatable, intent(out) :: error
-
-        call solve_condensed(self, size(rhs, 1, kind=ik), size(rhs, 2, kind=ik), rhs, error)
-    end subroutine solve_rhs_columns
-
-    !> Both solves on n x m columns (each column's arithmetic that of a single solve).
-    subroutine solve_condensed(self, n, m, rhs, error)
-        type(condensed_solver_type), intent(inout) :: self
-        integer(ik), intent(in) :: n, m
-        real(wp), intent(inout) :: rhs(n, m)
         type(error_type), allocatable, intent(out) :: error
         integer(ik) :: j, k, i, e, c, offset
         ! Per call, not kept: m columns of the reduced order (16 at 963,600 unknowns:
@@ -242,20 +223,16 @@ contains
             end do
         end do
         if (self%n_reduced == 0) return
-        allocate(part(self%n_reduced, m))
-        do c = 1, m
+        allocate(part(self%n_reduced, size(rhs, 2)))
+        do c = 1, size(rhs, 2, kind=ik)
             part(:, c) = rhs(self%kept, c)
         end do
-        if (m == 1) then
-            call self%inner%solve(part(:, 1), error)
-        else
-            call self%inner%solve_columns(part, error)
-        end if
+        call self%inner%solve_columns(part, error)
         if (allocated(error)) return
-        do c = 1, m
+        do c = 1, size(rhs, 2, kind=ik)
             rhs(self%kept, c) = part(:, c)
         end do
-    end subroutine solve_condensed
+    end subroutine solve_rhs_columns
 
     !> The diagonal entries of the candidate columns and the off-diagonal entries of the
     !> candidate rows (first_candidate clipped to 1..n + 1).

@@ -46,7 +46,6 @@ module yarnfort_linalg_dense
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
-        procedure :: solve_rhs
         procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
@@ -93,39 +92,20 @@ contains
         end if
     end subroutine factor_values
 
-    !> Overwrite rhs with the solution.
-    subroutine solve_rhs(self, rhs, error)
-        class(dense_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:)
-        type(error_type), allocatable, intent(out) :: error
-
-        call solve_lu(self, 1, rhs, error)
-    end subroutine solve_rhs
-
     !> Overwrite each column of rhs with its solution (one dgetrs for all of them).
     subroutine solve_rhs_columns(self, rhs, error)
         class(dense_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:, :)
         type(error_type), allocatable, intent(out) :: error
-
-        call solve_lu(self, size(rhs, 2), rhs, error)
-    end subroutine solve_rhs_columns
-
-    !> The nrhs columns of rhs (n x nrhs) overwritten with their solutions by dgetrs.
-    subroutine solve_lu(self, nrhs, rhs, error)
-        type(dense_solver_type), intent(in) :: self
-        integer, intent(in) :: nrhs
-        real(wp), intent(inout) :: rhs(self%n, nrhs)
-        type(error_type), allocatable, intent(out) :: error
         integer :: info, n
 
         n = int(self%n)
-        call dgetrs('N', n, nrhs, self%lu, n, self%pivots, rhs, n, info)
+        call dgetrs('N', n, size(rhs, 2), self%lu, n, self%pivots, rhs, n, info)
         if (info /= 0) then
             call fatal_error(error, 'dense: dgetrs rejected argument ' &
                 // format_integer(int(-info, ik)))
         end if
-    end subroutine solve_lu
+    end subroutine solve_rhs_columns
 
     !> Free the dense matrix.
     subroutine release(self)

@@ -1,11 +1,12 @@
 ! SPDX-License-Identifier: MIT
 !> The bookkeeping every linear solver over a kept pattern shares (UMFPACK, KLU, CHOLMOD,
-!> dense LAPACK and the CHOLMOD-then-KLU fallback): `analyse`, `factor` and `solve` check
-!> the pattern, the call sequence and the array sizes, keep the copy of the CSC pattern
-!> the libraries read again at factor time and the state (analysed, factored), and call
-!> the solver's own `analyse_pattern`, `factor_values` and `solve_rhs`, which hold only
-!> the library calls; `destroy` calls the solver's `release` and drops the pattern and
-!> the state. Also the messages of a failed library call and of a status code.
+!> dense LAPACK and the CHOLMOD-then-KLU fallback): `analyse`, `factor` and
+!> `solve_columns` check the pattern, the call sequence and the array sizes, keep the
+!> copy of the CSC pattern the libraries read again at factor time and the state
+!> (analysed, factored), and call the solver's own `analyse_pattern`, `factor_values` and
+!> `solve_rhs_columns`, which hold only the library calls; `destroy` calls the solver's
+!> `release` and drops the pattern and the state. Also the messages of a failed library
+!> call and of a status code.
 module yarnfort_linalg_direct
     use, intrinsic :: iso_c_binding, only: c_long
     use yarnfort_kinds, only: wp, ik
@@ -28,7 +29,6 @@ module yarnfort_linalg_direct
     contains
         procedure :: analyse
         procedure :: factor
-        procedure :: solve
         procedure :: solve_columns
         procedure :: destroy
         !> The solver's analysis of the kept pattern (n, col_ptr, row_index are set); a
@@ -36,10 +36,8 @@ module yarnfort_linalg_direct
         procedure(analyse_pattern_interface), deferred :: analyse_pattern
         !> The solver's factorisation of these values (enough of them, after analyse).
         procedure(factor_values_interface), deferred :: factor_values
-        !> The solver's solve with the last factorisation (rhs of size n).
-        procedure(solve_rhs_interface), deferred :: solve_rhs
-        !> The solver's solve of several columns (n x m, m >= 1); by default column by column.
-        procedure :: solve_rhs_columns
+        !> The solver's solve of n x m columns (m >= 1) with the last factorisation.
+        procedure(solve_rhs_columns_interface), deferred :: solve_rhs_columns
         !> Free the solver's own handles and buffers (safe to call twice; for `destroy`).
         procedure(release_interface), deferred :: release
         !> Set `error` to '<name>: <stage> failed: <reason>'.
@@ -60,12 +58,12 @@ module yarnfort_linalg_direct
             type(error_type), allocatable, intent(out) :: error
         end subroutine factor_values_interface
 
-        subroutine solve_rhs_interface(self, rhs, error)
+        subroutine solve_rhs_columns_interface(self, rhs, error)
             import :: direct_solver_type, wp, error_type
             class(direct_solver_type), intent(inout) :: self
-            real(wp), intent(inout) :: rhs(:)
+            real(wp), intent(inout) :: rhs(:, :)
             type(error_type), allocatable, intent(out) :: error
-        end subroutine solve_rhs_interface
+        end subroutine solve_rhs_columns_interface
 
         subroutine release_interface(self)
             import :: direct_solver_type
@@ -110,32 +108,10 @@ contains
         self%factored = .not. allocated(error)
     end subroutine factor
 
-    !> Overwrite rhs with the solution, using the last factorisation.
-    subroutine solve(self, rhs, error)
-        class(direct_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:)
-        type(error_type), allocatable, intent(out) :: error
-
-        call check_solve(self, size(rhs, kind=ik), error)
-        if (allocated(error)) return
-        call self%solve_rhs(rhs, error)
-    end subroutine solve
-
     !> Overwrite each column of rhs with its solution, using the last factorisation.
     subroutine solve_columns(self, rhs, error)
         class(direct_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:, :)
-        type(error_type), allocatable, intent(out) :: error
-
-        call check_solve(self, size(rhs, 1, kind=ik), error)
-        if (allocated(error) .or. size(rhs, 2) == 0) return
-        call self%solve_rhs_columns(rhs, error)
-    end subroutine solve_columns
-
-    !> A valid factorisation and a right-hand side of n rows.
-    subroutine check_solve(self, rows, error)
-        class(direct_solver_type), intent(in) :: self
-        integer(ik), intent(in) :: rows
         type(error_type), allocatable, intent(out) :: error
 
         if (.not. self%factored) then
@@ -143,20 +119,10 @@ contains
                 // ': solve called without a valid factorisation')
             return
         end if
-        call check_array_size(self%get_name(), 'rhs', rows, self%n, error)
-    end subroutine check_solve
-
-    subroutine solve_rhs_columns(self, rhs, error)
-        class(direct_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:, :)
-        type(error_type), allocatable, intent(out) :: error
-        integer :: c
-
-        do c = 1, size(rhs, 2)
-            call self%solve_rhs(rhs(:, c), error)
-            if (allocated(error)) return
-        end do
-    end subroutine solve_rhs_columns
+        call check_array_size(self%get_name(), 'rhs', size(rhs, 1, kind=ik), self%n, error)
+        if (allocated(error) .or. size(rhs, 2) == 0) return
+        call self%solve_rhs_columns(rhs, error)
+    end subroutine solve_columns
 
     !> Free the solver's handles and buffers, the pattern copy and the state (safe to call
     !> twice).

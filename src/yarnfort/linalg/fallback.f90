@@ -22,7 +22,6 @@ module yarnfort_linalg_fallback
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
-        procedure :: solve_rhs
         procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
@@ -53,14 +52,6 @@ contains
         if (allocated(error)) return
         call self%active%factor(values, error)
     end subroutine factor_values
-
-    subroutine solve_rhs(self, rhs, error)
-        class(fallback_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:)
-        type(error_type), allocatable, intent(out) :: error
-
-        call self%active%solve(rhs, error)
-    end subroutine solve_rhs
 
     subroutine solve_rhs_columns(self, rhs, error)
         class(fallback_solver_type), intent(inout) :: self

@@ -49,7 +49,6 @@ module yarnfort_linalg_klu
     contains
         procedure :: analyse_pattern
         procedure :: factor_values
-        procedure :: solve_rhs
         procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
@@ -143,21 +142,9 @@ contains
         end subroutine choose_ordering
     end subroutine factor_values
 
-    !> Overwrite rhs with the solution (in place, no allocation).
-    subroutine solve_rhs(self, rhs, error)
-        class(klu_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:)
-        type(error_type), allocatable, intent(out) :: error
-        integer(c_long) :: ok
-
-        ok = klu_l_solve(self%symbolic, self%numeric, self%n, 1_c_long, rhs, self%common)
-        if (ok /= c_true) then
-            call self%fail(error, 'solve', status_message(self%common%status))
-        end if
-    end subroutine solve_rhs
-
-    !> Overwrite each column of rhs with its solution in one call (KLU sweeps the factors
-    !> once for every 4 columns; each column's arithmetic is that of a single solve).
+    !> Overwrite each column of rhs with its solution in one call, in place, without
+    !> allocation (KLU sweeps the factors once for every 4 columns; each column's
+    !> arithmetic is that of a single solve).
     subroutine solve_rhs_columns(self, rhs, error)
         class(klu_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:, :)

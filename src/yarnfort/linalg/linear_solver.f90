@@ -20,11 +20,12 @@ module yarnfort_linalg_linear_solver
         procedure(analyse_interface), deferred :: analyse
         !> Numeric factorisation of the matrix with the analysed pattern and these values.
         procedure(factor_interface), deferred :: factor
-        !> Overwrite rhs with the solution of A x = rhs using the last factorisation.
-        procedure(solve_interface), deferred :: solve
-        !> Overwrite each column of rhs (n x m) with its solution; by default one `solve`
-        !> per column, a solver that solves several columns at once overrides it.
-        procedure :: solve_columns
+        !> Overwrite rhs with the solution of A x = rhs using the last factorisation: the
+        !> one-column case of `solve_columns`.
+        procedure, non_overridable :: solve
+        !> Overwrite each column of rhs (n x m) with its solution; each column's arithmetic
+        !> is that of a single solve.
+        procedure(solve_columns_interface), deferred :: solve_columns
         !> Free every handle and buffer (safe to call twice).
         procedure(destroy_interface), deferred :: destroy
         !> Short lowercase name, e.g. 'umfpack'.
@@ -47,12 +48,12 @@ module yarnfort_linalg_linear_solver
             type(error_type), allocatable, intent(out) :: error
         end subroutine factor_interface
 
-        subroutine solve_interface(self, rhs, error)
+        subroutine solve_columns_interface(self, rhs, error)
             import :: linear_solver_type, wp, error_type
             class(linear_solver_type), intent(inout) :: self
-            real(wp), intent(inout) :: rhs(:)
+            real(wp), intent(inout) :: rhs(:, :)
             type(error_type), allocatable, intent(out) :: error
-        end subroutine solve_interface
+        end subroutine solve_columns_interface
 
         subroutine destroy_interface(self)
             import :: linear_solver_type
@@ -68,16 +69,22 @@ module yarnfort_linalg_linear_solver
 
 contains
 
-    subroutine solve_columns(self, rhs, error)
+    subroutine solve(self, rhs, error)
         class(linear_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:, :)
+        real(wp), intent(inout) :: rhs(:)
         type(error_type), allocatable, intent(out) :: error
-        integer :: c
 
-        do c = 1, size(rhs, 2)
-            call self%solve(rhs(:, c), error)
-            if (allocated(error)) return
-        end do
-    end subroutine solve_columns
+        call solve_one_column(self, size(rhs, kind=ik), rhs, error)
+    end subroutine solve
+
+    !> rhs seen as the n x 1 matrix it is.
+    subroutine solve_one_column(self, n, rhs, error)
+        class(linear_solver_type), intent(inout) :: self
+        integer(ik), intent(in) :: n
+        real(wp), intent(inout) :: rhs(n, 1)
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%solve_columns(rhs, error)
+    end subroutine solve_one_column
 
 end module yarnfort_linalg_linear_solver

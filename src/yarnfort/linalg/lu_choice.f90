@@ -36,7 +36,6 @@ module yarnfort_linalg_lu_choice
     contains
         procedure :: analyse
         procedure :: factor
-        procedure :: solve
         procedure :: solve_columns
         procedure :: destroy
         procedure :: get_name
@@ -84,16 +83,6 @@ contains
         if (allocated(error)) return
         call self%chosen%factor(values, error)
     end subroutine factor
-
-    subroutine solve(self, rhs, error)
-        class(lu_choice_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:)
-        type(error_type), allocatable, intent(out) :: error
-
-        call require_solver(self, 'solve called without a valid factorisation', error)
-        if (allocated(error)) return
-        call self%chosen%solve(rhs, error)
-    end subroutine solve
 
     subroutine solve_columns(self, rhs, error)
         class(lu_choice_solver_type), intent(inout) :: self

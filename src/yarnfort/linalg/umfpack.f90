@@ -65,7 +65,7 @@ module yarnfort_linalg_umfpack
         procedure :: get_memory
         procedure :: analyse_pattern
         procedure :: factor_values
-        procedure :: solve_rhs
+        procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
         final :: finalize
@@ -126,20 +126,26 @@ contains
         end if
     end subroutine factor_values
 
-    !> Overwrite rhs with the solution, without refinement and without allocation.
-    subroutine solve_rhs(self, rhs, error)
+    !> Overwrite each column of rhs with its solution, one column at a time, without
+    !> refinement and without allocation.
+    subroutine solve_rhs_columns(self, rhs, error)
         class(umfpack_solver_type), intent(inout) :: self
-        real(wp), intent(inout) :: rhs(:)
+        real(wp), intent(inout) :: rhs(:, :)
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: status
+        integer :: c
 
-        self%rhs_copy(:) = rhs
-        status = umfpack_dl_wsolve(umfpack_a, x=rhs, b=self%rhs_copy, numeric=self%numeric, &
-            control=self%control, info=self%info, wi=self%int_work, w=self%real_work)
-        if (status /= umfpack_ok) then
-            call self%fail(error, 'solve', status_message(status))
-        end if
-    end subroutine solve_rhs
+        do c = 1, size(rhs, 2)
+            self%rhs_copy(:) = rhs(:, c)
+            status = umfpack_dl_wsolve(umfpack_a, x=rhs(:, c), b=self%rhs_copy, &
+                numeric=self%numeric, control=self%control, info=self%info, &
+                wi=self%int_work, w=self%real_work)
+            if (status /= umfpack_ok) then
+                call self%fail(error, 'solve', status_message(status))
+                return
+            end if
+        end do
+    end subroutine solve_rhs_columns
 
     !> Free the Numeric and Symbolic objects.
     subroutine release(self)
