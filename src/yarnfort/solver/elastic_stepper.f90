@@ -7,10 +7,7 @@ module yarnfort_solver_elastic_stepper
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
-    use yarnfort_solver_stepper, only: load_stepper_type, step_state_type, start_stepper, &
-        save_common, restore_common
-    use yarnfort_solver_state, only: fill_step_state
-    use yarnfort_solver_restart, only: restart_type, stepper_elastic
+    use yarnfort_solver_stepper, only: load_stepper_type, start_stepper
     implicit none
     private
 
@@ -21,9 +18,6 @@ module yarnfort_solver_elastic_stepper
         type(newton_solver_type) :: newton
     contains
         procedure :: try_step
-        procedure :: get_state
-        procedure :: save_state
-        procedure :: restore_state
         final :: finalize
     end type elastic_stepper_type
 
@@ -54,30 +48,6 @@ contains
         iterations = stats%iterations
         self%factors_trial = factors
     end subroutine try_step
-
-    subroutine get_state(self, state, error)
-        class(elastic_stepper_type), intent(inout) :: self
-        type(step_state_type), intent(inout) :: state
-        type(error_type), allocatable, intent(out) :: error
-        call fill_step_state(self%scene, self%u, self%problem%length0, self%factors, state, &
-            error)
-    end subroutine get_state
-
-    subroutine save_state(self, snapshot)
-        class(elastic_stepper_type), intent(in) :: self
-        type(restart_type), intent(inout) :: snapshot
-        call save_common(self, snapshot, stepper_elastic)
-    end subroutine save_state
-
-    !> The reference lengths never change without sliding: the snapshot's must be the
-    !> scene's, bit for bit.
-    subroutine restore_state(self, snapshot, error)
-        class(elastic_stepper_type), intent(inout) :: self
-        type(restart_type), intent(in) :: snapshot
-        type(error_type), allocatable, intent(out) :: error
-        call restore_common(self, snapshot, stepper_elastic, 'the restart file was written ' &
-            // 'by a run with sliding passages, this scene has none', error)
-    end subroutine restore_state
 
     subroutine finalize(self)
         type(elastic_stepper_type), intent(inout) :: self
