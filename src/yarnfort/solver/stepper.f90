@@ -1,6 +1,8 @@
 ! SPDX-License-Identifier: MIT
 !> What the continuation needs from a load-step solver: try a step to new load factors
-!> from the last accepted state, accept it, and report the accepted state.
+!> from the last accepted state, accept it, and report the accepted state. The base type
+!> holds what every stepper shares (the scene, accepted and trial positions and factors,
+!> the snapshot's common part) and serves, by default, a stepper without sliding.
 module yarnfort_solver_stepper
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
