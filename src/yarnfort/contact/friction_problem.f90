@@ -78,12 +78,9 @@ module yarnfort_contact_friction_problem
     real(wp), parameter :: kink_round_off = 8 * epsilon(1.0_wp)
 
     type, extends(nonlinear_problem_type) :: friction_problem_type
-        type(scene_type), pointer :: scene => null()
         !> Flows are the only unknowns; positions come from `u_frozen`.
         logical :: positions_frozen = .false.
         integer :: n_x = 0, n_p = 0
-        !> Factors of the load channels.
-        real(wp), allocatable :: factors(:)
         !> Active set: mode of each passage, and the flow a stick passage keeps.
         integer, allocatable :: mode(:)
         real(wp), allocatable :: flow_target(:)
@@ -97,14 +94,13 @@ module yarnfort_contact_friction_problem
         !> Position unknowns used while positions are frozen.
         real(wp), allocatable :: u_frozen(:)
         real(wp) :: stick_scale = 1.0_wp
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
         !> Cliques: element [6 coordinates, flow at start, flow at end]; passage
         !> [coordinates of the node before, the node, the node after, own flow, flow at
         !> the start of the element before, flow at the end of the element after].
         integer, allocatable :: element_slot(:, :, :), passage_slot(:, :, :)
         integer, allocatable :: element_clique(:, :), passage_clique(:, :)
-        !> Work arrays.
-        real(wp), allocatable :: x(:, :), length0(:), internal(:), tension(:), stretch(:)
+        !> Work arrays (besides x and length0).
+        real(wp), allocatable :: internal(:), tension(:), stretch(:)
         !> Rounding error of each element's tension at that state (the row levels' noise).
         real(wp), allocatable :: rounding(:)
         !> What the work arrays were last computed from (update_state): the unknowns, the
@@ -116,8 +112,6 @@ module yarnfort_contact_friction_problem
         real(wp) :: state_spring = 0.0_wp
     contains
         procedure :: get_size
-        procedure :: get_nonzeros
-        procedure :: copy_pattern
         procedure :: evaluate_residual
         procedure :: evaluate_jacobian
         procedure :: prepare_solve
@@ -275,18 +269,6 @@ contains
         get_size = self%n_p
         if (.not. self%positions_frozen) get_size = self%n_x + self%n_p
     end function get_size
-
-    pure integer(ik) function get_nonzeros(self)
-        class(friction_problem_type), intent(in) :: self
-        get_nonzeros = size(self%row_index, kind=ik)
-    end function get_nonzeros
-
-    subroutine copy_pattern(self, col_ptr, row_index)
-        class(friction_problem_type), intent(in) :: self
-        integer(ik), intent(out) :: col_ptr(:), row_index(:)
-        col_ptr = self%col_ptr
-        row_index = self%row_index
-    end subroutine copy_pattern
 
     !> Positions, reference lengths, internal forces and tensions for unknowns u.
     subroutine update_state(self, u, error)
@@ -489,10 +471,10 @@ contains
         noise = self%rounding(e)
     end function get_element_noise
 
-    subroutine evaluate_residual(self, u, residual, error)
+    subroutine evaluate_residual(self, u, values, error)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
-        real(wp), intent(out) :: residual(:)
+        real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         integer :: p, row
         real(wp) :: t_before, t_after, angle, critical, dcrit_dt, dcrit_da, flow
@@ -507,24 +489,24 @@ contains
         row = 0
         if (.not. self%positions_frozen) then
             call get_applied_force(self%scene, self%factors, applied)
-            call self%scene%dofs%gather(self%internal - applied, residual(1:self%n_x))
+            call self%scene%dofs%gather(self%internal - applied, values(1:self%n_x))
             row = self%n_x
         end if
         do p = 1, self%n_p
             flow = u(row + p)
             select case (self%mode(p))
             case (mode_stick)
-                residual(row + p) = self%stick_scale * (flow - self%flow_target(p))
+                values(row + p) = self%stick_scale * (flow - self%flow_target(p))
             case (mode_forward)
                 call self%get_passage_state(p, t_before, t_after, angle)
                 call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
                     t_before, angle, critical, dcrit_dt, dcrit_da)
-                residual(row + p) = (critical - t_after) / self%slip_weight(p)
+                values(row + p) = (critical - t_after) / self%slip_weight(p)
             case (mode_backward)
                 call self%get_passage_state(p, t_before, t_after, angle)
                 call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
                     t_after, angle, critical, dcrit_dt, dcrit_da)
-                residual(row + p) = (t_before - critical) / self%slip_weight(p)
+                values(row + p) = (t_before - critical) / self%slip_weight(p)
             end select
         end do
     end subroutine evaluate_residual

@@ -40,7 +40,8 @@ module yarnfort_contact_friction_stepper
     use yarnfort_linalg_bordered, only: bordered_solver_type
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
-    use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
+    use yarnfort_solver_stepper, only: load_stepper_type, step_state_type, start_stepper, &
+        accept_trial, save_common, restore_common
     use yarnfort_solver_state, only: fill_step_state
     use yarnfort_solver_restart, only: restart_type, stepper_friction
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
@@ -134,19 +135,16 @@ module yarnfort_contact_friction_stepper
     real(wp), parameter :: length_round_off = 64 * epsilon(1.0_wp)
 
     type, extends(load_stepper_type) :: friction_stepper_type
-        type(scene_type), pointer :: scene => null()
         logical :: staggered = .false.
         type(friction_problem_type), pointer :: full => null(), sliding => null()
         type(elastic_problem_type), pointer :: elastic => null()
         type(newton_solver_type) :: newton_full, newton_elastic, newton_sliding
-        !> Accepted state: position unknowns, flows, active set, load factors.
-        real(wp), allocatable :: u(:), flow(:)
+        !> Accepted state besides u and factors: flows, active set.
+        real(wp), allocatable :: flow(:)
         integer, allocatable :: mode(:)
-        real(wp), allocatable :: factors(:)
-        !> Trial state of the last successful try_step.
-        real(wp), allocatable :: u_trial(:), flow_trial(:)
+        !> Trial state of the last successful try_step (with u_trial, factors_trial).
+        real(wp), allocatable :: flow_trial(:)
         integer, allocatable :: mode_trial(:)
-        real(wp), allocatable :: factors_trial(:)
         !> The accepted state before the current one, for a secant predictor.
         real(wp), allocatable :: u_old(:), flow_old(:)
         real(wp) :: load_old = 0.0_wp
@@ -189,7 +187,7 @@ contains
         character(len=:), allocatable :: general_name, full_name
         integer :: n_p
 
-        self%scene => scene
+        call start_stepper(self, scene)
         self%staggered = trim(scene%solver%scheme) == 'staggered'
         n_p = scene%passages%size()
         ! The flows-only system of the staggered sliding step has order n_p, the
@@ -249,13 +247,8 @@ contains
         self%newton_full%quick = self%staggered
         ! The staggered scheme's finish takes full Newton steps only (above).
         if (.not. self%staggered) self%newton_full%chord_steps = chord_steps
-        allocate(self%u(scene%dofs%n_unknowns))
-        call scene%dofs%restrict(scene%network%position, self%u)
         allocate(self%flow(n_p), source=0.0_wp)
         allocate(self%mode(n_p), source=mode_stick)
-        allocate(self%factors(scene%path%n_channels()), source=0.0_wp)
-        self%factors_trial = self%factors
-        self%u_trial = self%u
         self%flow_trial = self%flow
         self%mode_trial = self%mode
         ! Written to restart files whether valid or not.
@@ -1217,10 +1210,9 @@ contains
         self%flow_old = self%flow
         self%load_old = sum(self%factors)
         self%have_old = .true.
-        self%u = self%u_trial
+        call accept_trial(self)
         self%flow = self%flow_trial
         self%mode = self%mode_trial
-        self%factors = self%factors_trial
     end subroutine accept
 
     subroutine get_state(self, state, error)
@@ -1244,9 +1236,7 @@ contains
         class(friction_stepper_type), intent(in) :: self
         type(restart_type), intent(inout) :: snapshot
 
-        snapshot%stepper = stepper_friction
-        snapshot%factors = self%factors
-        snapshot%u = self%u
+        call save_common(self, snapshot, stepper_friction, self%flow)
         snapshot%flow = self%flow
         snapshot%mode = self%mode
         snapshot%have_old = self%have_old
@@ -1263,10 +1253,6 @@ contains
         snapshot%load_older = self%load_older
         snapshot%u_older = self%u_older
         snapshot%flow_older = self%flow_older
-        if (.not. allocated(snapshot%length0)) &
-            allocate(snapshot%length0(self%scene%network%n_elements()))
-        call self%scene%passages%get_length0(self%scene%network%length0, self%flow, &
-            snapshot%length0)
     end subroutine save_state
 
     !> The reference lengths follow from the flows: the snapshot's must be those, bit
@@ -1275,33 +1261,10 @@ contains
         class(friction_stepper_type), intent(inout) :: self
         type(restart_type), intent(in) :: snapshot
         type(error_type), allocatable, intent(out) :: error
-        real(wp), allocatable :: length0(:)
 
-        if (snapshot%stepper /= stepper_friction) then
-            call fatal_error(error, 'the restart file was written by a run without sliding ' &
-                // 'passages, this scene has some')
-            return
-        end if
-        if (size(snapshot%u) /= size(self%u) .or. size(snapshot%flow) /= size(self%flow) &
-                .or. size(snapshot%length0) /= self%scene%network%n_elements()) then
-            call fatal_error(error, 'the restart file does not match the scene: other sizes')
-            return
-        end if
-        allocate(length0(self%scene%network%n_elements()))
-        call self%scene%passages%get_length0(self%scene%network%length0, snapshot%flow, &
-            length0)
-        if (any(length0 /= snapshot%length0)) then
-            call fatal_error(error, 'the restart file does not match the scene: other ' &
-                // 'element reference lengths')
-            return
-        end if
-        if (size(snapshot%factors) /= size(self%factors)) then
-            call fatal_error(error, 'the restart file does not match the scene: other ' &
-                // 'load channels')
-            return
-        end if
-        self%factors = snapshot%factors
-        self%u = snapshot%u
+        call restore_common(self, snapshot, stepper_friction, 'the restart file was written ' &
+            // 'by a run without sliding passages, this scene has some', error, size(self%flow))
+        if (allocated(error)) return
         self%flow = snapshot%flow
         self%mode = snapshot%mode
         self%have_old = snapshot%have_old
@@ -1317,8 +1280,6 @@ contains
         ! the run that wrote the file (a 48 x 24 clamped knit's step 1 from the initial
         ! state's slip set took 625 Newton iterations instead of 25).
         self%from_initial = snapshot%step == 0
-        self%factors_trial = self%factors
-        self%u_trial = self%u
         self%flow_trial = self%flow
         self%mode_trial = self%mode
     end subroutine restore_state

@@ -2,7 +2,7 @@
 !> Equilibrium of the network at given load factors with reference lengths held fixed
 !> (paper eqs. 51-52): the unknowns are the free coordinates.
 module yarnfort_solver_elastic_problem
-    use yarnfort_kinds, only: wp, ik
+    use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_assembly_pattern, only: pattern_type, new_pattern
@@ -15,17 +15,9 @@ module yarnfort_solver_elastic_problem
     public :: elastic_problem_type, new_elastic_problem
 
     type, extends(nonlinear_problem_type) :: elastic_problem_type
-        type(scene_type), pointer :: scene => null()
+        !> The Jacobian's value slots per element (its CSC arrays moved to the base type).
         type(pattern_type) :: pattern
-        !> Factors of the load channels.
-        real(wp), allocatable :: factors(:)
-        !> Current reference lengths of the elements.
-        real(wp), allocatable :: length0(:)
-        real(wp), allocatable :: x(:, :)
     contains
-        procedure :: get_size
-        procedure :: get_nonzeros
-        procedure :: copy_pattern
         procedure :: evaluate_residual
         procedure :: evaluate_jacobian
         procedure :: get_row_levels
@@ -40,36 +32,21 @@ contains
 
         self%scene => scene
         call new_pattern(self%pattern, scene%network, scene%dofs)
+        call move_alloc(self%pattern%col_ptr, self%col_ptr)
+        call move_alloc(self%pattern%row_index, self%row_index)
         self%length0 = scene%network%length0
         allocate(self%factors(scene%path%n_channels()), source=0.0_wp)
         allocate(self%x(3, scene%network%n_nodes()))
         self%length_scale = scene%length_scale
     end subroutine new_elastic_problem
 
-    pure integer function get_size(self)
-        class(elastic_problem_type), intent(in) :: self
-        get_size = self%scene%dofs%n_unknowns
-    end function get_size
-
-    pure integer(ik) function get_nonzeros(self)
-        class(elastic_problem_type), intent(in) :: self
-        get_nonzeros = self%pattern%nnz
-    end function get_nonzeros
-
-    subroutine copy_pattern(self, col_ptr, row_index)
-        class(elastic_problem_type), intent(in) :: self
-        integer(ik), intent(out) :: col_ptr(:), row_index(:)
-        col_ptr = self%pattern%col_ptr
-        row_index = self%pattern%row_index
-    end subroutine copy_pattern
-
-    subroutine evaluate_residual(self, u, residual, error)
+    subroutine evaluate_residual(self, u, values, error)
         class(elastic_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
-        real(wp), intent(out) :: residual(:)
+        real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         call self%scene%dofs%expand(u, self%factors, self%x)
-        call assemble_residual(self%scene, self%x, self%length0, self%factors, residual, error, &
+        call assemble_residual(self%scene, self%x, self%length0, self%factors, values, error, &
             self%spring)
     end subroutine evaluate_residual
 

@@ -400,7 +400,7 @@ contains
                 ! Judge convergence by our own test on the final iterate, with its levels.
                 call set_row_weights(self, .false., error)
                 if (allocated(error)) return
-                call residual_timed(self, self%u, residual, error)
+                call evaluate_timed(self%problem, self%u, .false., residual, error)
                 if (allocated(error)) then
                     if (attempt == n_attempts) return
                     deallocate(error)
@@ -611,7 +611,7 @@ contains
             if (f > tol / 100) then
                 ! The new rows (Jacobian at u) less the kept ones: V, a few entries per row.
                 allocate(values(self%problem%nnz))
-                call jacobian_timed(self, self%u, values, trial_error)
+                call evaluate_timed(self%problem, self%u, .true., values, trial_error)
                 stats%jacobian_evaluations = stats%jacobian_evaluations + 1
                 if (allocated(trial_error)) return
                 allocate(col_ptr(n + 1), row_index(self%problem%nnz))
@@ -692,7 +692,7 @@ contains
             call start_newton(self, u, error)
             if (allocated(error)) return
             allocate(residual(size(u)))
-            call residual_timed(self, self%u, residual, error)
+            call evaluate_timed(self%problem, self%u, .false., residual, error)
             if (allocated(error)) return
             call newton_step(self, residual, error)
             if (allocated(error)) return
@@ -727,7 +727,7 @@ contains
         real(wp), allocatable :: values(:), step(:)
 
         allocate(values(self%problem%nnz))
-        call jacobian_timed(self, self%u, values, error)
+        call evaluate_timed(self%problem, self%u, .true., values, error)
         if (allocated(error)) return
         call factor_counted(self%adapter, values, error)
         if (allocated(error)) return
@@ -739,29 +739,24 @@ contains
         self%u = self%u + step
     end subroutine newton_step
 
-    !> The problem's residual at u, timed like KINSOL's calls (get_timings).
-    subroutine residual_timed(self, u, residual, error)
-        class(newton_solver_type), intent(inout) :: self
+    !> The problem's residual at u, or with `jacobian` its Jacobian values; the wall time
+    !> goes to residual_time or jacobian_time (get_timings), for our calls and KINSOL's.
+    subroutine evaluate_timed(problem, u, jacobian, values, error)
+        type(equilibrium_type), intent(inout) :: problem
         real(wp), intent(in) :: u(:)
-        real(wp), intent(out) :: residual(:)
-        type(error_type), allocatable, intent(out) :: error
-        real(wp) :: start
-        start = wall_time()
-        call self%problem%problem%evaluate_residual(u, residual, error)
-        self%problem%residual_time = self%problem%residual_time + (wall_time() - start)
-    end subroutine residual_timed
-
-    !> The problem's Jacobian values at u, timed like KINSOL's calls (get_timings).
-    subroutine jacobian_timed(self, u, values, error)
-        class(newton_solver_type), intent(inout) :: self
-        real(wp), intent(in) :: u(:)
+        logical, intent(in) :: jacobian
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp) :: start
         start = wall_time()
-        call self%problem%problem%evaluate_jacobian(u, values, error)
-        self%problem%jacobian_time = self%problem%jacobian_time + (wall_time() - start)
-    end subroutine jacobian_timed
+        if (jacobian) then
+            call problem%problem%evaluate_jacobian(u, values, error)
+            problem%jacobian_time = problem%jacobian_time + (wall_time() - start)
+        else
+            call problem%problem%evaluate_residual(u, values, error)
+            problem%residual_time = problem%residual_time + (wall_time() - start)
+        end if
+    end subroutine evaluate_timed
 
     !> The residual at self%u and its scaled max-norm, the row levels taken there.
     subroutine get_scaled_residual(self, residual, f, error)
@@ -772,7 +767,7 @@ contains
         f = huge(1.0_wp)
         call set_row_weights(self, .false., error)
         if (allocated(error)) return
-        call residual_timed(self, self%u, residual, error)
+        call evaluate_timed(self%problem, self%u, .false., residual, error)
         if (allocated(error)) return
         if (.not. all(ieee_is_finite(residual))) then
             call fatal_error(error, 'the residual is not a finite number (NaN or an overflow)')
@@ -824,14 +819,14 @@ contains
             shift = max(level, tiny(1.0_wp)) / problem%length_scale
             call set_row_weights(self, .false., error)
             if (allocated(error)) return
-            call residual_timed(self, self%u, residual, error)
+            call evaluate_timed(self%problem, self%u, .false., residual, error)
             if (allocated(error)) return
             f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
             merit = norm2(residual * self%f_scale_data)
             mu = 1.0_wp
             do iteration = 1, transient_iterations * self%options%max_iterations
                 if (f <= self%options%residual_tolerance) exit
-                call jacobian_timed(self, self%u, values, error)
+                call evaluate_timed(self%problem, self%u, .true., values, error)
                 if (allocated(error)) return
                 values(diagonal) = values(diagonal) + mu * shift
                 call factor_counted(self%adapter, values, trial_error)
@@ -842,7 +837,7 @@ contains
                 end if
                 if (.not. allocated(trial_error)) then
                     trial = self%u + step
-                    call residual_timed(self, trial, residual, trial_error)
+                    call evaluate_timed(self%problem, trial, .false., residual, trial_error)
                     stats%residual_evaluations = stats%residual_evaluations + 1
                 end if
                 ! Accept a step that lowers the weighted 2-norm of the residual (a smooth
@@ -865,7 +860,7 @@ contains
                 else
                     mu = 10 * mu
                     if (mu > max_transient_shift) exit
-                    call residual_timed(self, self%u, residual, error)
+                    call evaluate_timed(self%problem, self%u, .false., residual, error)
                     if (allocated(error)) return
                 end if
             end do
@@ -907,14 +902,13 @@ contains
         type(c_ptr), value :: user_data
         type(equilibrium_type), pointer :: problem
         real(c_double), pointer :: u(:), f(:)
-        real(wp) :: start
+        type(error_type), allocatable :: error
 
         call c_f_pointer(user_data, problem)
         u => FN_VGetArrayPointer(sunvec_u)
         f => FN_VGetArrayPointer(sunvec_f)
-        start = wall_time()
-        call problem%problem%evaluate_residual(u, f, problem%error)
-        problem%residual_time = problem%residual_time + (wall_time() - start)
+        call evaluate_timed(problem, u, .false., f, error)
+        call move_alloc(error, problem%error)
         ierr = 0
         if (allocated(problem%error)) ierr = -1
         if (ierr == 0 .and. .not. all(ieee_is_finite(f))) then
@@ -937,6 +931,7 @@ contains
         integer(c_int64_t), pointer :: col_ptr(:), row_index(:)
         integer(ik) :: n, nnz
         real(wp) :: start
+        type(error_type), allocatable :: error
         integer(c_int64_t), pointer :: p(:)
         real(c_double), pointer :: d(:)
         real(wp) :: norm
@@ -972,8 +967,10 @@ contains
         call problem%problem%copy_pattern(col_ptr, row_index)
         d => FSUNSparseMatrix_Data(sunmat_j)
         call c_f_pointer(c_loc(d(1)), values, [nnz])
-        call problem%problem%evaluate_jacobian(u, values, problem%error)
+        ! The pattern's copy counts as Jacobian time too.
         problem%jacobian_time = problem%jacobian_time + (wall_time() - start)
+        call evaluate_timed(problem, u, .true., values, error)
+        call move_alloc(error, problem%error)
         ierr = 0
         if (allocated(problem%error)) ierr = -1
     end function jacobian_callback

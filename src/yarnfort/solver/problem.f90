@@ -4,6 +4,7 @@
 module yarnfort_solver_problem
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
+    use yarnfort_scene_scene, only: scene_type
     implicit none
     private
 
@@ -18,18 +19,23 @@ module yarnfort_solver_problem
         !> tangent of slack strings only (see yarnfort_assembly_truss).
         real(wp) :: spring = 0.0_wp
         real(wp) :: tangent_spring = 0.0_wp
+        !> The scene (which must outlive the problem), the load channels' factors, the
+        !> elements' reference lengths and a work array of node positions (3, n_nodes).
+        type(scene_type), pointer :: scene => null()
+        real(wp), allocatable :: factors(:), length0(:), x(:, :)
+        !> The Jacobian's CSC pattern (0-based), fixed for the problem's lifetime.
+        integer(ik), allocatable :: col_ptr(:), row_index(:)
     contains
-        !> Number of unknowns.
-        procedure(get_size_interface), deferred :: get_size
+        !> Number of unknowns (default: the order of the pattern).
+        procedure :: get_size
         !> Number of stored entries of the Jacobian's CSC pattern.
-        procedure(get_nonzeros_interface), deferred :: get_nonzeros
-        !> Write the Jacobian's CSC pattern (0-based, fixed for the problem's lifetime)
-        !> into arrays of its size: the Newton solver restores it in KINSOL's matrix
-        !> before each Jacobian, without a copy of its own.
-        procedure(copy_pattern_interface), deferred :: copy_pattern
-        procedure(evaluate_residual_interface), deferred :: evaluate_residual
+        procedure :: get_nonzeros
+        !> Write the Jacobian's CSC pattern into arrays of its size: the Newton solver
+        !> restores it in KINSOL's matrix before each Jacobian, without a copy of its own.
+        procedure :: copy_pattern
+        procedure(evaluate_interface), deferred :: evaluate_residual
         !> Jacobian values in the order of the pattern.
-        procedure(evaluate_jacobian_interface), deferred :: evaluate_jacobian
+        procedure(evaluate_interface), deferred :: evaluate_jacobian
         !> The force level of each residual row at u and the rounding level of its
         !> evaluation: row i is converged when |F_i| <= tol * level_i + noise_i.
         procedure(get_row_levels_interface), deferred :: get_row_levels
@@ -42,37 +48,13 @@ module yarnfort_solver_problem
     end type nonlinear_problem_type
 
     abstract interface
-        pure integer function get_size_interface(self)
-            import :: nonlinear_problem_type
-            class(nonlinear_problem_type), intent(in) :: self
-        end function get_size_interface
-
-        pure integer(ik) function get_nonzeros_interface(self)
-            import :: nonlinear_problem_type, ik
-            class(nonlinear_problem_type), intent(in) :: self
-        end function get_nonzeros_interface
-
-        subroutine copy_pattern_interface(self, col_ptr, row_index)
-            import :: nonlinear_problem_type, ik
-            class(nonlinear_problem_type), intent(in) :: self
-            integer(ik), intent(out) :: col_ptr(:), row_index(:)
-        end subroutine copy_pattern_interface
-
-        subroutine evaluate_residual_interface(self, u, residual, error)
-            import :: nonlinear_problem_type, wp, error_type
-            class(nonlinear_problem_type), intent(inout) :: self
-            real(wp), intent(in) :: u(:)
-            real(wp), intent(out) :: residual(:)
-            type(error_type), allocatable, intent(out) :: error
-        end subroutine evaluate_residual_interface
-
-        subroutine evaluate_jacobian_interface(self, u, values, error)
+        subroutine evaluate_interface(self, u, values, error)
             import :: nonlinear_problem_type, wp, error_type
             class(nonlinear_problem_type), intent(inout) :: self
             real(wp), intent(in) :: u(:)
             real(wp), intent(out) :: values(:)
             type(error_type), allocatable, intent(out) :: error
-        end subroutine evaluate_jacobian_interface
+        end subroutine evaluate_interface
 
         subroutine get_row_levels_interface(self, u, level, noise, error)
             import :: nonlinear_problem_type, wp, error_type
@@ -84,6 +66,23 @@ module yarnfort_solver_problem
     end interface
 
 contains
+
+    pure integer function get_size(self)
+        class(nonlinear_problem_type), intent(in) :: self
+        get_size = size(self%col_ptr) - 1
+    end function get_size
+
+    pure integer(ik) function get_nonzeros(self)
+        class(nonlinear_problem_type), intent(in) :: self
+        get_nonzeros = size(self%row_index, kind=ik)
+    end function get_nonzeros
+
+    subroutine copy_pattern(self, col_ptr, row_index)
+        class(nonlinear_problem_type), intent(in) :: self
+        integer(ik), intent(out) :: col_ptr(:), row_index(:)
+        col_ptr = self%col_ptr
+        row_index = self%row_index
+    end subroutine copy_pattern
 
     !> Nothing to prepare.
     subroutine prepare_solve(self, u, error)

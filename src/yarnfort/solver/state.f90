@@ -1,16 +1,45 @@
 ! SPDX-License-Identifier: MIT
-!> Fill a step state (positions, tensions, reactions) from unknowns and reference lengths.
+!> A converged state of the net (positions, tensions, reactions), filled from unknowns and
+!> reference lengths.
 module yarnfort_solver_state
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type, get_applied_force
     use yarnfort_assembly_assemble, only: assemble_internal_force
-    use yarnfort_solver_stepper, only: step_state_type
+    use yarnfort_solver_newton, only: newton_stats_type
     implicit none
     private
 
-    public :: fill_step_state
+    public :: step_state_type, fill_step_state
+
+    !> A converged state of the net.
+    type :: step_state_type
+        integer :: step = 0
+        real(wp) :: time = 0.0_wp
+        !> Factors of the load channels (scene%path%channel).
+        real(wp), allocatable :: factors(:)
+        !> Node positions (3, n_nodes), element tension, stretch and reference length.
+        real(wp), allocatable :: position(:, :), tension(:), stretch(:), length0(:)
+        !> Force applied by each support set on the net, (3, n_supports).
+        real(wp), allocatable :: reaction(:, :)
+        !> The same per prescribed coordinate: the force on coordinate
+        !> scene%supports(s)%coordinates(i), for s = 1, 2, ... and i in order, concatenated.
+        real(wp), allocatable :: coordinate_reaction(:)
+        !> Figures of the step's (last) Newton solve; total Newton iterations of the step.
+        type(newton_stats_type) :: newton
+        integer :: newton_iterations = 0
+        !> Friction: passages that slipped in this step, and all sliding passages.
+        integer :: n_slipping = 0, n_passages = 0
+        !> Friction: passages held in stick by chatter damping in this step (their mode
+        !> flipped too often; each ended within its limit, else the step failed).
+        integer :: n_held = 0
+        !> 1 while the load factors grow, -1 while they shrink, 0 at rest.
+        integer :: direction = 0
+        !> Step cuts before this step converged, and its wall time in seconds.
+        integer :: step_cuts = 0
+        real(wp) :: wall_time = 0.0_wp
+    end type step_state_type
 
 contains
 
