@@ -72,7 +72,7 @@ contains
             call umfpack%analyse(n, col_ptr, row_index, error)
             if (allocated(error)) return
             if (allocated(order) .and. symmetry >= umfpack_min_symmetry) then
-                call umfpack%set_column_order(order, error)
+                call umfpack%set_column_order(order, self%predicted_nonzeros, error)
                 if (allocated(error)) return
             end if
             call move_alloc(umfpack, self%chosen)

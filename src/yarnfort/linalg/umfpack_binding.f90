@@ -23,6 +23,7 @@ module yarnfort_linalg_umfpack_binding
     public :: umfpack_dl_defaults, umfpack_dl_symbolic, umfpack_dl_qsymbolic
     public :: umfpack_dl_numeric
     public :: umfpack_strategy, umfpack_strategy_symmetric, umfpack_symbolic_time
+    public :: umfpack_alloc_init, umfpack_lnz_estimate, umfpack_unz_estimate
     public :: umfpack_dl_wsolve, umfpack_dl_free_symbolic, umfpack_dl_free_numeric
 
     !> Sizes of the Control and Info arrays (UMFPACK_CONTROL, UMFPACK_INFO).
@@ -48,6 +49,13 @@ module yarnfort_linalg_umfpack_binding
     integer, parameter :: umfpack_strategy_used = 18
     !> 0-based index into Info: CPU seconds of the symbolic analysis.
     integer, parameter :: umfpack_symbolic_time = 15
+    !> 0-based index into Control: the numeric factorisation's first allocation for
+    !> the factors and fronts, as a fraction of the symbolic analysis's upper bound
+    !> (used unless UMFPACK ordered with AMD itself).
+    integer, parameter :: umfpack_alloc_init = 6
+    !> 0-based indices into Info: the symbolic analysis's upper bounds on the nonzeros
+    !> of L and U (diagonal included).
+    integer, parameter :: umfpack_lnz_estimate = 23, umfpack_unz_estimate = 24
     !> 0-based index into Info: the flops of the factorisation that the symbolic
     !> analysis predicts.
     integer, parameter :: umfpack_flops_estimate = 22

@@ -828,7 +828,7 @@ contains
             if (allocated(error)) return
             if (natural) then
                 call solver%set_column_order([(k, k = 0_c_long, int(a%n, c_long) - 1)], &
-                    error)
+                    0.0_wp, error)
                 if (allocated(error)) return
             end if
             call solver%factor(a%values, error)
@@ -855,17 +855,17 @@ contains
         integer(c_long) :: k
 
         a = laplacian_2d(4)
-        call solver%set_column_order([(k, k = 0_c_long, 15_c_long)], error)
+        call solver%set_column_order([(k, k = 0_c_long, 15_c_long)], 0.0_wp, error)
         call expect_error('umfpack column order', 'before analyse', error)
         if (allocated(error)) return
         call solver%analyse(a%n, a%col_ptr, a%row_index, error)
         if (allocated(error)) return
-        call solver%set_column_order([(k, k = 0_c_long, 14_c_long)], error)
+        call solver%set_column_order([(k, k = 0_c_long, 14_c_long)], 0.0_wp, error)
         call expect_error('umfpack column order', 'of size 15 for order 16', error)
         if (allocated(error)) return
         call solver%factor(a%values, error)
         if (allocated(error)) return
-        call solver%set_column_order([(k, k = 0_c_long, 15_c_long)], error)
+        call solver%set_column_order([(k, k = 0_c_long, 15_c_long)], 0.0_wp, error)
         call expect_error('umfpack column order', 'after the first factorisation', &
             error)
     end subroutine test_umfpack_bad_order
