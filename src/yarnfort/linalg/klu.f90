@@ -15,7 +15,7 @@ module yarnfort_linalg_klu
     use yarnfort_linalg_klu_binding, only: klu_l_common, klu_ok, klu_singular, &
         klu_out_of_memory, klu_invalid, klu_too_large, klu_l_defaults, klu_l_analyze, &
         klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_rcond, klu_l_free_symbolic, &
-        klu_l_numeric_sizes, klu_l_symbolic_estimates, klu_l_free_numeric
+        klu_l_numeric_sizes, klu_l_symbolic, klu_l_free_numeric
     implicit none
     private
 
@@ -52,8 +52,10 @@ module yarnfort_linalg_klu
         procedure :: solve_rhs_columns
         procedure :: release
         procedure :: get_name
-        !> AMD's prediction of the factorisation's cost (yarnfort_linalg_lu_choice).
+        !> AMD's prediction of the factorisation's cost and its ordering
+        !> (yarnfort_linalg_lu_choice).
         procedure :: get_prediction
+        procedure :: get_symmetric_order
         final :: finalize
     end type klu_solver_type
 
@@ -183,7 +185,7 @@ contains
     subroutine get_prediction(self, flops, factor_nonzeros)
         class(klu_solver_type), intent(in) :: self
         real(wp), intent(out) :: flops, factor_nonzeros
-        type(klu_l_symbolic_estimates), pointer :: estimates
+        type(klu_l_symbolic), pointer :: estimates
 
         flops = 0.0_wp
         factor_nonzeros = 0.0_wp
@@ -192,6 +194,28 @@ contains
         flops = estimates%est_flops
         factor_nonzeros = estimates%lnz + estimates%unz
     end subroutine get_prediction
+
+    !> The column order of the last analysis (0-based: column order(k) is the k-th) when
+    !> it is a symmetric permutation (the rows in the same order: BTF matched every
+    !> column to its diagonal, as on a zero-free diagonal) and AMD made it; with the
+    !> symmetry AMD saw in the largest block. Not allocated otherwise.
+    subroutine get_symmetric_order(self, order, symmetry)
+        class(klu_solver_type), intent(in) :: self
+        integer(c_long), allocatable, intent(out) :: order(:)
+        real(wp), intent(out) :: symmetry
+        type(klu_l_symbolic), pointer :: symbolic
+        integer(c_long), pointer :: p(:), q(:)
+
+        symmetry = 0.0_wp
+        if (.not. c_associated(self%symbolic) .or. self%unsymmetric_ordering) return
+        call c_f_pointer(self%symbolic, symbolic)
+        if (symbolic%ordering /= 0) return
+        call c_f_pointer(symbolic%p, p, [symbolic%n])
+        call c_f_pointer(symbolic%q, q, [symbolic%n])
+        if (any(p /= q)) return
+        order = q
+        symmetry = symbolic%symmetry
+    end subroutine get_symmetric_order
 
     pure function get_name(self) result(name)
         class(klu_solver_type), intent(in) :: self

@@ -8,7 +8,7 @@ module yarnfort_linalg_klu_binding
     implicit none
     private
 
-    public :: klu_l_common, klu_l_numeric_sizes, klu_l_symbolic_estimates
+    public :: klu_l_common, klu_l_numeric_sizes, klu_l_symbolic
     public :: klu_ok, klu_singular, klu_out_of_memory, klu_invalid, klu_too_large
     public :: klu_l_defaults, klu_l_analyze, klu_l_factor, klu_l_refactor, klu_l_solve
     public :: klu_l_rcond, klu_l_free_symbolic, klu_l_free_numeric
@@ -36,13 +36,19 @@ module yarnfort_linalg_klu_binding
         integer(c_long) :: n, nblocks, lnz, unz
     end type klu_l_numeric_sizes
 
-    !> The leading members of `klu_l_symbolic` (klu.h): AMD's predictions for the ordering
-    !> it found (filled for AMD only), summed over the diagonal blocks of the block
-    !> triangular form: symmetry of the largest block, flop count of the factorisation
-    !> and nonzeros of L and U (diagonals included), pivoting on the diagonal.
-    type, bind(C) :: klu_l_symbolic_estimates
+    !> Mirror of `klu_l_symbolic` (klu.h). AMD's predictions for the ordering it found
+    !> (filled for AMD only), summed over the diagonal blocks of the block triangular
+    !> form: symmetry of the largest block, flop count of the factorisation and nonzeros
+    !> of L and U (diagonals included), pivoting on the diagonal. Then the order, the
+    !> row and column permutations P and Q (0-based, size n: A(P, Q) is block upper
+    !> triangular with its blocks ordered) and the block boundaries R.
+    type, bind(C) :: klu_l_symbolic
         real(c_double) :: symmetry, est_flops, lnz, unz
-    end type klu_l_symbolic_estimates
+        type(c_ptr) :: lnz_per_block
+        integer(c_long) :: n, nz
+        type(c_ptr) :: p, q, r
+        integer(c_long) :: nzoff, nblocks, maxblock, ordering, do_btf, structural_rank
+    end type klu_l_symbolic
 
     interface
         !> Set default parameters; returns TRUE (1) on success.

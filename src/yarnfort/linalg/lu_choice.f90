@@ -7,6 +7,7 @@
 !> nonzero decide: few on chain-like patterns (the woven nets' reduced friction systems),
 !> many where the factors fill in two dimensions (the knit's, or any net at 1e6 unknowns).
 module yarnfort_linalg_lu_choice
+    use, intrinsic :: iso_c_binding, only: c_long
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
@@ -26,6 +27,9 @@ module yarnfort_linalg_lu_choice
     !> step took 60 s with UMFPACK against 106 s with KLU. Whole knit runs crossed near
     !> 80-90 before; 100 left the 30 x 30 knit on KLU.
     real(wp), parameter :: umfpack_min_flops_per_nonzero = 80.0_wp
+    !> UMFPACK's automatic strategy takes the symmetric one at this symmetry of the
+    !> pattern (matched entries over off-diagonal entries) and a nonzero diagonal.
+    real(wp), parameter :: umfpack_min_symmetry = 0.5_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks
     !> the calls and keeps the pattern.
@@ -43,13 +47,18 @@ module yarnfort_linalg_lu_choice
 
 contains
 
-    !> KLU's analysis, kept if KLU is chosen, else UMFPACK's.
+    !> KLU's analysis, kept if KLU is chosen, else UMFPACK's. UMFPACK is handed KLU's
+    !> AMD order when that is symmetric and so is the pattern by UMFPACK's own test
+    !> (umfpack_min_symmetry): its symmetric strategy would order A + A^T again.
     subroutine analyse(self, n, col_ptr, row_index, error)
         class(lu_choice_solver_type), intent(inout) :: self
         integer(ik), intent(in) :: n
         integer(ik), intent(in) :: col_ptr(:), row_index(:)
         type(error_type), allocatable, intent(out) :: error
         type(klu_solver_type), allocatable :: klu
+        type(umfpack_solver_type), allocatable :: umfpack
+        integer(c_long), allocatable :: order(:)
+        real(wp) :: symmetry
 
         call self%destroy()
         allocate(klu)
@@ -57,9 +66,16 @@ contains
         if (allocated(error)) return
         call klu%get_prediction(self%predicted_flops, self%predicted_nonzeros)
         if (prefers_umfpack(self%predicted_flops, self%predicted_nonzeros)) then
+            call klu%get_symmetric_order(order, symmetry)
             call klu%destroy()
-            allocate(umfpack_solver_type :: self%chosen)
-            call self%chosen%analyse(n, col_ptr, row_index, error)
+            allocate(umfpack)
+            call umfpack%analyse(n, col_ptr, row_index, error)
+            if (allocated(error)) return
+            if (allocated(order) .and. symmetry >= umfpack_min_symmetry) then
+                call umfpack%set_column_order(order, self%predicted_nonzeros, error)
+                if (allocated(error)) return
+            end if
+            call move_alloc(umfpack, self%chosen)
         else
             call move_alloc(klu, self%chosen)
         end if

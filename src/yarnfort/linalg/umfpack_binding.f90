@@ -20,7 +20,10 @@ module yarnfort_linalg_umfpack_binding
     public :: umfpack_error_invalid_matrix, umfpack_error_different_pattern
     public :: umfpack_error_invalid_system, umfpack_error_invalid_permutation
     public :: umfpack_error_internal_error, umfpack_error_ordering_failed
-    public :: umfpack_dl_defaults, umfpack_dl_symbolic, umfpack_dl_numeric
+    public :: umfpack_dl_defaults, umfpack_dl_symbolic, umfpack_dl_qsymbolic
+    public :: umfpack_dl_numeric
+    public :: umfpack_strategy, umfpack_strategy_symmetric, umfpack_symbolic_time
+    public :: umfpack_alloc_init, umfpack_lnz_estimate, umfpack_unz_estimate
     public :: umfpack_dl_wsolve, umfpack_dl_free_symbolic, umfpack_dl_free_numeric
 
     !> Sizes of the Control and Info arrays (UMFPACK_CONTROL, UMFPACK_INFO).
@@ -39,8 +42,20 @@ module yarnfort_linalg_umfpack_binding
     !> and U (diagonal included).
     integer, parameter :: umfpack_size_of_unit = 3, umfpack_numeric_size = 40, &
         umfpack_peak_memory = 41, umfpack_lnz = 43, umfpack_unz = 44
+    !> 0-based index into Control: the strategy, and its symmetric value (AMD on A + A^T,
+    !> diagonal pivots preferred; with a given column order, that order for both).
+    integer, parameter :: umfpack_strategy = 5, umfpack_strategy_symmetric = 3
     !> 0-based index into Info: the strategy used (1 unsymmetric, 3 symmetric).
     integer, parameter :: umfpack_strategy_used = 18
+    !> 0-based index into Info: CPU seconds of the symbolic analysis.
+    integer, parameter :: umfpack_symbolic_time = 15
+    !> 0-based index into Control: the numeric factorisation's first allocation for
+    !> the factors and fronts, as a fraction of the symbolic analysis's upper bound
+    !> (used unless UMFPACK ordered with AMD itself).
+    integer, parameter :: umfpack_alloc_init = 6
+    !> 0-based indices into Info: the symbolic analysis's upper bounds on the nonzeros
+    !> of L and U (diagonal included).
+    integer, parameter :: umfpack_lnz_estimate = 23, umfpack_unz_estimate = 24
     !> 0-based index into Info: the flops of the factorisation that the symbolic
     !> analysis predicts.
     integer, parameter :: umfpack_flops_estimate = 22
@@ -82,6 +97,21 @@ module yarnfort_linalg_umfpack_binding
             real(c_double), intent(inout) :: info(*)
             integer(c_long) :: status
         end function umfpack_dl_symbolic
+
+        !> Symbolic analysis with the given column pre-ordering (0-based) instead of
+        !> AMD or COLAMD.
+        function umfpack_dl_qsymbolic(n_row, n_col, ap, ai, ax, qinit, symbolic, control, &
+                info) result(status) bind(C, name='umfpack_dl_qsymbolic')
+            import :: c_long, c_double, c_ptr
+            integer(c_long), value :: n_row, n_col
+            integer(c_long), intent(in) :: ap(*), ai(*)
+            real(c_double), intent(in), optional :: ax(*)
+            integer(c_long), intent(in) :: qinit(*)
+            type(c_ptr), intent(inout) :: symbolic
+            real(c_double), intent(in) :: control(*)
+            real(c_double), intent(inout) :: info(*)
+            integer(c_long) :: status
+        end function umfpack_dl_qsymbolic
 
         function umfpack_dl_numeric(ap, ai, ax, symbolic, numeric, control, info) &
                 result(status) bind(C, name='umfpack_dl_numeric')

@@ -3,7 +3,7 @@
 !> linear_solver_type, and of the factory.
 module test_linalg
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-    use, intrinsic :: iso_c_binding, only: c_size_t
+    use, intrinsic :: iso_c_binding, only: c_size_t, c_long
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_testing, only: unittest_type, new_unittest, check
@@ -104,6 +104,9 @@ contains
             new_unittest('factory rejects an unknown name', test_factory_unknown), &
             new_unittest('default solver follows the measured table', test_default_rule), &
             new_unittest('umfpack analyses with the values', test_umfpack_strategy), &
+            new_unittest('umfpack with a given column order', test_umfpack_given_order), &
+            new_unittest('umfpack: a wrong column order is an error', &
+                test_umfpack_bad_order), &
             new_unittest('thread policy applied once', test_thread_policy_once), &
             new_unittest('limited OpenMP regions run on the calling thread', &
                 test_serial_regions), &
@@ -790,6 +793,82 @@ contains
         call check_solution('umfpack symmetric strategy', a, multiply(a, x_true), x, x_true, &
             error)
     end subroutine test_umfpack_strategy
+
+    !> A given order is used: on a 2D Laplacian (grid m x m) the natural order fills the
+    !> band of the factors (about m nonzeros per column of L) where UMFPACK's own AMD
+    !> order fills far less; the symmetric strategy, and the right solution either way.
+    subroutine test_umfpack_given_order(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(csc_type) :: a
+        real(wp), allocatable :: x_true(:)
+        real(wp) :: own_nonzeros, natural_nonzeros
+        integer(c_long) :: k
+
+        a = laplacian_2d(laplacian_grid)
+        x_true = random_vector(a%n, random_seed + 11)
+        call factor_and_solve(.false., own_nonzeros, error)
+        if (allocated(error)) return
+        call factor_and_solve(.true., natural_nonzeros, error)
+        if (allocated(error)) return
+        call check(error, natural_nonzeros > 2.0_wp * own_nonzeros, 'umfpack: natural ' &
+            // 'order L + U nonzeros ' // format_integer(nint(natural_nonzeros)) &
+            // ' not above twice those of its own order, ' &
+            // format_integer(nint(own_nonzeros)))
+    contains
+        subroutine factor_and_solve(natural, factor_nonzeros, error)
+            logical, intent(in) :: natural
+            real(wp), intent(out) :: factor_nonzeros
+            type(error_type), allocatable, intent(out) :: error
+            type(umfpack_solver_type) :: solver
+            type(umfpack_memory_type) :: memory
+            real(wp), allocatable :: x(:)
+
+            factor_nonzeros = 0.0_wp
+            call solver%analyse(a%n, a%col_ptr, a%row_index, error)
+            if (allocated(error)) return
+            if (natural) then
+                call solver%set_column_order([(k, k = 0_c_long, int(a%n, c_long) - 1)], &
+                    0.0_wp, error)
+                if (allocated(error)) return
+            end if
+            call solver%factor(a%values, error)
+            if (allocated(error)) return
+            memory = solver%get_memory()
+            factor_nonzeros = memory%l_nonzeros + memory%u_nonzeros
+            call check(error, memory%strategy == 3, 'umfpack: strategy ' &
+                // format_integer(memory%strategy) // ', expected 3 (symmetric)')
+            if (allocated(error)) return
+            x = multiply(a, x_true)
+            call solver%solve(x, error)
+            if (allocated(error)) return
+            call check_solution('umfpack given order', a, multiply(a, x_true), x, x_true, &
+                error)
+        end subroutine factor_and_solve
+    end subroutine test_umfpack_given_order
+
+    !> A column order before analyse, of the wrong size, or after the first
+    !> factorisation is an error.
+    subroutine test_umfpack_bad_order(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(umfpack_solver_type) :: solver
+        type(csc_type) :: a
+        integer(c_long) :: k
+
+        a = laplacian_2d(4)
+        call solver%set_column_order([(k, k = 0_c_long, 15_c_long)], 0.0_wp, error)
+        call expect_error('umfpack column order', 'before analyse', error)
+        if (allocated(error)) return
+        call solver%analyse(a%n, a%col_ptr, a%row_index, error)
+        if (allocated(error)) return
+        call solver%set_column_order([(k, k = 0_c_long, 14_c_long)], 0.0_wp, error)
+        call expect_error('umfpack column order', 'of size 15 for order 16', error)
+        if (allocated(error)) return
+        call solver%factor(a%values, error)
+        if (allocated(error)) return
+        call solver%set_column_order([(k, k = 0_c_long, 15_c_long)], 0.0_wp, error)
+        call expect_error('umfpack column order', 'after the first factorisation', &
+            error)
+    end subroutine test_umfpack_bad_order
 
     !> The thread policy acts at most once per process: a second call changes nothing.
     subroutine test_thread_policy_once(error)
