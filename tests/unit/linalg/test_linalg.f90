@@ -14,6 +14,7 @@ module test_linalg
     use yarnfort_linalg_umfpack, only: umfpack_solver_type, umfpack_memory_type
     use yarnfort_linalg_threads, only: apply_thread_policy, count_serial_regions
     use yarnfort_linalg_heap, only: apply_heap_policy
+    use yarnfort_text, only: format_real, format_integer
     implicit none
     private
 
@@ -1333,23 +1334,5 @@ contains
 
         difference = maxval(abs(x - y)) / maxval(abs(y))
     end function relative_difference
-
-    function format_real(value) result(text)
-        real(wp), intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=16) :: buffer
-
-        write(buffer, '(es10.3)') value
-        text = trim(adjustl(buffer))
-    end function format_real
-
-    function format_integer(value) result(text)
-        integer, intent(in) :: value
-        character(len=:), allocatable :: text
-        character(len=16) :: buffer
-
-        write(buffer, '(i0)') value
-        text = trim(buffer)
-    end function format_integer
 
 end module test_linalg
