@@ -60,48 +60,39 @@ contains
 
     subroutine test_klu(error)
         type(error_type), allocatable, intent(out) :: error
-        class(linear_solver_type), allocatable :: solver
-
-        call new_linear_solver(solver, 'klu', error)
-        if (allocated(error)) return
-        call check_columns(solver, 'bordered', error)
+        call check_named('klu', 'bordered', error)
     end subroutine test_klu
 
     subroutine test_umfpack(error)
         type(error_type), allocatable, intent(out) :: error
-        class(linear_solver_type), allocatable :: solver
-
-        call new_linear_solver(solver, 'umfpack', error)
-        if (allocated(error)) return
-        call check_columns(solver, 'bordered', error)
+        call check_named('umfpack', 'bordered', error)
     end subroutine test_umfpack
 
     subroutine test_cholmod(error)
         type(error_type), allocatable, intent(out) :: error
-        class(linear_solver_type), allocatable :: solver
-
-        call new_linear_solver(solver, 'cholmod', error)
-        if (allocated(error)) return
-        call check_columns(solver, 'spd', error)
+        call check_named('cholmod', 'spd', error)
     end subroutine test_cholmod
 
     subroutine test_dense(error)
         type(error_type), allocatable, intent(out) :: error
-        class(linear_solver_type), allocatable :: solver
-
-        call new_linear_solver(solver, 'dense', error)
-        if (allocated(error)) return
-        call check_columns(solver, 'bordered', error)
+        call check_named('dense', 'bordered', error)
     end subroutine test_dense
 
     subroutine test_lu_choice(error)
         type(error_type), allocatable, intent(out) :: error
+        call check_named(chosen_lu_name, 'bordered', error)
+    end subroutine test_lu_choice
+
+    !> The solver the factory makes under `name`, on the test matrix of `kind`.
+    subroutine check_named(name, kind, error)
+        character(len=*), intent(in) :: name, kind
+        type(error_type), allocatable, intent(out) :: error
         class(linear_solver_type), allocatable :: solver
 
-        call new_linear_solver(solver, chosen_lu_name, error)
+        call new_linear_solver(solver, name, error)
         if (allocated(error)) return
-        call check_columns(solver, 'bordered', error)
-    end subroutine test_lu_choice
+        call check_columns(solver, kind, error)
+    end subroutine check_named
 
     !> Rows 10 and 12 eliminated, the rest (order 10) by KLU or UMFPACK.
     subroutine test_condensed_lu(error)
