@@ -10,7 +10,7 @@ module yarnfort_csv
     use, intrinsic :: iso_fortran_env, only: iostat_end
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_text, only: format_integer, read_line, is_folder, byte_order_mark
+    use yarnfort_text, only: format_integer, read_line, is_folder, drop_byte_order_mark
     implicit none
     private
 
@@ -88,9 +88,7 @@ contains
                     // ': cannot read the line (' // trim(iomsg) // ')')
                 exit
             end if
-            ! Some editors start a UTF-8 file with a byte order mark: not text of the table.
-            if (line_number == 1 .and. index(line, byte_order_mark) == 1) &
-                line = line(len(byte_order_mark) + 1:)
+            if (line_number == 1) call drop_byte_order_mark(line)
             call parse_line(line, names, row, outcome, message)
             if (outcome == line_skip) cycle
             if (outcome == line_bad) then

@@ -13,7 +13,7 @@ module yarnfort_text
     public :: string_type, read_line, to_lower, format_integer, format_real, quote_string
     public :: split_words, parse_integer, parse_real, edit_distance, closest_name
     public :: join_names, folder_of, resolve_path, is_folder, max_line_length
-    public :: byte_order_mark, remove_characters, read_file_text, open_to_read
+    public :: drop_byte_order_mark, remove_characters, read_file_text, open_to_read
 
     interface format_integer
         module procedure format_default_integer, format_long_integer
@@ -169,6 +169,14 @@ contains
         digits = digits // repeat('0', max(point + 1 - len(digits), 0))
         text = minus // digits(:point) // '.' // digits(point + 1:) // suffix
     end function format_real
+
+    !> Drop the UTF-8 byte order mark some editors put at the start of a file: it is not
+    !> text of the file.
+    pure subroutine drop_byte_order_mark(text)
+        character(len=:), allocatable, intent(inout) :: text
+
+        if (index(text, byte_order_mark) == 1) text = text(len(byte_order_mark) + 1:)
+    end subroutine drop_byte_order_mark
 
     !> `text` without the characters of `set`.
     pure function remove_characters(text, set) result(cleaned)

@@ -103,6 +103,14 @@ def test_geometry_line_ends(run_yarnfort, tmp_path, end):
     assert "3 nodes, 2 elements" in run.stderr
 
 
+def test_geometry_with_byte_order_mark(run_yarnfort, tmp_path):
+    (tmp_path / "net.geo").write_bytes(b"\xef\xbb\xbfnode 1 0 0 0\nnode 2 1 0 0\nyarn a 1 1 2\n")
+    text = SCENE.format(law=LINEAR, network="&geometry file = 'net.geo' /", last=2)
+    run = run_yarnfort(text)
+    assert run.returncode == 0, run.stderr
+    assert "2 nodes, 1 elements" in run.stderr
+
+
 def test_geometry_file_that_is_a_folder(run_yarnfort, tmp_path):
     (tmp_path / "net.geo").mkdir()
     text = SCENE.format(law=LINEAR, network="&geometry file = 'net.geo' /", last=3)

@@ -15,7 +15,7 @@ module yarnfort_input_geometry
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: yarn_config_type, name_length
     use yarnfort_text, only: string_type, to_lower, format_integer, split_words, &
-        parse_integer, parse_real, read_file_text, byte_order_mark
+        parse_integer, parse_real, read_file_text, drop_byte_order_mark
     implicit none
     private
 
@@ -44,8 +44,7 @@ contains
             error%message = '&geometry: ' // error%message
             return
         end if
-        ! Some editors start a UTF-8 file with a byte order mark: not text of the file.
-        if (index(content, byte_order_mark) == 1) content = content(len(byte_order_mark) + 1:)
+        call drop_byte_order_mark(content)
         allocate(node_ids(1024), node_lines(1024), node_xyz(3, 1024), yarns(16), &
             yarn_lines(16), stat=stat, errmsg=message)
         call check_memory()

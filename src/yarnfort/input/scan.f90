@@ -9,7 +9,7 @@
 module yarnfort_input_scan
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_text, only: string_type, read_line, to_lower, format_integer, &
-        closest_name, join_names, byte_order_mark, parse_integer, remove_characters
+        closest_name, join_names, drop_byte_order_mark, parse_integer, remove_characters
     implicit none
     private
 
@@ -98,9 +98,7 @@ contains
                 call move_alloc(grown, scan%lines)
             end if
             n_lines = n_lines + 1
-            ! Some editors start a UTF-8 file with a byte order mark: not text of the input.
-            if (n_lines == 1 .and. index(line, byte_order_mark) == 1) &
-                line = line(len(byte_order_mark) + 1:)
+            if (n_lines == 1) call drop_byte_order_mark(line)
             call move_alloc(line, scan%lines(n_lines)%text)
         end do
         scan%lines = scan%lines(:n_lines)
