@@ -49,19 +49,28 @@ contains
     !> force is unchanged, so a Newton step keeps a regular matrix while the converged
     !> state is that of the exact law.
     !> `rounding`: the rounding error of the tension (get_tension_rounding).
+    !> `dforce_dlength0`: the derivative of the force on node 2 with respect to L0,
+    !> -c (dT/dlambda) lambda / L0 (a sliding flow changes L0).
+    !> `known_length`: norm2(x2 - x1) where the caller has it (it is not computed again).
     pure subroutine get_truss_response(law, spring, length0, x1, x2, &
-            tension, stretch, force, block, tangent_spring, rounding)
+            tension, stretch, force, block, tangent_spring, rounding, dforce_dlength0, &
+            known_length)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: spring, length0, x1(3), x2(3)
         real(wp), intent(out) :: tension, stretch, force(3)
         real(wp), intent(out), optional :: block(3, 3)
         real(wp), intent(in), optional :: tangent_spring
-        real(wp), intent(out), optional :: rounding
+        real(wp), intent(out), optional :: rounding, dforce_dlength0(3)
+        real(wp), intent(in), optional :: known_length
         real(wp) :: d(3), length, c(3), dtension, transverse, axial, k_tangent
         integer :: k
 
         d = x2 - x1
-        length = norm2(d)
+        if (present(known_length)) then
+            length = known_length
+        else
+            length = norm2(d)
+        end if
         stretch = length / length0
         call get_truss_tension(law, spring, stretch, tension, dtension)
         if (present(rounding)) rounding = get_tension_rounding(law, x1, x2, length, length0, &
@@ -72,6 +81,7 @@ contains
             c = 0.0_wp
         end if
         force = tension * c
+        if (present(dforce_dlength0)) dforce_dlength0 = -c * dtension * stretch / length0
         if (present(block)) then
             transverse = tension / length
             axial = dtension / length0

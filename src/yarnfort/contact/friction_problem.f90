@@ -103,6 +103,8 @@ module yarnfort_contact_friction_problem
         real(wp), allocatable :: internal(:), tension(:), stretch(:)
         !> Rounding error of each element's tension at that state (the row levels' noise).
         real(wp), allocatable :: rounding(:)
+        !> Each element's d(force on node 2)/dL0, from the Jacobian's element tangents.
+        real(wp), allocatable :: dforce_dl0(:, :)
         !> What the work arrays were last computed from (update_state): the unknowns, the
         !> frozen positions, the load factors and the spring weight. A solve asks for the
         !> same state several times (initial guess, row levels, the last iterate, the
@@ -153,6 +155,7 @@ contains
         allocate(self%x(3, scene%network%n_nodes()), self%length0(n_elements))
         allocate(self%internal(3 * scene%network%n_nodes()))
         allocate(self%tension(n_elements), self%stretch(n_elements), self%rounding(n_elements))
+        allocate(self%dforce_dl0(3, n_elements))
 
         allocate(self%element_clique(8, n_elements), source=0)
         do e = 1, n_elements
@@ -516,8 +519,7 @@ contains
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
-        integer :: e, p, n1, n2, a, b, slot
-        real(wp) :: tension, stretch, dtension, c(3), length
+        integer :: e, p, a, b, slot
         real(wp) :: dforce_dl0(3)
 
         call self%update_state(u, error)
@@ -532,21 +534,14 @@ contains
         values = 0.0_wp
         associate(scene => self%scene, net => self%scene%network)
             if (.not. self%positions_frozen) then
+                ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2,
+                ! from the tangents' own evaluation of each element.
                 call add_element_tangents(scene, self%element_slot, self%x, self%length0, &
-                    values, error, self%spring, self%tangent_spring)
+                    values, error, self%spring, self%tangent_spring, self%dforce_dl0)
                 if (allocated(error)) return
                 do e = 1, net%n_elements()
-                    n1 = net%element_nodes(1, e)
-                    n2 = net%element_nodes(2, e)
-                    ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2.
-                    length = norm2(self%x(:, n2) - self%x(:, n1))
-                    stretch = length / self%length0(e)
-                    call get_truss_tension(scene%laws(net%element_material(e))%law, &
-                        self%spring, stretch, tension, dtension)
-                    c = (self%x(:, n2) - self%x(:, n1)) / length
                     ! L0 changes by share(e) times the flows bounding its segment.
-                    dforce_dl0 = -c * dtension * stretch / self%length0(e) &
-                        * scene%passages%share(e)
+                    dforce_dl0 = self%dforce_dl0(:, e) * scene%passages%share(e)
                     do b = 7, 8
                         do a = 1, 6
                             slot = self%element_slot(a, b, e)
