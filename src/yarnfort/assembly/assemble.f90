@@ -32,18 +32,22 @@ contains
         real(wp), intent(in), optional :: spring
         !> Each tension's rounding error (get_tension_rounding), for the row levels.
         real(wp), intent(out), optional :: rounding(:)
-        integer :: e, n1, n2
+        integer :: e, n1, n2, n
         real(wp) :: force(3), weight
+        real(wp), allocatable :: position_norm(:)
 
         weight = 0.0_wp
         if (present(spring)) weight = spring
         internal = 0.0_wp
+        ! Each node's |x| once, not once per element at it (the roundings' r).
+        if (present(rounding)) position_norm = [(norm2(x(:, n)), n = 1, size(x, 2))]
         do e = 1, scene%network%n_elements()
             n1 = scene%network%element_nodes(1, e)
             n2 = scene%network%element_nodes(2, e)
             if (present(rounding)) then
                 call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
-                    force, error, rounding=rounding(e))
+                    force, error, rounding=rounding(e), &
+                    position_norm=position_norm(n1) + position_norm(n2))
             else
                 call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
                     force, error)
@@ -152,7 +156,7 @@ contains
     !> with `block`, its tangent; `spring`, `tangent_spring` as there) at node positions x,
     !> after checking that it has not degenerated to a point.
     subroutine get_element_response(scene, x, length0, e, spring, tension, stretch, force, &
-            error, block, tangent_spring, rounding, dforce_dlength0)
+            error, block, tangent_spring, rounding, dforce_dlength0, position_norm)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:)
         integer, intent(in) :: e
@@ -162,6 +166,8 @@ contains
         real(wp), intent(out), optional :: block(3, 3)
         real(wp), intent(in), optional :: tangent_spring
         real(wp), intent(out), optional :: rounding, dforce_dlength0(3)
+        !> norm2 of the element's two node positions, summed (for `rounding`).
+        real(wp), intent(in), optional :: position_norm
         real(wp) :: length
         character(len=160) :: buffer
 
@@ -176,7 +182,7 @@ contains
             end if
             call get_truss_response(scene%laws(scene%network%element_material(e))%law, spring, &
                 length0(e), x1, x2, tension, stretch, force, block, tangent_spring, rounding, &
-                dforce_dlength0, length)
+                dforce_dlength0, length, position_norm)
         end associate
     end subroutine get_element_response
 

@@ -88,7 +88,8 @@ contains
 
         length = norm2(x2 - x1)
         call get_truss_tension(law, spring, length / length0, tension, dtension)
-        noise = get_tension_rounding(law, x1, x2, length, length0, tension, dtension)
+        noise = get_tension_rounding(law, norm2(x1) + norm2(x2), length, length0, tension, &
+            dtension)
     end subroutine get_tension_with_noise
 
     !> The levels of the equilibrium rows (one per unknown coordinate) from the node
