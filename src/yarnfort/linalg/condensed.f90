@@ -44,6 +44,9 @@ module yarnfort_linalg_condensed
         !> pattern and, for each of its entries, the entry of the full matrix.
         integer(ik), allocatable :: reduced(:)
         integer(ik), allocatable :: reduced_col_ptr(:), reduced_row_index(:), source(:)
+        !> The reduced matrix's values, gathered here for `inner` (kept: a temporary of
+        !> this size was allocated and its pages cleared at every factorisation).
+        real(wp), allocatable :: reduced_values(:)
         integer(ik) :: n_reduced = 0
         !> The unknown of each reduced one, and the eliminated unknowns (increasing): what
         !> `solve` gathers and scatters.
@@ -132,7 +135,8 @@ contains
                 if (allocated(error)) return
                 self%inner_analysed = .true.
             end if
-            call self%inner%factor(values(self%source), error)
+            self%reduced_values = values(self%source)
+            call self%inner%factor(self%reduced_values, error)
             if (allocated(error)) return
         end if
     contains
@@ -213,13 +217,17 @@ contains
         real(wp), allocatable :: part(:, :)
 
         offset = self%col_ptr(self%first_candidate)
-        do e = 1, size(self%eliminated, kind=ik)
-            j = self%eliminated(e)
-            rhs(j, :) = rhs(j, :) / self%pivot(j)
-            do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
-                i = self%row_index(k) + 1
-                if (self%reduced(i) /= 0) &
-                    rhs(i, :) = rhs(i, :) - self%values(k - offset) * rhs(j, :)
+        ! Column by column (each column's arithmetic is its own; scalar updates, no
+        ! row sections of rhs).
+        do c = 1, size(rhs, 2, kind=ik)
+            do e = 1, size(self%eliminated, kind=ik)
+                j = self%eliminated(e)
+                rhs(j, c) = rhs(j, c) / self%pivot(j)
+                do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
+                    i = self%row_index(k) + 1
+                    if (self%reduced(i) /= 0) &
+                        rhs(i, c) = rhs(i, c) - self%values(k - offset) * rhs(j, c)
+                end do
             end do
         end do
         if (self%n_reduced == 0) return
@@ -282,6 +290,7 @@ contains
         if (allocated(self%reduced_col_ptr)) deallocate(self%reduced_col_ptr)
         if (allocated(self%reduced_row_index)) deallocate(self%reduced_row_index)
         if (allocated(self%source)) deallocate(self%source)
+        if (allocated(self%reduced_values)) deallocate(self%reduced_values)
         if (allocated(self%pivot)) deallocate(self%pivot)
         if (allocated(self%diagonal)) deallocate(self%diagonal)
         if (allocated(self%candidate_entry)) deallocate(self%candidate_entry)
