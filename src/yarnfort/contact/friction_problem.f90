@@ -109,9 +109,10 @@ module yarnfort_contact_friction_problem
         !> The loaded nodes and their channels' force magnitudes (get_loaded_nodes).
         integer, allocatable :: loaded(:)
         real(wp), allocatable :: load_magnitude(:, :)
-        !> The positions' prescribed part (dofs%get_prescribed) at the factors it was
-        !> taken at: it changes once per load step, the unknowns at every iterate.
-        real(wp), allocatable :: x_prescribed(:, :), prescribed_factors(:)
+        !> The positions' prescribed part (dofs%get_prescribed) and the applied forces
+        !> (3 * n_nodes) at the factors they were taken at (set_load): they change once
+        !> per load step, the unknowns at every iterate.
+        real(wp), allocatable :: x_prescribed(:, :), applied(:), load_factors(:)
         !> What the work arrays were last computed from (update_state): the unknowns, the
         !> frozen positions, the load factors and the spring weight. A solve asks for the
         !> same state several times (initial guess, row levels, the last iterate, the
@@ -296,14 +297,7 @@ contains
         end if
         self%state_valid = .false.
         associate(scene => self%scene)
-            if (.not. allocated(self%x_prescribed)) then
-                allocate(self%x_prescribed, mold=self%x)
-                self%prescribed_factors = self%factors
-                call scene%dofs%get_prescribed(self%factors, self%x_prescribed)
-            else if (any(self%prescribed_factors /= self%factors)) then
-                self%prescribed_factors = self%factors
-                call scene%dofs%get_prescribed(self%factors, self%x_prescribed)
-            end if
+            call set_load(self)
             ! dofs%expand, with the prescribed part kept.
             self%x = self%x_prescribed
             if (self%positions_frozen) then
@@ -324,6 +318,20 @@ contains
         self%state_spring = self%spring
         if (self%positions_frozen) self%state_u_frozen = self%u_frozen
     end subroutine update_state
+
+    !> The prescribed positions and the applied forces at the current factors.
+    subroutine set_load(self)
+        class(friction_problem_type), intent(inout) :: self
+
+        if (allocated(self%load_factors)) then
+            if (all(self%load_factors == self%factors)) return
+        end if
+        self%load_factors = self%factors
+        if (.not. allocated(self%x_prescribed)) allocate(self%x_prescribed, mold=self%x)
+        if (.not. allocated(self%applied)) allocate(self%applied, mold=self%internal)
+        call self%scene%dofs%get_prescribed(self%factors, self%x_prescribed)
+        call get_applied_force(self%scene, self%factors, self%applied)
+    end subroutine set_load
 
     pure subroutine get_passage_state(self, p, tension_before, tension_after, angle, dangle)
         class(friction_problem_type), intent(in) :: self
@@ -500,9 +508,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer :: p, row
         real(wp) :: t_before, t_after, angle, critical, dcrit_dt, dcrit_da, flow
-        real(wp), allocatable :: applied(:)
 
-        allocate(applied(size(self%internal)))
         call self%update_state(u, error)
         if (allocated(error)) return
         row = 0
@@ -510,8 +516,8 @@ contains
         if (self%semismooth) call self%choose_modes(u(row + 1:))
         row = 0
         if (.not. self%positions_frozen) then
-            call get_applied_force(self%scene, self%factors, applied)
-            call self%scene%dofs%gather(self%internal - applied, values(1:self%n_x))
+            ! The applied forces at these factors: update_state (set_load).
+            call self%scene%dofs%gather(self%internal - self%applied, values(1:self%n_x))
             row = self%n_x
         end if
         do p = 1, self%n_p
