@@ -223,6 +223,11 @@ contains
             do e = 1, size(self%eliminated, kind=ik)
                 j = self%eliminated(e)
                 rhs(j, c) = rhs(j, c) / self%pivot(j)
+                ! A zero moves nothing to the other rows (no value changes; at most the sign
+                ! of a zero would). Almost every stick flow's row is met exactly after the
+                ! first step: 221,324 of 221,356 eliminated entries on the woven cycle of
+                ! 10,120 unknowns were 0.
+                if (rhs(j, c) == 0.0_wp) cycle
                 do k = self%col_ptr(j) + 1, self%col_ptr(j + 1)
                     i = self%row_index(k) + 1
                     if (self%reduced(i) /= 0) &
