@@ -45,8 +45,6 @@ module yarnfort_linalg_bordered
         !> Pattern of K as analysed by `leading`, and for each of its entries the entry of
         !> the whole matrix.
         integer(ik), allocatable :: leading_col_ptr(:), leading_row_index(:), source(:)
-        !> K's values, gathered here for `leading` (kept, as in the condensed solver).
-        real(wp), allocatable :: leading_values(:)
         logical :: leading_analysed = .false.
         !> K^-1 B (n_leading x m) and the Schur complement's solver.
         real(wp), allocatable :: coupling(:, :)
@@ -196,8 +194,7 @@ contains
         real(wp), allocatable :: s(:, :)
         integer(ik) :: m, c, k, j
 
-        self%leading_values = values(self%source)
-        call self%leading%factor(self%leading_values, error)
+        call self%leading%factor(values(self%source), error)
         if (allocated(error)) then
             self%n_leading_failures = self%n_leading_failures + 1
             self%skip_patterns = self%next_skip
@@ -275,7 +272,6 @@ contains
         if (allocated(self%c_column)) deallocate(self%c_column)
         if (allocated(self%c_values)) deallocate(self%c_values)
         if (allocated(self%source)) deallocate(self%source)
-        if (allocated(self%leading_values)) deallocate(self%leading_values)
         self%use_border = .false.
     end subroutine release
 
