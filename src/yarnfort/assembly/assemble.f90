@@ -32,18 +32,22 @@ contains
         real(wp), intent(in), optional :: spring
         !> Each tension's rounding error (get_tension_rounding), for the row levels.
         real(wp), intent(out), optional :: rounding(:)
-        integer :: e, n1, n2
+        integer :: e, n1, n2, n
         real(wp) :: force(3), weight
+        real(wp), allocatable :: position_norm(:)
 
         weight = 0.0_wp
         if (present(spring)) weight = spring
         internal = 0.0_wp
+        ! Each node's |x| once, not once per element at it (the roundings' r).
+        if (present(rounding)) position_norm = [(norm2(x(:, n)), n = 1, size(x, 2))]
         do e = 1, scene%network%n_elements()
             n1 = scene%network%element_nodes(1, e)
             n2 = scene%network%element_nodes(2, e)
             if (present(rounding)) then
                 call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
-                    force, error, rounding=rounding(e))
+                    force, error, rounding=rounding(e), &
+                    position_norm=position_norm(n1) + position_norm(n2))
             else
                 call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
                     force, error)
@@ -108,15 +112,18 @@ contains
     !> a, b <= 6 of each element's slot table: node 1 xyz, node 2 xyz; 0 = skip).
     !> `spring`: the regularising spring in the model (predictor solves); `tangent_spring`:
     !> the spring in the tangent of slack strings only (get_truss_response). Both absent:
-    !> the exact tangent of the exact law.
+    !> the exact tangent of the exact law. `dforce_dlength0` (3, n_elements): each
+    !> element's derivative of its node-2 force with respect to L0, from the same
+    !> evaluation (for the flows of sliding contact).
     subroutine add_element_tangents(scene, element_slot, x, length0, values, error, spring, &
-            tangent_spring)
+            tangent_spring, dforce_dlength0)
         type(scene_type), intent(in) :: scene
         integer, intent(in) :: element_slot(:, :, :)
         real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(inout) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(in), optional :: spring, tangent_spring
+        real(wp), intent(out), optional :: dforce_dlength0(:, :)
         integer :: e, a, b, slot
         real(wp) :: force(3), block(3, 3), tension, stretch, sign_ab, weight, tangent_weight
 
@@ -126,8 +133,13 @@ contains
         if (present(tangent_spring)) tangent_weight = tangent_spring
 
         do e = 1, scene%network%n_elements()
-            call get_element_response(scene, x, length0, e, weight, tension, stretch, force, &
-                error, block, tangent_weight)
+            if (present(dforce_dlength0)) then
+                call get_element_response(scene, x, length0, e, weight, tension, stretch, &
+                    force, error, block, tangent_weight, dforce_dlength0=dforce_dlength0(:, e))
+            else
+                call get_element_response(scene, x, length0, e, weight, tension, stretch, &
+                    force, error, block, tangent_weight)
+            end if
             if (allocated(error)) return
             do b = 1, 6
                 do a = 1, 6
@@ -144,7 +156,7 @@ contains
     !> with `block`, its tangent; `spring`, `tangent_spring` as there) at node positions x,
     !> after checking that it has not degenerated to a point.
     subroutine get_element_response(scene, x, length0, e, spring, tension, stretch, force, &
-            error, block, tangent_spring, rounding)
+            error, block, tangent_spring, rounding, dforce_dlength0, position_norm)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:)
         integer, intent(in) :: e
@@ -153,7 +165,9 @@ contains
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(out), optional :: block(3, 3)
         real(wp), intent(in), optional :: tangent_spring
-        real(wp), intent(out), optional :: rounding
+        real(wp), intent(out), optional :: rounding, dforce_dlength0(3)
+        !> norm2 of the element's two node positions, summed (for `rounding`).
+        real(wp), intent(in), optional :: position_norm
         real(wp) :: length
         character(len=160) :: buffer
 
@@ -167,7 +181,8 @@ contains
                 return
             end if
             call get_truss_response(scene%laws(scene%network%element_material(e))%law, spring, &
-                length0(e), x1, x2, tension, stretch, force, block, tangent_spring, rounding)
+                length0(e), x1, x2, tension, stretch, force, block, tangent_spring, rounding, &
+                dforce_dlength0, length, position_norm)
         end associate
     end subroutine get_element_response
 

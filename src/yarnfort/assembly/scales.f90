@@ -6,7 +6,7 @@
 !> not with a material stiffness or a choice of units.
 module yarnfort_assembly_scales
     use yarnfort_kinds, only: wp
-    use yarnfort_scene_scene, only: scene_type, get_node_force_scale
+    use yarnfort_scene_scene, only: scene_type, get_loaded_nodes, get_force_scale
     use yarnfort_assembly_truss, only: get_truss_tension, get_tension_rounding
     use yarnfort_material_law, only: force_law_type
     implicit none
@@ -32,7 +32,8 @@ contains
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:), factors(:), spring
         real(wp), intent(out) :: level(:), noise(:), max_force
-        real(wp), allocatable :: tension(:), rounding(:)
+        real(wp), allocatable :: tension(:), rounding(:), magnitude(:, :)
+        integer, allocatable :: loaded(:)
         integer :: e
 
         allocate(tension(scene%network%n_elements()), rounding(scene%network%n_elements()))
@@ -42,15 +43,20 @@ contains
                     spring, x(:, nodes(1)), x(:, nodes(2)), length0(e), tension(e), rounding(e))
             end associate
         end do
-        call gather_node_force_levels(scene, tension, rounding, factors, level, noise, max_force)
+        call get_loaded_nodes(scene, loaded, magnitude)
+        call gather_node_force_levels(scene, tension, rounding, factors, loaded, magnitude, &
+            level, noise, max_force)
     end subroutine get_node_force_levels
 
     !> The same from each element's tension and its rounding error, where these are at
-    !> hand (assemble_internal_force gives them with the internal force).
-    pure subroutine gather_node_force_levels(scene, tension, rounding, factors, level, noise, &
-            max_force)
+    !> hand (assemble_internal_force gives them with the internal force), and the loaded
+    !> nodes with their channels' force magnitudes (get_loaded_nodes; at every other
+    !> node the applied force's scale is 0).
+    pure subroutine gather_node_force_levels(scene, tension, rounding, factors, loaded, &
+            magnitude, level, noise, max_force)
         type(scene_type), intent(in) :: scene
-        real(wp), intent(in) :: tension(:), rounding(:), factors(:)
+        real(wp), intent(in) :: tension(:), rounding(:), factors(:), magnitude(:, :)
+        integer, intent(in) :: loaded(:)
         real(wp), intent(out) :: level(:), noise(:), max_force
         integer :: e, n, k
 
@@ -64,8 +70,9 @@ contains
                 end do
             end associate
         end do
-        do n = 1, size(level)
-            level(n) = max(level(n), get_node_force_scale(scene, factors, n))
+        do k = 1, size(loaded)
+            n = loaded(k)
+            level(n) = max(level(n), get_force_scale(factors, magnitude(:, k)))
         end do
         max_force = maxval([0.0_wp, level])
         level = max(level, node_level_floor * max_force)
@@ -81,7 +88,8 @@ contains
 
         length = norm2(x2 - x1)
         call get_truss_tension(law, spring, length / length0, tension, dtension)
-        noise = get_tension_rounding(law, x1, x2, length, length0, tension, dtension)
+        noise = get_tension_rounding(law, norm2(x1) + norm2(x2), length, length0, tension, &
+            dtension)
     end subroutine get_tension_with_noise
 
     !> The levels of the equilibrium rows (one per unknown coordinate) from the node

@@ -49,29 +49,47 @@ contains
     !> force is unchanged, so a Newton step keeps a regular matrix while the converged
     !> state is that of the exact law.
     !> `rounding`: the rounding error of the tension (get_tension_rounding).
+    !> `dforce_dlength0`: the derivative of the force on node 2 with respect to L0,
+    !> -c (dT/dlambda) lambda / L0 (a sliding flow changes L0).
+    !> `known_length`: norm2(x2 - x1), `position_norm`: norm2(x1) + norm2(x2) (for
+    !> `rounding`), where the caller has them (they are not computed again).
     pure subroutine get_truss_response(law, spring, length0, x1, x2, &
-            tension, stretch, force, block, tangent_spring, rounding)
+            tension, stretch, force, block, tangent_spring, rounding, dforce_dlength0, &
+            known_length, position_norm)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: spring, length0, x1(3), x2(3)
         real(wp), intent(out) :: tension, stretch, force(3)
         real(wp), intent(out), optional :: block(3, 3)
         real(wp), intent(in), optional :: tangent_spring
-        real(wp), intent(out), optional :: rounding
+        real(wp), intent(out), optional :: rounding, dforce_dlength0(3)
+        real(wp), intent(in), optional :: known_length, position_norm
         real(wp) :: d(3), length, c(3), dtension, transverse, axial, k_tangent
         integer :: k
 
         d = x2 - x1
-        length = norm2(d)
+        if (present(known_length)) then
+            length = known_length
+        else
+            length = norm2(d)
+        end if
         stretch = length / length0
         call get_truss_tension(law, spring, stretch, tension, dtension)
-        if (present(rounding)) rounding = get_tension_rounding(law, x1, x2, length, length0, &
-            tension, dtension)
+        if (present(rounding)) then
+            if (present(position_norm)) then
+                rounding = get_tension_rounding(law, position_norm, length, length0, tension, &
+                    dtension)
+            else
+                rounding = get_tension_rounding(law, norm2(x1) + norm2(x2), length, length0, &
+                    tension, dtension)
+            end if
+        end if
         if (length > 0.0_wp) then
             c = d / length
         else
             c = 0.0_wp
         end if
         force = tension * c
+        if (present(dforce_dlength0)) dforce_dlength0 = -c * dtension * stretch / length0
         if (present(block)) then
             transverse = tension / length
             axial = dtension / length0
@@ -90,17 +108,18 @@ contains
     end subroutine get_truss_response
 
     !> Rounding error of the tension of an element with nodes at x1, x2 (length l,
-    !> reference length L0), computed as get_truss_tension gives tension and dtension:
+    !> reference length L0; position_norm = |x1| + |x2|), computed as get_truss_tension
+    !> gives tension and dtension:
     !> rounding_factor * eps * (|T| + r |dT/dlambda|), r = (|x1| + |x2| + l) / L0. A
     !> string within that rounding of stretch 1 (the kink of the tension-only law)
     !> counts with the slope of its taut side.
-    pure real(wp) function get_tension_rounding(law, x1, x2, length, length0, tension, &
+    pure real(wp) function get_tension_rounding(law, position_norm, length, length0, tension, &
             dtension) result(rounding)
         class(force_law_type), intent(in) :: law
-        real(wp), intent(in) :: x1(3), x2(3), length, length0, tension, dtension
+        real(wp), intent(in) :: position_norm, length, length0, tension, dtension
         real(wp) :: r, slope
 
-        r = (norm2(x1) + norm2(x2) + length) / length0
+        r = (position_norm + length) / length0
         slope = dtension
         if (dtension == 0.0_wp .and. length / length0 > 1.0_wp - rounding_factor &
                 * epsilon(1.0_wp) * r) slope = law%get_reference_stiffness()

@@ -50,7 +50,8 @@
 module yarnfort_contact_friction_problem
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_scene_scene, only: scene_type, get_applied_force, get_node_force_scale
+    use yarnfort_scene_scene, only: scene_type, get_applied_force, get_loaded_nodes, &
+        get_force_scale
     use yarnfort_assembly_truss, only: get_truss_tension
     use yarnfort_assembly_pattern, only: build_clique_pattern
     use yarnfort_assembly_assemble, only: assemble_internal_force, add_element_tangents
@@ -103,6 +104,15 @@ module yarnfort_contact_friction_problem
         real(wp), allocatable :: internal(:), tension(:), stretch(:)
         !> Rounding error of each element's tension at that state (the row levels' noise).
         real(wp), allocatable :: rounding(:)
+        !> Each element's d(force on node 2)/dL0, from the Jacobian's element tangents.
+        real(wp), allocatable :: dforce_dl0(:, :)
+        !> The loaded nodes and their channels' force magnitudes (get_loaded_nodes).
+        integer, allocatable :: loaded(:)
+        real(wp), allocatable :: load_magnitude(:, :)
+        !> The positions' prescribed part (dofs%get_prescribed) and the applied forces
+        !> (3 * n_nodes) at the factors they were taken at (set_load): they change once
+        !> per load step, the unknowns at every iterate.
+        real(wp), allocatable :: x_prescribed(:, :), applied(:), load_factors(:)
         !> What the work arrays were last computed from (update_state): the unknowns, the
         !> frozen positions, the load factors and the spring weight. A solve asks for the
         !> same state several times (initial guess, row levels, the last iterate, the
@@ -153,6 +163,8 @@ contains
         allocate(self%x(3, scene%network%n_nodes()), self%length0(n_elements))
         allocate(self%internal(3 * scene%network%n_nodes()))
         allocate(self%tension(n_elements), self%stretch(n_elements), self%rounding(n_elements))
+        allocate(self%dforce_dl0(3, n_elements))
+        call get_loaded_nodes(scene, self%loaded, self%load_magnitude)
 
         allocate(self%element_clique(8, n_elements), source=0)
         do e = 1, n_elements
@@ -285,11 +297,14 @@ contains
         end if
         self%state_valid = .false.
         associate(scene => self%scene)
+            call set_load(self)
+            ! dofs%expand, with the prescribed part kept.
+            self%x = self%x_prescribed
             if (self%positions_frozen) then
-                call scene%dofs%expand(self%u_frozen, self%factors, self%x)
+                call scene%dofs%add_unknowns(self%u_frozen, self%x)
                 call scene%passages%get_length0(scene%network%length0, u, self%length0)
             else
-                call scene%dofs%expand(u(1:self%n_x), self%factors, self%x)
+                call scene%dofs%add_unknowns(u(1:self%n_x), self%x)
                 call scene%passages%get_length0(scene%network%length0, u(self%n_x + 1:), &
                     self%length0)
             end if
@@ -303,6 +318,20 @@ contains
         self%state_spring = self%spring
         if (self%positions_frozen) self%state_u_frozen = self%u_frozen
     end subroutine update_state
+
+    !> The prescribed positions and the applied forces at the current factors.
+    subroutine set_load(self)
+        class(friction_problem_type), intent(inout) :: self
+
+        if (allocated(self%load_factors)) then
+            if (all(self%load_factors == self%factors)) return
+        end if
+        self%load_factors = self%factors
+        if (.not. allocated(self%x_prescribed)) allocate(self%x_prescribed, mold=self%x)
+        if (.not. allocated(self%applied)) allocate(self%applied, mold=self%internal)
+        call self%scene%dofs%get_prescribed(self%factors, self%x_prescribed)
+        call get_applied_force(self%scene, self%factors, self%applied)
+    end subroutine set_load
 
     pure subroutine get_passage_state(self, p, tension_before, tension_after, angle, dangle)
         class(friction_problem_type), intent(in) :: self
@@ -401,10 +430,11 @@ contains
     !> tension and the largest applied nodal force.
     real(wp) function get_force_level(self) result(level)
         class(friction_problem_type), intent(in) :: self
-        integer :: n
+        integer :: k
         level = maxval([0.0_wp, abs(self%tension)])
-        do n = 1, self%scene%network%n_nodes()
-            level = max(level, get_node_force_scale(self%scene, self%factors, n))
+        ! At the other nodes the applied force's scale is 0 (get_loaded_nodes).
+        do k = 1, size(self%loaded)
+            level = max(level, get_force_scale(self%factors, self%load_magnitude(:, k)))
         end do
     end function get_force_level
 
@@ -431,7 +461,7 @@ contains
         ! per cycle step, same run: woven 10,120 unknowns 9.94 -> 8.99 ms, 96,600 180.4 ->
         ! 167.9 ms; the same counts, forces bitwise equal on 47 scenes.
         call gather_node_force_levels(self%scene, self%tension, self%rounding, self%factors, &
-            node_level, node_noise, max_force)
+            self%loaded, self%load_magnitude, node_level, node_noise, max_force)
         row = 0
         if (.not. self%positions_frozen) then
             call get_unknown_levels(self%scene, node_level, node_noise, level(1:self%n_x), &
@@ -478,9 +508,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer :: p, row
         real(wp) :: t_before, t_after, angle, critical, dcrit_dt, dcrit_da, flow
-        real(wp), allocatable :: applied(:)
 
-        allocate(applied(size(self%internal)))
         call self%update_state(u, error)
         if (allocated(error)) return
         row = 0
@@ -488,8 +516,8 @@ contains
         if (self%semismooth) call self%choose_modes(u(row + 1:))
         row = 0
         if (.not. self%positions_frozen) then
-            call get_applied_force(self%scene, self%factors, applied)
-            call self%scene%dofs%gather(self%internal - applied, values(1:self%n_x))
+            ! The applied forces at these factors: update_state (set_load).
+            call self%scene%dofs%gather(self%internal - self%applied, values(1:self%n_x))
             row = self%n_x
         end if
         do p = 1, self%n_p
@@ -516,8 +544,7 @@ contains
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
-        integer :: e, p, n1, n2, a, b, slot
-        real(wp) :: tension, stretch, dtension, c(3), length
+        integer :: e, p, a, b, slot
         real(wp) :: dforce_dl0(3)
 
         call self%update_state(u, error)
@@ -532,21 +559,14 @@ contains
         values = 0.0_wp
         associate(scene => self%scene, net => self%scene%network)
             if (.not. self%positions_frozen) then
+                ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2,
+                ! from the tangents' own evaluation of each element.
                 call add_element_tangents(scene, self%element_slot, self%x, self%length0, &
-                    values, error, self%spring, self%tangent_spring)
+                    values, error, self%spring, self%tangent_spring, self%dforce_dl0)
                 if (allocated(error)) return
                 do e = 1, net%n_elements()
-                    n1 = net%element_nodes(1, e)
-                    n2 = net%element_nodes(2, e)
-                    ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2.
-                    length = norm2(self%x(:, n2) - self%x(:, n1))
-                    stretch = length / self%length0(e)
-                    call get_truss_tension(scene%laws(net%element_material(e))%law, &
-                        self%spring, stretch, tension, dtension)
-                    c = (self%x(:, n2) - self%x(:, n1)) / length
                     ! L0 changes by share(e) times the flows bounding its segment.
-                    dforce_dl0 = -c * dtension * stretch / self%length0(e) &
-                        * scene%passages%share(e)
+                    dforce_dl0 = self%dforce_dl0(:, e) * scene%passages%share(e)
                     do b = 7, 8
                         do a = 1, 6
                             slot = self%element_slot(a, b, e)

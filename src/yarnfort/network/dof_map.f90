@@ -33,6 +33,10 @@ module yarnfort_network_dof_map
         procedure :: get_gap_factor
         !> Coordinates x (3, n_nodes) from unknowns u at the channels' factors.
         procedure :: expand
+        !> The part of x that does not depend on u (x at u = 0).
+        procedure :: get_prescribed
+        !> x <- x + the unknowns' part (expand is get_prescribed, then this).
+        procedure :: add_unknowns
         !> Unknowns u from coordinates x (the inverse on free coordinates).
         procedure :: restrict
         !> Add a full coordinate vector into unknown space (transpose of the map).
@@ -44,6 +48,17 @@ contains
     pure subroutine expand(self, u, factors, x)
         class(dof_map_type), intent(in) :: self
         real(wp), intent(in) :: u(:), factors(:)
+        real(wp), intent(out) :: x(:, :)
+
+        call self%get_prescribed(factors, x)
+        call self%add_unknowns(u, x)
+    end subroutine expand
+
+    !> A caller that keeps the prescribed part for its factors (it changes once per
+    !> load step, u at every iterate) gets expand's x, bitwise, from add_unknowns alone.
+    pure subroutine get_prescribed(self, factors, x)
+        class(dof_map_type), intent(in) :: self
+        real(wp), intent(in) :: factors(:)
         real(wp), intent(out) :: x(:, :)
         integer :: i, node, k, c
         real(wp) :: gap_change
@@ -61,9 +76,22 @@ contains
                 x(k, node) = x(k, node) + factors(c) * self%delta(i, c)
             end do
             if (allocated(self%gap)) x(k, node) = x(k, node) + gap_change * self%gap(i)
-            if (self%unknown(i) > 0) x(k, node) = x(k, node) + u(self%unknown(i))
         end do
-    end subroutine expand
+    end subroutine get_prescribed
+
+    pure subroutine add_unknowns(self, u, x)
+        class(dof_map_type), intent(in) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(inout) :: x(:, :)
+        integer :: i, node, k
+
+        do i = 1, size(self%unknown)
+            if (self%unknown(i) <= 0) cycle
+            node = (i - 1) / 3 + 1
+            k = i - 3 * (node - 1)
+            x(k, node) = x(k, node) + u(self%unknown(i))
+        end do
+    end subroutine add_unknowns
 
     pure real(wp) function get_gap_factor(self, p_disp) result(factor)
         class(dof_map_type), intent(in) :: self

@@ -11,7 +11,7 @@ module yarnfort_scene_scene
     private
 
     public :: scene_type, law_holder_type, support_set_type, load_set_type, load_path_type
-    public :: get_applied_force, get_node_force_scale
+    public :: get_applied_force, get_node_force_scale, get_loaded_nodes, get_force_scale
 
     !> One yarn type's force law.
     type :: law_holder_type
@@ -130,11 +130,40 @@ contains
         integer, intent(in) :: n
         integer :: c
 
-        scale = 0.0_wp
-        do c = 1, size(scene%external_force, 2)
-            scale = scale + abs(factors(c)) * norm2(scene%external_force(3 * n - 2:3 * n, c))
-        end do
+        scale = get_force_scale(factors, [(norm2(scene%external_force(3 * n - 2:3 * n, c)), &
+            c = 1, size(scene%external_force, 2))])
     end function get_node_force_scale
+
+    !> get_node_force_scale from the magnitudes of the channels' forces at the node.
+    pure real(wp) function get_force_scale(factors, magnitude) result(scale)
+        real(wp), intent(in) :: factors(:), magnitude(:)
+        integer :: c
+
+        scale = 0.0_wp
+        do c = 1, size(magnitude)
+            scale = scale + abs(factors(c)) * magnitude(c)
+        end do
+    end function get_force_scale
+
+    !> The nodes where some channel applies a force, and each channel's magnitude there
+    !> (n_channels, n_loaded). Elsewhere get_node_force_scale is 0 at any factors, so a
+    !> caller that asks at every iterate (the row levels) need only visit these.
+    pure subroutine get_loaded_nodes(scene, nodes, magnitude)
+        type(scene_type), intent(in) :: scene
+        integer, allocatable, intent(out) :: nodes(:)
+        real(wp), allocatable, intent(out) :: magnitude(:, :)
+        integer :: n, c
+
+        nodes = pack([(n, n = 1, size(scene%external_force, 1) / 3)], &
+            [(any(scene%external_force(3 * n - 2:3 * n, :) /= 0.0_wp), &
+            n = 1, size(scene%external_force, 1) / 3)])
+        allocate(magnitude(size(scene%external_force, 2), size(nodes)))
+        do n = 1, size(nodes)
+            do c = 1, size(scene%external_force, 2)
+                magnitude(c, n) = norm2(scene%external_force(3 * nodes(n) - 2:3 * nodes(n), c))
+            end do
+        end do
+    end subroutine get_loaded_nodes
 
     pure integer function n_channels(self)
         class(load_path_type), intent(in) :: self
