@@ -110,8 +110,10 @@ module yarnfort_solver_newton
         real(c_double), pointer :: row_weight(:) => null()
         type(error_type), allocatable :: error
         character(len=:), allocatable :: kinsol_message
-        !> Accumulated wall time of residual and Jacobian assembly.
-        real(wp) :: residual_time = 0.0_wp, jacobian_time = 0.0_wp
+        !> Accumulated wall time of residual and Jacobian assembly, and of the row
+        !> levels (get_row_levels: the first call at a new iterate also computes the
+        !> problem's state, which the residual there then finds done).
+        real(wp) :: residual_time = 0.0_wp, jacobian_time = 0.0_wp, levels_time = 0.0_wp
     end type equilibrium_type
 
     !> Owns KINSOL's memory, vectors, matrix and the linear solver for one scene.
@@ -586,7 +588,6 @@ contains
         real(wp), allocatable :: residual(:), step(:), history(:), values(:)
         real(wp), allocatable :: z(:, :), capacity(:, :), y(:), entry_value(:)
         integer, allocatable :: slot(:), entry_slot(:), entry_column(:)
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
         type(dense_solver_type) :: correction
         integer :: k, n_rows, j, e, n_entries, a, b, i
         real(wp) :: f
@@ -598,7 +599,8 @@ contains
         if (self%kept_factorisation /= self%adapter%n_factorisations) return
         if (.not. allocated(self%kept_values)) return
         associate(problem => self%problem%problem, tol => self%options%residual_tolerance, &
-                n => size(u))
+                n => size(u), col_ptr => self%problem%problem%col_ptr, &
+                row_index => self%problem%problem%row_index)
             self%u = u
             allocate(residual(n), step(n))
             call get_scaled_residual(self, residual, f, trial_error)
@@ -614,8 +616,6 @@ contains
                 call evaluate_timed(self%problem, self%u, .true., values, trial_error)
                 stats%jacobian_evaluations = stats%jacobian_evaluations + 1
                 if (allocated(trial_error)) return
-                allocate(col_ptr(n + 1), row_index(self%problem%nnz))
-                call problem%copy_pattern(col_ptr, row_index)
                 allocate(slot(n), source=0)
                 do a = 1, n_rows
                     slot(rows(a)) = a
@@ -705,11 +705,11 @@ contains
         class(newton_solver_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
 
-        allocate(col_ptr(size(u) + 1), row_index(self%problem%nnz))
-        call self%problem%problem%copy_pattern(col_ptr, row_index)
-        call analyse_once(self, col_ptr, row_index, error)
+        ! The problem's own pattern (fixed for its lifetime), not a copy per solve.
+        associate(problem => self%problem%problem)
+            call analyse_once(self, problem%col_ptr, problem%row_index, error)
+        end associate
         if (allocated(error)) return
         ! New row weights (prepare_solve): the kept factors no longer match them.
         self%kept_factorisation = -1
@@ -814,7 +814,7 @@ contains
             if (allocated(error)) return
             self%u = u
             allocate(residual(n), step(n), level(n), noise(n), shift(n))
-            call problem%get_row_levels(self%u, level, noise, error)
+            call get_levels_timed(self%problem, self%u, level, noise, error)
             if (allocated(error)) return
             shift = max(level, tiny(1.0_wp)) / problem%length_scale
             call set_row_weights(self, .false., error)
@@ -884,7 +884,7 @@ contains
         real(wp), allocatable :: level(:), noise(:)
 
         allocate(level(size(self%u)), noise(size(self%u)))
-        call self%problem%problem%get_row_levels(self%u, level, noise, error)
+        call get_levels_timed(self%problem, self%u, level, noise, error)
         if (allocated(error)) return
         level = level + noise / self%options%residual_tolerance
         if (uniform) level = maxval([0.0_wp, level])
@@ -894,6 +894,18 @@ contains
             self%f_scale_data = 1.0_wp
         end where
     end subroutine set_row_weights
+
+    !> The problem's row levels at u; the wall time goes to levels_time (get_timings).
+    subroutine get_levels_timed(problem, u, level, noise, error)
+        type(equilibrium_type), intent(inout) :: problem
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: level(:), noise(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: start
+        start = wall_time()
+        call problem%problem%get_row_levels(u, level, noise, error)
+        problem%levels_time = problem%levels_time + (wall_time() - start)
+    end subroutine get_levels_timed
 
     !> KINSOL residual callback F(u).
     integer(c_int) function residual_callback(sunvec_u, sunvec_f, user_data) &
@@ -998,14 +1010,17 @@ contains
         problem%kinsol_message = transfer(text, problem%kinsol_message)
     end subroutine error_handler
 
-    !> Accumulated figures: assembly (residual, Jacobian) and linear algebra times.
+    !> Accumulated figures: assembly (residual, Jacobian) and linear algebra times, and
+    !> the row levels' time (`levels_time`: the state's computation at most iterates).
     subroutine get_timings(self, residual_time, jacobian_time, analyse_time, factor_time, &
-            solve_time, n_factorisations, n_solves)
+            solve_time, n_factorisations, n_solves, levels_time)
         class(newton_solver_type), intent(in) :: self
         real(wp), intent(out) :: residual_time, jacobian_time, analyse_time, factor_time
         real(wp), intent(out) :: solve_time
         integer, intent(out) :: n_factorisations
         integer, intent(out), optional :: n_solves
+        real(wp), intent(out), optional :: levels_time
+        if (present(levels_time)) levels_time = 0.0_wp
         if (.not. associated(self%problem)) then
             residual_time = 0.0_wp
             jacobian_time = 0.0_wp
@@ -1023,6 +1038,7 @@ contains
         solve_time = self%adapter%solve_time
         n_factorisations = self%adapter%n_factorisations
         if (present(n_solves)) n_solves = self%adapter%n_solves
+        if (present(levels_time)) levels_time = self%problem%levels_time
     end subroutine get_timings
 
     subroutine destroy(self)
