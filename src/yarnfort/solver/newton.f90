@@ -356,7 +356,7 @@ contains
         integer(c_long) :: count(1)
         real(c_double) :: residual(size(u))
         integer :: round, attempt, n_attempts
-        logical :: converged
+        logical :: converged, finite
         character(len=200) :: buffer
 
         ! KINSOL's factors and prepare_solve's weights are not those of newton_step.
@@ -408,7 +408,7 @@ contains
                     deallocate(error)
                     exit
                 end if
-                stats%residual_norm = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+                call get_scaled_norm(residual, self%f_scale_data, stats%residual_norm, finite)
                 ! Our test decides: a line search that stalls at a converged iterate is fine.
                 converged = stats%residual_norm <= self%options%residual_tolerance
                 if (ierr < 0 .or. converged) exit
@@ -764,17 +764,38 @@ contains
         real(wp), intent(out) :: residual(:), f
         type(error_type), allocatable, intent(out) :: error
 
+        logical :: finite
+
         f = huge(1.0_wp)
         call set_row_weights(self, .false., error)
         if (allocated(error)) return
         call evaluate_timed(self%problem, self%u, .false., residual, error)
         if (allocated(error)) return
-        if (.not. all(ieee_is_finite(residual))) then
+        call get_scaled_norm(residual, self%f_scale_data, f, finite)
+        if (.not. finite) then
+            f = huge(1.0_wp)
             call fatal_error(error, 'the residual is not a finite number (NaN or an overflow)')
             return
         end if
-        f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
     end subroutine get_scaled_residual
+
+    !> f = maxval([0, |residual| * weight]) (a NaN product is passed over, as by maxval)
+    !> and whether every residual entry is finite, in one pass without a temporary.
+    pure subroutine get_scaled_norm(residual, weight, f, finite)
+        real(wp), intent(in) :: residual(:), weight(:)
+        real(wp), intent(out) :: f
+        logical, intent(out) :: finite
+        real(wp) :: scaled
+        integer :: i
+
+        f = 0.0_wp
+        finite = .true.
+        do i = 1, size(residual)
+            finite = finite .and. ieee_is_finite(residual(i))
+            scaled = abs(residual(i)) * weight(i)
+            if (scaled > f) f = scaled
+        end do
+    end subroutine get_scaled_norm
 
     !> Pseudo-transient continuation (switched evolution relaxation): Newton steps on
     !> F(u) + mu D du = 0, D_i = level_i / length_scale, with mu falling as the scaled
@@ -796,6 +817,7 @@ contains
         integer, allocatable :: diagonal(:)
         integer :: i, k, iteration
         real(wp) :: mu, f, merit, merit_trial
+        logical :: finite
 
         converged = .false.
         associate(problem => self%problem%problem, n => size(u))
@@ -821,7 +843,7 @@ contains
             if (allocated(error)) return
             call evaluate_timed(self%problem, self%u, .false., residual, error)
             if (allocated(error)) return
-            f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+            call get_scaled_norm(residual, self%f_scale_data, f, finite)
             merit = norm2(residual * self%f_scale_data)
             mu = 1.0_wp
             do iteration = 1, transient_iterations * self%options%max_iterations
@@ -855,7 +877,7 @@ contains
                     ! The levels follow the state (as in solve_once).
                     call set_row_weights(self, .false., error)
                     if (allocated(error)) return
-                    f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+                    call get_scaled_norm(residual, self%f_scale_data, f, finite)
                     merit = norm2(residual * self%f_scale_data)
                 else
                     mu = 10 * mu
@@ -882,17 +904,31 @@ contains
         logical, intent(in) :: uniform
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: level(:), noise(:)
+        real(wp) :: row_level
+        integer :: i
 
         allocate(level(size(self%u)), noise(size(self%u)))
         call get_levels_timed(self%problem, self%u, level, noise, error)
         if (allocated(error)) return
-        level = level + noise / self%options%residual_tolerance
-        if (uniform) level = maxval([0.0_wp, level])
-        where (level > 0.0_wp)
-            self%f_scale_data = 1.0_wp / level
-        elsewhere
-            self%f_scale_data = 1.0_wp
-        end where
+        if (uniform) then
+            level = level + noise / self%options%residual_tolerance
+            level = maxval([0.0_wp, level])
+            where (level > 0.0_wp)
+                self%f_scale_data = 1.0_wp / level
+            elsewhere
+                self%f_scale_data = 1.0_wp
+            end where
+            return
+        end if
+        ! The same arithmetic in one pass (the weights at every new iterate).
+        do i = 1, size(level)
+            row_level = level(i) + noise(i) / self%options%residual_tolerance
+            if (row_level > 0.0_wp) then
+                self%f_scale_data(i) = 1.0_wp / row_level
+            else
+                self%f_scale_data(i) = 1.0_wp
+            end if
+        end do
     end subroutine set_row_weights
 
     !> The problem's row levels at u; the wall time goes to levels_time (get_timings).
@@ -947,11 +983,12 @@ contains
         integer(c_int64_t), pointer :: p(:)
         real(c_double), pointer :: d(:)
         real(wp) :: norm
+        logical :: finite
 
         call c_f_pointer(user_data, problem)
         u => FN_VGetArrayPointer(sunvec_u)
         f => FN_VGetArrayPointer(sunvec_f)
-        norm = maxval([0.0_wp, abs(f) * problem%row_weight])
+        call get_scaled_norm(f, problem%row_weight, norm, finite)
         if (problem%n_history < size(problem%history)) then
             problem%n_history = problem%n_history + 1
             problem%history(problem%n_history) = norm
