@@ -871,7 +871,8 @@ contains
         !> this state without `residual` (predict_modes' test of an accepted state).
         logical, allocatable, intent(inout), optional :: at_limit(:)
         integer :: p, new_mode, before, after, n_candidates, k, direction_p
-        real(wp) :: min_before, min_after, increment, floor, measure
+        integer :: unlocked_direction
+        real(wp) :: min_before, min_after, increment, floor, measure, unlocked_measure
         integer, allocatable :: candidate(:), direction(:)
         real(wp), allocatable :: violation(:)
         associate(scene => problem%scene, passages => problem%scene%passages)
@@ -903,13 +904,18 @@ contains
                     ! An element locked at its minimum length in an earlier step stays so.
                     if (is_at_min_length(problem, before)) locked_forward(p) = .true.
                     if (is_at_min_length(problem, after)) locked_backward(p) = .true.
-                    if (present(at_limit)) then
-                        call get_slip_tendency(problem, p, floor, locked_forward(p), &
-                            locked_backward(p), direction_p, measure, at_limit(p), &
-                            residual=residual)
+                    if (present(at_limit) .and. .not. (locked_forward(p) &
+                            .or. locked_backward(p))) then
+                        call get_slip_tendency(problem, p, floor, .false., .false., &
+                            direction_p, measure, at_limit(p), residual=residual)
                     else
                         call get_slip_tendency(problem, p, floor, locked_forward(p), &
                             locked_backward(p), direction_p, measure, residual=residual)
+                        ! The flag as predict_modes takes it, without locks (a lock lets
+                        ! the test go on past the first limit, which may change it).
+                        if (present(at_limit)) call get_slip_tendency(problem, p, floor, &
+                            .false., .false., unlocked_direction, unlocked_measure, &
+                            at_limit(p), residual=residual)
                     end if
                     if (direction_p /= mode_stick) call add_candidate(direction_p, measure)
                 case (mode_forward)
