@@ -159,6 +159,12 @@ module yarnfort_contact_friction_stepper
         logical :: from_initial = .false.
         !> Passages held in stick by chatter damping in the last step.
         integer :: n_damped = 0
+        !> The stick test's at_limit flag (get_slip_tendency) of each stick passage at
+        !> the accepted state (`have_limits`), from the last round of the step that
+        !> reached it, and of the last successful try_step (`limits_trial`): the next
+        !> step's predict_modes needs them and would test the same state again.
+        logical, allocatable :: at_limit(:), at_limit_trial(:)
+        logical :: have_limits = .false., limits_trial = .false.
         !> The current step's trace (since the last accept) and the last accepted one's.
         type(step_trace_type) :: trace, last_trace
     contains
@@ -269,6 +275,7 @@ contains
         self%flow_trial = self%flow
         self%mode_trial = self%mode
         self%n_damped = 0
+        self%limits_trial = .false.
         if (self%staggered) then
             call try_staggered(self, stats, iterations, error)
         else
@@ -303,8 +310,13 @@ contains
             case (predicted_state)
                 ! Stick passages that the predicted state takes across their limit start
                 ! the step slipping: a growing slip zone then costs no round per step.
-                call predict_modes(problem, [self%u, self%flow], self%factors, unknowns, &
-                    self%mode_trial, guessed, error)
+                if (self%have_limits) then
+                    call predict_modes(problem, [self%u, self%flow], self%factors, unknowns, &
+                        self%mode_trial, guessed, error, self%at_limit)
+                else
+                    call predict_modes(problem, [self%u, self%flow], self%factors, unknowns, &
+                        self%mode_trial, guessed, error)
+                end if
                 if (allocated(error)) return
             case (reversed)
                 ! The loading turned: slipping passages start the step in stick (measured:
@@ -539,7 +551,8 @@ contains
                 good_mode = self%mode_trial
                 good_flips = flips
                 call update_active_set(problem, unknowns(n_x + 1:), self%flow, self%mode_trial, &
-                    flips, locked_forward, locked_backward, changed, cap, new_slips)
+                    flips, locked_forward, locked_backward, changed, cap, new_slips, &
+                    at_limit=self%at_limit_trial)
                 call record_changes(self%trace, good_mode, self%mode_trial)
                 if (changed == 0) then
                     call check_damped(problem, flips, locked_forward, locked_backward, error)
@@ -547,6 +560,8 @@ contains
                     self%u_trial = unknowns(1:n_x)
                     self%flow_trial = unknowns(n_x + 1:)
                     self%n_damped = count(flips > max_flips)
+                    ! No mode changed: the stick passages tested are the step's.
+                    self%limits_trial = .true.
                     return
                 end if
             end do
@@ -839,7 +854,7 @@ contains
     !> was called at the solution). `flow` are the solved flows, `accepted` those at the
     !> start of the step. Returns the number of passages whose mode changed.
     subroutine update_active_set(problem, flow, accepted, mode, flips, locked_forward, &
-            locked_backward, changed, max_new_slips, new_slips, residual)
+            locked_backward, changed, max_new_slips, new_slips, residual, at_limit)
         type(friction_problem_type), intent(inout) :: problem
         real(wp), intent(in) :: flow(:), accepted(:)
         integer, intent(inout) :: mode(:), flips(:)
@@ -852,8 +867,12 @@ contains
         !> The scaled residual of the state when above the tolerance (a provisional
         !> iterate): the stick test's dead band grows with it (get_slip_tendency).
         real(wp), intent(in), optional :: residual
+        !> The stick test's at_limit flag of each passage that was stick (on entry), at
+        !> this state without `residual` (predict_modes' test of an accepted state).
+        logical, allocatable, intent(inout), optional :: at_limit(:)
         integer :: p, new_mode, before, after, n_candidates, k, direction_p
-        real(wp) :: min_before, min_after, increment, floor, measure
+        integer :: unlocked_direction
+        real(wp) :: min_before, min_after, increment, floor, measure, unlocked_measure
         integer, allocatable :: candidate(:), direction(:)
         real(wp), allocatable :: violation(:)
         associate(scene => problem%scene, passages => problem%scene%passages)
@@ -862,8 +881,18 @@ contains
             new_slips = 0
             n_candidates = 0
             allocate(candidate(size(mode)), direction(size(mode)), violation(size(mode)))
+            if (present(at_limit)) then
+                if (allocated(at_limit)) deallocate(at_limit)
+                allocate(at_limit(size(mode)), source=.false.)
+            end if
             do p = 1, size(mode)
-                if (flips(p) > max_flips) cycle
+                if (flips(p) > max_flips) then
+                    ! Held in stick (chatter damping): no test but its flag.
+                    if (present(at_limit) .and. mode(p) == mode_stick) &
+                        call get_slip_tendency(problem, p, floor, .false., .false., &
+                        direction_p, measure, at_limit(p), residual=residual)
+                    cycle
+                end if
                 before = passages%element_before(p)
                 after = passages%element_after(p)
                 min_before = scene%solver%min_length_ratio * scene%network%length0(before)
@@ -875,8 +904,19 @@ contains
                     ! An element locked at its minimum length in an earlier step stays so.
                     if (is_at_min_length(problem, before)) locked_forward(p) = .true.
                     if (is_at_min_length(problem, after)) locked_backward(p) = .true.
-                    call get_slip_tendency(problem, p, floor, locked_forward(p), &
-                        locked_backward(p), direction_p, measure, residual=residual)
+                    if (present(at_limit) .and. .not. (locked_forward(p) &
+                            .or. locked_backward(p))) then
+                        call get_slip_tendency(problem, p, floor, .false., .false., &
+                            direction_p, measure, at_limit(p), residual=residual)
+                    else
+                        call get_slip_tendency(problem, p, floor, locked_forward(p), &
+                            locked_backward(p), direction_p, measure, residual=residual)
+                        ! The flag as predict_modes takes it, without locks (a lock lets
+                        ! the test go on past the first limit, which may change it).
+                        if (present(at_limit)) call get_slip_tendency(problem, p, floor, &
+                            .false., .false., unlocked_direction, unlocked_measure, &
+                            at_limit(p), residual=residual)
+                    end if
                     if (direction_p /= mode_stick) call add_candidate(direction_p, measure)
                 case (mode_forward)
                     if (flows_back(mode(p), increment)) new_mode = mode_stick
@@ -944,31 +984,39 @@ contains
     !> 5): without this exclusion the predicted start cut steps on the singular set,
     !> and over the knit3d cycle it reached other branches, up to 36 % of the peak force
     !> away from the small-step limit.
+    !> `accepted_limits`: the stick passages' at_limit flags at the accepted state, kept
+    !> from the last round of the step that reached it (update_active_set, the same test
+    !> of the same state); without them the test is done here.
     subroutine predict_modes(problem, accepted, accepted_factors, unknowns, mode, changed, &
-            error)
+            error, accepted_limits)
         type(friction_problem_type), intent(inout) :: problem
         real(wp), intent(in) :: accepted(:), accepted_factors(:), unknowns(:)
         integer, intent(inout) :: mode(:)
         logical, intent(out) :: changed
         type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: accepted_limits(:)
         integer :: p, direction
         real(wp) :: floor, measure
         real(wp), allocatable :: trial_factors(:)
         logical, allocatable :: at_limit(:)
 
         changed = .false.
-        allocate(at_limit(size(mode)), source=.false.)
-        trial_factors = problem%factors
-        problem%factors = accepted_factors
-        call problem%update_state(accepted, error)
-        problem%factors = trial_factors
-        if (allocated(error)) return
-        floor = node_level_floor * problem%get_force_level()
-        do p = 1, size(mode)
-            if (mode(p) /= mode_stick) cycle
-            call get_slip_tendency(problem, p, floor, .false., .false., direction, measure, &
-                at_limit(p))
-        end do
+        if (present(accepted_limits)) then
+            at_limit = accepted_limits
+        else
+            allocate(at_limit(size(mode)), source=.false.)
+            trial_factors = problem%factors
+            problem%factors = accepted_factors
+            call problem%update_state(accepted, error)
+            problem%factors = trial_factors
+            if (allocated(error)) return
+            floor = node_level_floor * problem%get_force_level()
+            do p = 1, size(mode)
+                if (mode(p) /= mode_stick) cycle
+                call get_slip_tendency(problem, p, floor, .false., .false., direction, &
+                    measure, at_limit(p))
+            end do
+        end if
         call problem%update_state(unknowns, error)
         if (allocated(error)) return
         floor = node_level_floor * problem%get_force_level()
@@ -1206,6 +1254,8 @@ contains
             self%load_older = self%load_old
         end if
         self%from_initial = .not. self%have_old
+        self%have_limits = self%limits_trial
+        if (self%have_limits) self%at_limit = self%at_limit_trial
         self%u_old = self%u
         self%flow_old = self%flow
         self%load_old = sum(self%factors)
@@ -1280,6 +1330,7 @@ contains
         ! the run that wrote the file (a 48 x 24 clamped knit's step 1 from the initial
         ! state's slip set took 625 Newton iterations instead of 25).
         self%from_initial = snapshot%step == 0
+        self%have_limits = .false.
         self%flow_trial = self%flow
         self%mode_trial = self%mode
     end subroutine restore_state

@@ -110,8 +110,10 @@ module yarnfort_solver_newton
         real(c_double), pointer :: row_weight(:) => null()
         type(error_type), allocatable :: error
         character(len=:), allocatable :: kinsol_message
-        !> Accumulated wall time of residual and Jacobian assembly.
-        real(wp) :: residual_time = 0.0_wp, jacobian_time = 0.0_wp
+        !> Accumulated wall time of residual and Jacobian assembly, and of the row
+        !> levels (get_row_levels: the first call at a new iterate also computes the
+        !> problem's state, which the residual there then finds done).
+        real(wp) :: residual_time = 0.0_wp, jacobian_time = 0.0_wp, levels_time = 0.0_wp
     end type equilibrium_type
 
     !> Owns KINSOL's memory, vectors, matrix and the linear solver for one scene.
@@ -354,7 +356,7 @@ contains
         integer(c_long) :: count(1)
         real(c_double) :: residual(size(u))
         integer :: round, attempt, n_attempts
-        logical :: converged
+        logical :: converged, finite
         character(len=200) :: buffer
 
         ! KINSOL's factors and prepare_solve's weights are not those of newton_step.
@@ -406,7 +408,7 @@ contains
                     deallocate(error)
                     exit
                 end if
-                stats%residual_norm = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+                call get_scaled_norm(residual, self%f_scale_data, stats%residual_norm, finite)
                 ! Our test decides: a line search that stalls at a converged iterate is fine.
                 converged = stats%residual_norm <= self%options%residual_tolerance
                 if (ierr < 0 .or. converged) exit
@@ -586,7 +588,6 @@ contains
         real(wp), allocatable :: residual(:), step(:), history(:), values(:)
         real(wp), allocatable :: z(:, :), capacity(:, :), y(:), entry_value(:)
         integer, allocatable :: slot(:), entry_slot(:), entry_column(:)
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
         type(dense_solver_type) :: correction
         integer :: k, n_rows, j, e, n_entries, a, b, i
         real(wp) :: f
@@ -598,7 +599,8 @@ contains
         if (self%kept_factorisation /= self%adapter%n_factorisations) return
         if (.not. allocated(self%kept_values)) return
         associate(problem => self%problem%problem, tol => self%options%residual_tolerance, &
-                n => size(u))
+                n => size(u), col_ptr => self%problem%problem%col_ptr, &
+                row_index => self%problem%problem%row_index)
             self%u = u
             allocate(residual(n), step(n))
             call get_scaled_residual(self, residual, f, trial_error)
@@ -614,8 +616,6 @@ contains
                 call evaluate_timed(self%problem, self%u, .true., values, trial_error)
                 stats%jacobian_evaluations = stats%jacobian_evaluations + 1
                 if (allocated(trial_error)) return
-                allocate(col_ptr(n + 1), row_index(self%problem%nnz))
-                call problem%copy_pattern(col_ptr, row_index)
                 allocate(slot(n), source=0)
                 do a = 1, n_rows
                     slot(rows(a)) = a
@@ -705,11 +705,11 @@ contains
         class(newton_solver_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
-        integer(ik), allocatable :: col_ptr(:), row_index(:)
 
-        allocate(col_ptr(size(u) + 1), row_index(self%problem%nnz))
-        call self%problem%problem%copy_pattern(col_ptr, row_index)
-        call analyse_once(self, col_ptr, row_index, error)
+        ! The problem's own pattern (fixed for its lifetime), not a copy per solve.
+        associate(problem => self%problem%problem)
+            call analyse_once(self, problem%col_ptr, problem%row_index, error)
+        end associate
         if (allocated(error)) return
         ! New row weights (prepare_solve): the kept factors no longer match them.
         self%kept_factorisation = -1
@@ -764,17 +764,38 @@ contains
         real(wp), intent(out) :: residual(:), f
         type(error_type), allocatable, intent(out) :: error
 
+        logical :: finite
+
         f = huge(1.0_wp)
         call set_row_weights(self, .false., error)
         if (allocated(error)) return
         call evaluate_timed(self%problem, self%u, .false., residual, error)
         if (allocated(error)) return
-        if (.not. all(ieee_is_finite(residual))) then
+        call get_scaled_norm(residual, self%f_scale_data, f, finite)
+        if (.not. finite) then
+            f = huge(1.0_wp)
             call fatal_error(error, 'the residual is not a finite number (NaN or an overflow)')
             return
         end if
-        f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
     end subroutine get_scaled_residual
+
+    !> f = maxval([0, |residual| * weight]) (a NaN product is passed over, as by maxval)
+    !> and whether every residual entry is finite, in one pass without a temporary.
+    pure subroutine get_scaled_norm(residual, weight, f, finite)
+        real(wp), intent(in) :: residual(:), weight(:)
+        real(wp), intent(out) :: f
+        logical, intent(out) :: finite
+        real(wp) :: scaled
+        integer :: i
+
+        f = 0.0_wp
+        finite = .true.
+        do i = 1, size(residual)
+            finite = finite .and. ieee_is_finite(residual(i))
+            scaled = abs(residual(i)) * weight(i)
+            if (scaled > f) f = scaled
+        end do
+    end subroutine get_scaled_norm
 
     !> Pseudo-transient continuation (switched evolution relaxation): Newton steps on
     !> F(u) + mu D du = 0, D_i = level_i / length_scale, with mu falling as the scaled
@@ -796,6 +817,7 @@ contains
         integer, allocatable :: diagonal(:)
         integer :: i, k, iteration
         real(wp) :: mu, f, merit, merit_trial
+        logical :: finite
 
         converged = .false.
         associate(problem => self%problem%problem, n => size(u))
@@ -814,14 +836,14 @@ contains
             if (allocated(error)) return
             self%u = u
             allocate(residual(n), step(n), level(n), noise(n), shift(n))
-            call problem%get_row_levels(self%u, level, noise, error)
+            call get_levels_timed(self%problem, self%u, level, noise, error)
             if (allocated(error)) return
             shift = max(level, tiny(1.0_wp)) / problem%length_scale
             call set_row_weights(self, .false., error)
             if (allocated(error)) return
             call evaluate_timed(self%problem, self%u, .false., residual, error)
             if (allocated(error)) return
-            f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+            call get_scaled_norm(residual, self%f_scale_data, f, finite)
             merit = norm2(residual * self%f_scale_data)
             mu = 1.0_wp
             do iteration = 1, transient_iterations * self%options%max_iterations
@@ -855,7 +877,7 @@ contains
                     ! The levels follow the state (as in solve_once).
                     call set_row_weights(self, .false., error)
                     if (allocated(error)) return
-                    f = maxval([0.0_wp, abs(residual) * self%f_scale_data])
+                    call get_scaled_norm(residual, self%f_scale_data, f, finite)
                     merit = norm2(residual * self%f_scale_data)
                 else
                     mu = 10 * mu
@@ -882,18 +904,44 @@ contains
         logical, intent(in) :: uniform
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: level(:), noise(:)
+        real(wp) :: row_level
+        integer :: i
 
         allocate(level(size(self%u)), noise(size(self%u)))
-        call self%problem%problem%get_row_levels(self%u, level, noise, error)
+        call get_levels_timed(self%problem, self%u, level, noise, error)
         if (allocated(error)) return
-        level = level + noise / self%options%residual_tolerance
-        if (uniform) level = maxval([0.0_wp, level])
-        where (level > 0.0_wp)
-            self%f_scale_data = 1.0_wp / level
-        elsewhere
-            self%f_scale_data = 1.0_wp
-        end where
+        if (uniform) then
+            level = level + noise / self%options%residual_tolerance
+            level = maxval([0.0_wp, level])
+            where (level > 0.0_wp)
+                self%f_scale_data = 1.0_wp / level
+            elsewhere
+                self%f_scale_data = 1.0_wp
+            end where
+            return
+        end if
+        ! The same arithmetic in one pass (the weights at every new iterate).
+        do i = 1, size(level)
+            row_level = level(i) + noise(i) / self%options%residual_tolerance
+            if (row_level > 0.0_wp) then
+                self%f_scale_data(i) = 1.0_wp / row_level
+            else
+                self%f_scale_data(i) = 1.0_wp
+            end if
+        end do
     end subroutine set_row_weights
+
+    !> The problem's row levels at u; the wall time goes to levels_time (get_timings).
+    subroutine get_levels_timed(problem, u, level, noise, error)
+        type(equilibrium_type), intent(inout) :: problem
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: level(:), noise(:)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp) :: start
+        start = wall_time()
+        call problem%problem%get_row_levels(u, level, noise, error)
+        problem%levels_time = problem%levels_time + (wall_time() - start)
+    end subroutine get_levels_timed
 
     !> KINSOL residual callback F(u).
     integer(c_int) function residual_callback(sunvec_u, sunvec_f, user_data) &
@@ -935,11 +983,12 @@ contains
         integer(c_int64_t), pointer :: p(:)
         real(c_double), pointer :: d(:)
         real(wp) :: norm
+        logical :: finite
 
         call c_f_pointer(user_data, problem)
         u => FN_VGetArrayPointer(sunvec_u)
         f => FN_VGetArrayPointer(sunvec_f)
-        norm = maxval([0.0_wp, abs(f) * problem%row_weight])
+        call get_scaled_norm(f, problem%row_weight, norm, finite)
         if (problem%n_history < size(problem%history)) then
             problem%n_history = problem%n_history + 1
             problem%history(problem%n_history) = norm
@@ -998,14 +1047,17 @@ contains
         problem%kinsol_message = transfer(text, problem%kinsol_message)
     end subroutine error_handler
 
-    !> Accumulated figures: assembly (residual, Jacobian) and linear algebra times.
+    !> Accumulated figures: assembly (residual, Jacobian) and linear algebra times, and
+    !> the row levels' time (`levels_time`: the state's computation at most iterates).
     subroutine get_timings(self, residual_time, jacobian_time, analyse_time, factor_time, &
-            solve_time, n_factorisations, n_solves)
+            solve_time, n_factorisations, n_solves, levels_time)
         class(newton_solver_type), intent(in) :: self
         real(wp), intent(out) :: residual_time, jacobian_time, analyse_time, factor_time
         real(wp), intent(out) :: solve_time
         integer, intent(out) :: n_factorisations
         integer, intent(out), optional :: n_solves
+        real(wp), intent(out), optional :: levels_time
+        if (present(levels_time)) levels_time = 0.0_wp
         if (.not. associated(self%problem)) then
             residual_time = 0.0_wp
             jacobian_time = 0.0_wp
@@ -1023,6 +1075,7 @@ contains
         solve_time = self%adapter%solve_time
         n_factorisations = self%adapter%n_factorisations
         if (present(n_solves)) n_solves = self%adapter%n_solves
+        if (present(levels_time)) levels_time = self%problem%levels_time
     end subroutine get_timings
 
     subroutine destroy(self)
