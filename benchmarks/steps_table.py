@@ -21,12 +21,17 @@ Columns per build: Newton iterations, active-set rounds (Newton solves) and resi
 evaluations per step (a build with chord steps prints them too: `newton / chord`),
 passages turned stick -> slip and slip -> stick per step, CPU ms
 per step (the continuation alone, process CPU time), and that over the CPU ms of one
-elastic Newton iteration of the same net at the final state. The load average is printed
-before and after. Progress goes to stderr.
+elastic Newton iteration of the same net at the final state, and the floor: the cost of
+one friction Newton iteration of the run (one factorisation, one Jacobian, one solve and
+one residual with its row levels, each the run's mean from the `timings` line, wall ms)
+over that elastic iteration. A step that needs a new factorisation costs at least the
+floor, so where the floor is above 4, item 2's target cannot be met by fewer iterations
+or rounds alone. The load average is printed before and after. Progress goes to stderr.
 """
 import argparse
 import os
 import pathlib
+import re
 import subprocess
 import sys
 import tempfile
@@ -67,18 +72,37 @@ def run(binary, arguments, timeout):
     values = [float(x) for x in lines[-1].split()[1:]]
     if len(values) == len(SUMMARY) - 1:
         values.insert(SUMMARY.index('chords'), 0.0)   # a build without chord steps
-    return dict(zip(SUMMARY, values))
+    row = dict(zip(SUMMARY, values))
+    row['floor'] = floor(done.stdout, row)
+    return row
+
+
+def floor(stdout, row):
+    """One friction Newton iteration of the run over the elastic iteration (module
+    notes), or None without a `timings` line (older builds lack the levels column: 0)."""
+    lines = [line for line in stdout.splitlines() if line.startswith('timings')]
+    if not lines:
+        return None
+    numbers = [float(x) for x in re.findall(r'\s(-?\d+\.\d+)', lines[-1])]
+    jacobians, factorisations, solves, residual, jacobian, _, factor, solve = numbers[:8]
+    levels = numbers[8] if len(numbers) > 8 else 0.0
+    if min(jacobians, factorisations, solves, row['residuals']) <= 0:
+        return None
+    one = (factor / factorisations + jacobian / jacobians + solve / solves
+           + (residual + levels) / row['residuals'])
+    return one / row['elastic_ms']
 
 
 def cells(row):
     if 'failed' in row:
-        return ['failed: ' + row['failed'][:40]] + [''] * 6
+        return ['failed: ' + row['failed'][:40]] + [''] * 7
     steps = row['steps']
     newton = f"{row['newton']:.2f}" + (f" / {row['chords']:.2f}" if row['chords'] else '')
+    floor_cell = '-' if row['floor'] is None else f"{row['floor']:.2f}"
     return [newton, f"{row['rounds']:.2f}", f"{row['residuals']:.2f}",
             f"{row['to_slip']:.2f} / {row['to_stick']:.2f}", f"{row['cpu_ms']:.2f}",
-            f"{row['ratio']:.2f}", f"{int(steps)}" + (f" ({int(row['cuts'])} cuts)"
-                                                        if row['cuts'] else '')]
+            f"{row['ratio']:.2f}", floor_cell,
+            f"{int(steps)}" + (f" ({int(row['cuts'])} cuts)" if row['cuts'] else '')]
 
 
 def main():
@@ -122,7 +146,7 @@ def main():
                                               'residual evals / step',
                                               'to slip / to stick per step',
                                               'CPU ms / step', 'step / elastic iteration',
-                                              'steps')]
+                                              'floor: iteration / elastic', 'steps')]
     print('| ' + ' | '.join(header) + ' |')
     print('|' + '---|' + '---:|' * (len(header) - 1))
     for label, arguments in cases:
