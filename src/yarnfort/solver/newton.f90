@@ -465,7 +465,8 @@ contains
     !> peak force. Measured (benchmarks/steps_results.md, section 21; residual
     !> evaluations / solves per step): woven cycle 10,120 aligned 4.90 / 3.97 -> 4.22 /
     !> 3.28, skewed 7.38 / 6.85 -> 6.57 / 6.03; 8 x 8 clamped knit cycle 10.43 / 10.00
-    !> -> 9.85 / 9.43; the same steps, rounds and factorisations on 28 scenes.
+    !> -> 9.85 / 9.43; the same steps on 28 scenes, the same Newton iterations, rounds
+    !> and factorisations on 20 of 21 (woven skewed 840: one round fewer in 60 steps).
     subroutine solve_chord(self, u, stats, converged, error)
         class(newton_solver_type), intent(inout) :: self
         real(wp), intent(inout) :: u(:)
