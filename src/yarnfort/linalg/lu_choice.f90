@@ -7,12 +7,13 @@
 !> nonzero decide: few on chain-like patterns (the woven nets' reduced friction systems),
 !> many where the factors fill in two dimensions (the knit's, or any net at 1e6 unknowns).
 module yarnfort_linalg_lu_choice
-    use, intrinsic :: iso_c_binding, only: c_long
+    use, intrinsic :: iso_c_binding, only: c_long, c_double
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_klu, only: klu_solver_type
     use yarnfort_linalg_umfpack, only: umfpack_solver_type
+    use yarnfort_linalg_cholmod_binding, only: yarnfort_cholmod_metis_order, cholmod_ok
     implicit none
     private
 
@@ -30,6 +31,15 @@ module yarnfort_linalg_lu_choice
     !> UMFPACK's automatic strategy takes the symmetric one at this symmetry of the
     !> pattern (matched entries over off-diagonal entries) and a nonzero diagonal.
     real(wp), parameter :: umfpack_min_symmetry = 0.5_wp
+    !> At this many predicted flops per factor nonzero (AMD's order) METIS' nested
+    !> dissection of A + A^T is tried too, and its order taken when it predicts fewer
+    !> factor nonzeros than AMD's (the reduced friction systems at the final state of a
+    !> cycle, bare KLU refactor + solve, CPU ms, AMD / METIS: knit 8 x 8 cell, 73 flops
+    !> per nonzero, L + U 9.16e4 / 7.88e4, 3.5 / 2.3 ms; knit 16 x 16, 146, 5.23e5 /
+    !> 4.19e5, 39 / 24 ms (UMFPACK 21 / 16 ms). Below it METIS filled more: knit 4 x 4
+    !> (35) 1.45e4 / 1.51e4; woven 10,120 (11-16) 7.1e4 / 8.0e4; benchmarks/steps_results.md
+    !> section 22).
+    real(wp), parameter :: metis_min_flops_per_nonzero = 50.0_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks
     !> the calls and keeps the pattern.
@@ -49,7 +59,9 @@ contains
 
     !> KLU's analysis, kept if KLU is chosen, else UMFPACK's. UMFPACK is handed KLU's
     !> AMD order when that is symmetric and so is the pattern by UMFPACK's own test
-    !> (umfpack_min_symmetry): its symmetric strategy would order A + A^T again.
+    !> (umfpack_min_symmetry): its symmetric strategy would order A + A^T again. From
+    !> metis_min_flops_per_nonzero on, either is handed METIS' order of A + A^T instead
+    !> when that predicts fewer factor nonzeros (the choice stays AMD's prediction's).
     subroutine analyse(self, n, col_ptr, row_index, error)
         class(lu_choice_solver_type), intent(inout) :: self
         integer(ik), intent(in) :: n
@@ -58,27 +70,53 @@ contains
         type(klu_solver_type), allocatable :: klu
         type(umfpack_solver_type), allocatable :: umfpack
         integer(c_long), allocatable :: order(:)
-        real(wp) :: symmetry
+        real(wp) :: symmetry, factor_nonzeros
+        logical :: metis
 
         call self%destroy()
         allocate(klu)
         call klu%analyse(n, col_ptr, row_index, error)
         if (allocated(error)) return
         call klu%get_prediction(self%predicted_flops, self%predicted_nonzeros)
+        call klu%get_symmetric_order(order, symmetry)
+        factor_nonzeros = self%predicted_nonzeros
+        metis = .false.
+        if (allocated(order) .and. symmetry >= umfpack_min_symmetry .and. &
+                self%predicted_flops >= metis_min_flops_per_nonzero &
+                * self%predicted_nonzeros) call try_metis()
         if (prefers_umfpack(self%predicted_flops, self%predicted_nonzeros)) then
-            call klu%get_symmetric_order(order, symmetry)
             call klu%destroy()
             allocate(umfpack)
             call umfpack%analyse(n, col_ptr, row_index, error)
             if (allocated(error)) return
             if (allocated(order) .and. symmetry >= umfpack_min_symmetry) then
-                call umfpack%set_column_order(order, self%predicted_nonzeros, error)
+                call umfpack%set_column_order(order, factor_nonzeros, error)
                 if (allocated(error)) return
             end if
             call move_alloc(umfpack, self%chosen)
         else
+            if (metis) then
+                call move_alloc(order, klu%given_order)
+                call klu%analyse(n, col_ptr, row_index, error)
+                if (allocated(error)) return
+            end if
             call move_alloc(klu, self%chosen)
         end if
+    contains
+        !> METIS' order in place of AMD's when it predicts fewer nonzeros of L + U (twice
+        !> those of the Cholesky factor of A + A^T: L and U both hold the diagonal).
+        subroutine try_metis()
+            integer(c_long), allocatable :: metis_order(:)
+            real(c_double) :: lnz
+
+            allocate(metis_order(n))
+            if (yarnfort_cholmod_metis_order(int(n, c_long), klu%col_ptr, klu%row_index, &
+                    metis_order, lnz) /= cholmod_ok) return
+            if (2.0_wp * lnz >= factor_nonzeros) return
+            call move_alloc(metis_order, order)
+            factor_nonzeros = 2.0_wp * lnz
+            metis = .true.
+        end subroutine try_metis
     end subroutine analyse
 
     !> The rule: UMFPACK when the predicted flops per factor nonzero reach
