@@ -18,6 +18,7 @@ module yarnfort_linalg_lu_choice
     private
 
     public :: lu_choice_solver_type, prefers_umfpack, umfpack_min_flops_per_nonzero
+    public :: metis_min_flops_per_nonzero
 
     !> UMFPACK is chosen when KLU's predicted flops per nonzero of L + U reach this.
     !> Measured on the reduced friction systems (benchmarks/results-lu-choice.md, CPU
@@ -47,6 +48,10 @@ module yarnfort_linalg_lu_choice
         class(linear_solver_type), allocatable :: chosen
         !> KLU's prediction for the pattern: flops of a factorisation, nonzeros of L + U.
         real(wp) :: predicted_flops = 0.0_wp, predicted_nonzeros = 0.0_wp
+        !> The chosen solver was handed METIS' order (metis_min_flops_per_nonzero), and
+        !> the nonzeros of L + U predicted for the order it factors with (AMD's otherwise).
+        logical :: metis_order = .false.
+        real(wp) :: ordered_nonzeros = 0.0_wp
     contains
         procedure :: analyse
         procedure :: factor
@@ -70,8 +75,7 @@ contains
         type(klu_solver_type), allocatable :: klu
         type(umfpack_solver_type), allocatable :: umfpack
         integer(c_long), allocatable :: order(:)
-        real(wp) :: symmetry, factor_nonzeros
-        logical :: metis
+        real(wp) :: symmetry
 
         call self%destroy()
         allocate(klu)
@@ -79,8 +83,7 @@ contains
         if (allocated(error)) return
         call klu%get_prediction(self%predicted_flops, self%predicted_nonzeros)
         call klu%get_symmetric_order(order, symmetry)
-        factor_nonzeros = self%predicted_nonzeros
-        metis = .false.
+        self%ordered_nonzeros = self%predicted_nonzeros
         if (allocated(order) .and. symmetry >= umfpack_min_symmetry .and. &
                 self%predicted_flops >= metis_min_flops_per_nonzero &
                 * self%predicted_nonzeros) call try_metis()
@@ -90,12 +93,12 @@ contains
             call umfpack%analyse(n, col_ptr, row_index, error)
             if (allocated(error)) return
             if (allocated(order) .and. symmetry >= umfpack_min_symmetry) then
-                call umfpack%set_column_order(order, factor_nonzeros, error)
+                call umfpack%set_column_order(order, self%ordered_nonzeros, error)
                 if (allocated(error)) return
             end if
             call move_alloc(umfpack, self%chosen)
         else
-            if (metis) then
+            if (self%metis_order) then
                 call move_alloc(order, klu%given_order)
                 call klu%analyse(n, col_ptr, row_index, error)
                 if (allocated(error)) return
@@ -112,10 +115,10 @@ contains
             allocate(metis_order(n))
             if (yarnfort_cholmod_metis_order(int(n, c_long), klu%col_ptr, klu%row_index, &
                     metis_order, lnz) /= cholmod_ok) return
-            if (2.0_wp * lnz >= factor_nonzeros) return
+            if (2.0_wp * lnz >= self%ordered_nonzeros) return
             call move_alloc(metis_order, order)
-            factor_nonzeros = 2.0_wp * lnz
-            metis = .true.
+            self%ordered_nonzeros = 2.0_wp * lnz
+            self%metis_order = .true.
         end subroutine try_metis
     end subroutine analyse
 
@@ -168,6 +171,8 @@ contains
         end if
         self%predicted_flops = 0.0_wp
         self%predicted_nonzeros = 0.0_wp
+        self%metis_order = .false.
+        self%ordered_nonzeros = 0.0_wp
     end subroutine destroy
 
     !> The chosen solver's name, 'klu|umfpack' before the first analysis.
