@@ -32,14 +32,14 @@ module yarnfort_linalg_lu_choice
     !> UMFPACK's automatic strategy takes the symmetric one at this symmetry of the
     !> pattern (matched entries over off-diagonal entries) and a nonzero diagonal.
     real(wp), parameter :: umfpack_min_symmetry = 0.5_wp
-    !> At this many predicted flops per factor nonzero (AMD's order) METIS' nested
-    !> dissection of A + A^T is tried too, and its order taken when it predicts fewer
-    !> factor nonzeros than AMD's (the reduced friction systems at the final state of a
-    !> cycle, bare KLU refactor + solve, CPU ms, AMD / METIS: knit 8 x 8 cell, 73 flops
-    !> per nonzero, L + U 9.16e4 / 7.88e4, 3.5 / 2.3 ms; knit 16 x 16, 146, 5.23e5 /
-    !> 4.19e5, 39 / 24 ms (UMFPACK 21 / 16 ms). Below it METIS filled more: knit 4 x 4
-    !> (35) 1.45e4 / 1.51e4; woven 10,120 (11-16) 7.1e4 / 8.0e4; benchmarks/steps_results.md
-    !> section 22).
+    !> From this many predicted flops per factor nonzero (AMD's order) up to UMFPACK's
+    !> threshold, METIS' nested dissection of A + A^T is tried too, and KLU takes its
+    !> order when it predicts fewer factor nonzeros than AMD's (the reduced friction
+    !> systems at the final state of a cycle, bare KLU refactor + solve, CPU ms, AMD /
+    !> METIS: knit 8 x 8 cell, 73 flops per nonzero, L + U 9.16e4 / 7.88e4, 3.5 / 2.3 ms).
+    !> Below it METIS filled more: knit 4 x 4 (35) 1.45e4 / 1.51e4; woven 10,120 skewed
+    !> (15.5) 7.65e4 / 8.57e4. Not for UMFPACK: the woven cycle of 963,600 unknowns
+    !> factored 1.4x slower with METIS' order (benchmarks/steps_results.md section 22).
     real(wp), parameter :: metis_min_flops_per_nonzero = 50.0_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks
@@ -48,8 +48,8 @@ module yarnfort_linalg_lu_choice
         class(linear_solver_type), allocatable :: chosen
         !> KLU's prediction for the pattern: flops of a factorisation, nonzeros of L + U.
         real(wp) :: predicted_flops = 0.0_wp, predicted_nonzeros = 0.0_wp
-        !> The chosen solver was handed METIS' order (metis_min_flops_per_nonzero), and
-        !> the nonzeros of L + U predicted for the order it factors with (AMD's otherwise).
+        !> KLU was handed METIS' order (metis_min_flops_per_nonzero), and the nonzeros of
+        !> L + U predicted for the order the chosen solver factors with (AMD's otherwise).
         logical :: metis_order = .false.
         real(wp) :: ordered_nonzeros = 0.0_wp
     contains
@@ -64,8 +64,8 @@ contains
 
     !> KLU's analysis, kept if KLU is chosen, else UMFPACK's. UMFPACK is handed KLU's
     !> AMD order when that is symmetric and so is the pattern by UMFPACK's own test
-    !> (umfpack_min_symmetry): its symmetric strategy would order A + A^T again. From
-    !> metis_min_flops_per_nonzero on, either is handed METIS' order of A + A^T instead
+    !> (umfpack_min_symmetry): its symmetric strategy would order A + A^T again. KLU from
+    !> metis_min_flops_per_nonzero on is analysed again with METIS' order of A + A^T
     !> when that predicts fewer factor nonzeros (the choice stays AMD's prediction's).
     subroutine analyse(self, n, col_ptr, row_index, error)
         class(lu_choice_solver_type), intent(inout) :: self
@@ -84,20 +84,20 @@ contains
         call klu%get_prediction(self%predicted_flops, self%predicted_nonzeros)
         call klu%get_symmetric_order(order, symmetry)
         self%ordered_nonzeros = self%predicted_nonzeros
-        if (allocated(order) .and. symmetry >= umfpack_min_symmetry .and. &
-                self%predicted_flops >= metis_min_flops_per_nonzero &
-                * self%predicted_nonzeros) call try_metis()
         if (prefers_umfpack(self%predicted_flops, self%predicted_nonzeros)) then
             call klu%destroy()
             allocate(umfpack)
             call umfpack%analyse(n, col_ptr, row_index, error)
             if (allocated(error)) return
             if (allocated(order) .and. symmetry >= umfpack_min_symmetry) then
-                call umfpack%set_column_order(order, self%ordered_nonzeros, error)
+                call umfpack%set_column_order(order, self%predicted_nonzeros, error)
                 if (allocated(error)) return
             end if
             call move_alloc(umfpack, self%chosen)
         else
+            if (allocated(order) .and. symmetry >= umfpack_min_symmetry .and. &
+                    self%predicted_flops >= metis_min_flops_per_nonzero &
+                    * self%predicted_nonzeros) call try_metis()
             if (self%metis_order) then
                 call move_alloc(order, klu%given_order)
                 call klu%analyse(n, col_ptr, row_index, error)
