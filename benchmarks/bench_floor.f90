@@ -22,6 +22,7 @@ module bench_floor
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
     use yarnfort_linalg_cholmod, only: supernodal_switch
+    use yarnfort_linalg_cholmod_binding, only: yarnfort_cholmod_metis_order, cholmod_ok
     use yarnfort_linalg_umfpack_binding, only: umfpack_control, umfpack_info, umfpack_irstep, &
         umfpack_prl, umfpack_a, umfpack_ok, umfpack_strategy_used, umfpack_dl_defaults, &
         umfpack_dl_symbolic, umfpack_dl_numeric, umfpack_dl_wsolve, &
@@ -29,11 +30,30 @@ module bench_floor
         umfpack_ordering, umfpack_ordering_metis
     use yarnfort_linalg_klu_binding, only: klu_l_common, klu_l_defaults, klu_l_analyze, &
         klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_free_symbolic, klu_l_free_numeric, &
-        klu_l_numeric_sizes
+        klu_l_numeric_sizes, klu_l_analyze_given
     implicit none
     private
 
     public :: floor_type, measure_floor
+
+    !> AMD (amd.h), for orders with Control settings KLU does not expose.
+    interface
+        subroutine amd_l_defaults(control) bind(C, name='amd_l_defaults')
+            import :: c_double
+            real(c_double), intent(out) :: control(*)
+        end subroutine amd_l_defaults
+
+        function amd_l_order(n, ap, ai, p, control, info) result(status) &
+                bind(C, name='amd_l_order')
+            import :: c_long, c_double
+            integer(c_long), value :: n
+            integer(c_long), intent(in) :: ap(*), ai(*)
+            integer(c_long), intent(out) :: p(*)
+            real(c_double), intent(in) :: control(*)
+            real(c_double), intent(out) :: info(*)
+            integer(c_long) :: status
+        end function amd_l_order
+    end interface
 
     interface
         !> bench_cholmod.c
@@ -75,6 +95,10 @@ module bench_floor
         real(wp) :: klu_nobtf_lu = 0.0_wp
         !> UMFPACK's strategy with and without the values (1 unsymmetric, 3 symmetric).
         integer :: strategy = 0, strategy_pattern = 0
+        !> with_variants: bare KLU (refactor + solve) with scale 0 / 1, with METIS' order of
+        !> A + A^T as lu_choice finds it (klu_l_analyze_given), with AMD without
+        !> aggressive absorption, and with AMD's dense threshold 1: ms and L + U.
+        real(wp) :: variant_ms(5) = -1.0_wp, variant_lu(5) = 0.0_wp
     end type floor_type
 
 contains
@@ -86,7 +110,7 @@ contains
 
     !> Time `solver_name` and the bare libraries on the CSC matrix (0-based indices).
     subroutine measure_floor(solver_name, n, col_ptr, row_index, values, floor, error, &
-            with_klu, with_metis)
+            with_klu, with_metis, with_variants)
         character(len=*), intent(in) :: solver_name
         integer(ik), intent(in) :: n
         integer(ik), intent(in) :: col_ptr(:), row_index(:)
@@ -97,6 +121,8 @@ contains
         logical, intent(in), optional :: with_klu
         !> Also time UMFPACK with the METIS ordering (default false).
         logical, intent(in), optional :: with_metis
+        !> Also time the KLU variants (default false).
+        logical, intent(in), optional :: with_variants
         class(linear_solver_type), allocatable :: solver
         real(wp), allocatable :: rhs(:)
         real(wp) :: start, first
@@ -140,6 +166,9 @@ contains
             call time_klu(0, 1, floor%klu_ms, floor%klu_lu, floor%klu_analyse_ms)
             call time_klu(1, 1, floor%klu_colamd_ms, floor%klu_colamd_lu)
             call time_klu(0, 0, floor%klu_nobtf_ms, floor%klu_nobtf_lu)
+        end if
+        if (present(with_variants)) then
+            if (with_variants) call time_variants()
         end if
         if (solver_name == 'cholmod' .or. solver_name == 'cholmod+klu') then
             block
@@ -219,10 +248,37 @@ contains
             call umfpack_dl_free_symbolic(symbolic)
         end subroutine time_umfpack
 
-        subroutine time_klu(ordering, btf, ms, lu, analyse_ms)
+        subroutine time_variants()
+            integer(c_long), allocatable :: order(:)
+            real(c_double) :: amd_control(0:4), amd_info(0:19), lnz
+            integer(c_long) :: status
+
+            call time_klu(0, 1, floor%variant_ms(1), floor%variant_lu(1), scale=0)
+            call time_klu(0, 1, floor%variant_ms(2), floor%variant_lu(2), scale=1)
+            allocate(order(n))
+            if (yarnfort_cholmod_metis_order(int(n, c_long), col_ptr, row_index, order, &
+                    lnz) == cholmod_ok) call time_klu(0, 1, floor%variant_ms(3), &
+                floor%variant_lu(3), given=order)
+            call amd_l_defaults(amd_control)
+            amd_control(1) = 0
+            status = amd_l_order(int(n, c_long), col_ptr, row_index, order, amd_control, &
+                amd_info)
+            if (status >= 0) call time_klu(0, 1, floor%variant_ms(4), floor%variant_lu(4), &
+                given=order)
+            call amd_l_defaults(amd_control)
+            amd_control(0) = 1
+            status = amd_l_order(int(n, c_long), col_ptr, row_index, order, amd_control, &
+                amd_info)
+            if (status >= 0) call time_klu(0, 1, floor%variant_ms(5), floor%variant_lu(5), &
+                given=order)
+        end subroutine time_variants
+
+        subroutine time_klu(ordering, btf, ms, lu, analyse_ms, scale, given)
             integer, intent(in) :: ordering, btf
             real(wp), intent(out) :: ms, lu
             real(wp), intent(out), optional :: analyse_ms
+            integer, intent(in), optional :: scale
+            integer(c_long), intent(in), optional :: given(:)
             type(klu_l_common) :: common
             type(c_ptr) :: symbolic, numeric
             type(klu_l_numeric_sizes), pointer :: sizes
@@ -237,8 +293,14 @@ contains
             common%user_data = c_null_ptr
             common%ordering = ordering
             common%btf = btf
+            if (present(scale)) common%scale = scale
             start = cpu_seconds()
-            symbolic = klu_l_analyze(int(n, c_long), col_ptr, row_index, common)
+            if (present(given)) then
+                symbolic = klu_l_analyze_given(int(n, c_long), col_ptr, row_index, given, &
+                    given, common)
+            else
+                symbolic = klu_l_analyze(int(n, c_long), col_ptr, row_index, common)
+            end if
             if (.not. c_associated(symbolic)) return
             if (present(analyse_ms)) analyse_ms = 1e3_wp * (cpu_seconds() - start)
             start = cpu_seconds()

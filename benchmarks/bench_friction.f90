@@ -67,7 +67,11 @@ end module bench_friction_counter
 !> Then, when the monolithic solver eliminates stick flows, a line `reduced:` (the
 !> reduced system at the final state, as the `factors:` line, the reductions per step,
 !> and KLU's predicted flops per factor nonzero with the solver they chose:
-!> yarnfort_linalg_lu_choice), and a line `iteration:`: one Newton iteration of each problem at the final
+!> yarnfort_linalg_lu_choice, and whether it was handed METIS' order), before it a line
+!> `variants:` (bare KLU on the reduced system with scale 0 and 1, with METIS' order of
+!> A + A^T, with AMD without aggressive absorption and with AMD's dense threshold 1:
+!> nonzeros of L + U and CPU ms of refactor + solve; bench_floor's with_variants), and a
+!> line `iteration:`: one Newton iteration of each problem at the final
 !> state with the solvers yarnfort uses, and the cycle's CPU time per step against the
 !> elastic one (write_iterations).
 program bench_friction
@@ -364,8 +368,14 @@ contains
         type is (condensed_solver_type)
             call measure_floor('klu', linear%n_reduced, linear%reduced_col_ptr, &
                 linear%reduced_row_index, values(linear%source), reduced, error, &
-                with_metis=.true.)
+                with_metis=.true., with_variants=.true.)
             if (allocated(error)) call fail('bench_friction', error)
+            write(output_unit, '(a, 5(es9.2, a, f8.2, a))') 'variants: klu scale0 ', &
+                reduced%variant_lu(1), ' (', reduced%variant_ms(1), ' ms) scale1 ', &
+                reduced%variant_lu(2), ' (', reduced%variant_ms(2), ' ms) metis ', &
+                reduced%variant_lu(3), ' (', reduced%variant_ms(3), ' ms) amd-noaggr ', &
+                reduced%variant_lu(4), ' (', reduced%variant_ms(4), ' ms) amd-dense1 ', &
+                reduced%variant_lu(5), ' (', reduced%variant_ms(5), ' ms)'
             write(output_unit, '(a, i0, a, i0, a, f8.2, a, 3(es9.2, a, f8.2, a), a, &
                 & 3(f9.2, a))', advance='no') &
                 'reduced: n ', linear%n_reduced, ' nnz ', size(linear%source), &
@@ -425,6 +435,8 @@ contains
                 solver%predicted_nonzeros, ' flops/nonzero ', &
                 solver%predicted_flops / max(1.0_wp, solver%predicted_nonzeros), &
                 ' -> ' // solver%get_name()
+            if (solver%metis_order) write(output_unit, '(a, es9.2, a)', advance='no') &
+                ' with metis order (LU ', solver%ordered_nonzeros, ')'
         class default
             write(output_unit, '(a)', advance='no') ' ' // solver%get_name()
         end select

@@ -1,7 +1,8 @@
 ! SPDX-License-Identifier: MIT
 !> bind(C) interfaces to cholmod_shim.c (an opaque handle around CHOLMOD's 64-bit
 !> `cholmod_l_*` API, see the comment there for why a shim is used) and the CHOLMOD
-!> status codes of cholmod_core.h. Only yarnfort_linalg_cholmod uses this module.
+!> status codes of cholmod_core.h. Only yarnfort_linalg_cholmod uses this module, and
+!> yarnfort_linalg_lu_choice its METIS order.
 module yarnfort_linalg_cholmod_binding
     use, intrinsic :: iso_c_binding, only: c_int, c_long, c_double, c_ptr
     implicit none
@@ -12,6 +13,7 @@ module yarnfort_linalg_cholmod_binding
     public :: cholmod_gpu_problem, cholmod_no_handle
     public :: yarnfort_cholmod_create, yarnfort_cholmod_free, yarnfort_cholmod_analyze
     public :: yarnfort_cholmod_factorize, yarnfort_cholmod_solve
+    public :: yarnfort_cholmod_metis_order
 
     !> CHOLMOD status codes (cholmod_core.h); warnings are positive, errors negative.
     integer(c_int), parameter :: cholmod_ok = 0, cholmod_not_posdef = 1, cholmod_dsmall = 2
@@ -67,6 +69,18 @@ module yarnfort_linalg_cholmod_binding
             real(c_double), intent(inout) :: rhs(*)
             integer(c_int) :: status
         end function yarnfort_cholmod_solve
+
+        !> METIS' order of A + A^T (0-based, postordered) and the nonzeros of the Cholesky
+        !> factor of A + A^T in that order, diagonal included.
+        function yarnfort_cholmod_metis_order(n, col_ptr, row_index, perm, lnz) &
+                result(status) bind(C, name='yarnfort_cholmod_metis_order')
+            import :: c_int, c_long, c_double
+            integer(c_long), value :: n
+            integer(c_long), intent(in) :: col_ptr(*), row_index(*)
+            integer(c_long), intent(out) :: perm(*)
+            real(c_double), intent(out) :: lnz
+            integer(c_int) :: status
+        end function yarnfort_cholmod_metis_order
     end interface
 
 end module yarnfort_linalg_cholmod_binding

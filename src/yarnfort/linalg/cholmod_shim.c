@@ -303,3 +303,44 @@ int yarnfort_cholmod_solve(void *handle, SuiteSparse_long n, SuiteSparse_long nc
     }
     return h->common.status;
 }
+
+/* METIS' nested dissection of the pattern of A + A^T (n x n, 0-based CSC, any pattern),
+ * postordered, into perm (size n: the k-th pivot is perm[k]), and the nonzeros of the
+ * Cholesky factor of A + A^T in that order (diagonal included) into lnz: the order and
+ * the fill an LU factorisation with diagonal pivots gets from it. Its own CHOLMOD
+ * workspace. 0 or a CHOLMOD status. */
+int yarnfort_cholmod_metis_order(SuiteSparse_long n, SuiteSparse_long *col_ptr,
+                                 SuiteSparse_long *row_index, SuiteSparse_long *perm,
+                                 double *lnz)
+{
+    cholmod_common common;
+    cholmod_sparse a, *at = NULL, *sum = NULL;
+    cholmod_factor *factor = NULL;
+    double one[2] = {1.0, 0.0};
+    int status;
+
+    if (!cholmod_l_start(&common)) return YARNFORT_CHOLMOD_NO_HANDLE;
+    common.print = 0;
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_METIS;
+    common.postorder = 1;
+    a = wrap_sparse(n, col_ptr, row_index, NULL, 0);
+    a.sorted = 0;
+    at = cholmod_l_transpose(&a, 0, &common);
+    if (at) sum = cholmod_l_add(&a, at, one, one, 0, 0, &common);
+    if (sum) {
+        sum->stype = 1;
+        factor = cholmod_l_analyze(sum, &common);
+    }
+    if (factor && common.status == CHOLMOD_OK) {
+        memcpy(perm, factor->Perm, (size_t) n * sizeof(*perm));
+        *lnz = common.lnz;
+    }
+    status = factor ? common.status : (common.status != CHOLMOD_OK ? common.status
+                                                                    : CHOLMOD_INVALID);
+    cholmod_l_free_factor(&factor, &common);
+    cholmod_l_free_sparse(&sum, &common);
+    cholmod_l_free_sparse(&at, &common);
+    cholmod_l_finish(&common);
+    return status;
+}

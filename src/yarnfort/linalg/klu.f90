@@ -14,8 +14,8 @@ module yarnfort_linalg_klu
     use yarnfort_linalg_csc_pattern, only: format_integer
     use yarnfort_linalg_klu_binding, only: klu_l_common, klu_ok, klu_singular, &
         klu_out_of_memory, klu_invalid, klu_too_large, klu_l_defaults, klu_l_analyze, &
-        klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_rcond, klu_l_free_symbolic, &
-        klu_l_numeric_sizes, klu_l_symbolic, klu_l_free_numeric
+        klu_l_analyze_given, klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_rcond, &
+        klu_l_free_symbolic, klu_l_numeric_sizes, klu_l_symbolic, klu_l_free_numeric
     implicit none
     private
 
@@ -40,6 +40,10 @@ module yarnfort_linalg_klu
         !> 4.6 / 10.4 / 2.5 s; bench_friction woven nets 68 / 22 / 29 and 1480 / 374 /
         !> 623 ms per load step. The choice is never the worst and at most 1.8x the best.
         logical, public :: unsymmetric_ordering = .false.
+        !> A symmetric column order (0-based: column given_order(k) is the k-th) to use
+        !> instead of AMD's (klu_l_analyze_given, the rows in the same order; BTF still
+        !> splits reducible patterns); set before `analyse`.
+        integer(c_long), allocatable, public :: given_order(:)
         type(klu_l_common) :: common
         logical :: common_ready = .false.
         type(c_ptr) :: symbolic = c_null_ptr
@@ -74,7 +78,12 @@ contains
         self%common%user_data = c_null_ptr
         self%common%halt_if_singular = c_true
         self%common_ready = .true.
-        self%symbolic = klu_l_analyze(self%n, self%col_ptr, self%row_index, self%common)
+        if (allocated(self%given_order)) then
+            self%symbolic = klu_l_analyze_given(self%n, self%col_ptr, self%row_index, &
+                self%given_order, self%given_order, self%common)
+        else
+            self%symbolic = klu_l_analyze(self%n, self%col_ptr, self%row_index, self%common)
+        end if
         if (.not. c_associated(self%symbolic)) then
             call self%fail(error, 'symbolic analysis', status_message(self%common%status))
             return

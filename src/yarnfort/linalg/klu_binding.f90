@@ -10,7 +10,8 @@ module yarnfort_linalg_klu_binding
 
     public :: klu_l_common, klu_l_numeric_sizes, klu_l_symbolic
     public :: klu_ok, klu_singular, klu_out_of_memory, klu_invalid, klu_too_large
-    public :: klu_l_defaults, klu_l_analyze, klu_l_factor, klu_l_refactor, klu_l_solve
+    public :: klu_l_defaults, klu_l_analyze, klu_l_analyze_given, klu_l_factor
+    public :: klu_l_refactor, klu_l_solve
     public :: klu_l_rcond, klu_l_free_symbolic, klu_l_free_numeric
 
     !> Status codes stored in klu_l_common%status (klu.h).
@@ -67,6 +68,17 @@ module yarnfort_linalg_klu_binding
             type(klu_l_common), intent(inout) :: common
             type(c_ptr) :: symbolic
         end function klu_l_analyze
+
+        !> BTF with the given row and column orders P and Q (0-based) instead of AMD's;
+        !> returns the Symbolic object (without AMD's estimates) or NULL.
+        function klu_l_analyze_given(n, ap, ai, p, q, common) result(symbolic) &
+                bind(C, name='klu_l_analyze_given')
+            import :: c_long, c_ptr, klu_l_common
+            integer(c_long), value :: n
+            integer(c_long), intent(in) :: ap(*), ai(*), p(*), q(*)
+            type(klu_l_common), intent(inout) :: common
+            type(c_ptr) :: symbolic
+        end function klu_l_analyze_given
 
         !> Factorisation with partial pivoting; returns the Numeric object or NULL.
         function klu_l_factor(ap, ai, ax, symbolic, common) result(numeric) &

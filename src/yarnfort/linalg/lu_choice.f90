@@ -7,16 +7,18 @@
 !> nonzero decide: few on chain-like patterns (the woven nets' reduced friction systems),
 !> many where the factors fill in two dimensions (the knit's, or any net at 1e6 unknowns).
 module yarnfort_linalg_lu_choice
-    use, intrinsic :: iso_c_binding, only: c_long
+    use, intrinsic :: iso_c_binding, only: c_long, c_double
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_klu, only: klu_solver_type
     use yarnfort_linalg_umfpack, only: umfpack_solver_type
+    use yarnfort_linalg_cholmod_binding, only: yarnfort_cholmod_metis_order, cholmod_ok
     implicit none
     private
 
     public :: lu_choice_solver_type, prefers_umfpack, umfpack_min_flops_per_nonzero
+    public :: metis_min_flops_per_nonzero
 
     !> UMFPACK is chosen when KLU's predicted flops per nonzero of L + U reach this.
     !> Measured on the reduced friction systems (benchmarks/results-lu-choice.md, CPU
@@ -30,6 +32,15 @@ module yarnfort_linalg_lu_choice
     !> UMFPACK's automatic strategy takes the symmetric one at this symmetry of the
     !> pattern (matched entries over off-diagonal entries) and a nonzero diagonal.
     real(wp), parameter :: umfpack_min_symmetry = 0.5_wp
+    !> From this many predicted flops per factor nonzero (AMD's order) up to UMFPACK's
+    !> threshold, METIS' nested dissection of A + A^T is tried too, and KLU takes its
+    !> order when it predicts fewer factor nonzeros than AMD's (the reduced friction
+    !> systems at the final state of a cycle, bare KLU refactor + solve, CPU ms, AMD /
+    !> METIS: knit 8 x 8 cell, 73 flops per nonzero, L + U 9.16e4 / 7.88e4, 3.5 / 2.3 ms).
+    !> Below it METIS filled more: knit 4 x 4 (35) 1.45e4 / 1.51e4; woven 10,120 skewed
+    !> (15.5) 7.65e4 / 8.57e4. Not for UMFPACK: the woven cycle of 963,600 unknowns
+    !> factored 1.4x slower with METIS' order (benchmarks/steps_results.md section 22).
+    real(wp), parameter :: metis_min_flops_per_nonzero = 50.0_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks
     !> the calls and keeps the pattern.
@@ -37,6 +48,10 @@ module yarnfort_linalg_lu_choice
         class(linear_solver_type), allocatable :: chosen
         !> KLU's prediction for the pattern: flops of a factorisation, nonzeros of L + U.
         real(wp) :: predicted_flops = 0.0_wp, predicted_nonzeros = 0.0_wp
+        !> KLU was handed METIS' order (metis_min_flops_per_nonzero), and the nonzeros of
+        !> L + U predicted for the order the chosen solver factors with (AMD's otherwise).
+        logical :: metis_order = .false.
+        real(wp) :: ordered_nonzeros = 0.0_wp
     contains
         procedure :: analyse
         procedure :: factor
@@ -49,7 +64,9 @@ contains
 
     !> KLU's analysis, kept if KLU is chosen, else UMFPACK's. UMFPACK is handed KLU's
     !> AMD order when that is symmetric and so is the pattern by UMFPACK's own test
-    !> (umfpack_min_symmetry): its symmetric strategy would order A + A^T again.
+    !> (umfpack_min_symmetry): its symmetric strategy would order A + A^T again. KLU from
+    !> metis_min_flops_per_nonzero on is analysed again with METIS' order of A + A^T
+    !> when that predicts fewer factor nonzeros (the choice stays AMD's prediction's).
     subroutine analyse(self, n, col_ptr, row_index, error)
         class(lu_choice_solver_type), intent(inout) :: self
         integer(ik), intent(in) :: n
@@ -65,8 +82,9 @@ contains
         call klu%analyse(n, col_ptr, row_index, error)
         if (allocated(error)) return
         call klu%get_prediction(self%predicted_flops, self%predicted_nonzeros)
+        call klu%get_symmetric_order(order, symmetry)
+        self%ordered_nonzeros = self%predicted_nonzeros
         if (prefers_umfpack(self%predicted_flops, self%predicted_nonzeros)) then
-            call klu%get_symmetric_order(order, symmetry)
             call klu%destroy()
             allocate(umfpack)
             call umfpack%analyse(n, col_ptr, row_index, error)
@@ -77,8 +95,31 @@ contains
             end if
             call move_alloc(umfpack, self%chosen)
         else
+            if (allocated(order) .and. symmetry >= umfpack_min_symmetry .and. &
+                    self%predicted_flops >= metis_min_flops_per_nonzero &
+                    * self%predicted_nonzeros) call try_metis()
+            if (self%metis_order) then
+                call move_alloc(order, klu%given_order)
+                call klu%analyse(n, col_ptr, row_index, error)
+                if (allocated(error)) return
+            end if
             call move_alloc(klu, self%chosen)
         end if
+    contains
+        !> METIS' order in place of AMD's when it predicts fewer nonzeros of L + U (twice
+        !> those of the Cholesky factor of A + A^T: L and U both hold the diagonal).
+        subroutine try_metis()
+            integer(c_long), allocatable :: metis_order(:)
+            real(c_double) :: lnz
+
+            allocate(metis_order(n))
+            if (yarnfort_cholmod_metis_order(int(n, c_long), klu%col_ptr, klu%row_index, &
+                    metis_order, lnz) /= cholmod_ok) return
+            if (2.0_wp * lnz >= self%ordered_nonzeros) return
+            call move_alloc(metis_order, order)
+            self%ordered_nonzeros = 2.0_wp * lnz
+            self%metis_order = .true.
+        end subroutine try_metis
     end subroutine analyse
 
     !> The rule: UMFPACK when the predicted flops per factor nonzero reach
@@ -130,6 +171,8 @@ contains
         end if
         self%predicted_flops = 0.0_wp
         self%predicted_nonzeros = 0.0_wp
+        self%metis_order = .false.
+        self%ordered_nonzeros = 0.0_wp
     end subroutine destroy
 
     !> The chosen solver's name, 'klu|umfpack' before the first analysis.
