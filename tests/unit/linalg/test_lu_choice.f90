@@ -102,8 +102,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         class(linear_solver_type), allocatable :: solver
         integer(ik), allocatable :: col_ptr(:), row_index(:)
-        real(wp), allocatable :: values(:), x(:), rhs(:)
-        integer :: i
+        real(wp), allocatable :: values(:)
 
         call new_linear_solver(solver, chosen_lu_name, error)
         if (allocated(error)) return
@@ -111,6 +110,20 @@ contains
         call solver%analyse(int(n, ik), col_ptr, row_index, error)
         if (allocated(error)) return
         name = solver%get_name()
+        call factor_and_solve(solver, n, col_ptr, row_index, values, name, error)
+    end subroutine choose_and_solve
+
+    !> Factor the analysed `solver`, solve A x = A x_known, compare with x_known.
+    subroutine factor_and_solve(solver, n, col_ptr, row_index, values, label, error)
+        class(linear_solver_type), intent(inout) :: solver
+        integer, intent(in) :: n
+        integer(ik), intent(in) :: col_ptr(:), row_index(:)
+        real(wp), intent(in) :: values(:)
+        character(len=*), intent(in) :: label
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: x(:), rhs(:)
+        integer :: i
+
         call solver%factor(values, error)
         if (allocated(error)) return
         x = [(real(mod(i, 7) - 3, wp), i = 1, n)]
@@ -118,8 +131,8 @@ contains
         call solver%solve(rhs, error)
         if (allocated(error)) return
         call check(error, maxval(abs(rhs - x)) <= solution_tol * maxval(abs(x)), &
-            name // ': solution differs from the known x')
-    end subroutine choose_and_solve
+            label // ': solution differs from the known x')
+    end subroutine factor_and_solve
 
     !> A chain fills nothing: about 2 flops per factor nonzero.
     subroutine test_chain(error)
@@ -182,7 +195,7 @@ contains
         type(lu_choice_solver_type) :: solver
         type(klu_solver_type) :: klu
         integer(ik), allocatable :: col_ptr(:), row_index(:)
-        real(wp), allocatable :: values(:), x(:), rhs(:)
+        real(wp), allocatable :: values(:)
         integer :: i, d, k, row, column, place(3), step(3)
 
         allocate(col_ptr(n + 1), row_index(7 * n), values(7 * n))
@@ -221,27 +234,16 @@ contains
             solver%ordered_nonzeros < solver%predicted_nonzeros, &
             'the grid should go to klu with METIS'' sparser order')
         if (allocated(error)) return
-        call solver%factor(values, error)
-        if (allocated(error)) return
-        x = [(real(mod(i, 7) - 3, wp), i = 1, n)]
-        rhs = multiply(n, col_ptr, row_index, values, x)
-        call solver%solve(rhs, error)
-        if (allocated(error)) return
-        call check(error, maxval(abs(rhs - x)) <= solution_tol * maxval(abs(x)), &
-            solver%get_name() // ' with METIS'' order: solution differs from the known x')
+        call factor_and_solve(solver, n, col_ptr, row_index, values, &
+            solver%get_name() // ' with METIS'' order', error)
         if (allocated(error)) return
         call solver%destroy()
 
         klu%given_order = [(int(n - i, c_long), i = 1, n)]
         call klu%analyse(int(n, ik), col_ptr, row_index, error)
         if (allocated(error)) return
-        call klu%factor(values, error)
-        if (allocated(error)) return
-        rhs = multiply(n, col_ptr, row_index, values, x)
-        call klu%solve(rhs, error)
-        if (allocated(error)) return
-        call check(error, maxval(abs(rhs - x)) <= solution_tol * maxval(abs(x)), &
-            'klu with a given order: solution differs from the known x')
+        call factor_and_solve(klu, n, col_ptr, row_index, values, 'klu with a given order', &
+            error)
         call klu%destroy()
     end subroutine test_grid_metis
 
