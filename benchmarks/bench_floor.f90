@@ -252,6 +252,7 @@ contains
             integer(c_long), allocatable :: order(:)
             real(c_double) :: amd_control(0:4), amd_info(0:19), lnz
             integer(c_long) :: status
+            integer :: k
 
             call time_klu(0, 1, floor%variant_ms(1), floor%variant_lu(1), scale=0)
             call time_klu(0, 1, floor%variant_ms(2), floor%variant_lu(2), scale=1)
@@ -259,18 +260,16 @@ contains
             if (yarnfort_cholmod_metis_order(int(n, c_long), col_ptr, row_index, order, &
                     lnz) == cholmod_ok) call time_klu(0, 1, floor%variant_ms(3), &
                 floor%variant_lu(3), given=order)
-            call amd_l_defaults(amd_control)
-            amd_control(1) = 0
-            status = amd_l_order(int(n, c_long), col_ptr, row_index, order, amd_control, &
-                amd_info)
-            if (status >= 0) call time_klu(0, 1, floor%variant_ms(4), floor%variant_lu(4), &
-                given=order)
-            call amd_l_defaults(amd_control)
-            amd_control(0) = 1
-            status = amd_l_order(int(n, c_long), col_ptr, row_index, order, amd_control, &
-                amd_info)
-            if (status >= 0) call time_klu(0, 1, floor%variant_ms(5), floor%variant_lu(5), &
-                given=order)
+            ! AMD without aggressive absorption (variant 4), with dense threshold 1 (5).
+            do k = 4, 5
+                call amd_l_defaults(amd_control)
+                if (k == 4) amd_control(1) = 0
+                if (k == 5) amd_control(0) = 1
+                status = amd_l_order(int(n, c_long), col_ptr, row_index, order, amd_control, &
+                    amd_info)
+                if (status >= 0) call time_klu(0, 1, floor%variant_ms(k), floor%variant_lu(k), &
+                    given=order)
+            end do
         end subroutine time_variants
 
         subroutine time_klu(ordering, btf, ms, lu, analyse_ms, scale, given)
