@@ -23,13 +23,14 @@ contains
     !> and each element's tension and stretch, for node positions x (3, n_nodes) and
     !> element reference lengths length0. `spring`: weight of the regularising spring
     !> (get_truss_tension) of a Newton predictor; absent or 0 for the exact law.
+    !> `stiffness_cap`: that of get_truss_tension (another predictor); absent: none.
     subroutine assemble_internal_force(scene, x, length0, internal, tension, stretch, error, &
-            spring, rounding)
+            spring, rounding, stiffness_cap)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(out) :: internal(:), tension(:), stretch(:)
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: spring
+        real(wp), intent(in), optional :: spring, stiffness_cap
         !> Each tension's rounding error (get_tension_rounding), for the row levels.
         real(wp), intent(out), optional :: rounding(:)
         integer :: e, n1, n2, n
@@ -47,10 +48,11 @@ contains
             if (present(rounding)) then
                 call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
                     force, error, rounding=rounding(e), &
-                    position_norm=position_norm(n1) + position_norm(n2))
+                    position_norm=position_norm(n1) + position_norm(n2), &
+                    stiffness_cap=stiffness_cap)
             else
                 call get_element_response(scene, x, length0, e, weight, tension(e), stretch(e), &
-                    force, error)
+                    force, error, stiffness_cap=stiffness_cap)
             end if
             if (allocated(error)) return
             if (.not. ieee_is_finite(tension(e))) then
@@ -74,38 +76,39 @@ contains
     end subroutine assemble_internal_force
 
     !> Residual on the unknowns: P^T (internal - applied force at the channels' factors);
-    !> `spring` as for assemble_internal_force.
-    subroutine assemble_residual(scene, x, length0, factors, residual, error, spring)
+    !> `spring` and `stiffness_cap` as for assemble_internal_force.
+    subroutine assemble_residual(scene, x, length0, factors, residual, error, spring, &
+            stiffness_cap)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:), factors(:)
         real(wp), intent(out) :: residual(:)
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: spring
+        real(wp), intent(in), optional :: spring, stiffness_cap
         real(wp), allocatable :: internal(:), tension(:), stretch(:), applied(:)
 
         allocate(internal(size(scene%external_force, 1)), applied(size(scene%external_force, 1)))
         allocate(tension(scene%network%n_elements()), stretch(scene%network%n_elements()))
         call assemble_internal_force(scene, x, length0, internal, tension, stretch, error, &
-            spring)
+            spring, stiffness_cap=stiffness_cap)
         if (allocated(error)) return
         call get_applied_force(scene, factors, applied)
         call scene%dofs%gather(internal - applied, residual)
     end subroutine assemble_residual
 
     !> Jacobian values P^T K P in the slots of `pattern` (values are overwritten);
-    !> `spring` and `tangent_spring` as for add_element_tangents.
+    !> `spring`, `tangent_spring` and `stiffness_cap` as for add_element_tangents.
     subroutine assemble_jacobian(scene, pattern, x, length0, values, error, spring, &
-            tangent_spring)
+            tangent_spring, stiffness_cap)
         type(scene_type), intent(in) :: scene
         type(pattern_type), intent(in) :: pattern
         real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: spring, tangent_spring
+        real(wp), intent(in), optional :: spring, tangent_spring, stiffness_cap
 
         values = 0.0_wp
         call add_element_tangents(scene, pattern%element_slot, x, length0, values, error, &
-            spring, tangent_spring)
+            spring, tangent_spring, stiffness_cap=stiffness_cap)
     end subroutine assemble_jacobian
 
     !> Add every element's 6x6 tangent to `values` at element_slot(a, b, e) (entries
@@ -114,15 +117,16 @@ contains
     !> the spring in the tangent of slack strings only (get_truss_response). Both absent:
     !> the exact tangent of the exact law. `dforce_dlength0` (3, n_elements): each
     !> element's derivative of its node-2 force with respect to L0, from the same
-    !> evaluation (for the flows of sliding contact).
+    !> evaluation (for the flows of sliding contact). `stiffness_cap` as for
+    !> assemble_internal_force.
     subroutine add_element_tangents(scene, element_slot, x, length0, values, error, spring, &
-            tangent_spring, dforce_dlength0)
+            tangent_spring, dforce_dlength0, stiffness_cap)
         type(scene_type), intent(in) :: scene
         integer, intent(in) :: element_slot(:, :, :)
         real(wp), intent(in) :: x(:, :), length0(:)
         real(wp), intent(inout) :: values(:)
         type(error_type), allocatable, intent(out) :: error
-        real(wp), intent(in), optional :: spring, tangent_spring
+        real(wp), intent(in), optional :: spring, tangent_spring, stiffness_cap
         real(wp), intent(out), optional :: dforce_dlength0(:, :)
         integer :: e, a, b, slot
         real(wp) :: force(3), block(3, 3), tension, stretch, sign_ab, weight, tangent_weight
@@ -135,10 +139,11 @@ contains
         do e = 1, scene%network%n_elements()
             if (present(dforce_dlength0)) then
                 call get_element_response(scene, x, length0, e, weight, tension, stretch, &
-                    force, error, block, tangent_weight, dforce_dlength0=dforce_dlength0(:, e))
+                    force, error, block, tangent_weight, dforce_dlength0=dforce_dlength0(:, e), &
+                    stiffness_cap=stiffness_cap)
             else
                 call get_element_response(scene, x, length0, e, weight, tension, stretch, &
-                    force, error, block, tangent_weight)
+                    force, error, block, tangent_weight, stiffness_cap=stiffness_cap)
             end if
             if (allocated(error)) return
             do b = 1, 6
@@ -156,7 +161,8 @@ contains
     !> with `block`, its tangent; `spring`, `tangent_spring` as there) at node positions x,
     !> after checking that it has not degenerated to a point.
     subroutine get_element_response(scene, x, length0, e, spring, tension, stretch, force, &
-            error, block, tangent_spring, rounding, dforce_dlength0, position_norm)
+            error, block, tangent_spring, rounding, dforce_dlength0, position_norm, &
+            stiffness_cap)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:)
         integer, intent(in) :: e
@@ -168,6 +174,7 @@ contains
         real(wp), intent(out), optional :: rounding, dforce_dlength0(3)
         !> norm2 of the element's two node positions, summed (for `rounding`).
         real(wp), intent(in), optional :: position_norm
+        real(wp), intent(in), optional :: stiffness_cap
         real(wp) :: length
         character(len=160) :: buffer
 
@@ -182,7 +189,7 @@ contains
             end if
             call get_truss_response(scene%laws(scene%network%element_material(e))%law, spring, &
                 length0(e), x1, x2, tension, stretch, force, block, tangent_spring, rounding, &
-                dforce_dlength0, length, position_norm)
+                dforce_dlength0, length, position_norm, stiffness_cap)
         end associate
     end subroutine get_element_response
 

@@ -25,13 +25,14 @@ contains
     !> level(n) = max(largest |tension| of the elements at n, |applied force at n|),
     !> floored at node_level_floor * the largest such force of the scene (max_force);
     !> noise(n) = the rounding error of the residual at n (sum over its elements of
-    !> get_tension_rounding). `spring` as in
+    !> get_tension_rounding). `spring` and `stiffness_cap` as in
     !> get_truss_tension. With no force anywhere (max_force = 0) every level is 0.
     pure subroutine get_node_force_levels(scene, x, length0, factors, spring, level, noise, &
-            max_force)
+            max_force, stiffness_cap)
         type(scene_type), intent(in) :: scene
         real(wp), intent(in) :: x(:, :), length0(:), factors(:), spring
         real(wp), intent(out) :: level(:), noise(:), max_force
+        real(wp), intent(in), optional :: stiffness_cap
         real(wp), allocatable :: tension(:), rounding(:), magnitude(:, :)
         integer, allocatable :: loaded(:)
         integer :: e
@@ -40,7 +41,8 @@ contains
         do e = 1, scene%network%n_elements()
             associate(nodes => scene%network%element_nodes(:, e))
                 call get_tension_with_noise(scene%laws(scene%network%element_material(e))%law, &
-                    spring, x(:, nodes(1)), x(:, nodes(2)), length0(e), tension(e), rounding(e))
+                    spring, x(:, nodes(1)), x(:, nodes(2)), length0(e), tension(e), rounding(e), &
+                    stiffness_cap)
             end associate
         end do
         call get_loaded_nodes(scene, loaded, magnitude)
@@ -80,14 +82,16 @@ contains
 
     !> Tension of an element with nodes at x1, x2 and its rounding error
     !> (get_tension_rounding).
-    pure subroutine get_tension_with_noise(law, spring, x1, x2, length0, tension, noise)
+    pure subroutine get_tension_with_noise(law, spring, x1, x2, length0, tension, noise, &
+            stiffness_cap)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: spring, x1(3), x2(3), length0
         real(wp), intent(out) :: tension, noise
+        real(wp), intent(in), optional :: stiffness_cap
         real(wp) :: length, dtension
 
         length = norm2(x2 - x1)
-        call get_truss_tension(law, spring, length / length0, tension, dtension)
+        call get_truss_tension(law, spring, length / length0, tension, dtension, stiffness_cap)
         noise = get_tension_rounding(law, norm2(x1) + norm2(x2), length, length0, tension, &
             dtension)
     end subroutine get_tension_with_noise

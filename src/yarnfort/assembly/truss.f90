@@ -7,6 +7,10 @@ module yarnfort_assembly_truss
     private
 
     public :: get_truss_tension, get_truss_response, get_tension_rounding, slack_rest_stretch
+    public :: capped_stiffness, no_stiffness_cap
+
+    !> The `stiffness_cap` of the exact laws (no law is scaled).
+    real(wp), parameter :: no_stiffness_cap = huge(1.0_wp)
 
     !> Rest stretch of the regularising spring (see get_truss_tension).
     real(wp), parameter :: slack_rest_stretch = 0.5_wp
@@ -23,19 +27,31 @@ contains
     !> is a regularisation of the Newton solve only (yarnfort_solver_newton): a solve
     !> that fails with the exact law is predicted with the spring and corrected without
     !> it, so no converged answer carries it. spring = 0 is the exact law.
-    pure subroutine get_truss_tension(law, slack_stiffness, stretch, tension, dtension)
+    !> `stiffness_cap` (another predictor of the Newton solve, never of an answer): a law
+    !> whose reference stiffness k_ref exceeds the cap is scaled by cap / k_ref, so that
+    !> it and its spring act as a law of reference stiffness `cap`; absent or
+    !> no_stiffness_cap: the law as it is.
+    pure subroutine get_truss_tension(law, slack_stiffness, stretch, tension, dtension, &
+            stiffness_cap)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: slack_stiffness, stretch
         real(wp), intent(out) :: tension, dtension
-        real(wp) :: k_slack
+        real(wp), intent(in), optional :: stiffness_cap
+        real(wp) :: k_slack, k_ref, k_capped
 
+        k_ref = law%get_reference_stiffness()
+        k_capped = capped_stiffness(law, stiffness_cap)
         if (stretch > 1.0_wp) then
             call law%get_force(stretch, tension, dtension)
+            if (k_capped < k_ref) then
+                tension = tension * (k_capped / k_ref)
+                dtension = dtension * (k_capped / k_ref)
+            end if
         else
             tension = 0.0_wp
             dtension = 0.0_wp
         end if
-        k_slack = slack_stiffness * law%get_reference_stiffness()
+        k_slack = slack_stiffness * k_capped
         tension = tension + k_slack * (stretch - slack_rest_stretch)
         dtension = dtension + k_slack
     end subroutine get_truss_tension
@@ -53,16 +69,17 @@ contains
     !> -c (dT/dlambda) lambda / L0 (a sliding flow changes L0).
     !> `known_length`: norm2(x2 - x1), `position_norm`: norm2(x1) + norm2(x2) (for
     !> `rounding`), where the caller has them (they are not computed again).
+    !> `stiffness_cap` as for get_truss_tension.
     pure subroutine get_truss_response(law, spring, length0, x1, x2, &
             tension, stretch, force, block, tangent_spring, rounding, dforce_dlength0, &
-            known_length, position_norm)
+            known_length, position_norm, stiffness_cap)
         class(force_law_type), intent(in) :: law
         real(wp), intent(in) :: spring, length0, x1(3), x2(3)
         real(wp), intent(out) :: tension, stretch, force(3)
         real(wp), intent(out), optional :: block(3, 3)
         real(wp), intent(in), optional :: tangent_spring
         real(wp), intent(out), optional :: rounding, dforce_dlength0(3)
-        real(wp), intent(in), optional :: known_length, position_norm
+        real(wp), intent(in), optional :: known_length, position_norm, stiffness_cap
         real(wp) :: d(3), length, c(3), dtension, transverse, axial, k_tangent
         integer :: k
 
@@ -73,7 +90,7 @@ contains
             length = norm2(d)
         end if
         stretch = length / length0
-        call get_truss_tension(law, spring, stretch, tension, dtension)
+        call get_truss_tension(law, spring, stretch, tension, dtension, stiffness_cap)
         if (present(rounding)) then
             if (present(position_norm)) then
                 rounding = get_tension_rounding(law, position_norm, length, length0, tension, &
@@ -95,7 +112,7 @@ contains
             axial = dtension / length0
             if (present(tangent_spring)) then
                 if (tangent_spring > 0.0_wp .and. stretch <= 1.0_wp) then
-                    k_tangent = tangent_spring * law%get_reference_stiffness()
+                    k_tangent = tangent_spring * capped_stiffness(law, stiffness_cap)
                     transverse = transverse + k_tangent * (1.0_wp - slack_rest_stretch) / length
                     axial = axial + k_tangent / length0
                 end if
@@ -125,5 +142,14 @@ contains
                 * epsilon(1.0_wp) * r) slope = law%get_reference_stiffness()
         rounding = rounding_factor * epsilon(1.0_wp) * (abs(tension) + r * abs(slope))
     end function get_tension_rounding
+
+    !> The reference stiffness of `law` under `stiffness_cap` (get_truss_tension).
+    pure real(wp) function capped_stiffness(law, stiffness_cap) result(stiffness)
+        class(force_law_type), intent(in) :: law
+        real(wp), intent(in), optional :: stiffness_cap
+
+        stiffness = law%get_reference_stiffness()
+        if (present(stiffness_cap)) stiffness = min(stiffness, stiffness_cap)
+    end function capped_stiffness
 
 end module yarnfort_assembly_truss

@@ -52,7 +52,7 @@ module yarnfort_contact_friction_problem
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_scene_scene, only: scene_type, get_applied_force, get_loaded_nodes, &
         get_force_scale
-    use yarnfort_assembly_truss, only: get_truss_tension
+    use yarnfort_assembly_truss, only: get_truss_tension, capped_stiffness
     use yarnfort_assembly_pattern, only: build_clique_pattern
     use yarnfort_assembly_assemble, only: assemble_internal_force, add_element_tangents
     use yarnfort_assembly_scales, only: gather_node_force_levels, get_unknown_levels, &
@@ -119,7 +119,7 @@ module yarnfort_contact_friction_problem
         !> solution check, the stepper's active-set test); it is computed once.
         logical :: state_valid = .false.
         real(wp), allocatable :: state_u(:), state_u_frozen(:), state_factors(:)
-        real(wp) :: state_spring = 0.0_wp
+        real(wp) :: state_spring = 0.0_wp, state_stiffness_cap = 0.0_wp
     contains
         procedure :: get_size
         procedure :: evaluate_residual
@@ -290,6 +290,7 @@ contains
 
         if (self%state_valid) then
             if (self%state_spring == self%spring .and. all(self%state_u == u) &
+                    .and. self%state_stiffness_cap == self%stiffness_cap &
                     .and. all(self%state_factors == self%factors)) then
                 if (.not. self%positions_frozen) return
                 if (all(self%state_u_frozen == self%u_frozen)) return
@@ -309,13 +310,15 @@ contains
                     self%length0)
             end if
             call assemble_internal_force(scene, self%x, self%length0, self%internal, &
-                self%tension, self%stretch, error, self%spring, self%rounding)
+                self%tension, self%stretch, error, self%spring, self%rounding, &
+                self%stiffness_cap)
         end associate
         if (allocated(error)) return
         self%state_valid = size(u) == self%get_size()
         self%state_u = u
         self%state_factors = self%factors
         self%state_spring = self%spring
+        self%state_stiffness_cap = self%stiffness_cap
         if (self%positions_frozen) self%state_u_frozen = self%u_frozen
     end subroutine update_state
 
@@ -562,7 +565,8 @@ contains
                 ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2,
                 ! from the tangents' own evaluation of each element.
                 call add_element_tangents(scene, self%element_slot, self%x, self%length0, &
-                    values, error, self%spring, self%tangent_spring, self%dforce_dl0)
+                    values, error, self%spring, self%tangent_spring, self%dforce_dl0, &
+                    self%stiffness_cap)
                 if (allocated(error)) return
                 do e = 1, net%n_elements()
                     ! L0 changes by share(e) times the flows bounding its segment.
@@ -641,10 +645,11 @@ contains
                     ! flow by the factor exp(mu alpha), and the line search fails).
                     if (abs(lambda - 1.0_wp) > kink_round_off) return
                     t = 0.0_wp
-                    dt = self%scene%laws(net%element_material(e))%law%get_reference_stiffness()
+                    dt = capped_stiffness(self%scene%laws(net%element_material(e))%law, &
+                        self%stiffness_cap)
                 else
                     call get_truss_tension(self%scene%laws(net%element_material(e))%law, &
-                        self%spring, lambda, t, dt)
+                        self%spring, lambda, t, dt, self%stiffness_cap)
                 end if
                 gradient(first:first + 2) = -dt / self%length0(e) * c
                 gradient(first + 3:first + 5) = dt / self%length0(e) * c

@@ -47,7 +47,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         call self%scene%dofs%expand(u, self%factors, self%x)
         call assemble_residual(self%scene, self%x, self%length0, self%factors, values, error, &
-            self%spring)
+            self%spring, self%stiffness_cap)
     end subroutine evaluate_residual
 
     subroutine evaluate_jacobian(self, u, values, error)
@@ -57,7 +57,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         call self%scene%dofs%expand(u, self%factors, self%x)
         call assemble_jacobian(self%scene, self%pattern, self%x, self%length0, values, error, &
-            self%spring, self%tangent_spring)
+            self%spring, self%tangent_spring, self%stiffness_cap)
     end subroutine evaluate_jacobian
 
     !> Each coordinate row is judged against the forces meeting at its node.
@@ -72,7 +72,7 @@ contains
         allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
         call self%scene%dofs%expand(u, self%factors, self%x)
         call get_node_force_levels(self%scene, self%x, self%length0, self%factors, self%spring, &
-            node_level, node_noise, max_force)
+            node_level, node_noise, max_force, self%stiffness_cap)
         call get_unknown_levels(self%scene, node_level, node_noise, level, noise)
     end subroutine get_row_levels
 

@@ -13,7 +13,9 @@
 !> to slack_stiffness by factors of 10, each solve from the last) and corrected from
 !> there with the exact law, so the answer is always that of the exact law. A solve
 !> whose full Newton steps fail is repeated with a line search, and then by
-!> pseudo-transient continuation (solve_transient).
+!> pseudo-transient continuation (solve_transient). Last, a solve that still fails is
+!> predicted with the laws far stiffer than its forces scaled down, then stiffened
+!> tenfold per solve, and corrected with the exact laws (solve_stiffening).
 module yarnfort_solver_newton
     use, intrinsic :: iso_c_binding
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -33,6 +35,7 @@ module yarnfort_solver_newton
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc, &
         analyse_counted, factor_counted, solve_counted, solve_columns_counted
     use yarnfort_solver_timer, only: wall_time
+    use yarnfort_assembly_truss, only: no_stiffness_cap
     implicit none
     private
 
@@ -69,6 +72,12 @@ module yarnfort_solver_newton
     !> of strings that all carry a tenth of their reference stiffness is regular and
     !> well conditioned from any start; the weight then falls by factors of 10.
     real(wp), parameter :: predictor_weight = 0.1_wp
+    !> First stiffness cap of solve_stiffening, in units of the largest force of the
+    !> solve's rows: strings that stretch by about 1 % under the forces of the scene,
+    !> where a Newton step may move a node along a yarn by a tenth of its length. The
+    !> cap then rises by stiffening_factor per solve.
+    real(wp), parameter :: first_cap_per_force = 100.0_wp
+    real(wp), parameter :: stiffening_factor = 10.0_wp
 
     interface
         !> C's strlen, for KINSOL's messages.
@@ -291,7 +300,7 @@ contains
         type(error_type), allocatable :: exact_error
         real(wp), allocatable :: guess(:)
         real(wp) :: weight
-        logical :: converged
+        logical :: converged, tried
         associate(problem => self%problem%problem, spring => self%options%slack_stiffness)
             problem%spring = 0.0_wp
             problem%tangent_spring = spring
@@ -301,38 +310,57 @@ contains
             end if
             call solve_once(self, u, stats, exact_error)
             if (.not. allocated(exact_error)) return
-            if (.not. (spring > 0.0_wp) .or. self%quick) then
+            if (self%quick) then
                 call move_alloc(exact_error, error)
                 return
             end if
-            ! Predict with the spring in the model, weight driven down from
-            ! predictor_weight to slack_stiffness by factors of 10 (each solve from the
-            ! last), then correct with the exact law.
-            guess = u
-            weight = max(predictor_weight, spring)
-            do
-                problem%spring = weight
-                problem%tangent_spring = 0.0_wp
-                call solve_once(self, guess, stats, error)
-                if (allocated(error)) then
-                    problem%spring = 0.0_wp
-                    problem%tangent_spring = spring
-                    call combine(error, '; with the regularised law as predictor: ')
-                    return
-                end if
-                if (weight <= spring) exit
-                weight = max(spring, weight / 10)
-            end do
-            problem%spring = 0.0_wp
-            problem%tangent_spring = spring
-            call solve_once(self, guess, stats, error)
-            if (allocated(error)) then
-                call combine(error, '; corrected from the regularised prediction: ')
-                return
+            if (spring > 0.0_wp) then
+                call predict_with_spring()
+                if (.not. allocated(error)) return
+                exact_error%message = exact_error%message // error%message
+                deallocate(error)
             end if
-            u = guess
+            call solve_stiffening(self, u, stats, tried, error)
+            if (allocated(error)) then
+                call combine(error, '')
+            else if (.not. tried) then
+                call move_alloc(exact_error, error)
+            end if
         end associate
     contains
+        !> Predict with the spring in the model, weight driven down from
+        !> predictor_weight to slack_stiffness by factors of 10 (each solve from the
+        !> last), then correct with the exact law. An error says where it failed.
+        subroutine predict_with_spring()
+            associate(problem => self%problem%problem, spring => self%options%slack_stiffness)
+                guess = u
+                weight = max(predictor_weight, spring)
+                do
+                    problem%spring = weight
+                    problem%tangent_spring = 0.0_wp
+                    call solve_once(self, guess, stats, error)
+                    if (allocated(error)) then
+                        problem%spring = 0.0_wp
+                        problem%tangent_spring = spring
+                        error%message = '; with the regularised law as predictor: ' &
+                            // error%message
+                        return
+                    end if
+                    if (weight <= spring) exit
+                    weight = max(spring, weight / 10)
+                end do
+                problem%spring = 0.0_wp
+                problem%tangent_spring = spring
+                call solve_once(self, guess, stats, error)
+                if (allocated(error)) then
+                    error%message = '; corrected from the regularised prediction: ' &
+                        // error%message
+                    return
+                end if
+                u = guess
+            end associate
+        end subroutine predict_with_spring
+
         pure logical function present_and_true(flag)
             logical, intent(in), optional :: flag
             present_and_true = .false.
@@ -345,6 +373,58 @@ contains
             later%message = exact_error%message // link // later%message
         end subroutine combine
     end subroutine solve
+
+    !> The last fallback of `solve`, for yarns far stiffer than the forces they carry:
+    !> a full Newton step can move a node along such a yarn by only about
+    !> sqrt(l T / EA) (the stretch it causes grows with the step's square), so a ring
+    !> that must slide far along it takes thousands of them. Solved first with every
+    !> law stiffer than first_cap_per_force times the largest force of the rows at u
+    !> scaled down to that stiffness (get_truss_tension), then with the cap raised by
+    !> stiffening_factor per solve, each from the last, until no law is capped, and
+    !> corrected with the exact laws: only the initial guess of that last solve changes,
+    !> so the answer is the exact laws'. `tried` is false (u unchanged, no error) when no
+    !> law is that stiff; an error when a solve fails.
+    subroutine solve_stiffening(self, u, stats, tried, error)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: u(:)
+        type(newton_stats_type), intent(inout) :: stats
+        logical, intent(out) :: tried
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: guess(:), level(:), noise(:)
+        real(wp) :: cap, stiffest
+        character(len=12) :: cap_text
+        integer :: m
+
+        associate(problem => self%problem%problem)
+            allocate(level(size(u)), noise(size(u)))
+            call get_levels_timed(self%problem, u, level, noise, error)
+            if (allocated(error)) return
+            stiffest = maxval([(problem%scene%laws(m)%law%get_reference_stiffness(), &
+                m = 1, size(problem%scene%laws))])
+            cap = first_cap_per_force * maxval([0.0_wp, level])
+            tried = cap > 0.0_wp .and. cap < stiffest
+            if (.not. tried) return
+            guess = u
+            do while (cap < stiffest)
+                problem%stiffness_cap = cap
+                call solve_once(self, guess, stats, error)
+                problem%stiffness_cap = no_stiffness_cap
+                if (allocated(error)) then
+                    write(cap_text, '(es10.3)') cap
+                    error%message = '; with the yarns softened to a stiffness of ' &
+                        // trim(adjustl(cap_text)) // ' as predictor: ' // error%message
+                    return
+                end if
+                cap = cap * stiffening_factor
+            end do
+            call solve_once(self, guess, stats, error)
+            if (allocated(error)) then
+                error%message = '; corrected from the softened prediction: ' // error%message
+                return
+            end if
+            u = guess
+        end associate
+    end subroutine solve_stiffening
 
     !> One Newton solve with the problem's current spring weights. Rows are scaled by
     !> their levels at the initial guess; at the end the levels are taken again at the

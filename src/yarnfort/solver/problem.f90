@@ -5,6 +5,7 @@ module yarnfort_solver_problem
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_scene_scene, only: scene_type
+    use yarnfort_assembly_truss, only: no_stiffness_cap
     implicit none
     private
 
@@ -19,6 +20,10 @@ module yarnfort_solver_problem
         !> tangent of slack strings only (see yarnfort_assembly_truss).
         real(wp) :: spring = 0.0_wp
         real(wp) :: tangent_spring = 0.0_wp
+        !> Set by the Newton solver before each solve: laws stiffer than this are scaled
+        !> down to it (a predictor solve, get_truss_tension; no_stiffness_cap for the
+        !> exact laws).
+        real(wp) :: stiffness_cap = no_stiffness_cap
         !> The scene (which must outlive the problem), the load channels' factors, the
         !> elements' reference lengths and a work array of node positions (3, n_nodes).
         type(scene_type), pointer :: scene => null()
