@@ -28,6 +28,7 @@ contains
             new_unittest('element_force_is_energy_gradient', test_element_force), &
             new_unittest('element_tangent_matches_fd', test_element_tangent), &
             new_unittest('slack_element_force_and_tangent', test_slack_element), &
+            new_unittest('capped_element_is_the_scaled_law', test_capped_element), &
             new_unittest('pattern_is_symmetric_and_sorted', test_pattern), &
             new_unittest('global_jacobian_matches_fd', test_global_jacobian), &
             new_unittest('internal_forces_balance', test_internal_balance), &
@@ -203,6 +204,56 @@ contains
         call check(error, abs(tension) + maxval(abs(block)) <= 0.0_wp, &
             'exact tension-only law: a slack element carries nothing')
     end subroutine test_slack_element
+
+    !> The stiffness cap of Newton's softened predictor: below the law's reference
+    !> stiffness (EA for the linear law) a taut element's tension, force and tangent are
+    !> the exact ones times cap / EA and the tangent is still the force's derivative
+    !> (finite differences); at or above EA nothing changes; a slack element's
+    !> regularising spring takes the capped stiffness.
+    subroutine test_capped_element(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(linear_law_type) :: law
+        real(wp) :: force(3), block(3, 3), tension, stretch, exact_force(3)
+        real(wp) :: exact_block(3, 3), exact_tension, fp(3), fm(3), xp(3), xm(3), fd(3, 3)
+        real(wp), parameter :: ea = 3.0_wp, cap = 0.75_wp, length0 = 0.5_wp, ratio = 1.0e-4_wp
+        real(wp), parameter :: x1(3) = [0.0_wp, 0.0_wp, 0.0_wp]
+        real(wp), parameter :: x2(3) = [0.45_wp, 0.3_wp, -0.1_wp]
+        integer :: k
+
+        call new_linear_law(law, ea, error)
+        if (allocated(error)) return
+        call get_truss_response(law, 0.0_wp, length0, x1, x2, exact_tension, stretch, &
+            exact_force, exact_block)
+        call get_truss_response(law, 0.0_wp, length0, x1, x2, tension, stretch, force, block, &
+            stiffness_cap=cap)
+        call check_close(error, [tension, force, reshape(block, [9])], (cap / ea) &
+            * [exact_tension, exact_force, reshape(exact_block, [9])], 1.0e-14_wp, &
+            'capped tension, force and block', abs_tol=1.0e-15_wp)
+        if (allocated(error)) return
+        do k = 1, 3
+            xp = x2
+            xm = x2
+            xp(k) = xp(k) + fd_step
+            xm(k) = xm(k) - fd_step
+            call get_truss_response(law, 0.0_wp, length0, x1, xp, tension, stretch, fp, &
+                stiffness_cap=cap)
+            call get_truss_response(law, 0.0_wp, length0, x1, xm, tension, stretch, fm, &
+                stiffness_cap=cap)
+            fd(:, k) = (fp - fm) / (2 * fd_step)
+        end do
+        call check_close(error, reshape(block, [9]), reshape(fd, [9]), fd_tolerance, &
+            'capped Z', abs_tol=fd_tolerance * maxval(abs(fd)))
+        if (allocated(error)) return
+        call get_truss_response(law, 0.0_wp, length0, x1, x2, tension, stretch, force, block, &
+            stiffness_cap=ea)
+        call check(error, tension == exact_tension .and. all(force == exact_force) &
+            .and. all(block == exact_block), 'a cap at EA changes nothing')
+        if (allocated(error)) return
+        call get_truss_response(law, ratio, 1.0_wp, x1, [0.5_wp, 0.0_wp, 0.0_wp], tension, &
+            stretch, force, block, stiffness_cap=cap)
+        call check_close(error, block(1, 1), ratio * cap / 1.0_wp, 1.0e-14_wp, &
+            'slack element: axial stiffness of the spring of the capped law')
+    end subroutine test_capped_element
 
     !> A small 3D net: 6 nodes, 8 elements, two laws, nodes 1 and 6 fully prescribed and
     !> node 3 prescribed in z.
