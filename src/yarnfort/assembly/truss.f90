@@ -40,7 +40,8 @@ contains
         real(wp) :: k_slack, k_ref, k_capped
 
         k_ref = law%get_reference_stiffness()
-        k_capped = capped_stiffness(law, stiffness_cap)
+        k_capped = k_ref
+        if (present(stiffness_cap)) k_capped = min(k_ref, stiffness_cap)
         if (stretch > 1.0_wp) then
             call law%get_force(stretch, tension, dtension)
             if (k_capped < k_ref) then
