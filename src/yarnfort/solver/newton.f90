@@ -250,30 +250,29 @@ contains
             call fatal_error(error, 'KINSOL: could not create solver memory')
             return
         end if
-        call check(FKINInit(self%kinsol, c_funloc(residual_callback), self%u_vector), &
-            'FKINInit', error)
-        if (allocated(error)) return
-        call check(FKINSetErrHandlerFn(self%kinsol, c_funloc(error_handler), &
-            c_loc(self%problem)), 'FKINSetErrHandlerFn', error)
-        if (allocated(error)) return
-        call check(FKINSetLinearSolver(self%kinsol, self%sunls, self%jacobian), &
-            'FKINSetLinearSolver', error)
-        if (allocated(error)) return
-        call check(FKINSetJacFn(self%kinsol, c_funloc(jacobian_callback)), 'FKINSetJacFn', error)
-        if (allocated(error)) return
-        call check(FKINSetMaxSetupCalls(self%kinsol, int(options%max_setup_calls, c_long)), &
-            'FKINSetMaxSetupCalls', error)
-        if (allocated(error)) return
-        call check(FKINSetNumMaxIters(self%kinsol, int(options%max_iterations, c_long)), &
-            'FKINSetNumMaxIters', error)
-        if (allocated(error)) return
-        call check(FKINSetFuncNormTol(self%kinsol, real(options%residual_tolerance, c_double)), &
-            'FKINSetFuncNormTol', error)
-        if (allocated(error)) return
-        call check(FKINSetScaledStepTol(self%kinsol, real(options%step_tolerance, c_double)), &
-            'FKINSetScaledStepTol', error)
-        if (allocated(error)) return
-        call check(FKINSetUserData(self%kinsol, c_loc(self%problem)), 'FKINSetUserData', error)
+        ! In this order (the Jacobian function needs the linear solver); the first
+        ! failure is the error (the calls after it fail or do no harm).
+        call set(FKINInit(self%kinsol, c_funloc(residual_callback), self%u_vector), 'FKINInit')
+        call set(FKINSetErrHandlerFn(self%kinsol, c_funloc(error_handler), &
+            c_loc(self%problem)), 'FKINSetErrHandlerFn')
+        call set(FKINSetLinearSolver(self%kinsol, self%sunls, self%jacobian), &
+            'FKINSetLinearSolver')
+        call set(FKINSetJacFn(self%kinsol, c_funloc(jacobian_callback)), 'FKINSetJacFn')
+        call set(FKINSetMaxSetupCalls(self%kinsol, int(options%max_setup_calls, c_long)), &
+            'FKINSetMaxSetupCalls')
+        call set(FKINSetNumMaxIters(self%kinsol, int(options%max_iterations, c_long)), &
+            'FKINSetNumMaxIters')
+        call set(FKINSetFuncNormTol(self%kinsol, real(options%residual_tolerance, c_double)), &
+            'FKINSetFuncNormTol')
+        call set(FKINSetScaledStepTol(self%kinsol, real(options%step_tolerance, c_double)), &
+            'FKINSetScaledStepTol')
+        call set(FKINSetUserData(self%kinsol, c_loc(self%problem)), 'FKINSetUserData')
+    contains
+        subroutine set(flag, name)
+            integer(c_int), intent(in) :: flag
+            character(len=*), intent(in) :: name
+            if (.not. allocated(error)) call check(flag, name, error)
+        end subroutine set
     end subroutine new_newton_solver
 
     subroutine check(ierr, where, error)
