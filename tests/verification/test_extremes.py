@@ -65,6 +65,9 @@ minimum length: ratio 0.05 (default),  pin      closed form; element a down to 5
 alpha = 0 (collinear), 1e-9            pin      closed form; |T_b - T_a| <= T_crit(T_a) -
   (coulomb mu = 1e4; adhesion beta=1e3)         T_a, i.e. no friction resistance
 alpha = pi (folded back), pi - 1e-9    pin      closed form (adhesion: every phase)
+stiff yarn: EA = 1e5 P, a ring from   ring     every step against test_defaults.py's
+  the stress-free start far from its            play-operator reference (1e-8 of span
+  place, coulomb mu = 0.3, m+s                  and load)
 hundreds of step cuts, finishing:      pin      > 200 cuts (410 measured), every step at
   3x in one step, max_iterations = 2,           the closed form
   step_cut = 0.99
@@ -107,6 +110,9 @@ import numpy as np
 import pytest
 
 from scenes import group, scene
+from test_defaults import (FORCE_RTOL, FRICTION_START, POSITION_RTOL, RING_A, RING_B,
+                           RING_LOAD, RING_MU, RING_STIFFNESS, admissible_splits,
+                           ring_errors, ring_namelist, stuck_ring)
 from test_friction import angle_to_reach, arc_pegs, namelist, peg_net, wrap_angles
 from yarnfort import read_curve, read_states
 
@@ -903,3 +909,33 @@ def test_hundreds_of_step_cuts_then_a_clean_stop(run_yarnfort, tmp_path):
     assert "Newton did not converge" in message
     assert sum("cut:" in line for line in lines) == 301
     np.testing.assert_array_equal(outcome.curve["time"], [0.0, 0.5, 1.0])
+
+
+@pytest.mark.parametrize("scheme", ["monolithic", "staggered"])
+def test_ring_sliding_far_on_a_stiff_yarn(run_yarnfort, tmp_path, scheme):
+    """test_defaults.py's friction ring on its stiff yarn (EA = 1e5 P) with each scheme:
+    from the stress-free start far on the A side the ring must slide about 0.5 m at the
+    first state, where Newton's steps along the yarn are limited to about sqrt(l T / EA).
+    It converges through Newton's softened-yarn predictor (the monolithic scheme), and
+    through the staggered scheme's last monolithic finish with every Newton fallback
+    (its rounds alone creep: residual 7e-4 falling by 1e-10 per round). Every step
+    against the play-operator reference, as in test_friction_ring_with_defaults."""
+    stiffness = RING_STIFFNESS["stiff"]
+    text = ring_namelist(FRICTION_START, stiffness, RING_MU)
+    text = text.replace("&output", group("solver", scheme=scheme) + "&output", 1)
+    outcome = run_case(run_yarnfort, tmp_path, scheme, text)
+    assert outcome.returncode == 0, outcome.stderr
+    length0 = np.linalg.norm(RING_A - FRICTION_START) + np.linalg.norm(RING_B - FRICTION_START)
+    split, ends, rings, tensions = np.linalg.norm(RING_A - FRICTION_START), None, [], []
+    for p in outcome.curve["p_force"]:
+        ends = admissible_splits(length0, stiffness, p * RING_LOAD, RING_MU, hint=ends)
+        split = min(max(split, ends[0]), ends[1])
+        ring, t, _ = stuck_ring(split, length0, stiffness, p * RING_LOAD)
+        rings.append(ring)
+        tensions.append(t)
+    errors = ring_errors(outcome.curve, outcome.states, rings, tensions)
+    print(f"ring on a stiff yarn ({scheme}): {len(outcome.states)} steps, errors "
+          f"{', '.join(f'{n} {v:.1e}' for n, v in errors.items())}")
+    for key, value in errors.items():
+        assert value <= (POSITION_RTOL if key in ("ring", "stub_end") else FORCE_RTOL), \
+            (key, value)

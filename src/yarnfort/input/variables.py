@@ -197,7 +197,8 @@ GROUPS = [
                 "stick/slip active set; `'staggered'` is the paper's two-step scheme (elastic "
                 'solve, then sliding); a step that its first round does not solve is finished '
                 "by monolithic solves from that round's state (the alternation alone converges "
-                'slowly). Case-insensitive.'),
+                'slowly), and where the rounds run out by one with every Newton fallback. '
+                'Case-insensitive.'),
         Var('max_friction_iterations', 'integer', 200, range='>= 1',
             doc='Friction: most stick/slip active-set updates (monolithic) or elastic/sliding '
                 'alternations (staggered) per load step. A slip front advances by about one '
