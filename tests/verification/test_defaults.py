@@ -639,8 +639,10 @@ def test_frictionless_ring_reference_is_the_ellipse():
 #: band, ten times the rounding allowance of the passage's tensions (8 eps r EA each),
 #: is 2e-6 to 1e-7 of the tension: at three steps the ring stays stuck where the
 #: frictionless one slides, off by up to 1.3e-7 of the span, above POSITION_RTOL
-#: (test_inextensible_ring_converges_within_its_dead_band). Strict: the day it is
-#: within, these tests must become plain ones.
+#: (test_inextensible_ring_converges_within_its_dead_band). Below the band the rows'
+#: convergence allowance (the same rounding) leaves 4e-8, and at the first load the bare
+#: rounding of a tension (eps r EA) is 1e-8 of the load: the tests' tolerance is the
+#: arithmetic's there. Strict: the day it is within, these tests must become plain ones.
 INEXTENSIBLE_RING_LIMIT = pytest.mark.xfail(
     strict=True, reason="known limit: with EA = 1e7 tension the stick test's dead band "
     "(rounding of the tensions) leaves the ring off by up to 1.3e-7 of the span")
