@@ -168,19 +168,23 @@ def ring_errors(curve, states, rings, tensions) -> dict:
     return errors
 
 
-@pytest.mark.parametrize("first_load", [FIRST_LOAD, 0.0])
-def test_frictionless_ring_with_defaults(run_yarnfort, tmp_path, first_load):
+@pytest.mark.parametrize("yarn, first_load", [("soft", FIRST_LOAD), ("soft", 0.0),
+                                              ("stiff", 0.0)])
+def test_frictionless_ring_with_defaults(run_yarnfort, tmp_path, yarn, first_load):
     """mu = 0 ring at a &ring node, stress free at (0, -0.6), the load on the ring ramped
     to P: ring, tensions and reactions at every loaded step against the ellipse closed
-    form for the extensible yarn (test_defaults.frictionless_ring)."""
-    stiffness = RING_STIFFNESS["soft"]
+    form for the extensible yarn (test_defaults.frictionless_ring). The stiff yarn (EA
+    = 1e5 P) from zero load: its first loaded step must slide the ring far along a yarn
+    1e6 times stiffer than that step's load (before Newton's softened-yarn predictor it
+    failed after 17 step cuts)."""
+    stiffness = RING_STIFFNESS[yarn]
     start = np.array([0.0, -0.6, 0.0])
     length0 = np.linalg.norm(RING_A - start) + np.linalg.norm(RING_B - start)
     _, curve, states = run_scene(run_yarnfort, tmp_path, "ring",
                                  ring_scene(start, stiffness, 0.0, first_load))
     rings, tensions = frictionless_ring_path(length0, stiffness, curve["p_force"])
     errors = ring_errors(curve, states, rings, tensions)
-    print(f"frictionless &ring (from {first_load} P): {len(states)} steps, errors "
+    print(f"frictionless &ring ({yarn}, from {first_load} P): {len(states)} steps, errors "
           f"{', '.join(f'{n} {v:.1e}' for n, v in errors.items())}")
     assert errors["ring"] <= POSITION_RTOL
     assert errors["tension"] <= FORCE_RTOL and errors["reaction"] <= FORCE_RTOL
