@@ -770,10 +770,14 @@ contains
             ! as on a ring sliding along a yarn 1e5 times stiffer than its load (residual
             ! 7e-4 falling by 1e-10 per round), the softened-yarn predictor solves it.
             if (may_finish) then
-                self%newton_full%quick = .false.
-                call finish_monolithic(self, flips, locked_forward, locked_backward, &
-                    finished, iterations, error)
-                self%newton_full%quick = .true.
+                block
+                    logical :: quick
+                    quick = self%newton_full%quick
+                    self%newton_full%quick = .false.
+                    call finish_monolithic(self, flips, locked_forward, locked_backward, &
+                        finished, iterations, error)
+                    self%newton_full%quick = quick
+                end block
                 if (allocated(error)) return
                 if (finished) then
                     self%n_damped = count(flips > max_flips)
