@@ -296,6 +296,8 @@ contains
         !> Active set of the last Newton step's factors (try_chord, take_newton_step).
         integer, allocatable :: factored_mode(:), passage_index(:)
         logical :: have_good, guessed, full_retry, sign_tried, stopped, solved, moved, chorded
+        !> The last round's set was solved (see `cap` where a round solves).
+        logical :: solved_before
         type(error_type), allocatable :: step_error
         type(newton_stats_type) :: carried
 
@@ -343,6 +345,7 @@ contains
             full_retry = .false.
             sign_tried = .false.
             provisional_rounds = 0
+            solved_before = .false.
             failed_before = self%trace%failed_solves
             do round = 1, scene%solver%max_friction_iterations
                 problem%mode = self%mode_trial
@@ -464,6 +467,7 @@ contains
                 end if
                 call record_solve(self%trace, stats, allocated(error))
                 if (allocated(error)) then
+                    solved_before = .false.
                     if (self%newton_full%quick .and. .not. (have_good .or. guessed &
                         .or. sign_tried)) then
                         ! The step's first set failed, with no new slip: where a set that
@@ -547,6 +551,19 @@ contains
                     self%mode_trial = problem%mode
                 end if
                 have_good = .true.
+                ! A failed round halves the cap on new slips (above); two solved rounds in
+                ! a row double it again. Without that the cap kept its lowest value for
+                ! the rest of the step: the first load step of a 24 x 24 clamped knit
+                ! (default edge threads, 4,512 passages, about 2,200 of which start to
+                ! slip) failed at 1,104, 552, ... 2 new slips and then took 2 per round
+                ! until the 200 rounds ran out (a cut; the step at half the load took
+                ! 213 rounds and 1,258 Newton iterations). Doubling after every solved
+                ! round took 24 x 24 to 14.8 Newton iterations per load step from 59.6 but
+                ! 32 x 32 to 57.5 from 18.4 (every other round failed at twice a cap that
+                ! solved); after two in a row: 13.2 and 18.7 (benchmarks/steps_results.md,
+                ! section 23).
+                if (solved_before .and. cap < huge(1) / 2) cap = 2 * cap
+                solved_before = .true.
                 good_unknowns = unknowns
                 good_mode = self%mode_trial
                 good_flips = flips
