@@ -157,8 +157,8 @@ def test_large_sample_opens_its_slip_zone_in_one_step(run_yarnfort, tmp_path):
     in 200 rounds and was cut (benchmarks/steps_results.md, section 23). Checked on the
     step's converged state: not cut; every passage admissible against the closed form
     of the adhesion law (stick within T_crit(T_min), slip at it); the reactions balance;
-    and the state is mapped onto itself by the sample's half turn, which the capped
-    rounds' partial admissions do not respect on their way."""
+    and the state is mapped onto itself by the sample's half turn (the capped rounds
+    admit the most violated passages first and may split mirror pairs on the way)."""
     from scipy.spatial import cKDTree
     from test_contact_output import FRICTION_RTOL
     from test_knit_inlay import adhesion_critical
