@@ -47,6 +47,8 @@ contains
             ! Passages held in stick by chatter damping: rare, so named only when present.
             if (state%n_held > 0) write(error_unit, '("  held ", i0)', advance='no') &
                 state%n_held
+            ! A jump after a slip instability (try_jump), likewise.
+            if (state%jumped) write(error_unit, '("  jumped")', advance='no')
             write(error_unit, '()')
         else
             write(error_unit, '()')

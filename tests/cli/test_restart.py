@@ -26,7 +26,7 @@ VNET = (TOP / "inputs" / "vnet.nml").read_text()
 #: residual (below the tolerance, its digits are round-off).
 NOT_COMPARED = {"wall_time", "residual"}
 #: Counts that must agree exactly.
-INTEGER_COLUMNS = {"step", "direction", "slipping", "held", "passages",
+INTEGER_COLUMNS = {"step", "direction", "slipping", "held", "jumped", "passages",
                    "newton_iterations", "step_cuts"}
 #: Largest difference allowed between the restarted and the uninterrupted curve,
 #: relative to the largest magnitude in the column. The restarted run repeats every

@@ -30,6 +30,13 @@
 !> 9.6 factorisations per step against 2.5 for the active-set rounds, so the stepper's
 !> rounds (semismooth off) are the default. `locked` forbids a direction (minimum
 !> reference length reached, or chatter damping).
+!> Viscous slip (`viscosity` > 0, off by default; only the slip-instability jump of
+!> friction_stepper sets it): each slip row gets eta (s - s_start) added, eta =
+!> viscosity * stick_scale and s_start = flow_target, so a slipping passage is held
+!> above its limit by an overstress eta ds >= 0 (forward; backward likewise): implicit
+!> Euler steps of a viscoplastic slip law. Where the rate-independent law has no
+!> solution near the start (a slip instability), they have one, and their end state,
+!> where ds -> 0, is one of the exact law.
 !> Neutral modes: a set of slipping passages can let material run along a path without
 !> changing any tension (the yarn round a periodic cell, or a column of contact nodes
 !> sliding along a straight course whose heads and sinkers carry one tension); the
@@ -89,6 +96,8 @@ module yarnfort_contact_friction_problem
         real(wp), allocatable :: slip_weight(:)
         !> Choose modes from the iterate (semismooth Newton) instead of keeping `mode`.
         logical :: semismooth = .false.
+        !> Viscous slip, in units of stick_scale (module notes; 0: the exact law).
+        real(wp) :: viscosity = 0.0_wp
         !> Direction a passage may not slip in (mode_forward or mode_backward), both
         !> (locked_both), or 0.
         integer, allocatable :: locked(:)
@@ -532,12 +541,14 @@ contains
                 call self%get_passage_state(p, t_before, t_after, angle)
                 call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
                     t_before, angle, critical, dcrit_dt, dcrit_da)
-                values(row + p) = (critical - t_after) / self%slip_weight(p)
+                values(row + p) = (critical - t_after + self%viscosity * self%stick_scale &
+                    * (flow - self%flow_target(p))) / self%slip_weight(p)
             case (mode_backward)
                 call self%get_passage_state(p, t_before, t_after, angle)
                 call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
                     t_after, angle, critical, dcrit_dt, dcrit_da)
-                values(row + p) = (t_before - critical) / self%slip_weight(p)
+                values(row + p) = (t_before - critical + self%viscosity * self%stick_scale &
+                    * (flow - self%flow_target(p))) / self%slip_weight(p)
             end select
         end do
     end subroutine evaluate_residual
@@ -613,6 +624,7 @@ contains
                     row(1:9) = row(1:9) - dcrit_da * reshape(dangle, [9])
                 end if
             end associate
+            row(10) = row(10) + self%viscosity * self%stick_scale
             row = row / self%slip_weight(p)
             ! Tangent only: neutral modes (module notes).
             row(10) = row(10) + sign(neutral_shift * maxval(abs(row(10:12))), row(10))

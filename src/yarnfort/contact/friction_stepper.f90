@@ -28,10 +28,11 @@
 !> the element keeps that length, in this step and the next ones. A passage that flips
 !> more than max_flips times in one step is held in stick for the rest of the step
 !> (chatter damping); the step fails if a held passage ends beyond its limit
-!> (check_damped).
+!> (check_damped). A step whose rounds fail that way at every step size down to
+!> min_step is a slip instability: the continuation then asks for a jump (try_jump).
 module yarnfort_contact_friction_stepper
     use yarnfort_kinds, only: wp
-    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_error, only: error_type, fatal_error, prefix_error
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
@@ -127,6 +128,16 @@ module yarnfort_contact_friction_stepper
     integer, parameter :: max_provisional_rounds = 8, provisional_passes = 4
     real(wp), parameter :: provisional_contraction = 0.8_wp, provisional_band = 0.2_wp
 
+    !> The slip-instability jump (try_jump): viscosity of its first viscous step (units
+    !> of friction_problem's stick_scale, the scene's largest force per length_scale),
+    !> the most it may grow to after failed ones, and the most viscous steps. Measured
+    !> from the restart before the failing release step of the 32 x 32 free-sided
+    !> clamped knit (benchmarks/steps_results.md, section 24), with the viscosity in
+    !> the rounds of every step (an experiment): at 1 that step settled at once (2
+    !> Newton iterations); at 1e-3 it did, and a later one failed; 1e-6 changed nothing.
+    real(wp), parameter :: jump_viscosity = 1.0_wp, max_jump_viscosity = 1.0e6_wp
+    integer, parameter :: max_jump_steps = 100
+
     !> Outcomes of the predictor (predict).
     integer, parameter :: predicted_state = 1, reversed = -1
 
@@ -159,6 +170,11 @@ module yarnfort_contact_friction_stepper
         logical :: from_initial = .false.
         !> Passages held in stick by chatter damping in the last step.
         integer :: n_damped = 0
+        !> The last try failed in the stick/slip rounds (chatter or no settling), not in
+        !> a Newton solve: what try_jump starts from.
+        logical :: unsettled = .false.
+        !> The last successful trial, and the accepted state, were reached by a jump.
+        logical :: jumped_trial = .false., jumped = .false.
         !> The stick test's at_limit flag (get_slip_tendency) of each stick passage at
         !> the accepted state (`have_limits`), from the last round of the step that
         !> reached it, and of the last successful try_step (`limits_trial`): the next
@@ -169,6 +185,7 @@ module yarnfort_contact_friction_stepper
         type(step_trace_type) :: trace, last_trace
     contains
         procedure :: try_step
+        procedure :: try_jump
         procedure :: accept
         procedure :: get_state
         procedure :: save_state
@@ -269,6 +286,19 @@ contains
         integer, intent(out) :: iterations
         type(error_type), allocatable, intent(out) :: error
 
+        call start_trial(self, factors)
+        if (self%staggered) then
+            call try_staggered(self, stats, iterations, error)
+        else
+            call try_monolithic(self, stats, iterations, error)
+        end if
+    end subroutine try_step
+
+    !> A new try from the accepted state to the load `factors`.
+    subroutine start_trial(self, factors)
+        type(friction_stepper_type), intent(inout) :: self
+        real(wp), intent(in) :: factors(:)
+
         self%trace%tries = self%trace%tries + 1
         self%factors_trial = factors
         self%u_trial = self%u
@@ -276,12 +306,122 @@ contains
         self%mode_trial = self%mode
         self%n_damped = 0
         self%limits_trial = .false.
-        if (self%staggered) then
-            call try_staggered(self, stats, iterations, error)
+        self%unsettled = .false.
+        self%jumped_trial = .false.
+    end subroutine start_trial
+
+    !> Jump to the load `factors` after a slip instability: the last try failed in the
+    !> stick/slip rounds (chatter, or no settling) at the smallest step (`attempted`
+    !> is false otherwise, and nothing is done). There the rounds find no consistent
+    !> set: measured on the 32 x 32 free-sided clamped knit (benchmarks/
+    !> steps_results.md, sections 23 and 24), mirror pairs of passages flip for ever
+    !> (slipping, their flows go back; stuck, they exceed their limit, by an amount
+    !> proportional to the step), the semismooth mode's line search stalls, and
+    !> changing one passage per round (least index first) does not settle either.
+    !> From the accepted state, viscous slip steps at the load `factors`
+    !> (friction_problem's viscosity: implicit Euler steps of a viscoplastic law, whose
+    !> stick/slip problem is well posed) relax the net: each starts from the last one's
+    !> state, the viscosity halves after each solved step and grows fourfold after a
+    !> failed one, until the viscous overstress of every slipping passage is within the
+    !> solve's residual_tolerance of its own tensions. The rounds of the exact law then
+    !> solve the load from that state; their result, checked as any step's, is the
+    !> trial. The path in between is not quasi-static (the real net jumps with inertia
+    !> and damping this model does not have): the state reached is an equilibrium of
+    !> the exact law, one of possibly several after such a jump.
+    subroutine try_jump(self, factors, stats, iterations, attempted, error)
+        class(friction_stepper_type), intent(inout) :: self
+        real(wp), intent(in) :: factors(:)
+        type(newton_stats_type), intent(out) :: stats
+        integer, intent(out) :: iterations
+        logical, intent(out) :: attempted
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable :: u_accepted(:), flow_accepted(:), factors_accepted(:)
+        integer, allocatable :: mode_accepted(:)
+        logical :: have_old, from_initial, have_limits
+        real(wp) :: viscosity, overstress
+        integer :: k, step_iterations, solved_steps
+        type(error_type), allocatable :: step_error
+        character(len=200) :: buffer
+
+        iterations = 0
+        attempted = self%unsettled .and. .not. self%staggered
+        if (.not. attempted) return
+        u_accepted = self%u
+        flow_accepted = self%flow
+        mode_accepted = self%mode
+        factors_accepted = self%factors
+        have_old = self%have_old
+        from_initial = self%from_initial
+        have_limits = self%have_limits
+        ! Every viscous step starts from the last one's state with its slip set (no
+        ! extrapolation across the jump).
+        self%have_old = .false.
+        self%from_initial = .false.
+        self%have_limits = .false.
+        viscosity = jump_viscosity
+        overstress = huge(1.0_wp)
+        solved_steps = 0
+        do k = 1, max_jump_steps
+            self%full%viscosity = viscosity
+            call start_trial(self, factors)
+            call try_monolithic(self, stats, step_iterations, step_error)
+            iterations = iterations + step_iterations
+            if (allocated(step_error)) then
+                deallocate(step_error)
+                viscosity = 4 * viscosity
+                if (viscosity > max_jump_viscosity) exit
+                cycle
+            end if
+            solved_steps = solved_steps + 1
+            overstress = get_overstress(self%full, self%flow_trial - self%flow)
+            self%u = self%u_trial
+            self%flow = self%flow_trial
+            self%mode = self%mode_trial
+            self%factors = factors
+            if (overstress <= self%scene%solver%residual_tolerance) exit
+            viscosity = viscosity / 2
+        end do
+        self%full%viscosity = 0.0_wp
+        if (overstress <= self%scene%solver%residual_tolerance .and. solved_steps > 0) then
+            call start_trial(self, factors)
+            call try_monolithic(self, stats, step_iterations, error)
+            iterations = iterations + step_iterations
+            if (allocated(error)) call prefix_error(error, 'slip instability: the exact ' &
+                // 'law did not settle after the viscous relaxation')
         else
-            call try_monolithic(self, stats, iterations, error)
+            write(buffer, '("slip instability: the viscous relaxation did not come to rest (", &
+                &i0, " viscous steps solved, viscosity ", es9.2, ", overstress ", es9.2, ")")') &
+                solved_steps, viscosity, overstress
+            call fatal_error(error, trim(buffer))
         end if
-    end subroutine try_step
+        self%jumped_trial = .not. allocated(error)
+        self%u = u_accepted
+        self%flow = flow_accepted
+        self%mode = mode_accepted
+        self%factors = factors_accepted
+        self%have_old = have_old
+        self%from_initial = from_initial
+        self%have_limits = have_limits
+    end subroutine try_jump
+
+    !> The largest viscous overstress of a slipping passage over its larger tension (the
+    !> state held in `problem`: a viscous step's solution), for flow increments
+    !> `increment` of the step.
+    real(wp) function get_overstress(problem, increment) result(overstress)
+        type(friction_problem_type), intent(in) :: problem
+        real(wp), intent(in) :: increment(:)
+        real(wp) :: t_before, t_after, angle, floor
+        integer :: p
+
+        overstress = 0.0_wp
+        floor = node_level_floor * problem%get_force_level()
+        do p = 1, size(increment)
+            if (problem%mode(p) == mode_stick) cycle
+            call problem%get_passage_state(p, t_before, t_after, angle)
+            overstress = max(overstress, problem%viscosity * problem%stick_scale &
+                * abs(increment(p)) / max(t_before, t_after, floor))
+        end do
+    end function get_overstress
 
     subroutine try_monolithic(self, stats, iterations, error)
         type(friction_stepper_type), intent(inout) :: self
@@ -573,6 +713,7 @@ contains
                 call record_changes(self%trace, good_mode, self%mode_trial)
                 if (changed == 0) then
                     call check_damped(problem, flips, locked_forward, locked_backward, error)
+                    self%unsettled = allocated(error)
                     if (allocated(error)) return
                     self%u_trial = unknowns(1:n_x)
                     self%flow_trial = unknowns(n_x + 1:)
@@ -583,6 +724,7 @@ contains
                 end if
             end do
             call not_settled(error, scene%solver%max_friction_iterations, flips)
+            self%unsettled = .true.
         end associate
     contains
         !> The active set judged at a provisional iterate (flows `flow`) as at a solved
@@ -1289,7 +1431,7 @@ contains
             self%flow_older = self%flow_old
             self%load_older = self%load_old
         end if
-        self%from_initial = .not. self%have_old
+        self%from_initial = .not. (self%have_old .or. self%jumped)
         self%have_limits = self%limits_trial
         if (self%have_limits) self%at_limit = self%at_limit_trial
         self%u_old = self%u
@@ -1299,6 +1441,14 @@ contains
         call accept_trial(self)
         self%flow = self%flow_trial
         self%mode = self%mode_trial
+        ! Across a jump the path has no tangent: the next step is predicted from the new
+        ! state alone.
+        self%jumped = self%jumped_trial
+        if (self%jumped) then
+            self%have_old = .false.
+            self%have_older = .false.
+            self%held = .false.
+        end if
     end subroutine accept
 
     subroutine get_state(self, state, error)
@@ -1313,6 +1463,7 @@ contains
         state%n_passages = size(self%mode)
         state%n_slipping = count(self%mode /= mode_stick)
         state%n_held = self%n_damped
+        state%jumped = self%jumped
     end subroutine get_state
 
     !> Everything a step depends on besides the scene: the accepted state (whose flows
@@ -1366,6 +1517,8 @@ contains
         ! the run that wrote the file (a 48 x 24 clamped knit's step 1 from the initial
         ! state's slip set took 625 Newton iterations instead of 25).
         self%from_initial = snapshot%step == 0
+        ! Only a jump leaves a step after step 0 without a predictor state (accept).
+        self%jumped = snapshot%step > 0 .and. .not. snapshot%have_old
         self%have_limits = .false.
         self%flow_trial = self%flow
         self%mode_trial = self%mode

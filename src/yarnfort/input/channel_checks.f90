@@ -23,9 +23,9 @@ module yarnfort_input_channel_checks
     character(len=*), parameter :: default_displacement_channel = 'p_disp'
 
     !> The columns of curve.csv that are not named after a channel, support or load.
-    character(len=*), parameter :: fixed_curve_columns(12) = [character(len=17) :: &
+    character(len=*), parameter :: fixed_curve_columns(13) = [character(len=17) :: &
         'step', 'time', 'strain', 'force_per_width', 'direction', 'slipping', 'held', &
-        'passages', &
+        'jumped', 'passages', &
         'newton_iterations', 'residual', 'step_cuts', 'wall_time']
 
 contains

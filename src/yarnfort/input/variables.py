@@ -176,7 +176,9 @@ GROUPS = [
             doc='Smallest step, as a fraction of the knot interval being followed; min_step <= '
                 'max_step, and min_step times every knot interval at least `100 * epsilon` '
                 'times the largest absolute `&path time` (a shorter step would not advance the '
-                'pseudo-time).'),
+                'pseudo-time). A friction step whose stick/slip rounds fail at every step size '
+                'down to min_step jumps (see *Slip instabilities*); any other step that fails '
+                'there stops the run.'),
         Var('max_step', 'real', 0.25, unit='knot interval', range='> 0',
             presets={'fast': 0.25, 'balanced': 0.05, 'accurate': 0.01},
             doc='Largest step, as a fraction of the knot interval being followed: a path of N '

@@ -46,7 +46,8 @@ contains
     !> (m, the mean displacement of the nodes of &load #k) for each &load, then for a
     !> fabric strain and force_per_width, then direction (1 loading, -1 unloading, 0
     !> neither: sign of the change of the sum of the channels' factors), passages
-    !> slipping, passages held in stick by chatter damping, and sliding passages in all,
+    !> slipping, passages held in stick by chatter damping, 1 if the step ended in a jump
+    !> after a slip instability (else 0), and sliding passages in all,
     !> Newton iterations of the step (all solves), final scaled residual, step cuts and
     !> wall time (s) of the step.
     subroutine open_curve(self, folder, scene, error)
@@ -259,7 +260,8 @@ contains
             end do
         end if
         if (scene%fabric_set > 0) header = header // ',strain,force_per_width'
-        header = header // ',direction,slipping,held,passages,newton_iterations,residual,step_cuts,wall_time'
+        header = header // ',direction,slipping,held,jumped,passages,newton_iterations,residual,' &
+            // 'step_cuts,wall_time'
     end function get_header
 
     subroutine write_step(self, scene, state, error)
@@ -292,6 +294,7 @@ contains
         call row%add(state%direction)
         call row%add(state%n_slipping)
         call row%add(state%n_held)
+        call row%add(merge(1, 0, state%jumped))
         call row%add(state%n_passages)
         call row%add(state%newton_iterations)
         call row%add(state%newton%residual_norm)

@@ -77,8 +77,9 @@ contains
         type(newton_stats_type) :: stats
         type(step_state_type) :: state
         type(restart_type) :: snapshot
-        type(error_type), allocatable :: step_error
+        type(error_type), allocatable :: step_error, jump_error
         character(len=200) :: buffer
+        logical :: jumped
 
         if (present(stopped)) stopped = .false.
         allocate(factors(scene%path%n_channels()))
@@ -154,15 +155,22 @@ contains
                     cuts = cuts + 1
                     call observer%on_cut(t, t_next - t, step_error%message)
                     dt = (t_next - t) / interval * scene%solver%step_cut
-                    if (dt < scene%solver%min_step .or. cuts > scene%solver%max_step_cuts) then
+                    if (dt >= scene%solver%min_step .and. cuts <= scene%solver%max_step_cuts) then
+                        deallocate(step_error)
+                        cycle
+                    end if
+                    ! No step size works: a jump to the smallest step's load, where the
+                    ! stepper has one for the way it failed (a slip instability).
+                    call stepper%try_jump(factors, stats, iterations, jumped, jump_error)
+                    if (.not. jumped .or. allocated(jump_error)) then
                         write(buffer, '("step from time ", g0.6, " failed after ", i0, &
                             & " cuts (step ", es9.2, " of the knot interval, min_step ", es9.2, &
                             & "); last error")') t, cuts, dt, scene%solver%min_step
                         call fatal_error(error, trim(buffer) // ': ' // step_error%message)
+                        if (jumped) error%message = error%message // '; then ' &
+                            // jump_error%message
                         return
                     end if
-                    deallocate(step_error)
-                    cycle
                 end if
                 call stepper%accept()
                 step = step + 1

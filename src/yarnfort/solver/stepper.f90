@@ -24,6 +24,10 @@ module yarnfort_solver_stepper
     contains
         !> Solve for the channels' factors from the last accepted state (which stays as is).
         procedure(try_step_interface), deferred :: try_step
+        !> After a step failed at every step size: try to reach the load factors by a
+        !> jump (a non-quasi-static path to an equilibrium of the exact model), if the
+        !> stepper has one for the way the step failed (`attempted`). Default: none.
+        procedure :: try_jump
         !> Make the last successful trial the accepted state (default: u and factors).
         procedure :: accept => accept_trial
         !> The accepted state (positions, tensions, reactions, friction counts); default:
@@ -62,6 +66,18 @@ contains
         allocate(self%factors(scene%path%n_channels()), source=0.0_wp)
         self%factors_trial = self%factors
     end subroutine start_stepper
+
+    !> The default: no jump.
+    subroutine try_jump(self, factors, stats, iterations, attempted, error)
+        class(load_stepper_type), intent(inout) :: self
+        real(wp), intent(in) :: factors(:)
+        type(newton_stats_type), intent(out) :: stats
+        integer, intent(out) :: iterations
+        logical, intent(out) :: attempted
+        type(error_type), allocatable, intent(out) :: error
+        iterations = 0
+        attempted = .false.
+    end subroutine try_jump
 
     subroutine accept_trial(self)
         class(load_stepper_type), intent(inout) :: self
