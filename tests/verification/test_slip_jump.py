@@ -52,11 +52,17 @@ MU, BETA = 0.3999, 0.015
 ON_CURVE = 1e-5
 
 
-def test_release_step_without_quasi_static_continuation_jumps(run_yarnfort, tmp_path):
+def restart_point(tmp_path, name="slip_jump"):
+    """The fixture's folder, unpacked under tmp_path / name, and its scene (restart from
+    step 88, one step)."""
     with tarfile.open(FIXTURE) as archive:
-        archive.extractall(tmp_path, filter="data")
-    folder = tmp_path / "slip_jump"
-    scene = (folder / "scene.nml").read_text().replace("@FOLDER@", str(folder))
+        archive.extractall(tmp_path / name, filter="data")
+    folder = tmp_path / name / "slip_jump"
+    return folder, (folder / "scene.nml").read_text().replace("@FOLDER@", str(folder))
+
+
+def test_release_step_without_quasi_static_continuation_jumps(run_yarnfort, tmp_path):
+    folder, scene = restart_point(tmp_path)
     result = run_yarnfort(scene, cwd=TOP)
     assert result.returncode == 0, result.stderr
     cuts = [line for line in result.stderr.splitlines() if "cut:" in line]
@@ -105,3 +111,31 @@ def test_release_step_without_quasi_static_continuation_jumps(run_yarnfort, tmp_
     print(f"force per width {force[2]:.9g}, secant of the steps before {secant:.9g}: "
           f"{abs(force[2] - secant) / force[2]:.1e} of it")
     assert abs(force[2] - secant) <= ON_CURVE * force[2]
+
+
+def test_restart_after_a_jump_takes_the_same_steps(run_yarnfort, tmp_path):
+    """The step after a jump is predicted from the jumped state alone (no secant across
+    the jump), so the jump's restart snapshot has no earlier state, as otherwise only
+    step 0's has (inputs/REFERENCE.md, *Restart*: a restarted run takes the same steps).
+    Steps 89 and 90 jump; a run restarted after step 90 must take steps 91 and 92 as
+    the uninterrupted run does: the same times, Newton iterations, slip counts and
+    step cuts, and reactions within 1e-8 of the largest."""
+    folder, scene = restart_point(tmp_path, "through")
+    result = run_yarnfort(scene.replace("max_steps = 1", "max_steps = 4"), cwd=TOP)
+    assert result.returncode == 0, result.stderr
+    through = read_curve(folder)
+    folder, scene = restart_point(tmp_path, "restarted")
+    for _ in range(2):
+        result = run_yarnfort(scene.replace("max_steps = 1", "max_steps = 2"), cwd=TOP)
+        assert result.returncode == 0, result.stderr
+    restarted = read_curve(folder)
+    assert list(through["step"][-4:]) == list(restarted["step"][-4:]) == [89, 90, 91, 92]
+    assert list(through["jumped"][-4:]) == [1, 1, 0, 0]
+    print("steps 91, 92: Newton iterations", list(through["newton_iterations"][-2:]))
+    for name in ("time", "newton_iterations", "slipping", "step_cuts"):
+        assert list(through[name][-2:]) == list(restarted[name][-2:]), name
+    scale = np.max(np.abs(through["right_rx"]))
+    for name in through.names:
+        if name.endswith(("_rx", "_ry", "_rz")):
+            assert np.max(np.abs(through[name][-2:] - restarted[name][-2:])) \
+                <= BALANCE * scale, name
