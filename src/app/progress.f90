@@ -48,7 +48,8 @@ contains
             if (state%n_held > 0) write(error_unit, '("  held ", i0)', advance='no') &
                 state%n_held
             ! A jump after a slip instability (try_jump), likewise.
-            if (state%jumped) write(error_unit, '("  jumped")', advance='no')
+            if (state%jump_steps > 0) write(error_unit, '("  jumped (", i0, &
+                &" viscous steps)")', advance='no') state%jump_steps
             write(error_unit, '()')
         else
             write(error_unit, '()')

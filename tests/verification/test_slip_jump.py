@@ -67,6 +67,8 @@ def test_release_step_without_quasi_static_continuation_jumps(run_yarnfort, tmp_
     assert result.returncode == 0, result.stderr
     cuts = [line for line in result.stderr.splitlines() if "cut:" in line]
     assert cuts and all("stick/slip active set did not settle" in line for line in cuts)
+    progress = [line for line in result.stderr.splitlines() if line.startswith("step")]
+    assert len(progress) == 1 and "viscous steps)" in progress[0].split("jumped (")[1]
 
     curve = read_curve(folder)
     assert list(curve["step"][-2:]) == [88, 89]

@@ -175,6 +175,8 @@ module yarnfort_contact_friction_stepper
         logical :: unsettled = .false.
         !> The last successful trial, and the accepted state, were reached by a jump.
         logical :: jumped_trial = .false., jumped = .false.
+        !> The viscous steps solved by the last successful trial's jump.
+        integer :: jump_steps_trial = 0
         !> The stick test's at_limit flag (get_slip_tendency) of each stick passage at
         !> the accepted state (`have_limits`), from the last round of the step that
         !> reached it, and of the last successful try_step (`limits_trial`): the next
@@ -395,6 +397,7 @@ contains
             call fatal_error(error, trim(buffer))
         end if
         self%jumped_trial = .not. allocated(error)
+        self%jump_steps_trial = solved_steps
         self%u = u_accepted
         self%flow = flow_accepted
         self%mode = mode_accepted
@@ -1463,7 +1466,8 @@ contains
         state%n_passages = size(self%mode)
         state%n_slipping = count(self%mode /= mode_stick)
         state%n_held = self%n_damped
-        state%jumped = self%jumped
+        state%jump_steps = 0
+        if (self%jumped) state%jump_steps = self%jump_steps_trial
     end subroutine get_state
 
     !> Everything a step depends on besides the scene: the accepted state (whose flows

@@ -294,7 +294,7 @@ contains
         call row%add(state%direction)
         call row%add(state%n_slipping)
         call row%add(state%n_held)
-        call row%add(merge(1, 0, state%jumped))
+        call row%add(merge(1, 0, state%jump_steps > 0))
         call row%add(state%n_passages)
         call row%add(state%newton_iterations)
         call row%add(state%newton%residual_norm)

@@ -34,9 +34,10 @@ module yarnfort_solver_state
         !> Friction: passages held in stick by chatter damping in this step (their mode
         !> flipped too often; each ended within its limit, else the step failed).
         integer :: n_held = 0
-        !> Friction: the step ended in a jump after a slip instability (the rounds found
-        !> no state near the last one at any step size; friction_stepper try_jump).
-        logical :: jumped = .false.
+        !> Friction: the viscous steps of the jump the step ended in after a slip
+        !> instability (the rounds settled at no step size; friction_stepper try_jump),
+        !> 0 for a step without a jump.
+        integer :: jump_steps = 0
         !> 1 while the load factors grow, -1 while they shrink, 0 at rest.
         integer :: direction = 0
         !> Step cuts before this step converged, and its wall time in seconds.
