@@ -66,6 +66,9 @@ program yarnfort_main
     else
         write(error_unit, '(a)') 'yarnfort: done; results in ' // trim(config%output%folder)
     end if
+    if (writer%n_jumps > 0) write(error_unit, '(a, i0, a)') 'yarnfort: note: ', &
+        writer%n_jumps, ' step(s) ended in a jump after a slip instability (curve.csv ' &
+        // 'column jumped; inputs/REFERENCE.md, Slip instabilities)'
 
 contains
 

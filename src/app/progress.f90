@@ -15,6 +15,8 @@ module yarnfort_app_progress
     type, extends(output_writer_type) :: progress_writer_type
         logical :: progress = .true.
         logical :: residual_history = .false.
+        !> Steps of this run that ended in a jump (named at the end, progress or not).
+        integer :: n_jumps = 0
     contains
         procedure :: on_step
         procedure :: on_cut
@@ -32,7 +34,9 @@ contains
         integer :: c
 
         call self%output_writer_type%on_step(scene, state, error)
-        if (allocated(error) .or. .not. self%progress) return
+        if (allocated(error)) return
+        if (state%jump_steps > 0) self%n_jumps = self%n_jumps + 1
+        if (.not. self%progress) return
         write(error_unit, '("step ", i5, "  t = ", f9.5)', advance='no') state%step, state%time
         ! The factor of every load channel (p_force and p_disp without &path channels).
         do c = 1, size(state%factors)

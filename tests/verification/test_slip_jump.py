@@ -69,6 +69,7 @@ def test_release_step_without_quasi_static_continuation_jumps(run_yarnfort, tmp_
     assert cuts and all("stick/slip active set did not settle" in line for line in cuts)
     progress = [line for line in result.stderr.splitlines() if line.startswith("step")]
     assert len(progress) == 1 and "viscous steps)" in progress[0].split("jumped (")[1]
+    assert "note: 1 step(s) ended in a jump after a slip instability" in result.stderr
 
     curve = read_curve(folder)
     assert list(curve["step"][-2:]) == [88, 89]
