@@ -12,10 +12,12 @@ law's rounds solve it from there.
 
 tests/data/slip_jump.tar.gz holds the run's restart point, its step 88 (restart.dat,
 curve.csv up to that step, contacts.csv of that step, the folder's manifest; 660 kB),
-and the scene. Made by running the scene from the start without `restart` and
-`max_steps` (about 5 minutes), then keeping those files: the restart refuses a file
-made for another input (the table files, the generator's network), so a change there
-shows here as a failed restart, never as a silent pass.
+and the scene. Made by running the scene from the start with `restart = .false.` and
+`max_steps = 88` (about 5 minutes), then keeping those files (contacts.csv: its header
+and the rows of step 88; curve.csv and contacts.csv need the columns of the build that
+reads them). The restart refuses a file made for another input (the table files, the
+generator's network), so a change there shows here as a failed restart, never as a
+silent pass.
 
 Checked on the jumped step, against references independent of the solver:
 - the step is the restart's first, it was cut (the rounds failed at every step size)
