@@ -34,9 +34,10 @@
 !> friction_stepper sets it): each slip row gets eta (s - s_start) added, eta =
 !> viscosity * stick_scale and s_start = flow_target, so a slipping passage is held
 !> above its limit by an overstress eta ds >= 0 (forward; backward likewise): implicit
-!> Euler steps of a viscoplastic slip law. Where the rate-independent law has no
-!> solution near the start (a slip instability), they have one, and their end state,
-!> where ds -> 0, is one of the exact law.
+!> Euler steps of a viscoplastic slip law. Where the stepper's rounds find no
+!> consistent stick/slip set for the rate-independent law (a slip instability), the
+!> viscous one is well posed, and the end state of such steps, where ds -> 0, is one
+!> of the exact law.
 !> Neutral modes: a set of slipping passages can let material run along a path without
 !> changing any tension (the yarn round a periodic cell, or a column of contact nodes
 !> sliding along a straight course whose heads and sinkers carry one tension); the
