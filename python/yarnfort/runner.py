@@ -23,6 +23,7 @@ import os
 import signal
 import tempfile
 import threading
+import warnings
 from collections.abc import Callable
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -241,4 +242,22 @@ def _run_file(path: Path, progress: bool | Callable[[Step], Any]) -> RunResult:
         raise failure[0]
     if name == "interrupted":
         raise RunInterrupted(result)
+    _warn_of_jumps(result)
     return result
+
+
+def _warn_of_jumps(result: RunResult) -> None:
+    """Warn, as the program's last lines do, of steps of this run that ended in a jump
+    after a slip instability (``curve.csv`` column ``jumped``)."""
+    if result.n_steps <= 0:
+        return
+    curve = result.curve
+    if "jumped" not in curve.names:
+        return
+    steps = [int(s) for s, j in zip(curve["step"][-result.n_steps:],
+                                    curve["jumped"][-result.n_steps:]) if j]
+    if steps:
+        warnings.warn(f"{len(steps)} step(s) ended in a jump after a slip instability "
+                      f"(steps {', '.join(map(str, steps))}; curve.csv column 'jumped'; "
+                      "inputs/REFERENCE.md, Slip instabilities)", RuntimeWarning,
+                      stacklevel=3)

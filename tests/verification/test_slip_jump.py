@@ -144,3 +144,18 @@ def test_restart_after_a_jump_takes_the_same_steps(run_yarnfort, tmp_path):
         if name.endswith(("_rx", "_ry", "_rz")):
             assert np.max(np.abs(through[name][-2:] - restarted[name][-2:])) \
                 <= BALANCE * scale, name
+
+
+def test_python_run_warns_of_the_jump(tmp_path, monkeypatch):
+    """yarnfort.run_scene (in process) runs the same restart and warns of the jump, as
+    the program's last lines name it."""
+    import pytest
+    from yarnfort import run_scene
+
+    folder, scene = restart_point(tmp_path)
+    path = tmp_path / "scene.nml"
+    path.write_text(scene)
+    monkeypatch.chdir(TOP)
+    with pytest.warns(RuntimeWarning, match=r"1 step\(s\) ended in a jump .*steps 89;"):
+        result = run_scene(path)
+    assert (result.outcome, result.n_steps) == ("max_steps", 1)
