@@ -36,6 +36,7 @@ import tarfile
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from fabric_scenes import TOP
 from test_clamped_samples import BALANCE
@@ -149,7 +150,6 @@ def test_restart_after_a_jump_takes_the_same_steps(run_yarnfort, tmp_path):
 def test_python_run_warns_of_the_jump(tmp_path, monkeypatch):
     """yarnfort.run_scene (in process) runs the same restart and warns of the jump, as
     the program's last lines name it."""
-    import pytest
     from yarnfort import run_scene
 
     folder, scene = restart_point(tmp_path)

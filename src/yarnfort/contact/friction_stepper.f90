@@ -173,9 +173,10 @@ module yarnfort_contact_friction_stepper
         !> The last try failed in the stick/slip rounds (chatter or no settling), not in
         !> a Newton solve: what try_jump starts from.
         logical :: unsettled = .false.
-        !> The last successful trial, and the accepted state, were reached by a jump.
-        logical :: jumped_trial = .false., jumped = .false.
-        !> The viscous steps solved by the last successful trial's jump.
+        !> The accepted state was reached by a jump.
+        logical :: jumped = .false.
+        !> The viscous steps of the jump that reached the last successful trial (0: it
+        !> was not reached by a jump).
         integer :: jump_steps_trial = 0
         !> The stick test's at_limit flag (get_slip_tendency) of each stick passage at
         !> the accepted state (`have_limits`), from the last round of the step that
@@ -309,7 +310,7 @@ contains
         self%n_damped = 0
         self%limits_trial = .false.
         self%unsettled = .false.
-        self%jumped_trial = .false.
+        self%jump_steps_trial = 0
     end subroutine start_trial
 
     !> Jump to the load `factors` after a slip instability: the last try failed in the
@@ -396,8 +397,7 @@ contains
                 solved_steps, viscosity, overstress
             call fatal_error(error, trim(buffer))
         end if
-        self%jumped_trial = .not. allocated(error)
-        self%jump_steps_trial = solved_steps
+        if (.not. allocated(error)) self%jump_steps_trial = solved_steps
         self%u = u_accepted
         self%flow = flow_accepted
         self%mode = mode_accepted
@@ -1446,7 +1446,7 @@ contains
         self%mode = self%mode_trial
         ! Across a jump the path has no tangent: the next step is predicted from the new
         ! state alone.
-        self%jumped = self%jumped_trial
+        self%jumped = self%jump_steps_trial > 0
         if (self%jumped) then
             self%have_old = .false.
             self%have_older = .false.
