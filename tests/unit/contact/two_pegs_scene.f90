@@ -15,10 +15,12 @@ contains
 
     !> A yarn A-C-E-B (two elements per segment) passing two contact nodes C and E, each
     !> also the end of a peg yarn anchored at D1, D2. A, B, D1, D2 are fixed; A and B are
-    !> pulled along x.
-    subroutine make_scene(scene, error)
+    !> pulled along x: a rigid translation, so without `prestress` (of the yarn and the
+    !> pegs, N) every solution of the scene is unstressed.
+    subroutine make_scene(scene, error, prestress)
         type(scene_type), intent(out) :: scene
         type(error_type), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: prestress(2)
         type(config_type) :: config
 
         config%node_positions = reshape([-1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, -0.3_wp, 0.1_wp, &
@@ -32,6 +34,7 @@ contains
         config%materials(2)%name = 'peg'
         config%materials(2)%law = 'linear'
         config%materials(2)%stiffness = 20.0_wp
+        if (present(prestress)) config%materials(:)%prestress = prestress
         allocate(config%yarns(3))
         config%yarns(1)%material = 'yarn'
         config%yarns(1)%nodes = [1, 2, 3, 4]

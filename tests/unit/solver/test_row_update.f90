@@ -31,6 +31,12 @@ contains
 
     !> The scene's friction problem at half the displacement, all stick, solved; a
     !> Newton solver with chord steps (as the friction stepper's) and the unknowns `u`.
+    !> The yarn and the pegs are prestressed (2 N, 0.3 N), so the passages carry 1.3-1.4 N
+    !> that differ by 3-8 %: a slip direction and a slipping solution near `u` exist.
+    !> Without it the scene moves rigidly and the passages' tensions are 0 and 7e-15 N;
+    !> the tests then forced a slip in a direction chosen by that round-off, and whether
+    !> Newton found a solution depended on the BLAS kernels (OpenBLAS' Prescott and
+    !> SkylakeX kernels: no; Haswell, Sandybridge, reference BLAS: yes).
     subroutine set_up(scene, problem, newton, u, error)
         type(scene_type), target, intent(inout) :: scene
         type(friction_problem_type), target, intent(inout) :: problem
@@ -40,7 +46,7 @@ contains
         class(linear_solver_type), allocatable :: linear
         type(newton_stats_type) :: stats
 
-        call make_scene(scene, error)
+        call make_scene(scene, error, prestress=[2.0_wp, 0.3_wp])
         if (allocated(error)) return
         call new_friction_problem(problem, scene, positions_frozen=.false.)
         problem%semismooth = .false.
