@@ -43,6 +43,8 @@ import subprocess
 import sys
 import time
 
+import blas_env
+
 TOP = pathlib.Path(__file__).resolve().parent.parent
 BENCH = TOP / 'build' / 'benchmarks' / 'bench_newton'
 VENV = TOP / '.venv-bench'
@@ -197,7 +199,7 @@ def thread_state(python):
         f'- yarnfort BLAS: {os.path.realpath(blas.group(1)) if blas else "not linked"}',
         f'- OpenSeesPy libraries loaded: {ops_libs}',
         '- environment: ' + ', '.join(f'{k}={os.environ.get(k, "unset")}' for k in (
-            'OMP_NUM_THREADS', 'OMP_THREAD_LIMIT', 'OPENBLAS_NUM_THREADS')),
+            'OMP_NUM_THREADS', 'OMP_THREAD_LIMIT', 'OPENBLAS_NUM_THREADS', 'OPENBLAS_CORETYPE')),
         '- yarnfort thread policy (src/yarnfort/linalg/threads.f90; applies where the '
         'variables are unset): the libraries\' OpenMP regions and OpenBLAS on one thread',
         f'- load average at start: {" ".join(f"{x:.2f}" for x in os.getloadavg())}; '
@@ -218,6 +220,7 @@ def main():
     parser.add_argument('--systems', nargs='+', default=SYSTEMS,
                         help='OpenSees linear systems to try (default: %(default)s)')
     args = parser.parse_args()
+    blas_env.apply()
     if args.opensees:
         run_opensees(int(args.opensees[0]), args.opensees[1])
         return

@@ -25,6 +25,8 @@ import sys
 import time
 import os
 
+import blas_env
+
 TOP = pathlib.Path(__file__).resolve().parent.parent
 BENCH = TOP / 'build' / 'benchmarks' / 'bench_friction'
 # Crossings per side and the unknowns they give with 4 elements per segment:
@@ -105,6 +107,7 @@ def main():
     parser.add_argument('--max-border', type=int, default=None,
                         help="the bordered solver's limit (default: the build's)")
     args = parser.parse_args()
+    blas_env.apply()
     sides = args.sides or (QUICK if args.quick else SIDES)
     subprocess.run([str(TOP / 'tools' / 'bootstrap')], stdin=subprocess.DEVNULL, check=True)
     blas = subprocess.run(['ldd', args.bench], capture_output=True, text=True).stdout
@@ -116,7 +119,7 @@ def main():
           f'{" ".join(f"{x:.2f}" for x in os.getloadavg())}; {os.cpu_count()} cores')
     print(f'- BLAS: {os.path.realpath(blas.group(1)) if blas else "not linked"}; '
           + ', '.join(f'{k}={os.environ.get(k, "unset")}' for k in (
-              'OMP_NUM_THREADS', 'OMP_THREAD_LIMIT', 'OPENBLAS_NUM_THREADS')))
+              'OMP_NUM_THREADS', 'OMP_THREAD_LIMIT', 'OPENBLAS_NUM_THREADS', 'OPENBLAS_CORETYPE')))
     print('- woven net, 4 elements per segment; full cycle = load, unload to half, reload, '
           f'60 steps; above {args.cycle_max} crossings per side the first {args.steps} load '
           'step(s) only')

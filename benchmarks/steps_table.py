@@ -42,6 +42,8 @@ sys.path.insert(0, str(TOP / 'verification' / 'clamped'))
 from fabric_scenes import LOADING, ONE_CYCLE, patched_scene  # noqa: E402
 from run_study import THREAD  # noqa: E402  (the taut edge thread of the clamped study)
 
+import blas_env  # noqa: E402
+
 TRACE = TOP / 'build' / 'benchmarks' / 'steps_trace'
 SUMMARY = ('unknowns passages steps cuts newton chords rounds residuals to_slip to_stick '
            'cpu_ms elastic_ms ratio').split()
@@ -117,6 +119,7 @@ def main():
     parser.add_argument('--paths', nargs='*', default=['loading', 'cycle'])
     parser.add_argument('--timeout', type=float, default=1800)
     args = parser.parse_args()
+    core = blas_env.apply()
     builds = [('after', pathlib.Path(args.trace))] + ([('before', pathlib.Path(args.before))]
                                    if args.before else [])
     builds += [(name, pathlib.Path(path)) for name, path in
@@ -138,7 +141,7 @@ def main():
     def load():
         return ' '.join(f'{x:.2f}' for x in os.getloadavg())
 
-    print(f'Load average at the start: {load()}')
+    print(f'Load average at the start: {load()}; OPENBLAS_CORETYPE {core}')
     print()
     header = ['case']
     for name, _ in builds:

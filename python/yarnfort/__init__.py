@@ -6,14 +6,21 @@ The Python side of yarnfort: build scenes (:class:`Scene`), run them in process
 adhesion to a measured curve (:func:`calibrate`), and read and plot the results
 (:func:`read_run`, :mod:`yarnfort.plots`). The physics lives in the Fortran library.
 
-Names are loaded on first use, so that ``import yarnfort`` stays quick.
+Names are loaded on first use, so that ``import yarnfort`` stays quick. Importing it sets
+``OPENBLAS_CORETYPE`` where it is unset (:mod:`yarnfort._blas`).
 """
 from __future__ import annotations
 
 import importlib
 from typing import Any
 
+from ._blas import apply_openblas_core
 from ._version import __version__
+
+# OpenBLAS chooses its kernels when it is loaded: by the extension in this process, or by
+# the program in a child process (the console command, yarnfort.program_path()). Both
+# inherit this choice, so every route runs the same kernels (yarnfort._blas).
+apply_openblas_core()
 
 #: Public name -> module that defines it.
 _EXPORTS: dict[str, str] = {
