@@ -5,7 +5,6 @@ OpenSeesPy, which loads the same OpenBLAS) run with the kernels the program runs
 from __future__ import annotations
 
 import importlib.util
-import os
 import pathlib
 
 SOURCE = pathlib.Path(__file__).resolve().parent.parent / 'python' / 'yarnfort' / '_blas.py'
@@ -17,5 +16,4 @@ def apply() -> str:
     spec = importlib.util.spec_from_file_location('yarnfort_blas', SOURCE)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    module.apply_openblas_core()
-    return os.environ.get(module.VARIABLE, "unset (OpenBLAS's own detection)")
+    return module.apply_openblas_core() or "unset (OpenBLAS's own detection)"
