@@ -1,14 +1,15 @@
 ! SPDX-License-Identifier: MIT
-!> What the benchmark programs share: peak memory, failing with a message, and the
-!> node numbering of their square nets.
+!> What the benchmark programs share: peak memory, failing with a message (or with their
+!> usage, for a bad command line), and the node numbering of their square nets.
 module bench_common
-    use, intrinsic :: iso_fortran_env, only: error_unit
+    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     implicit none
     private
 
-    public :: peak_memory_mib, fail, number_grid_nodes
+    public :: peak_memory_mib, fail, number_grid_nodes, fail_usage, stop_if_help, &
+        read_integer_argument
 
 contains
 
@@ -55,7 +56,38 @@ contains
         character(len=*), intent(in) :: program_name
         type(error_type), intent(in) :: error
         write(error_unit, '(a)') program_name // ': ' // error%message
-        error stop 1
+        stop 1, quiet=.true.
     end subroutine fail
+
+    !> A bad command line: print the problem and the usage, stop with exit code 2.
+    subroutine fail_usage(program_name, problem, usage)
+        character(len=*), intent(in) :: program_name, problem, usage
+        write(error_unit, '(a)') program_name // ': ' // problem
+        write(error_unit, '(a)') usage
+        stop 2, quiet=.true.
+    end subroutine fail_usage
+
+    !> With -h or --help anywhere on the command line: print the usage, stop with 0.
+    subroutine stop_if_help(usage)
+        character(len=*), intent(in) :: usage
+        character(len=16) :: argument
+        integer :: k
+        do k = 1, command_argument_count()
+            call get_command_argument(k, argument)
+            if (argument == '-h' .or. argument == '--help') then
+                write(output_unit, '(a)') usage
+                stop 0, quiet=.true.
+            end if
+        end do
+    end subroutine stop_if_help
+
+    !> The integer `text` given for `what`, or fail_usage.
+    integer function read_integer_argument(program_name, what, text, usage) result(value)
+        character(len=*), intent(in) :: program_name, what, text, usage
+        integer :: status
+        read(text, *, iostat=status) value
+        if (status /= 0) call fail_usage(program_name, what // " must be an integer, not '" &
+            // trim(text) // "'", usage)
+    end function read_integer_argument
 
 end module bench_common

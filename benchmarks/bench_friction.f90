@@ -87,7 +87,8 @@ program bench_friction
     use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
     use yarnfort_solver_timer, only: wall_time
     use bench_friction_counter, only: counter_type
-    use bench_common, only: peak_memory_mib, fail
+    use bench_common, only: peak_memory_mib, fail, fail_usage, stop_if_help, &
+        read_integer_argument
     use bench_woven_net, only: make_woven_net, skew_net
     use bench_iteration, only: time_iteration
     use bench_floor, only: floor_type, measure_floor
@@ -112,7 +113,15 @@ program bench_friction
     character(len=32) :: argument, scheme, positional(4)
     character(len=:), allocatable :: input_file
     logical :: skewed, line_search, time_factors
+    character(len=*), parameter :: usage = 'usage: bench_friction --header' // new_line('a') &
+        // '       bench_friction <crossings per side> <scheme> [elements per segment] ' // &
+        '[linear solver] [options]' // new_line('a') // &
+        '       bench_friction --input <scene.nml> <scheme> [options]' // new_line('a') // &
+        'scheme: monolithic | staggered; options: --skewed --steps N --max-border M ' // &
+        '--no-line-search --no-factor-times (see the comment at the top of ' // &
+        'benchmarks/bench_friction.f90)'
 
+    call stop_if_help(usage)
     call get_command_argument(1, argument)
     if (trim(argument) == '--header') then
         write(output_unit, '(a)') '    scheme  unknowns  passages  steps  newton/step' // &
@@ -145,30 +154,23 @@ program bench_friction
         case ('--max-border')
             k = k + 1
             call get_command_argument(k, argument)
-            read(argument, *) max_border
+            max_border = read_integer_argument('bench_friction', '--max-border', argument, usage)
         case ('--steps')
             k = k + 1
             call get_command_argument(k, argument)
-            read(argument, *) max_steps
-            if (max_steps < 1 .or. max_steps > 20) then
-                write(error_unit, '(a)') 'bench_friction: --steps must be 1 to 20'
-                error stop 2
-            end if
+            max_steps = read_integer_argument('bench_friction', '--steps', argument, usage)
+            if (max_steps < 1 .or. max_steps > 20) call fail_usage('bench_friction', &
+                '--steps must be 1 to 20', usage)
         case default
-            if (n_positional == size(positional)) then
-                write(error_unit, '(a)') "bench_friction: unexpected argument '" // &
-                    trim(argument) // "'"
-                error stop 2
-            end if
+            if (n_positional == size(positional)) call fail_usage('bench_friction', &
+                "unexpected argument '" // trim(argument) // "'", usage)
             n_positional = n_positional + 1
             positional(n_positional) = argument
         end select
     end do
     if (allocated(input_file)) then
-        if (n_positional /= 1) then
-            write(error_unit, '(a)') 'bench_friction: need --input <file> <scheme>'
-            error stop 2
-        end if
+        if (n_positional /= 1) call fail_usage('bench_friction', &
+            'need --input <file> <scheme>', usage)
         call read_config_from_file(input_file, config, error, from_working_directory=.true.)
         if (allocated(error)) call fail('bench_friction', error)
         call check_config(config, error)
@@ -176,14 +178,14 @@ program bench_friction
         scheme = positional(1)
         config%solver%scheme = scheme
     else
-        if (n_positional < 2) then
-            write(error_unit, '(a)') 'bench_friction: need <crossings per side> <scheme>'
-            error stop 2
-        end if
-        read(positional(1), *) side
+        if (n_positional < 2) call fail_usage('bench_friction', &
+            'need <crossings per side> <scheme>', usage)
+        side = read_integer_argument('bench_friction', 'crossings per side', positional(1), &
+            usage)
         scheme = positional(2)
         per_segment = 2
-        if (n_positional >= 3) read(positional(3), *) per_segment
+        if (n_positional >= 3) per_segment = read_integer_argument('bench_friction', &
+            'elements per segment', positional(3), usage)
         call make_woven_net(config, side, per_segment, scheme)
         if (n_positional >= 4) config%solver%linear_solver = positional(4)
         if (skewed) call skew_net(config, side)

@@ -39,7 +39,8 @@ program bench_newton
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_timer, only: wall_time
-    use bench_common, only: peak_memory_mib, fail, number_grid_nodes
+    use bench_common, only: peak_memory_mib, fail, number_grid_nodes, fail_usage, &
+        stop_if_help, read_integer_argument
     use bench_floor, only: floor_type, measure_floor
     implicit none
     type(config_type) :: config
@@ -59,7 +60,11 @@ program bench_newton
     !> Largest order at which the floor times bare KLU (above it one KLU factorisation of
     !> the cable net takes over a minute, and KLU is never the default there).
     integer, parameter :: klu_floor_max = 300000
+    character(len=*), parameter :: usage = 'usage: bench_newton --header' // new_line('a') &
+        // '       bench_newton <interior nodes per side> <linear solver> ' // &
+        '[max_setup_calls] [neo_hookean | linear]'
 
+    call stop_if_help(usage)
     call get_command_argument(1, argument)
     if (trim(argument) == '--header') then
         write(output_unit, '(a)') 'solver  setup  unknowns       nnz  iters  facts' // &
@@ -69,19 +74,20 @@ program bench_newton
             '  iter_x_floor  cpu_s  w_centre'
         stop
     end if
-    read(argument, *) side
+    if (command_argument_count() < 2) call fail_usage('bench_newton', &
+        'need <interior nodes per side> <linear solver>', usage)
+    side = read_integer_argument('bench_newton', 'interior nodes per side', argument, usage)
     call get_command_argument(2, solver_name)
     setup_calls = 1
     if (command_argument_count() >= 3) then
         call get_command_argument(3, argument)
-        read(argument, *) setup_calls
+        setup_calls = read_integer_argument('bench_newton', 'max_setup_calls', argument, usage)
     end if
     variant = 'neo_hookean'
     if (command_argument_count() >= 4) call get_command_argument(4, variant)
     if (variant /= 'neo_hookean' .and. variant /= 'linear') then
-        write(error_unit, '(a)') "bench_newton: 4th argument '" // trim(variant) // &
-            "' is neither 'neo_hookean' nor 'linear'"
-        error stop 2
+        call fail_usage('bench_newton', "4th argument '" // trim(variant) // &
+            "' is neither 'neo_hookean' nor 'linear'", usage)
     end if
 
     baseline_mib = peak_memory_mib()

@@ -105,7 +105,7 @@ program steps_trace
     use yarnfort_driver, only: get_linear_solver_name
     use yarnfort_solver_continuation, only: run_continuation
     use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
-    use bench_common, only: fail
+    use bench_common, only: fail, fail_usage, stop_if_help, read_integer_argument
     use bench_woven_net, only: make_woven_net, skew_net
     use bench_iteration, only: time_elastic_iteration
     use steps_trace_observer, only: trace_observer_type
@@ -117,10 +117,16 @@ program steps_trace
     type(trace_observer_type) :: observer
     type(error_type), allocatable :: error
     character(len=512) :: argument, source, scheme
+    character(len=*), parameter :: usage = &
+        'usage: steps_trace <scene.nml> [--scheme monolithic|staggered] [--per-step]' // &
+        new_line('a') // '       steps_trace --woven <crossings per side> [--skewed] ' // &
+        '[--scheme ...] [--per-step]' // new_line('a') // &
+        '(the columns: the comment at the top of benchmarks/steps_trace.f90)'
     logical :: woven, skewed
     integer :: k, side
     real(wp) :: elastic_ms, per_step
 
+    call stop_if_help(usage)
     woven = .false.
     skewed = .false.
     scheme = ''
@@ -140,15 +146,17 @@ program steps_trace
             k = k + 1
             call get_command_argument(k, scheme)
         case default
+            if (argument(1:1) == '-') call fail_usage('steps_trace', &
+                "unknown option '" // trim(argument) // "'", usage)
+            if (len_trim(source) > 0) call fail_usage('steps_trace', &
+                "unexpected argument '" // trim(argument) // "'", usage)
             source = argument
         end select
     end do
-    if (len_trim(source) == 0) then
-        write(error_unit, '(a)') 'steps_trace: need a scene file or --woven <side>'
-        error stop 2
-    end if
+    if (len_trim(source) == 0) call fail_usage('steps_trace', &
+        'need a scene file or --woven <side>', usage)
     if (woven) then
-        read(source, *) side
+        side = read_integer_argument('steps_trace', '--woven', source, usage)
         call make_woven_net(config, side, 4, 'monolithic')
         if (skewed) call skew_net(config, side)
     else
@@ -162,7 +170,7 @@ program steps_trace
     if (allocated(error)) call fail('steps_trace', error)
     if (scene%passages%size() == 0) then
         write(error_unit, '(a)') 'steps_trace: the scene has no sliding passages'
-        error stop 2
+        stop 2, quiet=.true.
     end if
     call new_friction_stepper(stepper, scene, get_linear_solver_name(scene), error)
     if (allocated(error)) call fail('steps_trace', error)
