@@ -27,7 +27,7 @@
 !> codes start there: at the flat stress-free net the transverse stiffness of a truss
 !> model is zero and OpenSees' first factorisation fails).
 program bench_newton
-    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+    use, intrinsic :: iso_fortran_env, only: output_unit
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_input_config, only: config_type
