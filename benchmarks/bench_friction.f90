@@ -75,7 +75,7 @@ end module bench_friction_counter
 !> state with the solvers yarnfort uses, and the cycle's CPU time per step against the
 !> elastic one (write_iterations).
 program bench_friction
-    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+    use, intrinsic :: iso_fortran_env, only: output_unit
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     use yarnfort_input_config, only: config_type
