@@ -15,6 +15,7 @@ yarn or material ids, contact state, ...) are kept in :attr:`State.point_data` a
 from __future__ import annotations
 
 import csv
+import errno
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -439,19 +440,27 @@ def read_state(path: str | Path) -> State:
 
     Raises
     ------
+    FileNotFoundError
+        If there is no such file (with either reader).
     ResultError
         If the file is not a state of line cells with ``tension``, ``stretch`` and
         ``L0`` cell data.
     """
     path = Path(path)
+    # Checked here, not left to meshio, whose ReadError is no OSError.
+    if not path.exists():
+        raise FileNotFoundError(errno.ENOENT, "no such VTK state file", str(path))
     try:
         import meshio
     except ImportError:
         meshio = None
+    unreadable: tuple[type[Exception], ...] = (ET.ParseError, KeyError, ValueError)
+    if meshio is not None:
+        unreadable += (meshio.ReadError,)
     try:
         points, elements, point_data, cell_data, field_data = (
             _read_meshio(meshio, path) if meshio is not None else _read_ascii(path))
-    except (ET.ParseError, KeyError, ValueError) as error:
+    except unreadable as error:
         if isinstance(error, ResultError):
             raise
         raise ResultError(f"{path}: not a readable yarnfort VTK state ({error})") from None
@@ -490,6 +499,13 @@ def read_states(folder: str | Path) -> list[State]:
     Returns
     -------
     list of State
+
+    Raises
+    ------
+    FileNotFoundError
+        If a state the collection lists is missing.
+    ResultError
+        If the collection or a state is not readable as yarnfort wrote it.
     """
     folder = Path(folder)
     collection = folder / "states.pvd"

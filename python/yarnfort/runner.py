@@ -188,7 +188,13 @@ def run_scene(scene: str | os.PathLike | Any, *,
         solve (``status`` 1; the converged steps are kept and ``result`` describes them).
     RunInterrupted
         After Ctrl-C, once the step being solved is complete on disk.
+    TypeError
+        If ``progress`` is neither a bool nor a callable (before anything runs).
     """
+    # Anything else ('yes', 42, None) would run silently: refused, not guessed.
+    if not (isinstance(progress, bool) or callable(progress)):
+        raise TypeError(f"run_scene: progress must be a bool or a callable taking a Step, "
+                        f"not {type(progress).__name__} {progress!r}")
     if hasattr(scene, "to_namelist"):
         with tempfile.TemporaryDirectory(prefix="yarnfort-scene-") as folder:
             path = Path(folder) / "scene.nml"

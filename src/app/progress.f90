@@ -4,6 +4,7 @@ module yarnfort_app_progress
     use, intrinsic :: iso_fortran_env, only: error_unit
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
+    use yarnfort_text, only: format_short
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_writer, only: output_writer_type
@@ -31,7 +32,7 @@ contains
         type(step_state_type), intent(in) :: state
         type(error_type), allocatable, intent(out) :: error
 
-        integer :: c
+        integer :: c, k
 
         call self%output_writer_type%on_step(scene, state, error)
         if (allocated(error)) return
@@ -58,8 +59,10 @@ contains
         else
             write(error_unit, '()')
         end if
-        if (self%residual_history) write(error_unit, '("  residuals", *(1x, es9.2))') &
-            state%newton%residual_history
+        ! A diverging iterate's residual may pass 1e99 (where es9.2 drops the 'E').
+        if (self%residual_history) write(error_unit, '("  residuals", *(1x, a))') &
+            (format_short(state%newton%residual_history(k)), &
+            k = 1, size(state%newton%residual_history))
     end subroutine on_step
 
     subroutine on_cut(self, time, step, reason)

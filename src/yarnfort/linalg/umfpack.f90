@@ -12,6 +12,7 @@ module yarnfort_linalg_umfpack
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr, c_null_ptr, c_associated
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_text, only: format_short
     use yarnfort_linalg_direct, only: direct_solver_type, describe_status
     use yarnfort_linalg_csc_pattern, only: format_integer
     use yarnfort_linalg_umfpack_binding, only: umfpack_control, umfpack_info, umfpack_prl, &
@@ -123,7 +124,6 @@ contains
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         integer(c_long) :: status
-        character(len=24) :: rcond
 
         call umfpack_dl_free_numeric(self%numeric)
         if (.not. c_associated(self%symbolic)) then
@@ -158,10 +158,9 @@ contains
 
         call umfpack_dl_free_numeric(self%numeric)
         if (status == umfpack_warning_singular_matrix) then
-            write(rcond, '(es10.3)') self%info(umfpack_rcond)
             call self%fail(error, 'numeric factorisation', 'matrix is ' &
                 // 'singular (zero pivot, UMFPACK_WARNING_singular_matrix, rcond = ' &
-                // trim(adjustl(rcond)) // ')')
+                // format_short(self%info(umfpack_rcond), 4) // ')')
         else
             call self%fail(error, 'numeric factorisation', status_message(status))
         end if
