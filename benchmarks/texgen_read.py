@@ -31,8 +31,10 @@ CASES = [
     ("one attribute of 100 kB", f' Padding="{"x" * 100_000}"'),
     ("one attribute of 1 MB", f' Padding="{"x" * 1_000_000}"'),
     ("one attribute of 2 MB", f' Padding="{"x" * 2_000_000}"'),
+    ("one attribute of 1 MB of entities", f' Padding="{"&amp;" * 200_000}"'),
     ("one attribute of 2 MB of entities", f' Padding="{"&amp;" * 400_000}"'),
-    ("1 000 attributes", "".join(f' a{k}="{k}"' for k in range(1_000))),
+    ("one attribute of 1 MB of lone '&'", f' Padding="{"&" * 1_000_000}"'),
+    ("900 attributes", "".join(f' a{k}="{k}"' for k in range(900))),
     ("50 000 attributes", "".join(f' a{k}="{k}"' for k in range(50_000))),
     ("100 000 attributes", "".join(f' a{k}="{k}"' for k in range(100_000))),
 ]

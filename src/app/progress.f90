@@ -44,8 +44,9 @@ contains
             write(error_unit, '("  ", a, " = ", f8.4)', advance='no') &
                 trim(scene%path%channel(c)), state%factors(c)
         end do
-        write(error_unit, '("  newton ", i3, "  residual ", es9.2, "  ", f8.3, " s")', &
-            advance='no') state%newton_iterations, state%newton%residual_norm, state%wall_time
+        write(error_unit, '("  newton ", i3, "  residual ", a, "  ", f8.3, " s")', &
+            advance='no') state%newton_iterations, format_short(state%newton%residual_norm), &
+            state%wall_time
         if (state%n_passages > 0) then
             write(error_unit, '("  slipping ", i0, "/", i0)', advance='no') state%n_slipping, &
                 state%n_passages
@@ -59,7 +60,6 @@ contains
         else
             write(error_unit, '()')
         end if
-        ! A diverging iterate's residual may pass 1e99 (where es9.2 drops the 'E').
         if (self%residual_history) write(error_unit, '("  residuals", *(1x, a))') &
             (format_short(state%newton%residual_history(k)), &
             k = 1, size(state%newton%residual_history))
@@ -71,8 +71,8 @@ contains
         character(len=*), intent(in) :: reason
 
         if (.not. self%progress) return
-        write(error_unit, '("  cut: step of ", es9.2, " from t = ", f9.5, " failed: ", a)') &
-            step, time, reason
+        write(error_unit, '("  cut: step of ", a, " from t = ", f9.5, " failed: ", a)') &
+            format_short(step), time, reason
     end subroutine on_cut
 
     subroutine on_resume(self, step, time)

@@ -4,8 +4,9 @@
 !> declarations (<!...>) and CDATA sections are skipped; the five predefined entities and
 !> numeric character references below 128 are decoded in attribute values. The whole file
 !> becomes a flat list of elements, each with its parent, queried by name. Reading takes
-!> time linear in the file's size; a tag with more attributes, or an attribute value
-!> longer, than the limits below is an error.
+!> time linear in the file's size; a tag with more attributes, or an attribute name or
+!> value longer, than the limits below is an error (docs/decisions.md, "XML reader of
+!> TexGen files").
 !>
 !> Neither Debian nor PyPI offers a maintained XML library for Fortran, and the program
 !> must read the file without Python, so this is the one XML reader of the project.
