@@ -97,12 +97,12 @@ contains
                 if (.not. closed_by(2, '>', "a closing tag is not closed ('>')")) return
                 name = trim(adjustl(text(i + 2:close_at - 1)))
                 if (current == 0) then
-                    call fail(i, "closing tag </" // name // "> without an open element")
+                    call fail(i, "closing tag </" // shown(name) // "> without an open element")
                     return
                 end if
                 if (name /= document%elements(current)%name) then
-                    call fail(i, "closing tag </" // name // "> does not match <" &
-                        // document%elements(current)%name // ">")
+                    call fail(i, "closing tag </" // shown(name) // "> does not match <" &
+                        // shown(document%elements(current)%name) // ">")
                     return
                 end if
                 current = document%elements(current)%parent
@@ -120,7 +120,7 @@ contains
         end do
         if (current /= 0) then
             call fatal_error(error, 'the file ends inside element <' &
-                // document%elements(current)%name // '> (not closed)')
+                // shown(document%elements(current)%name) // '> (not closed)')
             return
         end if
         if (document%n_elements == 0) call fail(1, 'no elements (not an XML file?)')
