@@ -32,6 +32,7 @@ module yarnfort_generate_texgen
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_xml_subset, only: xml_document_type, read_xml_file
     use yarnfort_sort, only: sort_index
+    use yarnfort_text, only: format_integer, format_short
     implicit none
     private
 
@@ -39,6 +40,12 @@ module yarnfort_generate_texgen
 
     !> Relative tolerance of lattice checks (repeats, yarn periods), of the cell size.
     real(wp), parameter :: lattice_tolerance = 1.0e-6_wp
+    !> Contacts closer along a yarn than this fraction of its length in one period are
+    !> at one point (the contact search locates them to about 1e-10 of it): one node.
+    real(wp), parameter :: same_point_tolerance = 1.0e-6_wp
+    !> Yarns whose directions in the fabric plane differ by less than this (rad) run side
+    !> by side (a woven crossing is pi/2; neighbours touching sideways, 0).
+    real(wp), parameter :: side_by_side_angle = 10 * acos(-1.0_wp) / 180
 
     type :: texgen_yarn_type
         !> Sampled centre line (3, 0:m), point m = point 0 + period; arc length at each.
@@ -62,6 +69,8 @@ module yarnfort_generate_texgen
         !> Lattice shift of yarn 2's image.
         real(wp) :: shift(3) = 0.0_wp
         real(wp) :: distance = 0.0_wp
+        !> Each curve's tangent there (per unit span parameter).
+        real(wp) :: tangent(3, 2) = 0.0_wp
         integer :: node(2) = 0
     end type contact_type
 
@@ -435,8 +444,6 @@ contains
         integer :: range_x(2), range_y(2)
         real(wp) :: shift(3), reach, pa(3), pb(3), ta, tb, d, ra, rb, u(3)
         real(wp) :: lo(3), hi(3)
-        integer, allocatable :: order(:)
-        logical, allocatable :: kept(:)
 
         allocate(candidates(256))
         n_candidates = 0
@@ -499,26 +506,33 @@ contains
             end do
         end do
         ! Keep the closest pair of each patch.
-        allocate(order(n_candidates), kept(n_candidates))
-        order = sort_index(candidates(1:n_candidates)%distance)
-        kept = .false.
-        do k = 1, n_candidates
-            order_k = order(k)
-            kept(order_k) = .true.
-            do i = 1, k - 1
-                if (.not. kept(order(i))) cycle
-                if (same_patch(candidates(order(i)), candidates(order_k))) then
-                    kept(order_k) = .false.
-                    exit
-                end if
-            end do
-        end do
-        contacts = pack(candidates(1:n_candidates), kept)
+        contacts = pack(candidates(1:n_candidates), closest_of_patches(candidates(1: &
+            n_candidates)))
         do k = 1, size(contacts)
             call refine_contact(yarns(contacts(k)%yarn(1)), yarns(contacts(k)%yarn(2)), &
                 contacts(k))
         end do
+        contacts = pack(contacts, .not. side_by_side(contacts))
     contains
+        function closest_of_patches(list) result(kept)
+            type(contact_type), intent(in) :: list(:)
+            logical :: kept(size(list))
+            integer :: order(size(list))
+            order = sort_index(list%distance)
+            kept = .false.
+            do k = 1, size(list)
+                order_k = order(k)
+                kept(order_k) = .true.
+                do i = 1, k - 1
+                    if (.not. kept(order(i))) cycle
+                    if (same_patch(list(order(i)), list(order_k))) then
+                        kept(order_k) = .false.
+                        exit
+                    end if
+                end do
+            end do
+        end function closest_of_patches
+
         subroutine append(item)
             type(contact_type), intent(in) :: item
             type(contact_type), allocatable :: grown(:)
@@ -530,6 +544,25 @@ contains
             n_candidates = n_candidates + 1
             candidates(n_candidates) = item
         end subroutine append
+
+        !> Neighbours side by side: two different yarns whose directions in the fabric
+        !> plane are parallel (within side_by_side_angle) and that touch sideways (the
+        !> distance vector more in the plane than across it), as in a weave whose yarn
+        !> widths equal the spacing. They touch along a line, and neither wraps the
+        !> other; the string model's contacts are crossings (a rigid gap-holder and a
+        !> capstan passage), which would weld such neighbours (decisions.md: "TexGen
+        !> yarns side by side").
+        elemental logical function side_by_side(p)
+            type(contact_type), intent(in) :: p
+            real(wp) :: cross, lengths, gap(3)
+            side_by_side = .false.
+            if (p%yarn(1) == p%yarn(2)) return
+            cross = abs(p%tangent(1, 1) * p%tangent(2, 2) - p%tangent(2, 1) * p%tangent(1, 2))
+            lengths = norm2(p%tangent(1:2, 1)) * norm2(p%tangent(1:2, 2))
+            gap = p%point(:, 2) + p%shift - p%point(:, 1)
+            side_by_side = lengths > 0.0_wp .and. cross <= sin(side_by_side_angle) * lengths &
+                .and. abs(gap(3)) < norm2(gap(1:2))
+        end function side_by_side
 
         !> Two candidates of one contact patch: the same yarns, and both points within
         !> the sum of the widths of the other's, up to a lattice translation (also with
@@ -583,7 +616,7 @@ contains
         integer, parameter :: max_iterations = 20
         real(wp) :: u(2), u0(2), d(3), xa(3), xb(3), ta(3), tb(3), j(3, 2), m(2, 2), r(2)
         real(wp) :: step(2), determinant
-        integer :: iteration
+        integer :: iteration, wraps(2)
 
         u0 = [parameter_of(a, contact%s(1)), parameter_of(b, contact%s(2))]
         u = u0
@@ -603,12 +636,17 @@ contains
                 u0 + 1.0_wp / [a%samples, b%samples])
             if (all(abs(step) <= 10 * epsilon(1.0_wp) * max(1.0_wp, abs(u)))) exit
         end do
-        u = [modulo(u(1), real(size(a%node, 2) - 1, wp)), &
-            modulo(u(2), real(size(b%node, 2) - 1, wp))]
+        ! Back into the first period of each yarn; the image shift follows, so that the
+        ! pair of points stays the same pair in space.
+        wraps = floor(u / [size(a%node, 2) - 1, size(b%node, 2) - 1])
+        u = u - wraps * [size(a%node, 2) - 1, size(b%node, 2) - 1]
+        contact%shift = contact%shift + wraps(2) * b%period - wraps(1) * a%period
         call curve_point(a, u(1), xa, ta)
         call curve_point(b, u(2), xb, tb)
         contact%point(:, 1) = xa
         contact%point(:, 2) = xb
+        contact%tangent(:, 1) = ta
+        contact%tangent(:, 2) = tb
         contact%distance = norm2(xb + contact%shift - xa)
         contact%s = [arc_of(a, u(1)), arc_of(b, u(2))]
     end subroutine refine_contact
@@ -726,7 +764,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         integer :: y, k, n, c, side, first, last, leader, follower, anchor
         real(wp) :: total, cut, strain(3), gap(3), period(3), position(3)
-        real(wp), allocatable :: s(:), gaps(:), chain(:, :)
+        real(wp), allocatable :: s(:), gaps(:), chain(:, :), along(:)
         integer, allocatable :: who(:), order(:), list(:)
         logical, allocatable :: wrapped(:, :)
         character(len=300) :: buffer
@@ -760,15 +798,29 @@ contains
                 ! one direction end in line.
                 if (fabric%boundary == 'clamped') call first_of_ties(yarns(y), s, gaps, cut)
             end if
-            ! From the cut onwards; points before it lie one period on.
-            allocate(list(0), chain(3, n))
+            ! From the cut onwards; points before it lie one period on. Contacts at one
+            ! point of the yarn (a yarn pressed by two others there, e.g. between two
+            ! layers or between its neighbours on either side) share one node: two nodes
+            ! there would make a zero-length element.
+            allocate(list(0), chain(3, n), along(n))
             do k = 1, n
                 side = who(1 + modulo(k - 1 + count(s < cut), n))
                 c = (side - 1) / 2 + 1
                 side = side - 2 * (c - 1)
                 chain(:, k) = contacts(c)%point(:, side)
                 wrapped(side, c) = contacts(c)%s(side) < cut
-                if (wrapped(side, c)) chain(:, k) = chain(:, k) + yarns(y)%period
+                along(k) = contacts(c)%s(side)
+                if (wrapped(side, c)) then
+                    chain(:, k) = chain(:, k) + yarns(y)%period
+                    along(k) = along(k) + total
+                end if
+                if (k > 1) then
+                    if (along(k) - along(k - 1) <= same_point_tolerance * total) then
+                        chain(:, k) = chain(:, k - 1)
+                        contacts(c)%node(side) = list(size(list))
+                        cycle
+                    end if
+                end if
                 contacts(c)%node(side) = net%add_node(scale * chain(:, k))
                 list = [list, contacts(c)%node(side)]
             end do
@@ -805,41 +857,10 @@ contains
                 call net%add_link(first, last, strain, .false.)
                 if (anchor == 0) anchor = last
             end if
-            deallocate(s, who, list, chain)
+            deallocate(s, who, list, chain, along)
         end do
-        do c = 1, size(contacts)
-            associate(p => contacts(c))
-                ! gap: the actual distance vector; period: what separates the two nodes
-                ! besides it (the lattice vector of the image and the yarns' unwrapping).
-                gap = scale * (p%point(:, 2) + p%shift - p%point(:, 1))
-                period = scale * (merge(yarns(p%yarn(2))%period, 0.0_wp * gap, &
-                    wrapped(2, c)) - merge(yarns(p%yarn(1))%period, 0.0_wp * gap, &
-                    wrapped(1, c)) - p%shift)
-                if (positive(period) .or. all(abs(period) <= lattice_tolerance * scale &
-                        * maxval(cell))) then
-                    leader = p%node(1)
-                    follower = p%node(2)
-                else
-                    leader = p%node(2)
-                    follower = p%node(1)
-                    period = -period
-                end if
-                if (all(abs(period) <= lattice_tolerance * scale * maxval(cell))) &
-                    period = 0.0_wp
-                if (abs(period(1)) > lattice_tolerance * scale * cell(1) .and. &
-                        abs(period(1) - scale * cell(1)) > lattice_tolerance * scale * cell(1)) &
-                        then
-                    write(buffer, '("contact ", i0, " between yarns ", i0, " and ", i0, &
-                        & " spans ", g0, " cells along x; only neighbouring cells are ", &
-                        & "supported")') c, p%yarn - 1, period(1) / (scale * cell(1))
-                    call fatal_error(error, trim(buffer))
-                    return
-                end if
-                call net%add_link(follower, leader, strain, .true., period)
-                ! Hold one contact against rigid translation (a leader: not linked).
-                if (c == 1) anchor = leader
-            end associate
-        end do
+        call link_contacts(yarns, cell, scale, strain, contacts, wrapped, net, anchor, error)
+        if (allocated(error)) return
         call net%add_support('anchor', [anchor], 'xyz', [0.0_wp, 0.0_wp, 0.0_wp])
     contains
         subroutine first_of_ties(yarn, s, gaps, cut)
@@ -881,6 +902,128 @@ contains
             name = trim(fabric%texgen_materials(min(y, last_given)))
         end function material_of
     end subroutine build_cell
+
+    !> Gap-holders of the contacts between their nodes. Nodes joined by contacts form
+    !> groups (one node on a yarn may be in several contacts); each group gets a tree of
+    !> gap-holders whose root lies furthest towards -x (then -y), so that every node lies
+    !> at most one cell along +x from its root: the force across the cell is then the
+    !> sum of the x reactions of the nodes one cell on. A contact that would close a loop
+    !> of gap-holders (the same two nodes touching again through a periodic image, e.g.
+    !> a yarn between its two neighbours when widths equal the spacing) adds none: the
+    !> holders are rigid, and the loop's lattice vector would pin the cell's period.
+    !> `anchor`: the root of the first contact's group (unchanged without contacts).
+    subroutine link_contacts(yarns, cell, scale, strain, contacts, wrapped, net, anchor, &
+            error)
+        type(texgen_yarn_type), intent(in) :: yarns(:)
+        real(wp), intent(in) :: cell(2), scale, strain(3)
+        type(contact_type), intent(in) :: contacts(:)
+        logical, intent(in) :: wrapped(:, :)
+        type(net_builder_type), intent(inout) :: net
+        integer, intent(inout) :: anchor
+        type(error_type), allocatable, intent(out) :: error
+        ! Per contact: lattice vector from node 1 to node 2 besides the gap; the child end
+        ! (1 or 2) of a tree edge, 0 for a contact that adds no gap-holder.
+        real(wp) :: period(3, size(contacts)), small
+        integer :: child(size(contacts))
+        ! Per node of the net: lattice offset in its group, group, root of the group.
+        real(wp), allocatable :: offset(:, :)
+        integer, allocatable :: group(:), root(:), queue(:)
+        integer :: c, k, g, head, node, other, cells_x
+        character(len=60) :: buffer
+
+        small = lattice_tolerance * scale * maxval(cell)
+        do c = 1, size(contacts)
+            associate(p => contacts(c))
+                period(:, c) = scale * (merge(yarns(p%yarn(2))%period, 0.0_wp * p%shift, &
+                    wrapped(2, c)) - merge(yarns(p%yarn(1))%period, 0.0_wp * p%shift, &
+                    wrapped(1, c)) - p%shift)
+                if (all(abs(period(:, c)) <= small)) period(:, c) = 0.0_wp
+            end associate
+        end do
+        allocate(offset(3, net%n_nodes), source=0.0_wp)
+        allocate(group(net%n_nodes), source=0)
+        allocate(root(0), queue(0))
+        child = 0
+        ! Groups by breadth-first search from each contact's first node not yet grouped.
+        do c = 1, size(contacts)
+            if (group(contacts(c)%node(1)) /= 0) cycle
+            g = size(root) + 1
+            root = [root, contacts(c)%node(1)]
+            group(contacts(c)%node(1)) = g
+            queue = [contacts(c)%node(1)]
+            head = 1
+            do while (head <= size(queue))
+                node = queue(head)
+                head = head + 1
+                do k = 1, size(contacts)
+                    if (all(contacts(k)%node /= node)) cycle
+                    if (contacts(k)%node(1) == node) then
+                        other = contacts(k)%node(2)
+                        if (group(other) /= 0) cycle
+                        offset(:, other) = offset(:, node) + period(:, k)
+                    else
+                        other = contacts(k)%node(1)
+                        if (group(other) /= 0) cycle
+                        offset(:, other) = offset(:, node) - period(:, k)
+                    end if
+                    group(other) = g
+                    queue = [queue, other]
+                    ! Root: furthest towards -x, then -y.
+                    if (before(offset(:, other), offset(:, root(g)))) root(g) = other
+                end do
+            end do
+        end do
+        ! Tree edges from each root outwards (the same search again, now from the root).
+        group = -group
+        do g = 1, size(root)
+            group(root(g)) = g
+            queue = [root(g)]
+            head = 1
+            do while (head <= size(queue))
+                node = queue(head)
+                head = head + 1
+                do k = 1, size(contacts)
+                    if (child(k) /= 0 .or. all(contacts(k)%node /= node)) cycle
+                    other = sum(contacts(k)%node) - node
+                    if (other == node .or. group(other) > 0) cycle
+                    group(other) = g
+                    queue = [queue, other]
+                    child(k) = merge(2, 1, contacts(k)%node(2) == other)
+                    cells_x = nint((offset(1, other) - offset(1, root(g))) / (scale * cell(1)))
+                    if (cells_x > 1) then
+                        write(buffer, '("TexGen yarns ", i0, " and ", i0)') &
+                            contacts(k)%yarn - 1
+                        call fatal_error(error, trim(buffer) // ' touch at (' &
+                            // format_short(contacts(k)%point(1, 1)) // ', ' &
+                            // format_short(contacts(k)%point(2, 1)) // ', ' &
+                            // format_short(contacts(k)%point(3, 1)) // ') in a group of ' &
+                            // 'contacts that reaches over ' // format_integer(cells_x + 1) &
+                            // ' cells along x; at most two neighbouring cells are ' &
+                            // "supported: let every yarn's first master node lie in the " &
+                            // 'same cell')
+                        return
+                    end if
+                end do
+            end do
+        end do
+        do c = 1, size(contacts)
+            if (child(c) == 0) cycle
+            associate(p => contacts(c))
+                node = p%node(child(c))
+                other = p%node(3 - child(c))
+                call net%add_link(node, other, strain, .true., offset(:, node) &
+                    - offset(:, other))
+            end associate
+        end do
+        if (size(contacts) > 0) anchor = root(group(contacts(1)%node(1)))
+    contains
+        !> Lattice offset u before v: smaller x, then smaller y (beyond rounding).
+        logical function before(u, v)
+            real(wp), intent(in) :: u(3), v(3)
+            before = u(1) < v(1) - small .or. (abs(u(1) - v(1)) <= small .and. &
+                u(2) < v(2) - small)
+        end function before
+    end subroutine link_contacts
 
     !> A clamped sample of fabric%cells(1) x fabric%cells(2) copies of the periodic cell
     !> `unit` (lattice `period`, m). Each yarn runs on through the copies along its own
