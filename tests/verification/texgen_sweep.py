@@ -5,12 +5,13 @@ that TexGen accepts; each imported (a ``check_only`` run) and run (a short stret
 
     .venv/bin/python tests/verification/texgen_sweep.py [folder]    # prints the table
 
-Models are made with pytexgen in .venv-texgen where it is installed; the cases shipped
-as tests/data/texgen/<name>.tg3 are read from there otherwise (``SHIPPED``). Used by
+Models are made with pytexgen in .venv-texgen where it is installed; otherwise the cases
+shipped as tests/data/texgen/<name>.tg3.gz (the same pytexgen files, gzipped) are used. Used by
 tests/verification/test_texgen_sweep.py. Times are wall times: figures, not assertions.
 """
 from __future__ import annotations
 
+import gzip
 import re
 import subprocess
 import sys
@@ -70,11 +71,14 @@ def have_pytexgen() -> bool:
 
 def model(name: str, folder: Path, make: bool) -> Path | None:
     """The model file of case ``name``: made with pytexgen (``make``), else shipped."""
-    if not make:
-        shipped = SHIPPED / f"{name}.tg3"
-        return shipped if shipped.exists() else None
-    kind, values = CASES[name]
     path = folder / f"{name}.tg3"
+    if not make:
+        shipped = SHIPPED / f"{name}.tg3.gz"
+        if not shipped.exists():
+            return None
+        path.write_bytes(gzip.decompress(shipped.read_bytes()))
+        return path
+    kind, values = CASES[name]
     if not path.exists():
         proc = subprocess.run([str(TEXGEN_PYTHON), str(MODELS), kind, str(path),
                                *map(str, values)], capture_output=True, text=True,

@@ -32,7 +32,7 @@ module yarnfort_generate_texgen
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_xml_subset, only: xml_document_type, read_xml_file
     use yarnfort_sort, only: sort_index
-    use yarnfort_text, only: format_integer, format_short
+    use yarnfort_text, only: format_integer, format_real
     implicit none
     private
 
@@ -165,12 +165,14 @@ contains
         end if
         yarn_elements = document%children(textiles(1), 'Yarn')
         if (size(yarn_elements) == 0) then
-            call fatal_error(error, 'the textile has no yarns')
+            call fatal_error(error, 'the textile has no <Yarn> elements (no TexGen yarns: ' &
+                // 'saved with OUTPUT_MINIMAL, which keeps only the parameters TexGen builds ' &
+                // 'the yarns from?); save it with OUTPUT_STANDARD')
             return
         end if
         allocate(yarns(size(yarn_elements)))
         do y = 1, size(yarn_elements)
-            write(buffer, '("yarn ", i0, ": ")') y - 1
+            write(buffer, '("TexGen yarn ", i0, ": ")') y - 1
             nodes = document%children(yarn_elements(y), 'MasterNode')
             if (size(nodes) < 2) then
                 call fatal_error(error, trim(buffer) // ' fewer than two master nodes')
@@ -225,6 +227,12 @@ contains
                 call get_cell(lattice, vector_pair=first_lattice, error=error)
                 if (allocated(error)) goto 200
             end if
+            call drop_repeated_nodes(master, up, tangent, lattice_tolerance * minval(cell))
+            if (size(master, 2) < 2) then
+                call fatal_error(error, trim(buffer) // ' all its master nodes are at one ' &
+                    // 'point: give it master nodes along its path')
+                return
+            end if
             call read_section(document, yarn_elements(y), yarns(y)%width, yarns(y)%height, &
                 error)
             if (allocated(error)) goto 200
@@ -245,6 +253,36 @@ contains
         return
 200     error%message = trim(buffer) // ' ' // error%message
     end subroutine read_model
+
+    !> Master nodes at the position of the one before (within `tolerance`) are dropped:
+    !> TexGen accepts them, but their span has no length, nor a direction to sample.
+    !> The last node (the first's image one period on) stays.
+    subroutine drop_repeated_nodes(master, up, tangent, tolerance)
+        real(wp), allocatable, intent(inout) :: master(:, :), up(:, :), tangent(:, :)
+        real(wp), intent(in) :: tolerance
+        logical :: kept(size(master, 2))
+        integer :: k, previous, n
+
+        n = size(master, 2)
+        kept = .true.
+        previous = 1
+        do k = 2, n
+            if (norm2(master(:, k) - master(:, previous)) <= tolerance) then
+                ! Of the last node and a repeat before it, the last stays.
+                if (k == n .and. previous > 1) then
+                    kept(previous) = .false.
+                else
+                    kept(k) = .false.
+                    cycle
+                end if
+            end if
+            previous = k
+        end do
+        if (all(kept)) return
+        master = master(:, pack([(k, k = 1, n)], kept))
+        up = up(:, pack([(k, k = 1, n)], kept))
+        tangent = tangent(:, pack([(k, k = 1, n)], kept))
+    end subroutine drop_repeated_nodes
 
     !> The cell of a yarn's repeat vectors: one along x, one along y; a second call
     !> (vector_pair given) checks that the repeats are those.
@@ -278,7 +316,7 @@ contains
         end if
         if (present(vector_pair)) then
             if (any(abs(found - vector_pair) > lattice_tolerance * maxval(abs(vector_pair)))) &
-                call fatal_error(error, 'its repeat vectors differ from those of yarn 0')
+                call fatal_error(error, 'its repeat vectors differ from those of TexGen yarn 0')
         end if
         if (present(cell)) cell = found
     end subroutine get_cell
@@ -844,9 +882,12 @@ contains
             ! x period on: a yarn that spans several x periods would count once.
             if (abs(abs(period(1)) - scale * cell(1)) > lattice_tolerance * scale * cell(1) &
                     .and. abs(period(1)) > lattice_tolerance * scale * cell(1)) then
-                write(buffer, '("yarn ", i0, " spans ", g0, " cells along x in one period; ", &
-                    & "only yarns of one x period (or none) are supported")') y - 1, &
-                    period(1) / (scale * cell(1))
+                write(buffer, '("TexGen yarn ", i0, " spans ", i0, " cells along x in one ", &
+                    & "period (its last master node lies ", i0, " x repeats from its first); ", &
+                    & "only yarns that repeat after one cell along x (or run along y) are ", &
+                    & "supported: give it the master nodes of one x repeat")') y - 1, &
+                    nint(abs(period(1)) / (scale * cell(1))), &
+                    nint(abs(period(1)) / (scale * cell(1)))
                 call fatal_error(error, trim(buffer))
                 return
             end if
@@ -994,9 +1035,9 @@ contains
                         write(buffer, '("TexGen yarns ", i0, " and ", i0)') &
                             contacts(k)%yarn - 1
                         call fatal_error(error, trim(buffer) // ' touch at (' &
-                            // format_short(contacts(k)%point(1, 1)) // ', ' &
-                            // format_short(contacts(k)%point(2, 1)) // ', ' &
-                            // format_short(contacts(k)%point(3, 1)) // ') in a group of ' &
+                            // format_real(contacts(k)%point(1, 1)) // ', ' &
+                            // format_real(contacts(k)%point(2, 1)) // ', ' &
+                            // format_real(contacts(k)%point(3, 1)) // ') in a group of ' &
                             // 'contacts that reaches over ' // format_integer(cells_x + 1) &
                             // ' cells along x; at most two neighbouring cells are ' &
                             // "supported: let every yarn's first master node lie in the " &
@@ -1086,8 +1127,8 @@ contains
                 step = nint(offset(1:2) / period)
                 if (any(abs(offset(1:2) - step * period) > lattice_tolerance &
                         * maxval(period)) .or. all(step == 0)) then
-                    write(buffer, '("yarn ", i0, " does not end one lattice vector from its ", &
-                        & "start: cannot tile it into a sample")') y - 1
+                    write(buffer, '("TexGen yarn ", i0, " does not end one lattice vector ", &
+                        & "from its start: cannot tile it into a sample")') y - 1
                     call fatal_error(error, trim(buffer))
                     return
                 end if
