@@ -32,7 +32,7 @@ module yarnfort_generate_texgen
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_xml_subset, only: xml_document_type, read_xml_file
     use yarnfort_sort, only: sort_index
-    use yarnfort_text, only: format_integer, format_real
+    use yarnfort_text, only: format_integer, format_short
     implicit none
     private
 
@@ -1035,9 +1035,9 @@ contains
                         write(buffer, '("TexGen yarns ", i0, " and ", i0)') &
                             contacts(k)%yarn - 1
                         call fatal_error(error, trim(buffer) // ' touch at (' &
-                            // format_real(contacts(k)%point(1, 1)) // ', ' &
-                            // format_real(contacts(k)%point(2, 1)) // ', ' &
-                            // format_real(contacts(k)%point(3, 1)) // ') in a group of ' &
+                            // format_short(contacts(k)%point(1, 1)) // ', ' &
+                            // format_short(contacts(k)%point(2, 1)) // ', ' &
+                            // format_short(contacts(k)%point(3, 1)) // ') in a group of ' &
                             // 'contacts that reaches over ' // format_integer(cells_x + 1) &
                             // ' cells along x; at most two neighbouring cells are ' &
                             // "supported: let every yarn's first master node lie in the " &
