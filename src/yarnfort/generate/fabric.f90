@@ -377,11 +377,11 @@ contains
                 ! holder collapses its two nodes, and subnormal factors also slow every step.
                 k = findloc(f > 0.0_wp .and. f < coincidence_tolerance, .true., dim=1)
                 if (k > 0) then
-                    write(buffer, '(a, "gap_factor value ", i0, " (", es9.2, ") is below ", &
-                        & es9.2, " (100 * epsilon): it collapses the gap-holders to zero ", &
-                        & "length (give a factor that keeps a gap)")') label, k, f(k), &
-                        coincidence_tolerance
-                    call fatal_error(error, trim(buffer))
+                    call fatal_error(error, label // 'gap_factor(' // format_integer(k) &
+                        // ') = ' // format_real(f(k)) // ' is below ' &
+                        // format_real(coincidence_tolerance) // ' (100 * epsilon): it ' &
+                        // 'collapses the gap-holders to zero length (give a factor that ' &
+                        // 'keeps a gap)')
                     return
                 end if
                 if (.not. below_spacing) then

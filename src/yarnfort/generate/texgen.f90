@@ -32,6 +32,8 @@ module yarnfort_generate_texgen
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_xml_subset, only: xml_document_type, read_xml_file
     use yarnfort_sort, only: sort_index
+    use yarnfort_text, only: format_real, format_integer
+    use yarnfort_input_magnitudes, only: max_coordinate
     implicit none
     private
 
@@ -171,6 +173,14 @@ contains
             do k = 1, size(nodes)
                 call read_vector(document, nodes(k), 'Position', master(:, k), .true., error)
                 if (allocated(error)) goto 200
+                ! The coordinate limit of every scene (yarnfort_input_magnitudes).
+                if (.not. all(abs(master(:, k)) * scale <= max_coordinate)) then
+                    call fatal_error(error, 'master node ' // format_integer(k - 1) &
+                        // ': Position ' // format_real(maxval(abs(master(:, k)))) // ' (' &
+                        // format_real(maxval(abs(master(:, k))) * scale) // ' m) is above ' &
+                        // format_real(max_coordinate) // ' m, where squared lengths overflow')
+                    goto 200
+                end if
                 up(:, k) = [0.0_wp, 0.0_wp, 1.0_wp]
                 call read_vector(document, nodes(k), 'Up', vector, .false., error)
                 if (allocated(error)) goto 200
