@@ -96,9 +96,9 @@ BELT = """&material name = 'warp', law = 'linear', stiffness = 5.0, prestress = 
 MIN_GAP_FACTOR = 100 * 2.0 ** -52
 
 
-@pytest.mark.parametrize("factor, ok", [(MIN_GAP_FACTOR * 1.01, True), (MIN_GAP_FACTOR * 0.99,
-                                        False), (5e-324, False), (2.2250738585072014e-308,
-                                                                  False), (0.5, True)])
+@pytest.mark.parametrize("factor, ok", [
+    (MIN_GAP_FACTOR * 1.01, True), (MIN_GAP_FACTOR * 0.99, False), (5e-324, False),
+    (2.2250738585072014e-308, False), (0.5, True)])
 def test_gap_factor_bound(run_yarnfort, factor, ok):
     run = run_yarnfort(BELT.format(factor=factor))
     assert accepted(run) == ok, run.stderr

@@ -227,8 +227,9 @@ contains
             end if
             if (is_usable_stretch(stretch)) cycle
             call fatal_error(error, label // ': ' // name // '(' // format_integer(e) &
-                // ') = ' // format_real(value) // ' stretches element ' // format_integer(e) // ' (length ' &
-                // format_real(length) // ' m) by l / L0 = ' // format_real(stretch) &
+                // ') = ' // format_real(value) // ' stretches element ' &
+                // format_integer(e) // ' (length ' // format_real(length) &
+                // ' m) by l / L0 = ' // format_real(stretch) &
                 // ', outside [' // format_real(1 / max_stretch) // ', ' &
                 // format_real(max_stretch) // '] (2**-60 to 2**60: the bound on the ' &
                 // 'stretch a prestress gives)')
