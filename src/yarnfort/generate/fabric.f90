@@ -374,7 +374,7 @@ contains
                 end do
                 ! A holder gap * factor shorter than coincidence_tolerance * gap is a zero
                 ! length by the rule for elements (the gap is below the scene's size): the
-                ! holder collapses its two nodes (and subnormal factors slow the arithmetic).
+                ! holder collapses its two nodes (docs/decisions.md, Smallest gap factor).
                 k = findloc(f > 0.0_wp .and. f < coincidence_tolerance, .true., dim=1)
                 if (k > 0) then
                     call fatal_error(error, label // 'gap_factor(' // format_integer(k) &

@@ -10,7 +10,8 @@ module yarnfort_material_law
 
     !> Largest stretch l / L0 of an element: a prestress is refused when its law needs
     !> more (get_stretch_at_force searches up to it), and so are per-element reference
-    !> lengths that give more, or less than its inverse (is_usable_stretch).
+    !> lengths that give more, or less than its inverse (is_usable_stretch; docs/
+    !> decisions.md, One bound on an element's stretch).
     real(wp), parameter :: max_stretch = 2.0_wp**60
 
     !> Tension f(lambda) of a yarn, lambda = l/L0. f(lambda) = 0 and df/dlambda = 0 for
