@@ -183,6 +183,18 @@ contains
             end select
         end do read_lines
 
+        if (n_nodes == 0) then
+            if (len(content) == 0) then
+                call fatal_error(error, "&geometry: file '" // path // "' is empty (0 bytes " &
+                    // 'read; a device or a pipe reads as empty): it must hold the node and ' &
+                    // 'yarn lines')
+            else
+                call fatal_error(error, "&geometry: file '" // path // "' has no node lines " &
+                    // '(' // format_integer(line_number) // ' lines read; a node line is: ' &
+                    // 'node <id> <x> <y> <z>)')
+            end if
+            return
+        end if
         ! Node ids must be exactly 1..n. An id above the number of node lines means that
         ! some id up to it is missing (found below): nothing is allocated by such an id,
         ! which may be huge.

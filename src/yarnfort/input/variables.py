@@ -23,7 +23,8 @@ from descriptors import Group, Var
 #: Both columns of the gap-factor curve of &fabric.
 GAP_FACTOR = ('The gap factor as a piecewise-linear function of the displacement factor p_disp '
               "(constant beyond the end knots): the holders' length is gap * factor (paper "
-              'Fig. 13b). `gap_factor_p_disp` increasing; factors positive.')
+              'Fig. 13b). `gap_factor_p_disp` increasing; factors at least `100 * epsilon` '
+              '(about 2.2e-14): a smaller one collapses the holders to zero length.')
 #: A name that other groups or columns refer to.
 NAME_RULE = 'Required and unique. One word of letters, digits, `_`, `-`, `.`.'
 #: The nodes of a named node set.
@@ -240,8 +241,9 @@ GROUPS = [
                 '/ lambda_p, where f(lambda_p) = prestress and l is its length in the initial '
                 "geometry, so it carries that tension there (the paper's knitting yarns carry 2 "
                 'cN: `prestress = 0.02`). The initial geometry is then not in equilibrium in '
-                'general; step 0 of the run finds the equilibrium. An error if the law never '
-                'reaches that force.'),
+                'general; step 0 of the run finds the equilibrium. An error if the law does '
+                'not reach that force at a stretch up to 2**60 (about 1.2e18; the same bound '
+                'holds for `&yarn length0` and `stretch`).'),
     ]),
     Group('contact', 'repeatable',
           'The friction law where yarns of two types cross (one group per unordered pair).', [
@@ -410,13 +412,16 @@ GROUPS = [
             default_doc='none (from the geometry)',
             doc='Reference length L0 of every element of the yarn, in order along it (one '
                 'value per element: (number of nodes - 1) * elements_per_segment), so that a '
-                'measured or computed pretensioned state is given exactly. Each > 0. Not with '
-                '`stretch`, nor on a yarn whose material has a `prestress`.'),
+                'measured or computed pretensioned state is given exactly. Each > 0, with '
+                'l / L0 (l: the element\'s initial length) in [2**-60, 2**60], the bound of a '
+                '`prestress`. Not with `stretch`, nor on a yarn whose material has a '
+                '`prestress`.'),
         Var('stretch', 'real', None, shape='list', unit='1', range='> 0',
             default_doc='none (1)',
             doc='Initial stretch lambda of every element of the yarn instead: L0 = l / lambda, '
                 'l the element\'s length in the initial geometry (the operation `prestress` '
-                'does with one lambda per material). One value per element, each > 0. Not with '
+                'does with one lambda per material). One value per element, each in [2**-60, '
+                '2**60] (about 8.7e-19 to 1.2e18), the bound of a `prestress`. Not with '
                 '`length0`, nor with a `prestress` of the material.'),
     ]),
     Group('support', 'repeatable',

@@ -64,6 +64,14 @@ contains
         call build_loads(scene, config)
         call build_passages(scene, config, error)
         if (allocated(error)) return
+        ! Something to solve: a free coordinate or a passage that slides (an input error
+        ! here, before anything is written; yarnfort_input_validate finds the plain case).
+        if (scene%dofs%n_unknowns == 0 .and. scene%passages%size() == 0) then
+            call fatal_error(error, 'every coordinate of every node is prescribed (by ' &
+                // '&support, &obstacle or the links of a generated fabric) and no yarn ' &
+                // 'slides at a contact: the scene has no unknowns (nothing to solve)')
+            return
+        end if
         if (config%fabric_width > 0.0_wp) then
             scene%fabric_width = config%fabric_width
             scene%fabric_strain = config%fabric%strain
