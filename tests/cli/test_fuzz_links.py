@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import random
+import re
 import shutil
 import subprocess
 import sys
@@ -38,10 +39,10 @@ import pytest
 
 from test_faults import WRITTEN_NAMES, tree
 from test_fuzz import (CASE_TIMEOUT, CRASH_MARKERS, ERROR_LINE, SEED, SEEDS,  # noqa: F401
-                       executable, non_finite_in_outputs, with_control)
+                       executable, with_control)
 
-#: Cases, and the wall-clock seconds they may take together (about 0.3 s a case here).
-LINK_CASES = 60
+#: Cases, and the wall-clock seconds they may take together (about 0.2 s a case here).
+LINK_CASES = 120
 LINK_BUDGET = 90.0
 #: Load steps of each run (&control max_steps): the links act before the first step.
 MAX_STEPS = 3
@@ -70,9 +71,21 @@ class Plan:
     @property
     def refused(self) -> bool:
         """Whether the second run must refuse the folder (exit code 2)."""
-        return any(kind == "symlink" and name in WRITTEN_NAMES or
+        return any(kind == "symlink" and is_written_name(name) or
                    kind == "hardlink" and name == ".yarnfort-lock"
                    for kind, name, _ in self.plants)
+
+
+def is_written_name(name: str) -> bool:
+    """A name the program writes in an output folder (state files of any step)."""
+    return name in WRITTEN_NAMES or re.fullmatch(r"state_\d{5,}\.vtu", name) is not None
+
+
+def without_probe(content: dict[str, object]) -> dict[str, object]:
+    """A folder's tree without a regular file at the write probe's name: one there is
+    a leftover probe, replaced (never followed) before the folder is checked."""
+    return {name: value for name, value in content.items()
+            if not (name.endswith(".yarnfort-write-test") and not isinstance(value, tuple))}
 
 
 def make_plan(index: int) -> Plan:
@@ -85,7 +98,7 @@ def make_plan(index: int) -> Plan:
     hard = [n for n in WRITTEN_NAMES if not (restart and n in READ_ON_RESTART)]
     plants = []
     for _ in range(rng.choice((1, 1, 2, 3))):
-        kind = rng.choice(("symlink", "symlink", "symlink", "other", "hardlink"))
+        kind = rng.choice(("symlink", "other", "hardlink"))
         if kind == "other":
             plants.append(("symlink", rng.choice(OTHER_NAMES), rng.choice(TARGETS)))
         elif kind == "symlink":
@@ -184,7 +197,7 @@ def run_link_case(executable: Path, plan: Plan, case: Path) -> list[str]:
             problems.append(f"a planted link was not refused (exit {code})")
         elif not any(f"'{FOLDER}/{name}'" in stderr for name in planted):
             problems.append("the refusal names no planted link")
-        if before != after:
+        if without_probe(before) != without_probe(after):
             problems.append("a refused run changed the output folder")
     else:
         if code != 0:
@@ -193,7 +206,6 @@ def run_link_case(executable: Path, plan: Plan, case: Path) -> list[str]:
             if kind == "symlink" and before.get(f"{inside}/{name}") != after.get(
                     f"{inside}/{name}"):
                 problems.append(f"the link {name} of one's own was changed")
-        problems += non_finite_in_outputs(real)
     return [f"{p}; stderr: {stderr.strip()[-300:]}" for p in problems]
 
 
