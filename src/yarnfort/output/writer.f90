@@ -157,7 +157,7 @@ contains
                 call resume_files(self, scene, resume_step, error, resume_time, &
                     resume_previous_time)
             else
-                call start_files(self, scene, error)
+                call start_files(self, scene, found, error)
                 if (.not. allocated(error)) call start_contacts(self, error)
             end if
         end if
@@ -165,11 +165,13 @@ contains
     end subroutine open_writer
 
     !> A new run: delete what the manifest lists (the files an earlier run wrote; regular
-    !> files only) and a restart file of ours, then start the manifest anew, empty, and
-    !> the curve file.
-    subroutine start_files(self, scene, error)
+    !> files only), or without a manifest a restart file of ours, then start the manifest
+    !> anew, empty, and the curve file.
+    subroutine start_files(self, scene, listed, error)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
+        !> The folder has a manifest.
+        logical, intent(in) :: listed
         type(error_type), allocatable, intent(out) :: error
         integer :: i
 
@@ -182,8 +184,8 @@ contains
             if (allocated(error)) return
         end do
         ! A restart file of an earlier version (no manifest) must not survive either:
-        ! removed when it is one of ours.
-        call remove_restart(self%folder)
+        ! removed when its header says it is one of ours.
+        if (.not. listed) call remove_restart(self%folder)
         self%manifest%states = self%manifest%states(:0)
         self%manifest%steps = self%manifest%steps(:0)
         self%manifest%times = self%manifest%times(:0)
