@@ -15,17 +15,15 @@ module yarnfort_output_writer
     use yarnfort_input_echo, only: write_config
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_observer_type, step_state_type
-    use yarnfort_output_curve, only: curve_writer_type
+    use yarnfort_output_curve, only: curve_writer_type, curve_file_name
     use yarnfort_output_reactions, only: reactions_file_name, reactions_header, &
         get_reaction_rows
     use yarnfort_output_contacts, only: contacts_file_name, contacts_header, &
         get_contact_rows
-    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name
+    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, collection_file_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
         remove_file, open_new_file, close_new_file, get_links, refuse_link
     use yarnfort_output_manifest, only: manifest_type, is_own_name, is_bookkeeping_name
-    use yarnfort_output_curve, only: curve_file_name
-    use yarnfort_output_vtk, only: collection_file_name
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_output_restart, only: write_restart, remove_restart, restart_file_name
     implicit none
