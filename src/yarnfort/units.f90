@@ -8,11 +8,12 @@
 !> double as a hand-written 0.05.
 module yarnfort_units
     use yarnfort_kinds, only: wp
-    use yarnfort_text, only: to_lower
+    use yarnfort_text, only: to_lower, string_type
     implicit none
     private
 
     public :: unit_type, find_unit, unit_names, to_scene_unit, get_header_unit
+    public :: get_header_units
     public :: strain_kind, length_kind, force_kind
 
     !> The kinds of quantity a unit measures.
@@ -34,8 +35,8 @@ module yarnfort_units
     !> The avoirdupois pound-force, N (1 lb = 0.45359237 kg exactly, times standard_gravity).
     real(wp), parameter :: pound_force = 4.4482216152605_wp
     !> 'per mille' sign and micro sign in UTF-8.
-    character(len=*), parameter :: per_mille = achar(226) // achar(128) // achar(176)
-    character(len=*), parameter :: micro = achar(194) // achar(181)
+    character(len=*), parameter :: per_mille = char(226) // char(128) // char(176)
+    character(len=*), parameter :: micro = char(194) // char(181)
 
     !> Every unit a tensile tester or a CAD export writes for strain, elongation and force.
     type(unit_type), parameter :: known_units(*) = [ &
@@ -98,11 +99,8 @@ contains
         type(unit_type), intent(in) :: unit
         real(wp) :: converted
 
-        if (unit%numerator == 1.0_wp) then
-            converted = value / unit%denominator
-        else
-            converted = value * unit%numerator / unit%denominator
-        end if
+        ! Left to right: a numerator of 1 is exact, so 5 % is 5 / 100, one rounding.
+        converted = (value * unit%numerator) / unit%denominator
     end function to_scene_unit
 
     !> The unit a column header `field` states, as text: the contents of its last (...)
@@ -134,5 +132,29 @@ contains
         text = name(scan(name, ' /', back=.true.) + 1:)
         call find_unit(text, unit, stated)
     end subroutine get_header_unit
+
+    !> The fields of a two-column header line and the unit text each states
+    !> (`get_header_unit`); a line without exactly two comma-separated fields states none.
+    pure subroutine get_header_units(header, fields, texts, stated)
+        character(len=*), intent(in) :: header
+        type(string_type), intent(out) :: fields(2), texts(2)
+        logical, intent(out) :: stated(2)
+        integer :: comma, c
+
+        stated(:) = .false.
+        fields(1)%text = ''
+        fields(2)%text = ''
+        texts(1)%text = ''
+        texts(2)%text = ''
+        comma = index(header, ',')
+        if (comma == 0) return
+        if (index(header(comma + 1:), ',') /= 0) return
+        fields(1)%text = trim(adjustl(header(:comma - 1)))
+        fields(2)%text = trim(adjustl(header(comma + 1:)))
+        do c = 1, 2
+            if (len(fields(c)%text) > 0) call get_header_unit(fields(c)%text, texts(c)%text, &
+                stated(c))
+        end do
+    end subroutine get_header_units
 
 end module yarnfort_units

@@ -25,10 +25,10 @@ module yarnfort_material_table
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_material_law, only: force_law_type
-    use yarnfort_text, only: format_real, format_integer, quote_string
+    use yarnfort_text, only: format_real, format_integer, quote_string, string_type
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
     use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &
-        get_header_unit, strain_kind, length_kind, force_kind
+        get_header_units, strain_kind, length_kind, force_kind
     implicit none
     private
 
@@ -166,59 +166,43 @@ contains
         type(error_type), allocatable, intent(out) :: error
         character(len=*), parameter :: names(2) = [character(len=11) :: 'strain_unit', &
             'force_unit']
-        character(len=:), allocatable :: fields(:), stated(:), text, place
+        character(len=max_unit_text) :: stated(2)
+        character(len=:), allocatable :: place
+        type(string_type) :: fields(2), texts(2)
+        type(unit_type) :: declared
         logical :: in_header(2)
-        integer :: c, comma
+        integer :: c
 
-        ! The header's fields, if it has two; the units stated in &material.
-        allocate(character(len=max(len(header), 1)) :: fields(2))
-        fields(:) = ''
-        comma = index(header, ',')
-        if (header_line > 0 .and. comma > 0) then
-            if (index(header(comma + 1:), ',') == 0) then
-                fields(1) = header(:comma - 1)
-                fields(2) = header(comma + 1:)
-            end if
-        end if
-        allocate(character(len=max_unit_text) :: stated(2))
+        ! The header's units (if it has two fields); the units stated in &material.
+        call get_header_units(header, fields, texts, in_header)
+        if (header_line == 0) in_header(:) = .false.
         stated(:) = ''
         if (present(strain_unit)) stated(1) = strain_unit
         if (present(force_unit)) stated(2) = force_unit
 
         do c = 1, 2
             place = ', line ' // format_integer(header_line) // ', column ' &
-                // format_integer(c) // ' (' // quote_string(trim(adjustl(fields(c)))) // ')'
-            in_header(c) = .false.
-            if (len_trim(fields(c)) > 0) call get_header_unit(fields(c), text, in_header(c))
+                // format_integer(c) // ' (' // quote_string(fields(c)%text) // ')'
             if (in_header(c)) then
-                call take_unit(text, c, units(c), error)
+                call take_unit(texts(c)%text, c, units(c), error)
                 if (allocated(error)) then
                     error%message = place // ': ' // error%message
                     return
                 end if
             end if
             if (len_trim(stated(c)) == 0) cycle
-            if (in_header(c)) then
-                block
-                    type(unit_type) :: declared
-                    call take_unit(trim(adjustl(stated(c))), c, declared, error)
-                    if (allocated(error)) then
-                        error%message = ': ' // trim(names(c)) // ' ' // error%message
-                        return
-                    end if
-                    if (declared%name /= units(c)%name) then
-                        call fatal_error(error, place // ': the header states ' &
-                            // quote_string(trim(units(c)%name)) // ' but ' // trim(names(c)) &
-                            // ' = ' // quote_string(trim(adjustl(stated(c)))))
-                        return
-                    end if
-                end block
-            else
-                call take_unit(trim(adjustl(stated(c))), c, units(c), error)
-                if (allocated(error)) then
-                    error%message = ': ' // trim(names(c)) // ' ' // error%message
-                    return
-                end if
+            call take_unit(trim(adjustl(stated(c))), c, declared, error)
+            if (allocated(error)) then
+                error%message = ': ' // trim(names(c)) // ' ' // error%message
+                return
+            end if
+            if (.not. in_header(c)) then
+                units(c) = declared
+            else if (declared%name /= units(c)%name) then
+                call fatal_error(error, place // ': the header states ' &
+                    // quote_string(trim(units(c)%name)) // ' but ' // trim(names(c)) &
+                    // ' = ' // quote_string(trim(adjustl(stated(c)))))
+                return
             end if
         end do
         ! Neither states a unit: strain 1 (the default unit_type), force N.

@@ -62,7 +62,7 @@ contains
         if (allocated(error)) return
         call expect(error, 'Permille', 7.0_wp, 0.007_wp, 0.0_wp)
         if (allocated(error)) return
-        call expect(error, achar(226) // achar(128) // achar(176), 7.0_wp, 0.007_wp, 0.0_wp)
+        call expect(error, char(226) // char(128) // char(176), 7.0_wp, 0.007_wp, 0.0_wp)
         if (allocated(error)) return
         call expect(error, 'N', 1.25_wp, 1.25_wp, 0.0_wp)
         if (allocated(error)) return
@@ -94,7 +94,7 @@ contains
         if (allocated(error)) return
         call expect(error, 'um', 250.0_wp, 2.5e-4_wp, 0.0_wp)
         if (allocated(error)) return
-        call expect(error, achar(194) // achar(181) // 'm', 250.0_wp, 2.5e-4_wp, 0.0_wp)
+        call expect(error, char(194) // char(181) // 'm', 250.0_wp, 2.5e-4_wp, 0.0_wp)
     end subroutine test_unit_factors
 
     !> Spellings that are no unit, or another one in another case (MN is a meganewton).
