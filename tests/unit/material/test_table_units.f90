@@ -8,6 +8,7 @@ module test_table_units
     use yarnfort_testing, only: unittest_type, new_unittest, check, check_close
     use yarnfort_units, only: unit_type, find_unit, to_scene_unit, get_header_unit
     use yarnfort_material_table, only: table_law_type, read_table_law, max_table_strain
+    use yarnfort_friction_general, only: rate_table_type => table_law_type, read_rate_table
     implicit none
     private
 
@@ -39,7 +40,8 @@ contains
             new_unittest('units stated in &material', test_stated_units), &
             new_unittest('elongation over a gauge length', test_elongation_table), &
             new_unittest('plain headers and none: 1 and N', test_default_units), &
-            new_unittest('bad units and misread strains refused', test_refused_tables) &
+            new_unittest('bad units and misread strains refused', test_refused_tables), &
+            new_unittest('rate table in cN and cN/rad', test_rate_table_units) &
             ]
     end subroutine collect_table_units
 
@@ -295,6 +297,41 @@ contains
         if (allocated(error)) return
         call check(error, max_table_strain == 10.0_wp, 'the documented limit is 10')
     end subroutine test_refused_tables
+
+    !> A friction rate table in cN and cN/rad (and gf per radian) against the same in N and
+    !> N/rad by hand; a unit that is not a force per radian is refused.
+    subroutine test_rate_table_units(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(rate_table_type) :: lab, si
+        type(error_type), allocatable :: law_error
+
+        call write_file(path, 'T,g' // lf // '0,0.05' // lf // '0.2,0.1' // lf // '0.4,0.3' // lf)
+        call read_rate_table(si, path, law_error)
+        call check(error, .not. allocated(law_error), 'SI rate table refused')
+        if (allocated(error)) return
+        call write_file(path, 'T (cN),g (cN/rad)' // lf // '0,5' // lf // '20,10' // lf &
+            // '40,30' // lf)
+        call read_rate_table(lab, path, law_error)
+        call check(error, .not. allocated(law_error), 'rate table in cN refused')
+        if (allocated(error)) return
+        call check_close(error, lab%tension, si%tension, identity_tol, 'tensions')
+        if (allocated(error)) return
+        call check_close(error, lab%rate, si%rate, identity_tol, 'rates')
+        if (allocated(error)) return
+        call write_file(path, 'T [cN],g [gf]' // lf // '0,' // real_text(0.05_wp / 9.80665e-3_wp) &
+            // lf // '20,' // real_text(0.1_wp / 9.80665e-3_wp) // lf // '40,' &
+            // real_text(0.3_wp / 9.80665e-3_wp) // lf)
+        call read_rate_table(lab, path, law_error)
+        call check(error, .not. allocated(law_error), 'rate table in gf refused')
+        if (allocated(error)) return
+        call check_close(error, lab%rate, si%rate, identity_tol, 'rates in gf')
+        if (allocated(error)) return
+        call write_file(path, 'T (cN),g (cN/mm)' // lf // '0,5' // lf // '20,10' // lf)
+        call read_rate_table(lab, path, law_error)
+        call check_error(law_error, [character(len=60) :: path, 'line 1, column 2', &
+            "'cN/mm' is not a known force unit per rad"], error)
+        call delete_file(path)
+    end subroutine test_rate_table_units
 
     !> The value `value` in unit `name` is `expected` in the scene's unit.
     subroutine expect(error, name, value, expected, tolerance)
