@@ -125,7 +125,8 @@ def force_law(law: str, stretch: ArrayLike, **params: float | str | os.PathLike
     ----------
     law : str
         ``'linear'`` (``stiffness`` = EA in N), ``'neo_hookean'`` (``modulus`` C in Pa,
-        ``area`` S1 in m**2) or ``'table'`` (``table_file``: CSV of strain, force in N).
+        ``area`` S1 in m**2) or ``'table'`` (``table_file``: CSV of strain, force, in the
+        units its header states, else 1 and N).
     stretch : array_like
         Stretches lambda = l/L0, any shape.
     **params

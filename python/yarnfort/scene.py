@@ -179,7 +179,9 @@ class Material:
         Unique name, referred to by yarns and contacts.
     law : str
         ``'linear'`` (``stiffness`` EA, N), ``'neo_hookean'`` (``modulus`` C, Pa, and
-        ``area`` S1, m**2) or ``'table'`` (``table_file``: CSV of strain, force in N).
+        ``area`` S1, m**2) or ``'table'`` (``table_file``: CSV of strain, force; in the
+        units its header states, else 1 and N; ``extra`` may hold ``strain_unit``,
+        ``force_unit``, ``gauge_length``).
     prestress : float, optional
         Initial tension of every element of this type (N).
     extra : dict

@@ -107,6 +107,9 @@ contains
             'Load channels: each &load and &support names a channel (&path channels, one', &
             'column of &path factors per channel); default: p_force and p_disp.', &
             'Per-element reference lengths: &yarn length0 or stretch (one per element).', &
+            'Table files state their units: a header such as "Elongation (%),Force (cN)"', &
+            'or &material strain_unit, force_unit (an elongation in mm: gauge_length);', &
+            'none: strain and N. &geometry unit (or a unit line) converts a file to m.', &
             'Examples: inputs/*.nml.', &
             ''
         write(output_unit, '(a)') (trim(input_help_lines(i)), i = 1, size(input_help_lines))
