@@ -96,7 +96,8 @@ class RunResult:
         ``'done'`` (the load path's end reached), ``'max_steps'`` (stopped by
         ``&control max_steps``), ``'stopped'`` (stopped by the call-back),
         ``'interrupted'`` (Ctrl-C) or ``'failed'`` (a failed solve; see
-        :class:`~yarnfort.YarnfortError`).
+        :class:`~yarnfort.YarnfortError`); ``'read'`` for a folder read by
+        :func:`~yarnfort.read_run`.
     """
 
     folder: Path

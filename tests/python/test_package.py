@@ -246,7 +246,14 @@ def test_scene_validation_names_the_problem(workdir):
         scene.write(workdir / "x.nml")
     bad = vnet_scene()
     bad.materials[0].stiffness = -1.0
-    with pytest.raises(YarnfortError, match="stiffness") as info:
+    # A value out of range is found in Python, also after construction (and -1 is no
+    # 'not set' marker there).
+    with pytest.raises(yarnfort.SceneError, match=r"stiffness = -1.0 N: must be > 0"):
+        bad.check()
+    # A rule across variables is the library's: a parameter of another law.
+    bad.materials[0].stiffness = 100.0
+    bad.materials[0].modulus = 5.0
+    with pytest.raises(YarnfortError, match="modulus") as info:
         bad.check()
     assert info.value.category == "bad_input"
     vnet_scene().check()
