@@ -709,7 +709,10 @@ def load_drivers(curve: Curve, scene: Any) -> list[Driver]:
     -------
     list of Driver
         Supports with a nonzero displacement, then loads with a nonzero force, in input
-        order; only those whose channel and displacement columns are in the curve.
+        order; only those whose channel and displacement columns are in the curve. Then
+        the support sets of the curve that the input does not list (a generated fabric's)
+        and that move: along their displacement at its largest, on the channel that
+        moves supports (``p_disp`` without ``&path channels``).
     """
     default = {"displacement": "p_disp", "force": "p_force"}
     found = []
@@ -727,6 +730,17 @@ def load_drivers(curve: Curve, scene: Any) -> list[Driver]:
                 continue
             nodes = len(np.atleast_1d(entry.get("nodes", [])))
             found.append(Driver(channel, kind, name, vector / size, size, max(nodes, 1)))
+    listed = {str(entry.get("name", "")) for entry in _groups(scene, "support")}
+    channel = "p_disp" if "p_disp" in curve.channels else None
+    for name in supports(curve):
+        if name in listed or channel is None or f"{name}_ux" not in curve.names:
+            continue
+        moved = curve.displacement(name)
+        lengths = np.linalg.norm(moved, axis=1)
+        if len(lengths) and lengths.max() > 0.0:
+            largest = moved[int(np.argmax(lengths))]
+            found.append(Driver(channel, "displacement", name, largest / lengths.max(),
+                                float(lengths.max()), 1))
     return found
 
 
@@ -783,8 +797,8 @@ def driver_response(curve: Curve, driver: Driver, support: str | None = None
     driver : Driver
         From :func:`load_drivers`.
     support : str, optional
-        Another support set whose force is wanted instead: the force it holds against
-        the driver (its reaction along the driver's direction, negated).
+        Another support set whose force is wanted instead: its reaction on the net along
+        the driver's direction.
 
     Returns
     -------
@@ -796,7 +810,7 @@ def driver_response(curve: Curve, driver: Driver, support: str | None = None
     """
     displacement = curve.displacement(driver.name) @ driver.direction
     if support is not None and support != driver.name:
-        force = -(curve.reaction(support) @ driver.direction)
+        force = curve.reaction(support) @ driver.direction
     elif driver.kind == "displacement":
         force = curve.reaction(driver.name) @ driver.direction
     else:
@@ -843,7 +857,8 @@ def plot_load_displacement(curve: Curve, driver: Driver, ax: Axes | None = None,
 def force_label(driver: Driver, support: str | None = None) -> str:
     """Axis label of :func:`driver_response`'s force, with its sign convention."""
     if support not in (None, driver.name):
-        return f"force held by support '{support}' (N, + = tension)"
+        return (f"reaction of support '{support}' on the net along"
+                f" {_direction_text(driver.direction)} (N)")
     if driver.kind == "displacement":
         return f"pulling force of {driver.label} (N, + = tension)"
     return f"applied force of {driver.label} along {_direction_text(driver.direction)} (N)"

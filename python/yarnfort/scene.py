@@ -60,8 +60,8 @@ from numpy.typing import ArrayLike
 from .namelist import make_namelist, read_scene
 from .resources import input_description
 
-__all__ = ["Scene", "SceneError", "UnknownVariableError", "Material", "Contact", "Yarn", "Support", "Load",
-           "LoadPath", "Fabric", "Geometry", "Obstacle", "Ring"]
+__all__ = ["Scene", "SceneError", "UnknownVariableError", "Material", "Contact", "Yarn",
+           "Support", "Load", "LoadPath", "Fabric", "Geometry", "Obstacle", "Ring"]
 
 _NAME = re.compile(r"^[A-Za-z0-9_.\-]+$")
 _FIX = re.compile(r"^(?!.*(.).*\1)[xyzXYZ]{1,3}$")

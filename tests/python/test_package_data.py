@@ -49,10 +49,9 @@ def test_examples_command_writes_runnable_examples(tmp_path):
     # A scene with tables runs where they were written, by their relative paths.
     program = str(yarnfort.program_path())
     for scene in ("vnet", "knit"):
-        done = subprocess.run([program], stdin=open(tmp_path / "ex" / "inputs" /
-                                                    f"{scene}.nml"),
-                              capture_output=True, text=True, cwd=tmp_path / "ex",
-                              timeout=300)
+        with open(tmp_path / "ex" / "inputs" / f"{scene}.nml") as text:
+            done = subprocess.run([program], stdin=text, capture_output=True, text=True,
+                                  cwd=tmp_path / "ex", timeout=300)
         assert done.returncode == 0, done.stderr
         assert (tmp_path / "ex" / "out" / scene / "curve.csv").is_file()
 

@@ -7,6 +7,7 @@ conversions), not from the plotting code."""
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -29,11 +30,13 @@ MM = 1e3  # millimetres per metre
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory) -> Path:
-    """vnet, capstan_pins and ring_sideways run in one folder (out/<name>)."""
+    """vnet, capstan_pins, ring_sideways and knit run in one folder (out/<name>)."""
     where = tmp_path_factory.mktemp("runs")
-    for name in ("vnet", "capstan_pins", "ring_sideways"):
-        done = subprocess.run([str(yarnfort.program_path())], stdin=open(TOP / "inputs" / f"{name}.nml"),
-                              capture_output=True, text=True, cwd=where, timeout=600)
+    shutil.copytree(TOP / "inputs", where / "inputs")  # the knit's tables
+    for name in ("vnet", "capstan_pins", "ring_sideways", "knit"):
+        with open(TOP / "inputs" / f"{name}.nml") as scene:
+            done = subprocess.run([str(yarnfort.program_path())], stdin=scene,
+                                  capture_output=True, text=True, cwd=where, timeout=600)
         assert done.returncode == 0, done.stderr
     return where / "out"
 
@@ -148,3 +151,22 @@ def test_uniform_tension_has_a_plain_colour_range():
     assert norm.vmax - norm.vmin == pytest.approx(0.1 * value, rel=1e-6)
     spread = tension_norm(np.array([1.0, 3.0]))
     assert (spread.vmin, spread.vmax) == (1.0, 3.0)
+
+
+def test_another_support_and_a_fabric_support(runs):
+    """--support names a support that does not move: its reaction on the net along the
+    driver's direction (-y: minus R_y); a fabric's generated support that moves gives a
+    displacement axis in mm (the default stays force per width against strain)."""
+    curve = read_curve(runs / "capstan_pins")
+    figure = summary_figure(runs / "capstan_pins", support="fixed")
+    loading = [line for line in figure.axes[0].get_lines() if line.get_gid() == "loading"][0]
+    rows = len(loading.get_ydata())
+    np.testing.assert_allclose(loading.get_ydata(), -curve["fixed_ry"][:rows], rtol=1e-12)
+    assert "'fixed'" in figure.axes[0].get_ylabel() and "-y" in figure.axes[0].get_ylabel()
+    knit = read_curve(runs / "knit")
+    assert summary_figure(runs / "knit").axes[0].get_xlabel() == "macroscopic strain (1)"
+    pulled = summary_figure(runs / "knit", support="stretch").axes[0]
+    x, y = branches(pulled)
+    assert "(mm)" in pulled.get_xlabel() and "+x" in pulled.get_xlabel()
+    assert x.max() == pytest.approx(knit["stretch_ux"].max() * MM, rel=1e-12)
+    assert y.max() == pytest.approx(knit["stretch_rx"].max(), rel=1e-12)
