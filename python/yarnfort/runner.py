@@ -260,5 +260,5 @@ def _warn_of_jumps(result: RunResult) -> None:
     if steps:
         warnings.warn(f"{len(steps)} step(s) ended in a jump after a slip instability "
                       f"(steps {', '.join(map(str, steps))}; curve.csv column 'jumped'; "
-                      "inputs/REFERENCE.md, Slip instabilities)", RuntimeWarning,
+                      "python -m yarnfort reference: Slip instabilities)", RuntimeWarning,
                       stacklevel=3)
