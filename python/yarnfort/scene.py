@@ -139,7 +139,7 @@ def _check_value(group: str, var: dict[str, Any], value: Any, where: str) -> Non
             if isinstance(entry, (bool, np.bool_)) or not isinstance(
                     entry, (int, float, np.integer, np.floating)):
                 raise SceneError(f"{where} {name}: expected a number, got {entry!r}")
-            if kind == "integer" and float(entry) != int(entry):
+            if kind == "integer" and not isinstance(entry, (int, np.integer)):
                 raise SceneError(f"{where} {name}: expected an integer, got {entry!r}")
             rule = None if var["checked_by"] else var["range"]
             if not _in_range(float(entry), rule or "finite"):
