@@ -105,9 +105,11 @@ def test_installed_description_is_variables_py():
                     reason="builds a wheel of the whole package (minutes);"
                     " set YARNFORT_TEST_INSTALL=1")
 def test_wheel_carries_reference_examples_and_description(tmp_path):
+    # Without build isolation: the build tools of this environment (meson on its PATH).
+    path = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
     subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps",
                     "--no-build-isolation", "-w", str(tmp_path), str(TOP)], check=True,
-                   timeout=3600)
+                   timeout=3600, env=dict(os.environ, PATH=path))
     wheel = next(tmp_path.glob("yarnfort-*.whl"))
     names = set(zipfile.ZipFile(wheel).namelist())
     wanted = {f"yarnfort/data/{name}" for name in repository_examples()}
