@@ -225,7 +225,9 @@ def main():
         run_opensees(int(args.opensees[0]), args.opensees[1])
         return
     sides = args.sides or (QUICK if args.quick else SIDES)
-    subprocess.run([str(TOP / 'tools' / 'bootstrap')], stdin=subprocess.DEVNULL, check=True)
+    # --tests: the benchmark programs are built with the unit tests.
+    subprocess.run([str(TOP / 'tools' / 'bootstrap'), '--tests'], stdin=subprocess.DEVNULL,
+                   check=True)
     python = ensure_venv()
     print('# yarnfort against the SuiteSparse floor and OpenSeesPy (benchmarks/compare.py)')
     print(time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime()))
