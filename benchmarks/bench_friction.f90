@@ -94,7 +94,6 @@ program bench_friction
     use bench_floor, only: floor_type, measure_floor
     use yarnfort_kinds, only: ik
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
-    use yarnfort_solver_problem, only: nonlinear_problem_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
     use yarnfort_linalg_condensed, only: condensed_solver_type
