@@ -5,14 +5,12 @@ module yarnfort_linalg_factory
     use yarnfort_kinds, only: ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_umfpack, only: umfpack_solver_type
-    use yarnfort_linalg_klu, only: klu_solver_type
-    use yarnfort_linalg_cholmod, only: cholmod_solver_type
-    use yarnfort_linalg_dense, only: dense_solver_type
-    use yarnfort_linalg_fallback, only: fallback_solver_type
-    use yarnfort_linalg_lu_choice, only: lu_choice_solver_type
-    use yarnfort_linalg_threads, only: apply_thread_policy
-    use yarnfort_linalg_heap, only: apply_heap_policy
+    use yarnfort_linalg_backend_umfpack, only: umfpack_solver_type
+    use yarnfort_linalg_backend_klu, only: klu_solver_type
+    use yarnfort_linalg_backend_cholmod, only: cholmod_solver_type
+    use yarnfort_linalg_backend_dense, only: dense_solver_type
+    use yarnfort_linalg_composite_fallback, only: fallback_solver_type
+    use yarnfort_linalg_composite_lu_choice, only: lu_choice_solver_type
     use yarnfort_text, only: to_lower
     implicit none
     private
@@ -25,7 +23,7 @@ module yarnfort_linalg_factory
         "'umfpack', 'klu', 'cholmod', 'cholmod+klu', 'dense'"
 
     !> Name of KLU or UMFPACK chosen per pattern from KLU's predicted cost
-    !> (yarnfort_linalg_lu_choice): the friction stepper's solver of the reduced systems,
+    !> (yarnfort_linalg_composite_lu_choice): the friction stepper's solver of the reduced systems,
     !> not one of the names offered to users (&solver linear_solver).
     character(len=*), parameter :: chosen_lu_name = 'klu|umfpack'
 
@@ -48,8 +46,8 @@ contains
 
     !> Allocate `solver` as the solver called `name` ('umfpack', 'klu', 'cholmod' or
     !> 'dense'; case and surrounding blanks are ignored). Any old solver is destroyed.
-    !> The first call applies the thread policy of yarnfort_linalg_threads and the heap
-    !> policy of yarnfort_linalg_heap.
+    !> The process-wide settings of the libraries are the program's to make
+    !> (yarnfort_linalg_process), not this constructor's.
     subroutine new_linear_solver(solver, name, error, unsymmetric)
         class(linear_solver_type), allocatable, intent(out) :: solver
         character(len=*), intent(in) :: name
@@ -58,8 +56,6 @@ contains
         !> then keeps the sparser of its AMD and COLAMD orderings.
         logical, intent(in), optional :: unsymmetric
 
-        call apply_thread_policy()
-        call apply_heap_policy()
         select case (to_lower(trim(adjustl(name))))
         case ('umfpack')
             allocate(umfpack_solver_type :: solver)

@@ -15,7 +15,7 @@
 !>   knit cell 0.59-0.65x.
 !> The policy is applied once per process, at the first linear solver; OMP_THREAD_LIMIT
 !> and OPENBLAS_NUM_THREADS set by the user take precedence (threads.c).
-module yarnfort_linalg_threads
+module yarnfort_linalg_process_threads
     use, intrinsic :: iso_c_binding, only: c_int, c_long
     implicit none
     private
@@ -60,4 +60,4 @@ contains
         count_serial_regions = int(yarnfort_serial_regions())
     end function count_serial_regions
 
-end module yarnfort_linalg_threads
+end module yarnfort_linalg_process_threads

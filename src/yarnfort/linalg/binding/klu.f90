@@ -2,8 +2,8 @@
 !> bind(C) interfaces to KLU's 64-bit API (`klu_l_*`, SuiteSparse_long = C long) and a
 !> Fortran mirror of `klu_l_common`. The struct is plain data (doubles, longs, two
 !> pointers, two size_t), unchanged from KLU 1.0 through KLU 2.x, so it is mirrored here
-!> instead of going through a C shim. Only yarnfort_linalg_klu uses this module.
-module yarnfort_linalg_klu_binding
+!> instead of going through a C shim. Only yarnfort_linalg_backend_klu uses this module.
+module yarnfort_linalg_binding_klu
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_size_t, c_ptr, c_funptr
     implicit none
     private
@@ -139,4 +139,4 @@ module yarnfort_linalg_klu_binding
     !> Free and nullify the Numeric object.
     procedure(klu_l_free_interface), bind(C, name='klu_l_free_numeric') :: klu_l_free_numeric
 
-end module yarnfort_linalg_klu_binding
+end module yarnfort_linalg_binding_klu

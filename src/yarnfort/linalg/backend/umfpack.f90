@@ -8,13 +8,13 @@
 !> cable-net tangents). The object is kept while the pattern is unchanged (later
 !> factorisations are numeric only) and iterative refinement is off (design.md
 !> section 5: it makes solves 3-4x slower; Newton corrects).
-module yarnfort_linalg_umfpack
+module yarnfort_linalg_backend_umfpack
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr, c_null_ptr, c_associated
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_direct, only: direct_solver_type, describe_status
-    use yarnfort_linalg_csc_pattern, only: format_integer
-    use yarnfort_linalg_umfpack_binding, only: umfpack_control, umfpack_info, umfpack_prl, &
+    use yarnfort_linalg_backend_direct, only: direct_solver_type, describe_status
+    use yarnfort_text, only: format_integer
+    use yarnfort_linalg_binding_umfpack, only: umfpack_control, umfpack_info, umfpack_prl, &
         umfpack_irstep, umfpack_rcond, umfpack_a, umfpack_ok, &
         umfpack_warning_singular_matrix, umfpack_error_out_of_memory, &
         umfpack_error_invalid_numeric_object, umfpack_error_invalid_symbolic_object, &
@@ -262,4 +262,4 @@ contains
             'ordering failed (UMFPACK_ERROR_ordering_failed)'], 'UMFPACK')
     end function status_message
 
-end module yarnfort_linalg_umfpack
+end module yarnfort_linalg_backend_umfpack

@@ -6,14 +6,14 @@
 !> them with the BLAS, dearer per nonzero but faster per flop. So the flops per factor
 !> nonzero decide: few on chain-like patterns (the woven nets' reduced friction systems),
 !> many where the factors fill in two dimensions (the knit's, or any net at 1e6 unknowns).
-module yarnfort_linalg_lu_choice
+module yarnfort_linalg_composite_lu_choice
     use, intrinsic :: iso_c_binding, only: c_long, c_double
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_klu, only: klu_solver_type
-    use yarnfort_linalg_umfpack, only: umfpack_solver_type
-    use yarnfort_linalg_cholmod_binding, only: yarnfort_cholmod_metis_order, cholmod_ok
+    use yarnfort_linalg_backend_klu, only: klu_solver_type
+    use yarnfort_linalg_backend_umfpack, only: umfpack_solver_type
+    use yarnfort_linalg_binding_cholmod, only: yarnfort_cholmod_metis_order, cholmod_ok
     implicit none
     private
 
@@ -187,4 +187,4 @@ contains
         end if
     end function get_name
 
-end module yarnfort_linalg_lu_choice
+end module yarnfort_linalg_composite_lu_choice

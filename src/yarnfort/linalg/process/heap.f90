@@ -11,7 +11,7 @@
 !> memory returned to the system before the process ends, so the resident size stays at
 !> its peak. Applied once per process, at the first linear solver; a user's own malloc
 !> tuning (GLIBC_TUNABLES, MALLOC_*_) takes precedence.
-module yarnfort_linalg_heap
+module yarnfort_linalg_process_heap
     use, intrinsic :: iso_c_binding, only: c_int
     implicit none
     private
@@ -38,4 +38,4 @@ contains
         if (present(applied)) applied = status == 1_c_int
     end subroutine apply_heap_policy
 
-end module yarnfort_linalg_heap
+end module yarnfort_linalg_process_heap

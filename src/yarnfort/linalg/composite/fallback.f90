@@ -2,11 +2,11 @@
 !> A linear solver that tries a fast specialised solver first (CHOLMOD: symmetric
 !> positive definite only) and switches for good to a general one (KLU) the first time
 !> the specialised factorisation fails (e.g. "not positive definite").
-module yarnfort_linalg_fallback
+module yarnfort_linalg_composite_fallback
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_direct, only: direct_solver_type
+    use yarnfort_linalg_backend_direct, only: direct_solver_type
     implicit none
     private
 
@@ -79,4 +79,4 @@ contains
         end if
     end function get_name
 
-end module yarnfort_linalg_fallback
+end module yarnfort_linalg_composite_fallback

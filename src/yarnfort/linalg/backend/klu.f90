@@ -5,14 +5,14 @@
 !> full pivoting factorisation when that hits a zero pivot or the cheap reciprocal
 !> condition estimate drops below `refactor_rcond_min` (the rule of SUNDIALS'
 !> SUNLinSol_KLU).
-module yarnfort_linalg_klu
+module yarnfort_linalg_backend_klu
     use, intrinsic :: iso_c_binding, only: c_long, c_ptr, c_null_ptr, c_null_funptr, &
         c_associated, c_f_pointer
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_direct, only: direct_solver_type, describe_status
-    use yarnfort_linalg_csc_pattern, only: format_integer
-    use yarnfort_linalg_klu_binding, only: klu_l_common, klu_ok, klu_singular, &
+    use yarnfort_linalg_backend_direct, only: direct_solver_type, describe_status
+    use yarnfort_text, only: format_integer
+    use yarnfort_linalg_binding_klu, only: klu_l_common, klu_ok, klu_singular, &
         klu_out_of_memory, klu_invalid, klu_too_large, klu_l_defaults, klu_l_analyze, &
         klu_l_analyze_given, klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_rcond, &
         klu_l_free_symbolic, klu_l_numeric_sizes, klu_l_symbolic, klu_l_free_numeric
@@ -57,7 +57,7 @@ module yarnfort_linalg_klu
         procedure :: release
         procedure :: get_name
         !> AMD's prediction of the factorisation's cost and its ordering
-        !> (yarnfort_linalg_lu_choice).
+        !> (yarnfort_linalg_composite_lu_choice).
         procedure :: get_prediction
         procedure :: get_symmetric_order
         final :: finalize
@@ -253,4 +253,4 @@ contains
             'integer overflow (KLU_TOO_LARGE)'], 'KLU')
     end function status_message
 
-end module yarnfort_linalg_klu
+end module yarnfort_linalg_backend_klu

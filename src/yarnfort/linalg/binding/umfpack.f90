@@ -1,8 +1,8 @@
 ! SPDX-License-Identifier: MIT
 !> bind(C) interfaces to the 64-bit UMFPACK API (`umfpack_dl_*`, SuiteSparse_long = C long)
 !> and the array indices and status codes of umfpack.h (SuiteSparse 5.x). Only
-!> yarnfort_linalg_umfpack uses this module.
-module yarnfort_linalg_umfpack_binding
+!> yarnfort_linalg_backend_umfpack uses this module.
+module yarnfort_linalg_binding_umfpack
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr
     implicit none
     private
@@ -156,4 +156,4 @@ module yarnfort_linalg_umfpack_binding
         end subroutine umfpack_dl_free_numeric
     end interface
 
-end module yarnfort_linalg_umfpack_binding
+end module yarnfort_linalg_binding_umfpack

@@ -3,7 +3,7 @@
 !> last few unknowns) is not: [K B; C D], K of order n_leading. With few border unknowns
 !> it factors K alone (by `leading`, e.g. CHOLMOD) and the border through the dense Schur
 !> complement S = D - C K^-1 B; with more it factors the whole matrix (by `general`).
-!> Why: the friction Jacobian with its stick flows eliminated (yarnfort_linalg_condensed)
+!> Why: the friction Jacobian with its stick flows eliminated (yarnfort_linalg_composite_condensed)
 !> is the elastic tangent bordered by the slipping flows, often a handful (4 in the first
 !> load step of the woven net of 1e6 unknowns), and CHOLMOD factors the elastic tangent
 !> 2-3x faster than an LU factors the bordered matrix (benchmarks/results-scale.md). The
@@ -12,12 +12,12 @@
 !> applies its dense blocks to all of them at once: 1.4-3.7x cheaper per column than m
 !> single solves). A K that fails to factor sends the next patterns to `general` without
 !> trying K (1, 2, 4, ... patterns while it keeps failing).
-module yarnfort_linalg_bordered
+module yarnfort_linalg_composite_bordered
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_direct, only: direct_solver_type, get_subpattern
-    use yarnfort_linalg_dense, only: dense_solver_type
+    use yarnfort_linalg_backend_direct, only: direct_solver_type, get_subpattern
+    use yarnfort_linalg_backend_dense, only: dense_solver_type
     implicit none
     private
 
@@ -287,4 +287,4 @@ contains
         end if
     end function get_name
 
-end module yarnfort_linalg_bordered
+end module yarnfort_linalg_composite_bordered

@@ -2,11 +2,11 @@
 !> Dense LU with partial pivoting (LAPACK dgetrf/dgetrs) on a dense copy of the CSC
 !> matrix: a reference for tests and a solver for tiny systems (memory and time grow as
 !> n**2 and n**3).
-module yarnfort_linalg_dense
+module yarnfort_linalg_backend_dense
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_direct, only: direct_solver_type
-    use yarnfort_linalg_csc_pattern, only: format_integer
+    use yarnfort_linalg_backend_direct, only: direct_solver_type
+    use yarnfort_text, only: format_integer
     implicit none
     private
 
@@ -122,4 +122,4 @@ contains
         name = 'dense'
     end function get_name
 
-end module yarnfort_linalg_dense
+end module yarnfort_linalg_backend_dense

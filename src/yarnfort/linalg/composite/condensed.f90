@@ -21,11 +21,11 @@
 !> refactorisation 31 ms; new analyses per 60-step cycle 50 -> 15 aligned, 131 -> 52
 !> skewed, CPU per step -15 % and -17 %, at 963,600 unknowns -26 %; the answers the
 !> same to 3e-15 of the peak force: benchmarks/results-issue16-run7.md).
-module yarnfort_linalg_condensed
+module yarnfort_linalg_composite_condensed
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_direct, only: direct_solver_type, get_subpattern
+    use yarnfort_linalg_backend_direct, only: direct_solver_type, get_subpattern
     implicit none
     private
 
@@ -310,4 +310,4 @@ contains
         end if
     end function get_name
 
-end module yarnfort_linalg_condensed
+end module yarnfort_linalg_composite_condensed

@@ -1,9 +1,9 @@
 ! SPDX-License-Identifier: MIT
 !> bind(C) interfaces to cholmod_shim.c (an opaque handle around CHOLMOD's 64-bit
 !> `cholmod_l_*` API, see the comment there for why a shim is used) and the CHOLMOD
-!> status codes of cholmod_core.h. Only yarnfort_linalg_cholmod uses this module, and
-!> yarnfort_linalg_lu_choice its METIS order.
-module yarnfort_linalg_cholmod_binding
+!> status codes of cholmod_core.h. Only yarnfort_linalg_backend_cholmod uses this module, and
+!> yarnfort_linalg_composite_lu_choice its METIS order.
+module yarnfort_linalg_binding_cholmod
     use, intrinsic :: iso_c_binding, only: c_int, c_long, c_double, c_ptr
     implicit none
     private
@@ -83,4 +83,4 @@ module yarnfort_linalg_cholmod_binding
         end function yarnfort_cholmod_metis_order
     end interface
 
-end module yarnfort_linalg_cholmod_binding
+end module yarnfort_linalg_binding_cholmod

@@ -2,14 +2,14 @@
 !> Checks shared by the linear solvers: a square CSC pattern with 0-based 64-bit indices,
 !> sorted strictly increasing row indices in each column (UMFPACK requires this), and
 !> value and right-hand-side arrays of the right size.
-module yarnfort_linalg_csc_pattern
+module yarnfort_linalg_backend_csc_pattern
     use yarnfort_kinds, only: ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_text, only: format_integer
     implicit none
     private
 
-    public :: check_csc_pattern, check_array_size, format_integer
+    public :: check_csc_pattern, check_array_size
 
 contains
 
@@ -95,4 +95,4 @@ contains
         end if
     end subroutine check_array_size
 
-end module yarnfort_linalg_csc_pattern
+end module yarnfort_linalg_backend_csc_pattern

@@ -4,14 +4,14 @@
 !> full symmetric pattern; only the upper triangle (row <= column) is read (stype = 1),
 !> entries below the diagonal are ignored. A matrix that is not positive definite gives
 !> an error value saying so, and the caller may fall back to UMFPACK.
-module yarnfort_linalg_cholmod
+module yarnfort_linalg_backend_cholmod
     use, intrinsic :: iso_c_binding, only: c_int, c_long, c_double, c_ptr, c_null_ptr, &
         c_associated
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_linalg_direct, only: direct_solver_type, describe_status
-    use yarnfort_linalg_csc_pattern, only: format_integer
-    use yarnfort_linalg_cholmod_binding, only: cholmod_ok, cholmod_not_posdef, &
+    use yarnfort_linalg_backend_direct, only: direct_solver_type, describe_status
+    use yarnfort_text, only: format_integer
+    use yarnfort_linalg_binding_cholmod, only: cholmod_ok, cholmod_not_posdef, &
         cholmod_dsmall, cholmod_not_installed, cholmod_out_of_memory, cholmod_too_large, &
         cholmod_invalid, cholmod_gpu_problem, cholmod_no_handle, yarnfort_cholmod_create, &
         yarnfort_cholmod_free, yarnfort_cholmod_analyze, yarnfort_cholmod_factorize, &
@@ -136,4 +136,4 @@ contains
             'no CHOLMOD handle'], 'CHOLMOD')
     end function status_message
 
-end module yarnfort_linalg_cholmod
+end module yarnfort_linalg_backend_cholmod

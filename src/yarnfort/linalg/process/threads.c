@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * The thread policy for the libraries under the linear solvers, applied once per process
- * (see yarnfort_linalg_threads for the measurements that chose it):
+ * (see yarnfort_linalg_process_threads for the measurements that chose it):
  * - OpenMP regions inside the libraries (Debian's CHOLMOD asks for a fixed 4 threads in
  *   its supernodal factorisation, a num_threads clause that OMP_NUM_THREADS does not
  *   override) run on one thread: max-active-levels is set to 0, unless the user set

@@ -7,12 +7,13 @@
 !> `solve_rhs_columns`, which hold only the library calls; `destroy` calls the solver's
 !> `release` and drops the pattern and the state. Also the messages of a failed library
 !> call and of a status code.
-module yarnfort_linalg_direct
+module yarnfort_linalg_backend_direct
     use, intrinsic :: iso_c_binding, only: c_long
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_csc_pattern, only: check_csc_pattern, check_array_size, format_integer
+    use yarnfort_linalg_backend_csc_pattern, only: check_csc_pattern, check_array_size
+    use yarnfort_text, only: format_integer
     implicit none
     private
 
@@ -192,4 +193,4 @@ contains
         end if
     end function describe_status
 
-end module yarnfort_linalg_direct
+end module yarnfort_linalg_backend_direct

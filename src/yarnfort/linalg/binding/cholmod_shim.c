@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Minimal C shim between yarnfort_linalg_cholmod and CHOLMOD's 64-bit API (cholmod_l_*).
+ * Minimal C shim between yarnfort_linalg_backend_cholmod and CHOLMOD's 64-bit API (cholmod_l_*).
  *
  * Why it exists: cholmod_common is a ~2.7 kB struct whose layout changes between
  * CHOLMOD versions (and with build options such as GPU support), and cholmod_sparse,
