@@ -1,9 +1,11 @@
 ! SPDX-License-Identifier: MIT
 !> Sparse Cholesky (LL') with CHOLMOD's 64-bit API, for symmetric positive definite
-!> matrices: fastest for large SPD systems (design.md section 5). The caller passes the
+!> matrices, the fastest measured on them (docs/decisions.md, 'Linear solver: CHOLMOD,
+!> falling back to KLU, ...'). The caller passes the
 !> full symmetric pattern; only the upper triangle (row <= column) is read (stype = 1),
 !> entries below the diagonal are ignored. A matrix that is not positive definite gives
-!> an error value saying so, and the caller may fall back to UMFPACK.
+!> an error value saying so, and the caller may fall back to a general solver
+!> (yarnfort_linalg_composite_fallback).
 module yarnfort_linalg_backend_cholmod
     use, intrinsic :: iso_c_binding, only: c_int, c_long, c_double, c_ptr, c_null_ptr, &
         c_associated
@@ -22,12 +24,9 @@ module yarnfort_linalg_backend_cholmod
     public :: cholmod_solver_type, supernodal_switch
 
     !> Supernodal factor (dense blocks, BLAS) where the analysis predicts at least this
-    !> many flops per nonzero of L, else simplicial (CHOLMOD's default: 40). Measured
-    !> (benchmarks/results-blas-threads.md; CPU, supernodal over simplicial): cable nets
-    !> of bench_newton 0.91 / 0.77 / 0.62 / 0.37 at 22 / 29 / 37 / 45 flops per nonzero
-    !> (factorisation); woven nets 1.31 / 1.26 / 1.07 at 7 / 12 / 23 and about 1 at 34
-    !> (96,600 unknowns; whole elastic iteration). The switch was worth 40 while every
-    !> supernode paid libgomp's team of one (threads.c).
+    !> many flops per nonzero of L, else simplicial (CHOLMOD's default: 40): below it the
+    !> dense blocks are too small to pay (docs/decisions.md, 'CHOLMOD: supernodal from 25
+    !> flops per nonzero of L').
     real(wp), parameter :: supernodal_switch = 25.0_wp
 
     !> CHOLMOD solver. Owns a C handle: never copy an analysed object by assignment.

@@ -1,6 +1,7 @@
 ! SPDX-License-Identifier: MIT
 !> Sparse LU with KLU's 64-bit interface (`klu_l_*`): BTF + AMD ordering, fastest for
-!> small systems such as unit cells (design.md section 5). After the first factorisation
+!> small systems such as unit cells (docs/decisions.md, 'Linear solver: KLU up to 5,000
+!> unknowns, UMFPACK above'). After the first factorisation
 !> `factor` refactors with the old pivot order (`klu_l_refactor`) and falls back to a
 !> full pivoting factorisation when that hits a zero pivot or the cheap reciprocal
 !> condition estimate drops below `refactor_rcond_min` (the rule of SUNDIALS'
@@ -35,10 +36,8 @@ module yarnfort_linalg_backend_klu
         real(wp), public :: refactor_rcond_min = default_refactor_rcond_min
         !> Fill-reducing ordering: AMD on A + A^T (KLU's default), or, for unsymmetric
         !> patterns, the sparser of AMD and COLAMD, chosen by factoring the first matrix
-        !> both ways. Neither wins everywhere on the friction Jacobian (whole runs, AMD /
-        !> COLAMD / this choice): 32 x 16 twill strip 44 / 5.9 / 10.5 s; 8 x 8 knit cell
-        !> 4.6 / 10.4 / 2.5 s; bench_friction woven nets 68 / 22 / 29 and 1480 / 374 /
-        !> 623 ms per load step. The choice is never the worst and at most 1.8x the best.
+        !> both ways: neither wins everywhere on the friction Jacobian (docs/decisions.md,
+        !> 'KLU ordering of the friction Jacobian: the sparser of AMD and COLAMD').
         logical, public :: unsymmetric_ordering = .false.
         !> A symmetric column order (0-based: column given_order(k) is the k-th) to use
         !> instead of AMD's (klu_l_analyze_given, the rows in the same order; BTF still
@@ -190,7 +189,8 @@ contains
 
     !> Flops of a factorisation and nonzeros of L + U that the AMD ordering of the last
     !> analysis predicts without pivoting (KLU's factors of the friction Jacobians never
-    !> pivot off the diagonal: benchmarks/results-friction-factor.md); 0 before analyse.
+    !> pivot off the diagonal: docs/decisions.md, 'Not kept: KLU pivoting threshold, row
+    !> scaling, no BTF'); 0 before analyse.
     subroutine get_prediction(self, flops, factor_nonzeros)
         class(klu_solver_type), intent(in) :: self
         real(wp), intent(out) :: flops, factor_nonzeros

@@ -4,10 +4,10 @@
 !> factorisation after analyse, with the values: UMFPACK then sees which diagonal entries
 !> are nonzero and can choose its symmetric strategy (AMD on A + A^T, diagonal pivots
 !> preferred) where it fits; given the pattern alone it assumes a zero-free diagonal is
-!> unlikely and takes the unsymmetric one (measured 1.6-1.7x per iteration on the
-!> cable-net tangents). The object is kept while the pattern is unchanged (later
-!> factorisations are numeric only) and iterative refinement is off (design.md
-!> section 5: it makes solves 3-4x slower; Newton corrects).
+!> unlikely and takes the unsymmetric one, which is slower on the tangents. The object is
+!> kept while the pattern is unchanged (later factorisations are numeric only) and
+!> iterative refinement is off, Newton corrects (docs/decisions.md, 'UMFPACK analysed
+!> with the values; no iterative refinement').
 module yarnfort_linalg_backend_umfpack
     use, intrinsic :: iso_c_binding, only: c_long, c_double, c_ptr, c_null_ptr, c_associated
     use yarnfort_kinds, only: wp, ik
@@ -32,7 +32,9 @@ module yarnfort_linalg_backend_umfpack
 
     public :: umfpack_solver_type, umfpack_refinement_steps, umfpack_memory_type
 
-    !> Iterative refinement steps per solve (Control(UMFPACK_IRSTEP)); see design.md sec. 5.
+    !> Iterative refinement steps per solve (Control(UMFPACK_IRSTEP)): none, Newton
+    !> corrects (docs/decisions.md, 'UMFPACK analysed with the values; no iterative
+    !> refinement').
     integer, parameter :: umfpack_refinement_steps = 0
     !> UMFPACK print level (Control(UMFPACK_PRL)): library code never prints.
     integer, parameter :: umfpack_print_level = 0

@@ -21,11 +21,10 @@
  * one triangle its factorisation reads without copying (the upper for a simplicial
  * factor, the lower for a supernodal one), and factorised in the natural order. Given
  * the caller's matrix and its ordering, cholmod_l_factorize would instead build the
- * permuted triangle by one or two transposes per factorisation: on the woven nets'
- * simplicial factors (7-23 flops per nonzero of L) those cost as much as the
- * factorisation itself (perf, 10,120 unknowns). Here each factorisation gathers the
- * values through a map made once per pattern, and each solve permutes its right-hand
- * sides (O(n)). */
+ * permuted triangle by one or two transposes per factorisation, which cost as much as a
+ * simplicial factorisation itself (docs/decisions.md, 'CHOLMOD factorises the
+ * pre-permuted triangle'). Here each factorisation gathers the values through a map made
+ * once per pattern, and each solve permutes its right-hand sides (O(n)). */
 typedef struct {
     cholmod_common common;
     cholmod_factor *factor;    /* of the permuted matrix, natural order */

@@ -4,14 +4,14 @@
 !> it factors K alone (by `leading`, e.g. CHOLMOD) and the border through the dense Schur
 !> complement S = D - C K^-1 B; with more it factors the whole matrix (by `general`).
 !> Why: the friction Jacobian with its stick flows eliminated (yarnfort_linalg_composite_condensed)
-!> is the elastic tangent bordered by the slipping flows, often a handful (4 in the first
-!> load step of the woven net of 1e6 unknowns), and CHOLMOD factors the elastic tangent
-!> 2-3x faster than an LU factors the bordered matrix (benchmarks/results-scale.md). The
+!> is the elastic tangent bordered by the slipping flows, often a handful, and CHOLMOD
+!> factors the elastic tangent faster than an LU factors the bordered matrix
+!> (docs/decisions.md, 'Bordered solver: up to 16 border unknowns'). The
 !> pattern of K does not change with the active set: its analysis is kept for the next
 !> pattern while that block stays the same. K^-1 B is one solve of m columns (CHOLMOD
-!> applies its dense blocks to all of them at once: 1.4-3.7x cheaper per column than m
-!> single solves). A K that fails to factor sends the next patterns to `general` without
-!> trying K (1, 2, 4, ... patterns while it keeps failing).
+!> applies its dense blocks to all of them at once). A K that fails to factor sends the
+!> next patterns to `general` without trying K (1, 2, 4, ... patterns while it keeps
+!> failing).
 module yarnfort_linalg_composite_bordered
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -24,12 +24,9 @@ module yarnfort_linalg_composite_bordered
     public :: bordered_solver_type, default_max_border
 
     !> Most border unknowns handled through the Schur complement: each costs a column of
-    !> the solve with K's factors per factorisation and n_leading reals of memory. Set
-    !> from where the border stops paying (benchmarks/steps_results.md, h16t): (LU of the
-    !> whole + its analysis per pattern - CHOLMOD of K) / solve per column, CPU ms at the
-    !> final state: woven 2,200 unknowns ~5 (0.27 + 0.12 - 0.31 over 0.023), 10,120
-    !> aligned ~44 (5.65 + 1.1 - 2.28 over 0.10), skewed ~14 (4.52 + 1.0 - 3.62 over
-    !> 0.14), 96,600 ~22 (84.7 + 8 - 42.0 over 2.27), knit 40 x 40 ~100 (UMFPACK).
+    !> the solve with K's factors per factorisation and n_leading reals of memory; set
+    !> from where the border stops paying (docs/decisions.md, 'Bordered solver: up to 16
+    !> border unknowns').
     integer(ik), parameter :: default_max_border = 16
     !> Most patterns sent to `general` after K failed to factor, before K is tried again.
     integer, parameter :: max_skip_patterns = 16

@@ -6,9 +6,9 @@
 !> reduced system is analysed again whenever the set of eliminated unknowns changes
 !> (between the stick/slip active-set rounds of a step) and refactored otherwise.
 !> Why: a sticking flow's column couples every coordinate of the two segments it
-!> bounds, which is what makes the friction Jacobian's factors dense (benchmarks/
-!> results-friction-factor.md); with the stick flows gone the reduced system is the
-!> elastic tangent plus the slipping flows.
+!> bounds, which is what makes the friction Jacobian's factors dense; with the stick
+!> flows gone the reduced system is the elastic tangent plus the slipping flows
+!> (docs/decisions.md, 'Stick flows eliminated before factorising (condensed solver)').
 !> With more than `superset_above` kept candidates (the inner solver then factors the
 !> whole reduced matrix, not a border) the reduction keeps a superset: the candidates
 !> that must stay and their neighbours in the pattern up to `superset_reach` steps (the
@@ -16,11 +16,8 @@
 !> solved with that reduction while they fit in it; the trivial rows kept are at most
 !> `superset_fraction` of the coordinates. A kept trivial row is only not eliminated
 !> (the solve stays exact); what it saves is the inner solver's analysis and full
-!> factorisation, which a new pattern costs and a refactorisation does not (woven net
-!> of 96,600 unknowns: KLU analysis 18 ms + full factorisation 68 ms against a
-!> refactorisation 31 ms; new analyses per 60-step cycle 50 -> 15 aligned, 131 -> 52
-!> skewed, CPU per step -15 % and -17 %, at 963,600 unknowns -26 %; the answers the
-!> same to 3e-15 of the peak force: benchmarks/results-issue16-run7.md).
+!> factorisation, which a new pattern costs and a refactorisation does not
+!> (docs/decisions.md, 'Condensed solver: superset reduction (16 / 4 / 2 %)').
 module yarnfort_linalg_composite_condensed
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -66,15 +63,13 @@ module yarnfort_linalg_composite_condensed
         integer(ik) :: superset_above = 16
         !> How far the superset reaches: candidates within this many steps of a
         !> non-trivial row in the pattern (along a yarn, the flows of the passages next
-        !> to a slipping one). Skewed woven cycle of 96,600 unknowns, without the bound
-        !> superset_fraction: new analyses per cycle 131 before, 76 / 65 / 57 / 53 / 43
-        !> for reach 1 / 2 / 3 / 4 / 6, CPU per step 419 -> 389 / 364 / 355 / 355 / 341 ms
-        !> (benchmarks/results-issue16-run7.md).
+        !> to a slipping one); fewer new analyses per cycle as it grows, little gained
+        !> beyond 4 (docs/decisions.md, 'Condensed solver: superset reduction').
         integer :: superset_reach = 4
         !> Most trivial rows kept, as a fraction of the unknowns before first_candidate
         !> (the coordinates): a kept stick flow costs the factors what a slipping one
-        !> does, so a net where much slips (the clamped 100 x 100 knit, 39,600 of 79,600
-        !> passages) gets the exact set (without this bound: 122.7 -> 160.5 s CPU).
+        !> does, so a net where much slips gets the exact set (docs/decisions.md,
+        !> 'Condensed solver: superset reduction').
         real(wp) :: superset_fraction = 0.02_wp
         !> Column of each of candidate_entry (its row is candidate_row): the neighbours.
         integer(ik), allocatable :: candidate_column(:)

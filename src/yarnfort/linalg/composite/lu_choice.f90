@@ -20,26 +20,19 @@ module yarnfort_linalg_composite_lu_choice
     public :: lu_choice_solver_type, prefers_umfpack, umfpack_min_flops_per_nonzero
     public :: metis_min_flops_per_nonzero
 
-    !> UMFPACK is chosen when KLU's predicted flops per nonzero of L + U reach this.
-    !> Measured on the reduced friction systems (benchmarks/results-lu-choice.md, CPU
-    !> time of UMFPACK's numeric factorisation over KLU's refactorisation, same matrix):
-    !> 3-5 at 10-31 flops per nonzero (woven nets, 1e4-1e5 unknowns), 1.30 at 62 (knit,
-    !> 20 x 20 loops), 0.76 at 92 (30 x 30), 0.63 at 120 (40 x 40), 0.48 at 170
-    !> (60 x 60); at 127 (woven, 1e6) 1.27 and 0.94 in two runs, and a whole first load
-    !> step took 60 s with UMFPACK against 106 s with KLU. Whole knit runs crossed near
-    !> 80-90 before; 100 left the 30 x 30 knit on KLU.
+    !> UMFPACK is chosen when KLU's predicted flops per nonzero of L + U reach this: many
+    !> flops per nonzero is where UMFPACK's BLAS-based fronts beat KLU's sparse column
+    !> updates (docs/decisions.md, 'Reduced friction systems: UMFPACK from 80 predicted
+    !> flops per factor nonzero').
     real(wp), parameter :: umfpack_min_flops_per_nonzero = 80.0_wp
     !> UMFPACK's automatic strategy takes the symmetric one at this symmetry of the
     !> pattern (matched entries over off-diagonal entries) and a nonzero diagonal.
     real(wp), parameter :: umfpack_min_symmetry = 0.5_wp
     !> From this many predicted flops per factor nonzero (AMD's order) up to UMFPACK's
     !> threshold, METIS' nested dissection of A + A^T is tried too, and KLU takes its
-    !> order when it predicts fewer factor nonzeros than AMD's (the reduced friction
-    !> systems at the final state of a cycle, bare KLU refactor + solve, CPU ms, AMD /
-    !> METIS: knit 8 x 8 cell, 73 flops per nonzero, L + U 9.16e4 / 7.88e4, 3.5 / 2.3 ms).
-    !> Below it METIS filled more: knit 4 x 4 (35) 1.45e4 / 1.51e4; woven 10,120 skewed
-    !> (15.5) 7.65e4 / 8.57e4. Not for UMFPACK: the woven cycle of 963,600 unknowns
-    !> factored 1.4x slower with METIS' order (benchmarks/steps_results.md section 22).
+    !> order when it predicts fewer factor nonzeros than AMD's; below it METIS filled
+    !> more; not for UMFPACK, which factored slower on it (docs/decisions.md, 'KLU on
+    !> METIS' order from 50 predicted flops per nonzero').
     real(wp), parameter :: metis_min_flops_per_nonzero = 50.0_wp
 
     !> KLU or UMFPACK (owned), chosen again at each `analyse`; the chosen solver checks

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The heap policy, applied once per process (yarnfort_linalg_process_heap has the measurements
- * that chose it): glibc's malloc serves every request from its heap (M_MMAP_MAX = 0)
+ * The heap policy, applied once per process (docs/decisions.md, 'Process settings:
+ * malloc keeps its heap'): glibc's malloc serves every request from its heap (M_MMAP_MAX = 0)
  * and never returns freed memory at the top of the heap to the system
  * (M_TRIM_THRESHOLD = -1, "disables trimming completely", mallopt(3)). Without it each
  * block above glibc's largest dynamic mmap threshold (32 MiB), such as the working

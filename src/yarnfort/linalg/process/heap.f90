@@ -1,16 +1,11 @@
 ! SPDX-License-Identifier: MIT
-!> How the process's heap serves the factorisations' large blocks, chosen by
-!> measurement (benchmarks/results-issue16-run9.md; woven load cycle of 963,600 unknowns,
-!> `steps_trace --woven 219`, 60 steps, idle machine): with glibc's defaults every
-!> UMFPACK numeric factorisation maps its working memory afresh and the kernel
-!> zero-fills it page by page, 35.6 million page faults and 98 s of system time against
-!> 260 s user; served from a heap that keeps what is freed, 0.85 million faults, 7.6 s
-!> system, the same user time, 5,848 -> 4,344 CPU ms per load step (peak RSS 2.98 ->
-!> 3.40 GB). At 96,600 unknowns (KLU, blocks under 32 MiB) 0.43 -> 0.24 s system.
-!> The policy (heap.c): no memory mapped by malloc while the heap can grow, and no freed
-!> memory returned to the system before the process ends, so the resident size stays at
-!> its peak. Applied once per process, at the first linear solver; a user's own malloc
-!> tuning (GLIBC_TUNABLES, MALLOC_*_) takes precedence.
+!> How the process's heap serves the factorisations' large blocks (heap.c): no memory
+!> mapped by malloc while the heap can grow, and no freed memory returned to the system
+!> before the process ends, so that UMFPACK's working memory is not zero-filled by the
+!> kernel page by page at every factorisation; the resident size stays at its peak
+!> (docs/decisions.md, 'Process settings: malloc keeps its heap'). Applied once per
+!> process by the program and the Python entry point (yarnfort_linalg_process); a user's
+!> own malloc tuning (GLIBC_TUNABLES, MALLOC_*_) takes precedence.
 module yarnfort_linalg_process_heap
     use, intrinsic :: iso_c_binding, only: c_int
     implicit none

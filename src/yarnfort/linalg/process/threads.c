@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * The thread policy for the libraries under the linear solvers, applied once per process
- * (see yarnfort_linalg_process_threads for the measurements that chose it):
+ * (docs/decisions.md, 'Process settings: ...'):
  * - OpenMP regions inside the libraries (Debian's CHOLMOD asks for a fixed 4 threads in
  *   its supernodal factorisation, a num_threads clause that OMP_NUM_THREADS does not
  *   override) run on one thread: max-active-levels is set to 0, unless the user set
@@ -14,11 +14,10 @@
  *
  * OpenBLAS (pthreads build) starts its worker threads when it is loaded, one per core
  * but the caller's, and each spins (sched_yield) for 2^28 TSC cycles, about 0.1 s, before
- * it sleeps; openblas_set_num_threads starts them again if they were stopped. On this
- * 2-core machine that burnt a second core at the start of every process (0.04-0.1 s CPU,
- * whatever the number of threads). Unless the user set OPENBLAS_NUM_THREADS, the workers
- * are stopped when this library is loaded (a constructor: it runs after those of the
- * libraries it depends on) and again right after the policy sets one thread, with
+ * it sleeps; openblas_set_num_threads starts them again if they were stopped: a second
+ * core burnt at the start of every process, whatever the number of threads. Unless the
+ * user set OPENBLAS_NUM_THREADS, the workers are stopped when this library is loaded (a
+ * constructor: it runs after those of the libraries it depends on) and again right after the policy sets one thread, with
  * OpenBLAS's own blas_thread_shutdown_ (the call its fork handler makes). OpenBLAS starts
  * them again at its first multithreaded call, which with one thread never comes.
  */
@@ -88,14 +87,11 @@ int yarnfort_apply_thread_policy(int library_openmp, int blas_threads)
  * that holds this library) before libgomp. Debian's CHOLMOD (the only user: it imports
  * GOMP_parallel, omp_get_num_threads and omp_get_thread_num and nothing else) enters a
  * region two or three times per supernode, `if` clause or not, and libgomp makes a team
- * of one for each, ending with a futex wake: 49,000 system calls in one run of the
- * 8 x 8 knit cell of benchmarks/steps_table.py. With the regions limited (the policy
- * above) the body runs here on the calling thread, where omp_get_num_threads() is 1 and
- * omp_get_thread_num() 0, as in a team of one: the same work, in the same order.
- * Measured (benchmarks/results-blas-threads.md, CPU): CHOLMOD's factorisation 0.76x /
- * 0.81x on the cable nets of 1e4 / 1e5 unknowns on an idle machine (0.56x / 0.63x with
- * the cores busy), an elastic Newton iteration of the 8 x 8 knit cell 0.59-0.65x; the
- * woven nets' factors, with few rows per supernode, as before.
+ * of one for each, ending with a futex wake (a system call per region). With the regions
+ * limited (the policy above) the body runs here on the calling thread, where
+ * omp_get_num_threads() is 1 and omp_get_thread_num() 0, as in a team of one: the same
+ * work, in the same order (docs/decisions.md, 'Process settings: limited OpenMP regions
+ * run on the calling thread').
  * Otherwise (the user's OMP_THREAD_LIMIT, or before the policy) libgomp's own runs.
  */
 void GOMP_parallel(region_body body, void *data, unsigned num_threads, unsigned flags)

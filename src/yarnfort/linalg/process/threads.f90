@@ -1,20 +1,10 @@
 ! SPDX-License-Identifier: MIT
-!> Threads of the libraries under the linear solvers, chosen by measurement
-!> (benchmarks/bench_newton, cable nets, 2 cores shared with other work, ms per CHOLMOD
-!> factorisation at 1e4 / 3e4 unknowns):
-!> - Debian's CHOLMOD starts 4 OpenMP threads in its supernodal factorisation whatever
-!>   OMP_NUM_THREADS says: 38 / 117 ms with them against 17 / 99 ms on one thread
-!>   (reference BLAS), 19 / 121 against 8.5 / 35 ms with OpenBLAS. Off.
-!> - OpenBLAS (pthreads build) with 1 or 2 threads: 8.5 / 35 against 9.3 / 32 ms, equal
-!>   within the noise of a shared machine; one thread, which never competes with other
-!>   processes for the cores.
-!> - With the regions limited, Debian's CHOLMOD still entered libgomp two or three times
-!>   per supernode for a team of one (a futex system call each); its regions now run on
-!>   the calling thread (threads.c, GOMP_parallel): factorisation 0.76x / 0.81x on the
-!>   cable nets of 1e4 / 1e5 unknowns (idle machine), an elastic iteration of the 8 x 8
-!>   knit cell 0.59-0.65x.
-!> The policy is applied once per process, at the first linear solver; OMP_THREAD_LIMIT
-!> and OPENBLAS_NUM_THREADS set by the user take precedence (threads.c).
+!> Threads of the libraries under the linear solvers: their own OpenMP regions (Debian's
+!> CHOLMOD asks for 4 threads whatever OMP_NUM_THREADS says) and OpenBLAS run on one
+!> thread, which is faster on the factorisations measured and never competes with other
+!> processes for the cores (docs/decisions.md, 'Process settings: ...'). Applied once
+!> per process by the program and the Python entry point (yarnfort_linalg_process);
+!> OMP_THREAD_LIMIT and OPENBLAS_NUM_THREADS set by the user take precedence (threads.c).
 module yarnfort_linalg_process_threads
     use, intrinsic :: iso_c_binding, only: c_int, c_long
     implicit none
