@@ -17,9 +17,10 @@
  * it sleeps; openblas_set_num_threads starts them again if they were stopped: a second
  * core burnt at the start of every process, whatever the number of threads. Unless the
  * user set OPENBLAS_NUM_THREADS, the workers are stopped when this library is loaded (a
- * constructor: it runs after those of the libraries it depends on) and again right after the policy sets one thread, with
- * OpenBLAS's own blas_thread_shutdown_ (the call its fork handler makes). OpenBLAS starts
- * them again at its first multithreaded call, which with one thread never comes.
+ * constructor: it runs after those of the libraries it depends on) and again right
+ * after the policy sets one thread, with OpenBLAS's own blas_thread_shutdown_ (the call
+ * its fork handler makes). OpenBLAS starts them again at its first multithreaded call,
+ * which with one thread never comes.
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
