@@ -1,27 +1,36 @@
 ! SPDX-License-Identifier: MIT
 !> The manifest of an output folder, folder/.yarnfort-manifest: every file a run wrote
 !> there, so that a later run deletes only files of its own (never one named in a file
-!> another tool may have written, such as a foreign states.pvd). One entry a line:
+!> another tool may have written, such as a foreign states.pvd, nor a file of a name
+!> this program may write that no run of it wrote, such as one's own reactions.csv).
+!> One entry a line:
 !>
 !>     file <name>
 !>     state <name> <step> <time>
 !>
-!> A state is listed before its file is written (a kill in between leaves a listed file
-!> that is incomplete or missing, never an unlisted one). Only names this program writes
-!> are ever taken from the file (is_own_name), so a damaged or foreign manifest cannot
-!> make it delete anything else. The whole file is replaced atomically (tmp + rename);
-!> states are appended one line at a time.
+!> A name is listed when the run is about to create it (add_file, add_state), before the
+!> file exists: a kill in between leaves a listed file that is incomplete or missing,
+!> never an unlisted one. Only names this program writes are ever taken from the file
+!> (is_own_name), so a damaged or foreign manifest cannot make it delete anything else.
+!> The whole file is replaced atomically (tmp + rename); entries are appended one line
+!> at a time.
 module yarnfort_output_manifest
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, open_append, &
-        flush_checked, open_new_file, close_new_file
+        flush_checked, open_new_file, close_new_file, lock_file_name, probe_file_name
     implicit none
     private
 
     public :: manifest_type, manifest_file_name, is_own_name, is_state_name
+    public :: is_bookkeeping_name
 
     character(len=*), parameter :: manifest_file_name = '.yarnfort-manifest'
+
+    !> The files of the folder's bookkeeping (never listed, never deleted): the manifest
+    !> and its temporary, the lock and the write probe.
+    character(len=*), parameter :: bookkeeping_names(*) = [character(len=22) :: &
+        manifest_file_name, manifest_file_name // '.tmp', lock_file_name, probe_file_name]
 
     !> The fixed names a run may write (and their temporaries).
     character(len=*), parameter :: fixed_names(*) = [character(len=17) :: 'curve.csv', &
@@ -47,9 +56,11 @@ module yarnfort_output_manifest
         procedure :: save
         !> Append a state about to be written.
         procedure :: add_state
+        !> Append a fixed name about to be written (once; saved first if not open).
+        procedure :: add_file
+        !> Whether a fixed name is listed (written by a run of ours).
+        procedure :: has_file
         procedure :: close => close_manifest
-        !> Set the fixed files to every name a run may write.
-        procedure :: list_fixed_files
     end type manifest_type
 
 contains
@@ -99,11 +110,36 @@ contains
         close(unit)
     end subroutine load
 
-    subroutine list_fixed_files(self)
+    pure logical function has_file(self, name)
+        class(manifest_type), intent(in) :: self
+        character(len=*), intent(in) :: name
+        has_file = .false.
+        if (allocated(self%files)) has_file = any(self%files == name)
+    end function has_file
+
+    subroutine add_file(self, name, error)
         class(manifest_type), intent(inout) :: self
-        integer :: i
-        self%files = [(fixed_names(i), i = 1, size(fixed_names))]
-    end subroutine list_fixed_files
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        character(len=256) :: message
+        integer :: status
+
+        if (self%has_file(name)) return
+        if (self%unit == -1) then
+            call self%save(error)
+            if (allocated(error)) return
+        end if
+        message = ''
+        write(self%unit, '(a)', iostat=status, iomsg=message) 'file ' // name
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // self%folder // '/' &
+                // manifest_file_name // "': " // trim(message))
+            return
+        end if
+        call flush_checked(self%unit, self%folder // '/' // manifest_file_name, error)
+        if (allocated(error)) return
+        self%files = [self%files, [character(len=entry_length) :: name]]
+    end subroutine add_file
 
     subroutine save(self, error)
         class(manifest_type), intent(inout) :: self
@@ -184,6 +220,12 @@ contains
         if (self%unit /= -1) close(self%unit, iostat=status)
         self%unit = -1
     end subroutine close_manifest
+
+    !> A file of the folder's bookkeeping: the manifest, its temporary, the lock, the probe.
+    pure logical function is_bookkeeping_name(name)
+        character(len=*), intent(in) :: name
+        is_bookkeeping_name = any(bookkeeping_names == name)
+    end function is_bookkeeping_name
 
     !> A name this program writes into an output folder: a fixed name, or a state file.
     pure logical function is_own_name(name)

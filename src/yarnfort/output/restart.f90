@@ -436,6 +436,7 @@ contains
     !> new run starts from the beginning); any other file of that name is left alone.
     subroutine remove_restart(folder)
         character(len=*), intent(in) :: folder
+        type(error_type), allocatable :: ignored
         character(len=16) :: header
         integer :: unit, status
 
@@ -443,11 +444,10 @@ contains
             access='stream', form='unformatted', action='read', iostat=status)
         if (status /= 0) return
         read(unit, iostat=status) header
-        if (status == 0 .and. header == magic) then
-            close(unit, status='delete')
-        else
-            close(unit)
-        end if
+        close(unit)
+        ! (A regular file only: a link of that name is left alone.)
+        if (status == 0 .and. header == magic) &
+            call remove_file(folder // '/' // restart_file_name, ignored)
     end subroutine remove_restart
 
     !> Fingerprint (16 hex digits) of what determines a run's path: the effective input

@@ -3,7 +3,9 @@
 !> VTK state every `vtk_every` steps (and always the last one, written by `finish`), and
 !> the restart file of every converged step. It holds the output folder's lock from
 !> `open` (or `lock`) to `finish`, and lists every file it writes in the folder's
-!> manifest (yarnfort_output_manifest): a new run deletes only files listed there.
+!> manifest (yarnfort_output_manifest), as it first creates it: a new run deletes only
+!> files listed there. A symbolic link at any name it writes is refused when the folder
+!> is locked, before anything is deleted or written.
 !> Every write is checked; a failed one ends the run with an error (`failed` is then
 !> set), and what was written before it stays.
 module yarnfort_output_writer
@@ -13,17 +15,17 @@ module yarnfort_output_writer
     use yarnfort_input_echo, only: write_config
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_observer_type, step_state_type
-    use yarnfort_output_curve, only: curve_writer_type
+    use yarnfort_output_curve, only: curve_writer_type, curve_file_name
     use yarnfort_output_reactions, only: reactions_file_name, reactions_header, &
         get_reaction_rows
     use yarnfort_output_contacts, only: contacts_file_name, contacts_header, &
         get_contact_rows
-    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name
+    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, collection_file_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
-        remove_file, lock_file_name, open_new_file, close_new_file
-    use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name
+        remove_file, open_new_file, close_new_file, get_links, refuse_link
+    use yarnfort_output_manifest, only: manifest_type, is_own_name, is_bookkeeping_name
     use yarnfort_solver_restart, only: restart_type
-    use yarnfort_output_restart, only: write_restart, remove_restart
+    use yarnfort_output_restart, only: write_restart, remove_restart, restart_file_name
     implicit none
     private
 
@@ -74,7 +76,8 @@ module yarnfort_output_writer
 contains
 
     !> Take the lock of the scene's output folder (created when missing, unless
-    !> `create` is false: then a missing folder is left alone and not locked).
+    !> `create` is false: then a missing folder is left alone and not locked), and
+    !> refuse a folder with a symbolic link at a name the program writes.
     subroutine lock_writer(self, folder, error, create)
         class(output_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: folder
@@ -93,7 +96,39 @@ contains
         call make_folder(self%folder, error)
         if (allocated(error)) return
         call self%folder_lock%acquire(self%folder, error)
+        if (allocated(error)) return
+        call check_links(self%folder, error)
+        if (allocated(error)) call self%folder_lock%release()
     end subroutine lock_writer
+
+    !> Refuse a symbolic link in `folder` at a name the program writes (its files, their
+    !> temporaries, the states, the manifest, the lock, the probe): a write there would
+    !> follow it out of the folder. (Writes refuse links too; this says so before the run.)
+    subroutine check_links(folder, error)
+        character(len=*), intent(in) :: folder
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: names(:)
+        integer :: i
+
+        call get_links(folder, names, error)
+        if (allocated(error)) return
+        do i = 1, size(names)
+            if (is_own_name(trim(names(i))) .or. is_bookkeeping_name(trim(names(i)))) then
+                call refuse_link(folder // '/' // trim(names(i)), .true., error)
+                return
+            end if
+        end do
+    end subroutine check_links
+
+    !> List a file written through `name`.tmp renamed to `name`: both names.
+    subroutine list_atomic_file(self, name, error)
+        class(output_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%manifest%add_file(name // '.tmp', error)
+        if (.not. allocated(error)) call self%manifest%add_file(name, error)
+    end subroutine list_atomic_file
 
     !> Lock the output folder, delete the files an earlier run listed in its manifest,
     !> and start the curve file; with `resume_step` (a restart), continue the folder's
@@ -120,18 +155,21 @@ contains
                 call resume_files(self, scene, resume_step, error, resume_time, &
                     resume_previous_time)
             else
-                call start_files(self, scene, error)
+                call start_files(self, scene, found, error)
                 if (.not. allocated(error)) call start_contacts(self, error)
             end if
         end if
         if (allocated(error)) call self%folder_lock%release()
     end subroutine open_writer
 
-    !> A new run: delete what the manifest lists (the files of an earlier run) and a
-    !> restart file of ours, then list the fixed names and start the curve file.
-    subroutine start_files(self, scene, error)
+    !> A new run: delete what the manifest lists (the files an earlier run wrote; regular
+    !> files only), or without a manifest a restart file of ours, then start the manifest
+    !> anew, empty, and the curve file.
+    subroutine start_files(self, scene, listed, error)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
+        !> The folder has a manifest.
+        logical, intent(in) :: listed
         type(error_type), allocatable, intent(out) :: error
         integer :: i
 
@@ -144,20 +182,22 @@ contains
             if (allocated(error)) return
         end do
         ! A restart file of an earlier version (no manifest) must not survive either:
-        ! removed when it is one of ours.
-        call remove_restart(self%folder)
+        ! removed when its header says it is one of ours.
+        if (.not. listed) call remove_restart(self%folder)
         self%manifest%states = self%manifest%states(:0)
         self%manifest%steps = self%manifest%steps(:0)
         self%manifest%times = self%manifest%times(:0)
-        call self%manifest%list_fixed_files()
+        self%manifest%files = self%manifest%files(:0)
         call self%manifest%save(error)
         if (allocated(error)) return
         if (allocated(self%vtk%files)) deallocate(self%vtk%files, self%vtk%times)
         allocate(self%vtk%files(0), self%vtk%times(0))
-        call self%curve%open(self%folder, scene, error)
+        call self%manifest%add_file(curve_file_name, error)
+        if (.not. allocated(error)) call self%curve%open(self%folder, scene, error)
         if (allocated(error) .or. .not. self%node_reactions) return
-        call self%reactions%open_table(self%folder, reactions_file_name, reactions_header, &
-            error)
+        call self%manifest%add_file(reactions_file_name, error)
+        if (.not. allocated(error)) call self%reactions%open_table(self%folder, &
+            reactions_file_name, reactions_header, error)
     end subroutine start_files
 
     !> Start contacts.csv when it is asked for.
@@ -165,13 +205,17 @@ contains
         class(output_writer_type), intent(inout) :: self
         type(error_type), allocatable, intent(out) :: error
 
-        if (self%contact_state) call self%contacts%open_table(self%folder, &
+        if (.not. self%contact_state) return
+        call self%manifest%add_file(contacts_file_name, error)
+        if (.not. allocated(error)) call self%contacts%open_table(self%folder, &
             contacts_file_name, contacts_header, error)
     end subroutine start_contacts
 
     !> A restart after `step`: keep curve rows and the listed states up to that step,
     !> delete the listed states after it (and any that is incomplete), and rewrite the
-    !> manifest and states.pvd with what is kept.
+    !> manifest and states.pvd with what is kept. A listed reactions.csv or contacts.csv
+    !> this run does not write is deleted (its rows would contradict this run's); one
+    !> that is not listed is not ours and stays.
     subroutine resume_files(self, scene, step, error, time, previous_time)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
@@ -181,21 +225,25 @@ contains
         logical, allocatable :: keep(:)
         integer :: i
 
+        call list_atomic_file(self, curve_file_name, error)
+        if (allocated(error)) return
         call self%curve%resume(self%folder, scene, step, error, time, previous_time)
         if (allocated(error)) return
         if (self%node_reactions) then
-            call self%reactions%resume_table(self%folder, reactions_file_name, &
-                reactions_header, step, error, row_required=has_constrained_nodes(scene))
+            call list_atomic_file(self, reactions_file_name, error)
+            if (.not. allocated(error)) call self%reactions%resume_table(self%folder, &
+                reactions_file_name, reactions_header, step, error, &
+                row_required=has_constrained_nodes(scene))
         else
-            ! Rows of the first run beyond this step would contradict this one's.
-            call remove_file(self%folder // '/' // reactions_file_name, error)
+            call drop_file(self, reactions_file_name, error)
         end if
         if (allocated(error)) return
         if (self%contact_state) then
-            call self%contacts%resume_table(self%folder, contacts_file_name, &
-                contacts_header, step, error)
+            call list_atomic_file(self, contacts_file_name, error)
+            if (.not. allocated(error)) call self%contacts%resume_table(self%folder, &
+                contacts_file_name, contacts_header, step, error)
         else
-            call remove_file(self%folder // '/' // contacts_file_name, error)
+            call drop_file(self, contacts_file_name, error)
         end if
         if (allocated(error)) return
         allocate(keep(size(self%manifest%states)))
@@ -213,13 +261,30 @@ contains
         self%manifest%states = pack(self%manifest%states, keep)
         self%manifest%steps = pack(self%manifest%steps, keep)
         self%manifest%times = pack(self%manifest%times, keep)
-        call self%manifest%list_fixed_files()
         call self%manifest%save(error)
         if (allocated(error)) return
         self%vtk%files = self%manifest%states
         self%vtk%times = self%manifest%times
-        call self%vtk%write_collection(error)
+        call list_atomic_file(self, collection_file_name, error)
+        if (.not. allocated(error)) call self%vtk%write_collection(error)
     end subroutine resume_files
+
+    !> A restart that does not write the table `name`: delete it if a run of ours wrote
+    !> it (listed), and list it no more; leave it alone otherwise.
+    subroutine drop_file(self, name, error)
+        class(output_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        logical, allocatable :: keep(:)
+
+        if (.not. self%manifest%has_file(name)) return
+        call remove_file(self%folder // '/' // name, error)
+        if (allocated(error)) return
+        keep = self%manifest%files /= name .and. self%manifest%files /= name // '.tmp'
+        call remove_file(self%folder // '/' // name // '.tmp', error)
+        if (allocated(error)) return
+        self%manifest%files = pack(self%manifest%files, keep)
+    end subroutine drop_file
 
     !> Whether a state file is whole: it ends with the closing tag.
     logical function is_complete(path)
@@ -252,6 +317,8 @@ contains
 
         path = self%folder // '/' // input_file_name
         temporary = path // '.tmp'
+        call list_atomic_file(self, input_file_name, error)
+        if (allocated(error)) return
         call open_new_file(unit, temporary, error)
         if (allocated(error)) then
             call remove_file(temporary, ignored)
@@ -327,7 +394,9 @@ contains
             call write_last_state(self, scene, error)
             if (allocated(error)) return
         end if
-        call write_restart(self%folder, snapshot, self%input_hash, error)
+        call list_atomic_file(self, restart_file_name, error)
+        if (.not. allocated(error)) &
+            call write_restart(self%folder, snapshot, self%input_hash, error)
         if (allocated(error)) self%failed = .true.
     end subroutine on_checkpoint
 
@@ -337,8 +406,10 @@ contains
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
 
-        call self%manifest%add_state(get_state_name(self%last%step), self%last%step, &
-            self%last%time, error)
+        ! The first state is followed by states.pvd at once (vtk%write_state).
+        call list_atomic_file(self, collection_file_name, error)
+        if (.not. allocated(error)) call self%manifest%add_state(get_state_name( &
+            self%last%step), self%last%step, self%last%time, error)
         if (.not. allocated(error)) then
             if (.not. allocated(self%last_mode)) self%last_mode = [integer :: ]
             if (.not. allocated(self%last_flow)) self%last_flow = [real(wp) :: ]
