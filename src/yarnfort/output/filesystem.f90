@@ -8,7 +8,7 @@ module yarnfort_output_filesystem
     implicit none
     private
 
-    public :: make_folder, rename_file, remove_file, sync_file, folder_lock_type
+    public :: make_folder, rename_file, remove_file, sync_file, sync_folder, folder_lock_type
     public :: close_checked, flush_checked, truncate_file, ignore_file_size_signal
     public :: open_append, open_new_file, close_new_file
     public :: lock_file_name
@@ -81,7 +81,7 @@ module yarnfort_output_filesystem
     end interface
 
     abstract interface
-        !> yarnfort_sync_file, yarnfort_remove_file: 0 on success, -1 on failure (the
+        !> yarnfort_sync_file, yarnfort_sync_folder, yarnfort_remove_file: 0 on success, -1 on failure (the
         !> reason: c_last_error).
         function path_status_interface(path) result(status) bind(C)
             import :: c_int, c_char
@@ -99,6 +99,7 @@ module yarnfort_output_filesystem
     end interface
 
     procedure(path_status_interface), bind(C, name='yarnfort_sync_file') :: c_sync_file
+    procedure(path_status_interface), bind(C, name='yarnfort_sync_folder') :: c_sync_folder
     procedure(path_status_interface), bind(C, name='yarnfort_remove_file') :: c_remove_file
     procedure(path_bytes_interface), bind(C, name='yarnfort_file_size') :: c_file_size
     procedure(path_bytes_interface), bind(C, name='yarnfort_free_space') :: c_free_space
@@ -164,6 +165,15 @@ contains
         call check_call(c_sync_file(path // c_null_char), &
             "cannot write '" // path // "' to disk", error)
     end subroutine sync_file
+
+    !> Flush the entries of the folder `path` (a rename in it) to its device.
+    subroutine sync_folder(path, error)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_call(c_sync_folder(path // c_null_char), &
+            "cannot write the entries of folder '" // path // "' to disk", error)
+    end subroutine sync_folder
 
     !> Cut the (closed) file `path` back to `bytes` bytes, e.g. to drop a line that could
     !> be written only in part.

@@ -2,7 +2,11 @@
 !> The restart file, folder/restart.dat: the snapshot of the last converged step
 !> (yarnfort_solver_restart), rewritten after every step. It is written to
 !> restart.dat.tmp and renamed over restart.dat, so a run killed at any moment leaves
-!> either the previous complete file or the new one.
+!> either the previous complete file or the new one (a kill loses no written data: no
+!> fsync is needed for that). Flushing it to the device (fsync of the file before the
+!> rename and of the folder after it), which only a power cut or a crash of the system
+!> needs, is the caller's choice per write (`sync`; see docs/decisions.md, "restart.dat
+!> is flushed to disk by time, not by step").
 !>
 !> Binary (unformatted stream, native byte order, full precision), version 4:
 !>     'yarnfort-restart' (16 characters), version (integer),
@@ -28,13 +32,13 @@ module yarnfort_output_restart
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_text, only: resolve_path, format_integer, format_real, join_names
     use yarnfort_solver_restart, only: restart_type, stepper_elastic, stepper_friction
-    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, close_checked, &
-        open_new_file, close_new_file
+    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, sync_folder, &
+        close_checked, open_new_file, close_new_file
     implicit none
     private
 
     public :: restart_file_name, write_restart, read_restart, check_restart
-    public :: remove_restart, get_input_hash
+    public :: remove_restart, get_input_hash, sync_restart
 
     character(len=*), parameter :: restart_file_name = 'restart.dat'
     character(len=16), parameter :: magic = 'yarnfort-restart'
@@ -61,17 +65,21 @@ module yarnfort_output_restart
 
 contains
 
-    !> Write `snapshot` (stamped with `input_hash`) to folder/restart.dat atomically.
-    subroutine write_restart(folder, snapshot, input_hash, error)
+    !> Write `snapshot` (stamped with `input_hash`) to folder/restart.dat atomically;
+    !> with `sync` (default true) also flushed to the device before it replaces the
+    !> previous file, and the rename after it.
+    subroutine write_restart(folder, snapshot, input_hash, error, sync)
         character(len=*), intent(in) :: folder
         type(restart_type), intent(in) :: snapshot
         character(len=*), intent(in) :: input_hash
         type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: sync
         character(len=:), allocatable :: path, temporary
         character(len=16) :: stamp, stepper
         character(len=256) :: message
         type(error_type), allocatable :: ignored
         integer :: unit, status
+        logical :: flush_now
 
         path = folder // '/' // restart_file_name
         temporary = path // '.tmp'
@@ -112,11 +120,21 @@ contains
             error%message = error%message // kept()
             return
         end if
+        if (present(sync)) then
+            flush_now = sync
+        else
+            flush_now = .true.
+        end if
         ! On disk before it replaces the previous file: a crash of the machine cannot
         ! leave an empty restart file behind.
-        call sync_file(temporary, error)
+        if (flush_now) call sync_file(temporary, error)
         if (.not. allocated(error)) call rename_file(temporary, path, error)
-        if (allocated(error)) call remove_file(temporary, ignored)
+        if (allocated(error)) then
+            call remove_file(temporary, ignored)
+            return
+        end if
+        ! The folder holds the rename: on disk too, or a crash may bring back the old file.
+        if (flush_now) call sync_folder(folder, error)
     contains
         !> What the failure leaves: the previous restart file, if there is one.
         function kept() result(text)
@@ -431,6 +449,18 @@ contains
                 .and. all(ieee_is_finite(flow))
         end function finite_state
     end subroutine check_restart
+
+    !> Flush folder/restart.dat, written without `sync`, and the folder (which holds its
+    !> last rename) to the device. No restart file is fine (no step converged).
+    subroutine sync_restart(folder, error)
+        character(len=*), intent(in) :: folder
+        type(error_type), allocatable, intent(out) :: error
+        logical :: exists
+
+        inquire(file=folder // '/' // restart_file_name, exist=exists)
+        if (exists) call sync_file(folder // '/' // restart_file_name, error)
+        if (.not. allocated(error)) call sync_folder(folder, error)
+    end subroutine sync_restart
 
     !> Delete folder/restart.dat if there is one and it is a yarnfort restart file (a
     !> new run starts from the beginning); any other file of that name is left alone.
