@@ -1,14 +1,15 @@
 ! SPDX-License-Identifier: MIT
 !> File-system calls Fortran has no portable statement for, through the C library and a
-!> small C shim (filesystem_shim.c): folder creation, atomic rename, removal, fsync, and
-!> the exclusive lock of an output folder.
+!> small C shim (filesystem_shim.c): folder creation, atomic rename, hard links, removal,
+!> fsync, and the exclusive lock of an output folder.
 module yarnfort_output_filesystem
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_long_long
     use yarnfort_error, only: error_type, fatal_error
     implicit none
     private
 
-    public :: make_folder, rename_file, remove_file, sync_file, sync_folder, folder_lock_type
+    public :: make_folder, rename_file, link_file, remove_file, sync_file, sync_folder
+    public :: folder_lock_type
     public :: close_checked, flush_checked, truncate_file, ignore_file_size_signal
     public :: open_append, open_new_file, close_new_file
     public :: lock_file_name
@@ -40,6 +41,12 @@ module yarnfort_output_filesystem
             character(kind=c_char), intent(in) :: old(*), new(*)
             integer(c_int) :: status
         end function c_rename
+
+        function c_link(old, new) result(status) bind(C, name='link')
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: old(*), new(*)
+            integer(c_int) :: status
+        end function c_link
 
         function c_lock_file(path, fd, holder, holder_length) result(status) &
                 bind(C, name='yarnfort_lock_file')
@@ -146,6 +153,16 @@ contains
         call check_call(c_rename(old // c_null_char, new // c_null_char), &
             "cannot rename '" // old // "' to '" // new // "'", error)
     end subroutine rename_file
+
+    !> Give the file `old` the second name `new` (a hard link: one file, two names;
+    !> renaming another file over `old` later leaves `new` as it is). `new` must not exist.
+    subroutine link_file(old, new, error)
+        character(len=*), intent(in) :: old, new
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_call(c_link(old // c_null_char, new // c_null_char), &
+            "cannot link '" // old // "' to '" // new // "'", error)
+    end subroutine link_file
 
     !> Remove the file `path`; a missing file is fine.
     subroutine remove_file(path, error)

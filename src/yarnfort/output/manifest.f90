@@ -27,7 +27,7 @@ module yarnfort_output_manifest
     character(len=*), parameter :: fixed_names(*) = [character(len=17) :: 'curve.csv', &
         'curve.csv.tmp', 'input.nml', 'input.nml.tmp', 'restart.dat', 'restart.dat.tmp', &
         'states.pvd', 'states.pvd.tmp', 'reactions.csv', 'reactions.csv.tmp', &
-        'contacts.csv', 'contacts.csv.tmp']
+        'contacts.csv', 'contacts.csv.tmp', 'restart.sync', 'restart.sync.tmp']
 
     !> Longest file name kept (state names are far shorter).
     integer, parameter :: entry_length = 64
