@@ -119,22 +119,22 @@ def run_steps(args: argparse.Namespace, work: Path) -> None:
     sync = args.sync_interval
     print(f"# {EXECUTABLE}, median of {args.repeats}"
           + ("" if sync is None else f", sync_interval = {sync} s"))
-    print(f"{'case':<26} {'steps':>6} {'user s':>8} {'wall s':>8} {'user s':>8} {'wall s':>8}")
-    print(f"{'':<26} {'':>6} {'VTK every step':>17} {'no VTK':>17}")
+    print(f"{'case':<30} {'steps':>6} {'user s':>8} {'wall s':>8} {'user s':>8} {'wall s':>8}")
+    print(f"{'':<30} {'':>6} {'VTK every step':>17} {'no VTK':>17}")
     for steps in PULL_STEPS:
         row = []
         for every in (1, 0):
             folder = f"pull_{steps}_{every}"
             row += best_run(pull_scene(steps, folder, every, sync), work, args.repeats)
         name = f"two elements, {steps} steps"
-        print(f"{name:<26} {count_steps(work / folder):6d} "
+        print(f"{name:<30} {count_steps(work / folder):6d} "
               + " ".join(f"{value:8.2f}" for value in row))
     row = []
     for every in (1, 0):
         folder = f"pin_{every}"
         row += best_run(pin_scene(folder, every, sync), work, args.repeats)
     name = f"one pin, {PIN_KNOTS} knots, accurate"
-    print(f"{name:<26} {count_steps(work / folder):6d} "
+    print(f"{name:<30} {count_steps(work / folder):6d} "
           + " ".join(f"{value:8.2f}" for value in row))
 
 
