@@ -15,7 +15,7 @@ with binary (appended base64) and ASCII states. Prints the median wall time over
 repeats, the extra time per state over the run without states, and the size of one
 state file.
 
-    .venv/bin/python benchmarks/output_cost.py [steps] [--repeats 1] [--sync-interval S]
+    .venv/bin/python benchmarks/output_cost.py [steps] [--repeats 1]
     .venv/bin/python benchmarks/output_cost.py size [--nodes 200000] [--repeats 3]
 
 YARNFORT_EXE names the program to time (default build/yarnfort), e.g. the build of
@@ -53,14 +53,11 @@ def chain_scene(nodes: int, folder: str, every: int, fmt: str) -> str:
 """
 
 
-def output_group(folder: str, every: int, sync: float | None) -> str:
-    text = f"&output folder = '{folder}', vtk_every = {every}, progress = .false."
-    if sync is not None:
-        text += f", sync_interval = {sync}"
-    return text + " /\n"
+def output_group(folder: str, every: int) -> str:
+    return f"&output folder = '{folder}', vtk_every = {every}, progress = .false. /\n"
 
 
-def pull_scene(steps: int, folder: str, every: int, sync: float | None) -> str:
+def pull_scene(steps: int, folder: str, every: int) -> str:
     """Two elements, pulled to 10 % strain in `steps` equal steps."""
     return f"""&material name = 'yarn', law = 'linear', stiffness = 10.0 /
 &nodes xyz = 0 0 0, 0.5 0 0, 1 0 0 /
@@ -70,10 +67,10 @@ def pull_scene(steps: int, folder: str, every: int, sync: float | None) -> str:
 &support name = 'm', nodes = 2, fix = 'yz' /
 &path time = 0 1, p_disp = 0 1 /
 &solver max_step = {1.0 / steps!r}, initial_step = {1.0 / steps!r} /
-""" + output_group(folder, every, sync)
+""" + output_group(folder, every)
 
 
-def pin_scene(folder: str, every: int, sync: float | None) -> str:
+def pin_scene(folder: str, every: int) -> str:
     """A yarn over one pin (a quarter turn), pulled and released with a growing amplitude
     over PIN_KNOTS knots."""
     times = ", ".join(str(k) for k in range(PIN_KNOTS))
@@ -88,7 +85,7 @@ def pin_scene(folder: str, every: int, sync: float | None) -> str:
 &contact at = 'pin', law = 'adhesion', friction_coefficient = 0.3, adhesion = 0.05 /
 &path time = {times}, p_disp = {factors} /
 &solver preset = 'accurate' /
-""" + output_group(folder, every, sync)
+""" + output_group(folder, every)
 
 
 def timed_run(text: str, work: Path) -> tuple[float, float]:
@@ -116,23 +113,21 @@ def best_run(text: str, work: Path, repeats: int) -> tuple[float, float]:
 
 
 def run_steps(args: argparse.Namespace, work: Path) -> None:
-    sync = args.sync_interval
-    print(f"# {EXECUTABLE}, median of {args.repeats}"
-          + ("" if sync is None else f", sync_interval = {sync} s"))
+    print(f"# {EXECUTABLE}, median of {args.repeats}")
     print(f"{'case':<30} {'steps':>6} {'user s':>8} {'wall s':>8} {'user s':>8} {'wall s':>8}")
     print(f"{'':<30} {'':>6} {'VTK every step':>17} {'no VTK':>17}")
     for steps in PULL_STEPS:
         row = []
         for every in (1, 0):
             folder = f"pull_{steps}_{every}"
-            row += best_run(pull_scene(steps, folder, every, sync), work, args.repeats)
+            row += best_run(pull_scene(steps, folder, every), work, args.repeats)
         name = f"two elements, {steps} steps"
         print(f"{name:<30} {count_steps(work / folder):6d} "
               + " ".join(f"{value:8.2f}" for value in row))
     row = []
     for every in (1, 0):
         folder = f"pin_{every}"
-        row += best_run(pin_scene(folder, every, sync), work, args.repeats)
+        row += best_run(pin_scene(folder, every), work, args.repeats)
     name = f"one pin, {PIN_KNOTS} knots, accurate"
     print(f"{name:<30} {count_steps(work / folder):6d} "
           + " ".join(f"{value:8.2f}" for value in row))
@@ -166,8 +161,6 @@ def main() -> None:
     parser.add_argument("--nodes", type=int, default=200_000, help="size: chain length")
     parser.add_argument("--repeats", type=int, default=None,
                         help="runs per case (median); default 1 for steps, 3 for size")
-    parser.add_argument("--sync-interval", type=float, default=None,
-                        help="steps: &output sync_interval (default: the program's)")
     parser.add_argument("--work", type=Path, default=TOP / "out" / "bench_output_cost",
                         help="folder of the runs (emptied first)")
     args = parser.parse_args()

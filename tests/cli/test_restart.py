@@ -258,7 +258,7 @@ def test_new_run_removes_an_old_restart_file(run_yarnfort, tmp_path):
 
 def test_restart_after_a_power_cut(run_yarnfort, tmp_path):
     """After a power cut restart.dat may be damaged, or on disk further than curve.csv
-    (it is replaced every step, flushed to disk only every sync_interval seconds).
+    (it is replaced every step, flushed to disk only every 10 s).
     restart.sync, the restart file of the last flush, is one the tables hold: the
     refusal names it, and renamed to restart.dat it goes on to the uninterrupted curve.
     The cut is made by hand: the files flushed at the end of a first piece of 10 steps,

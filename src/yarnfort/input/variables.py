@@ -474,11 +474,6 @@ GROUPS = [
                 "XML 1.0) or `'ascii'` (inline text, 17 significant digits: the same values)."),
         Var('progress', 'logical', True,
             doc='Progress lines on stderr.'),
-        Var('sync_interval', 'real', 10.0, unit='s', range='>= 0',
-            doc='Flush `restart.dat` (with the tables and the folder) to disk with fsync at '
-                'most this often, and at the end of the run: a power cut loses at most about '
-                'this much of the run. 0 flushes after every step. A kill loses nothing '
-                'either way (see *Restart* below).'),
         Var('node_reactions', 'logical', False,
             doc='Also write `reactions.csv`: the reaction of every constrained node at every '
                 'converged step, in long format (columns `step,support,node,rx,ry,rz`; one row '

@@ -33,6 +33,10 @@ module yarnfort_output_writer
 
     !> The effective input, echoed for provenance.
     character(len=*), parameter :: input_file_name = 'input.nml'
+    !> Least seconds between two flushes of the tables and restart.dat to disk (fsync): a
+    !> power cut loses about this much of a run, and a flush costs a few ms (docs/
+    !> decisions.md, "restart.dat is flushed to disk by time, not by step").
+    real(wp), parameter :: sync_interval = 10.0_wp
 
     type, extends(step_observer_type) :: output_writer_type
         character(len=:), allocatable :: folder
@@ -60,9 +64,8 @@ module yarnfort_output_writer
         character(len=16) :: input_hash = ''
         !> A write to the folder failed (the error of on_step or on_checkpoint).
         logical :: failed = .false.
-        !> Least seconds between two flushes to disk (&output sync_interval), the clock
-        !> count of the last (or of open), and whether a restart file was written since.
-        real(wp) :: sync_interval = 0.0_wp
+        !> The clock count of the last flush to disk (or of open), and whether a restart
+        !> file was written since.
         integer(int64) :: synced_at = 0
         logical :: unsynced = .false.
     contains
@@ -119,7 +122,6 @@ contains
         self%node_reactions = scene%output%node_reactions
         self%contact_state = scene%output%contact_state .and. scene%passages%size() > 0
         self%vtk%ascii = trim(scene%output%vtk_format) == 'ascii'
-        self%sync_interval = scene%output%sync_interval
         call system_clock(self%synced_at)
         call self%lock(scene%output%folder, error)
         if (.not. allocated(error)) then
@@ -337,7 +339,7 @@ contains
         end if
         ! Flushed when due: the tables first, so that the rows of the restart's step
         ! are on disk when it is.
-        due = seconds_since(self%synced_at) >= self%sync_interval
+        due = seconds_since(self%synced_at) >= sync_interval
         if (due) call sync_tables(self, error)
         if (.not. allocated(error)) &
             call write_restart(self%folder, snapshot, self%input_hash, error, sync=due)
