@@ -42,7 +42,7 @@ module yarnfort_output_filesystem
             integer(c_int) :: status
         end function c_rename
 
-        function c_link(old, new) result(status) bind(C, name='link')
+        function c_link(old, new) result(status) bind(C, name='yarnfort_link_file')
             import :: c_int, c_char
             character(kind=c_char), intent(in) :: old(*), new(*)
             integer(c_int) :: status
@@ -156,12 +156,17 @@ contains
 
     !> Give the file `old` the second name `new` (a hard link: one file, two names;
     !> renaming another file over `old` later leaves `new` as it is). `new` must not exist.
-    subroutine link_file(old, new, error)
+    !> `linked` is false, and no error, on a file system without hard links.
+    subroutine link_file(old, new, error, linked)
         character(len=*), intent(in) :: old, new
         type(error_type), allocatable, intent(out) :: error
+        logical, intent(out) :: linked
+        integer(c_int) :: status
 
-        call check_call(c_link(old // c_null_char, new // c_null_char), &
-            "cannot link '" // old // "' to '" // new // "'", error)
+        status = c_link(old // c_null_char, new // c_null_char)
+        linked = status == 0
+        if (status /= 1) call check_call(status, "cannot link '" // old // "' to '" // new &
+            // "'", error)
     end subroutine link_file
 
     !> Remove the file `path`; a missing file is fine.

@@ -108,6 +108,15 @@ int yarnfort_sync_folder(const char *path)
     return close(folder);
 }
 
+/* Give the file `old` the second name `new` (a hard link). Returns 0, 1 when the file
+ * system has no hard links (FAT, some network shares), -1 on any other failure. */
+int yarnfort_link_file(const char *old, const char *new)
+{
+    if (link(old, new) == 0) return 0;
+    if (errno == EPERM || errno == ENOTSUP || errno == EOPNOTSUPP || errno == ENOSYS) return 1;
+    return -1;
+}
+
 /* Remove a file; a missing file is no error. */
 int yarnfort_remove_file(const char *path)
 {

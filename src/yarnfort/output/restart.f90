@@ -475,17 +475,20 @@ contains
     end subroutine sync_restart
 
     !> Give the flushed restart file `path` the name folder/restart.sync, atomically
-    !> (a link under restart.sync.tmp renamed over it).
+    !> (a link under restart.sync.tmp renamed over it). A file system without hard links
+    !> keeps the restart.sync of earlier flushes, if any (still one the tables hold).
     subroutine keep_synced(folder, path, error)
         character(len=*), intent(in) :: folder, path
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: synced
+        logical :: linked
 
         synced = folder // '/' // synced_file_name
         ! A link left by a kill would make link() fail.
         call remove_file(synced // '.tmp', error)
-        if (.not. allocated(error)) call link_file(path, synced // '.tmp', error)
-        if (.not. allocated(error)) call rename_file(synced // '.tmp', synced, error)
+        if (.not. allocated(error)) call link_file(path, synced // '.tmp', error, linked)
+        if (.not. allocated(error) .and. linked) call rename_file(synced // '.tmp', synced, &
+            error)
     end subroutine keep_synced
 
     !> Delete folder/restart.dat and folder/restart.sync, each if it is a yarnfort
