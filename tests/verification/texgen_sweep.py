@@ -47,6 +47,22 @@ CASES: dict[str, tuple[str, tuple[float, ...]]] = {
     "knit_1_1_1.2_0.2": ("knit", (1.0, 1.0, 1.2, 0.2)),
     "knit_1.2_1_1.5_0.25": ("knit", (1.2, 1.0, 1.5, 0.25)),
     "knit_1_1_1.2_0.4": ("knit", (1.0, 1.0, 1.2, 0.4)),
+    "plain_2x2_s1_t1": ("plain", (2, 2, 1.0, 1.0)),
+    "plain_2x2_s1_t0.4_w1.2": ("plain", (2, 2, 1.0, 0.4, 1.2)),
+    "twill_4x4_s1_t0.1": ("twill", (4, 4, 1.0, 0.1)),
+    "layered_2x2_s1_t0.2": ("layered", (2, 2, 1.0, 0.2)),
+    "knit_1_1_2_0.2": ("knit", (1.0, 1.0, 2.0, 0.2)),
+    "knit_1_1.5_1.2_0.2": ("knit", (1.0, 1.5, 1.2, 0.2)),
+    "knit_1_1_1.2_0.5": ("knit", (1.0, 1.0, 1.2, 0.5)),
+    "knit_1_1_1.2_0.6": ("knit", (1.0, 1.0, 1.2, 0.6)),
+}
+#: Cases TexGen builds that the import refuses, and words the refusal must hold: a weft
+#: knit whose YarnThickness reaches CourseWidth / 2 (the head of a loop meets its
+#: neighbour's: TexGen puts its sides CourseWidth / 4 - YarnThickness / 2 from the
+#: loop's middle), or whose loop legs are too close to be told apart.
+REFUSED: dict[str, str] = {
+    "knit_1_1_1.2_0.5": "give a smaller YarnThickness",
+    "knit_1_1_1.2_0.6": "give a YarnThickness (here 0.6) below CourseWidth / 2 (here 0.6)",
 }
 #: What a refusal must name to be in TexGen's terms: TexGen's yarn index, and what to change.
 TEXGEN_TERMS = re.compile(r"TexGen yarn \d+")
@@ -119,9 +135,12 @@ def table(outcomes: list[Outcome]) -> str:
             "|---|---|---|---|---|"]
     for o in outcomes:
         kind, values = CASES[o.name]
+        # A refusal: its message without the program's prefix and the file's path.
+        detail = o.detail if o.ok else re.sub(r"^.*?texgen_file '[^']*': ", "", o.detail)
+        run = f"{o.run_time:.2f}" if o.ok else "-"
         rows.append(f"| {o.name} | {kind} {' '.join(f'{v:g}' for v in values)} | "
-                    f"{'runs: ' if o.ok else 'refused: '}{o.detail} | {o.import_time:.2f} | "
-                    f"{o.run_time:.2f} |")
+                    f"{'runs: ' if o.ok else 'refused: '}{detail} | {o.import_time:.2f} | "
+                    f"{run} |")
     return "\n".join(rows)
 
 

@@ -47,6 +47,9 @@ module yarnfort_generate_texgen
     !> Yarns whose directions in the fabric plane differ by less than this (rad) run side
     !> by side (a woven crossing is pi/2; neighbours touching sideways, 0).
     real(wp), parameter :: side_by_side_angle = 10 * acos(-1.0_wp) / 180
+    !> Centre lines closer at a contact than this fraction of the sum of the two half
+    !> thicknesses meet there: no direction to press along, nor two places for nodes.
+    real(wp), parameter :: meeting_tolerance = 1.0e-6_wp
 
     type :: texgen_yarn_type
         !> Sampled centre line (3, 0:m), point m = point 0 + period; arc length at each.
@@ -108,6 +111,10 @@ contains
         if (fabric%boundary == 'clamped') then
             call build_cell(fabric, yarns, cell, scale, contacts, unit_cell, error)
             if (allocated(error)) goto 100
+            call check_meetings(yarns, contacts, textile_hint(document), error)
+            if (allocated(error)) goto 100
+            call check_weft_knit(document, size(contacts), error)
+            if (allocated(error)) goto 100
             call tile_sample(fabric, unit_cell, cell * scale, net, error)
             if (allocated(error)) goto 100
             width = fabric%cells(2) * cell(2) * scale
@@ -115,6 +122,12 @@ contains
             return
         end if
         call build_cell(fabric, yarns, cell, scale, contacts, net, error)
+        if (allocated(error)) goto 100
+        ! After the cell: a yarn over several cells meets its own image, which the cell
+        ! refuses in its own terms first.
+        call check_meetings(yarns, contacts, textile_hint(document), error)
+        if (allocated(error)) goto 100
+        call check_weft_knit(document, size(contacts), error)
         if (allocated(error)) goto 100
         width = cell(2) * scale
         return
@@ -260,6 +273,68 @@ contains
         return
 200     error%message = trim(buffer) // ' ' // error%message
     end subroutine read_model
+
+    !> What to change in the TexGen textile's own parameters where its centre lines meet
+    !> (empty for textiles without such a rule): a CTextileWeftKnit puts the sides of a
+    !> loop's head CourseWidth / 4 - YarnThickness / 2 from the loop's middle, so at
+    !> YarnThickness = CourseWidth / 2 the head touches its neighbour's at one point.
+    function textile_hint(document) result(hint)
+        type(xml_document_type), intent(in) :: document
+        character(len=:), allocatable :: hint
+        integer, allocatable :: roots(:), textiles(:)
+        character(len=:), allocatable :: value
+        real(wp) :: thickness, width
+        logical :: present
+        integer :: stat(2)
+
+        hint = ''
+        roots = document%children(0, 'TexGenModel')
+        textiles = document%children(roots(1), 'Textile')
+        call document%attribute(textiles(1), 'type', value, present)
+        if (value /= 'CTextileWeftKnit') return
+        call document%attribute(textiles(1), 'YarnThickness', value, present)
+        read(value, *, iostat=stat(1)) thickness
+        call document%attribute(textiles(1), 'CourseWidth', value, present)
+        read(value, *, iostat=stat(2)) width
+        if (any(stat /= 0)) return
+        hint = '; CTextileWeftKnit: give a YarnThickness (here ' // format_real(thickness) &
+            // ') below CourseWidth / 2 (here ' // format_real(0.5_wp * width) // ')'
+    end function textile_hint
+
+    !> A CTextileWeftKnit cell (one loop) has at least two contacts: the head of each
+    !> loop holds the loop above by its two legs. Fewer: the legs were not told apart
+    !> (one contact patch), and the loop would hang on one leg.
+    subroutine check_weft_knit(document, n_contacts, error)
+        type(xml_document_type), intent(in) :: document
+        integer, intent(in) :: n_contacts
+        type(error_type), allocatable, intent(out) :: error
+        integer, allocatable :: roots(:), textiles(:)
+        character(len=:), allocatable :: value
+        real(wp) :: thickness, width
+        logical :: present
+        integer :: stat(2)
+
+        if (n_contacts >= 2) return
+        roots = document%children(0, 'TexGenModel')
+        textiles = document%children(roots(1), 'Textile')
+        call document%attribute(textiles(1), 'type', value, present)
+        if (value /= 'CTextileWeftKnit') return
+        call document%attribute(textiles(1), 'YarnThickness', value, present)
+        read(value, *, iostat=stat(1)) thickness
+        call document%attribute(textiles(1), 'CourseWidth', value, present)
+        read(value, *, iostat=stat(2)) width
+        if (any(stat /= 0)) then
+            thickness = 0.0_wp
+            width = 0.0_wp
+        end if
+        call fatal_error(error, 'TexGen yarn 0 (CTextileWeftKnit): ' &
+            // format_integer(n_contacts) // ' contact(s) found in the cell, where the ' &
+            // 'head of a loop holds the loop above by its two legs (2 contacts): the ' &
+            // 'legs, CourseWidth / 2 - YarnThickness = ' &
+            // format_short(0.5_wp * width - thickness) // ' apart at their feet ' &
+            // '(YarnThickness ' // format_real(thickness) // '), are not told apart; ' &
+            // 'give a smaller YarnThickness')
+    end subroutine check_weft_knit
 
     !> Master nodes at the position of the one before (within `tolerance`) are dropped:
     !> TexGen accepts them, but their span has no length, nor a direction to sample.
@@ -638,6 +713,7 @@ contains
                 q%point(:, 1) - q%shift, patch)
         end function same_patch
 
+
         logical function close_pair(a1, b1, a2, b2, patch)
             real(wp), intent(in) :: a1(3), b1(3), a2(3), b2(3), patch
             real(wp) :: translation(3)
@@ -663,6 +739,48 @@ contains
                 < acos(-1.0_wp) * max(yarn%width, yarn%height)
         end function same_yarn_nearby
     end subroutine find_contacts
+
+    !> Refused: a contact where the two centre lines meet (a yarn through another, or
+    !> through itself): neither wraps the other there, and the gap-holder has no
+    !> direction. `hint`: what to change in the textile's parameters, if known.
+    subroutine check_meetings(yarns, contacts, hint, error)
+        type(texgen_yarn_type), intent(in) :: yarns(:)
+        type(contact_type), intent(in) :: contacts(:)
+        character(len=*), intent(in) :: hint
+        type(error_type), allocatable, intent(out) :: error
+        integer :: k, side, node(2)
+        real(wp) :: thickness
+        character(len=:), allocatable :: who, what
+
+        do k = 1, size(contacts)
+            associate(p => contacts(k), a => yarns(contacts(k)%yarn(1)), &
+                    b => yarns(contacts(k)%yarn(2)))
+                thickness = 0.5_wp * (max(a%width, a%height) + max(b%width, b%height))
+                if (p%distance > meeting_tolerance * thickness) cycle
+                do side = 1, 2
+                    associate(y => yarns(p%yarn(side)))
+                        node(side) = modulo(nint(parameter_of(y, p%s(side))), &
+                            size(y%node, 2) - 1)
+                    end associate
+                end do
+                if (p%yarn(1) == p%yarn(2)) then
+                    who = 'TexGen yarn ' // format_integer(p%yarn(1) - 1) // ' meets itself'
+                    what = 'its centre line passes twice through one point'
+                else
+                    who = 'TexGen yarns ' // format_integer(p%yarn(1) - 1) // ' and ' &
+                        // format_integer(p%yarn(2) - 1) // ' meet'
+                    what = 'their centre lines pass through one point'
+                end if
+                call fatal_error(error, who // ' at (' // format_short(p%point(1, 1)) &
+                    // ', ' // format_short(p%point(2, 1)) // ', ' &
+                    // format_short(p%point(3, 1)) // ') (master nodes ' &
+                    // format_integer(node(1)) // ' and ' // format_integer(node(2)) &
+                    // '): ' // what // ', where neither pass wraps the other; the string ' &
+                    // 'model needs them apart by the thickness of a contact' // hint)
+                return
+            end associate
+        end do
+    end subroutine check_meetings
 
     !> The closest points of the two curves themselves (not of their samples), from the
     !> candidate's sample points: Gauss-Newton on the distance vector, kept within one
