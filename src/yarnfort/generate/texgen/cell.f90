@@ -35,8 +35,8 @@ contains
         type(contact_type), intent(inout) :: contacts(:)
         type(net_builder_type), intent(inout) :: net
         type(error_type), allocatable, intent(out) :: error
-        integer :: y, k, n, c, side, first, last, leader, follower, anchor
-        real(wp) :: total, cut, strain(3), gap(3), period(3), position(3)
+        integer :: y, k, n, c, side, first, last, anchor
+        real(wp) :: total, cut, strain(3), period(3), position(3)
         real(wp), allocatable :: s(:), gaps(:), chain(:, :), along(:)
         integer, allocatable :: who(:), order(:), list(:)
         logical, allocatable :: wrapped(:, :)

@@ -27,7 +27,7 @@ contains
         real(wp), intent(in) :: period(2)
         type(net_builder_type), intent(inout) :: net
         type(error_type), allocatable, intent(out) :: error
-        integer :: nx, ny, a, b, k, y, n, step(2), shift(2), node, first, last
+        integer :: nx, ny, a, b, k, y, n, step(2), shift(2), first, last
         integer, allocatable :: id(:, :, :), chain(:), left(:), right(:), sides(:)
         integer, allocatable :: moved(:, :)
         ! The gap-holders (links) and the copies between each one's follower and leader.
