@@ -169,22 +169,12 @@ contains
     function textile_hint(document) result(hint)
         type(xml_document_type), intent(in) :: document
         character(len=:), allocatable :: hint
-        integer, allocatable :: roots(:), textiles(:)
-        character(len=:), allocatable :: value
         real(wp) :: thickness, width
-        logical :: present
-        integer :: stat(2)
+        logical :: knit, sized
 
         hint = ''
-        roots = document%children(0, 'TexGenModel')
-        textiles = document%children(roots(1), 'Textile')
-        call document%attribute(textiles(1), 'type', value, present)
-        if (value /= 'CTextileWeftKnit') return
-        call document%attribute(textiles(1), 'YarnThickness', value, present)
-        read(value, *, iostat=stat(1)) thickness
-        call document%attribute(textiles(1), 'CourseWidth', value, present)
-        read(value, *, iostat=stat(2)) width
-        if (any(stat /= 0)) return
+        call get_weft_knit_sizes(document, knit, sized, thickness, width)
+        if (.not. (knit .and. sized)) return
         hint = '; CTextileWeftKnit: give a YarnThickness (here ' // format_real(thickness) &
             // ') below CourseWidth / 2 (here ' // format_real(0.5_wp * width) // ')'
     end function textile_hint
@@ -196,25 +186,12 @@ contains
         type(xml_document_type), intent(in) :: document
         integer, intent(in) :: n_contacts
         type(error_type), allocatable, intent(out) :: error
-        integer, allocatable :: roots(:), textiles(:)
-        character(len=:), allocatable :: value
         real(wp) :: thickness, width
-        logical :: present
-        integer :: stat(2)
+        logical :: knit, sized
 
         if (n_contacts >= 2) return
-        roots = document%children(0, 'TexGenModel')
-        textiles = document%children(roots(1), 'Textile')
-        call document%attribute(textiles(1), 'type', value, present)
-        if (value /= 'CTextileWeftKnit') return
-        call document%attribute(textiles(1), 'YarnThickness', value, present)
-        read(value, *, iostat=stat(1)) thickness
-        call document%attribute(textiles(1), 'CourseWidth', value, present)
-        read(value, *, iostat=stat(2)) width
-        if (any(stat /= 0)) then
-            thickness = 0.0_wp
-            width = 0.0_wp
-        end if
+        call get_weft_knit_sizes(document, knit, sized, thickness, width)
+        if (.not. knit) return
         call fatal_error(error, 'TexGen yarn 0 (CTextileWeftKnit): ' &
             // format_integer(n_contacts) // ' contact(s) found in the cell, where the ' &
             // 'head of a loop holds the loop above by its two legs (2 contacts): the ' &
@@ -223,6 +200,35 @@ contains
             // '(YarnThickness ' // format_real(thickness) // '), are not told apart; ' &
             // 'give a smaller YarnThickness')
     end subroutine check_weft_knit
+
+    !> Whether the file's textile is TexGen's CTextileWeftKnit, and its YarnThickness and
+    !> CourseWidth (`sized`: both read; else 0).
+    subroutine get_weft_knit_sizes(document, knit, sized, thickness, width)
+        type(xml_document_type), intent(in) :: document
+        logical, intent(out) :: knit, sized
+        real(wp), intent(out) :: thickness, width
+        integer, allocatable :: roots(:), textiles(:)
+        character(len=:), allocatable :: value
+        logical :: present
+        integer :: stat(2)
+
+        thickness = 0.0_wp
+        width = 0.0_wp
+        sized = .false.
+        roots = document%children(0, 'TexGenModel')
+        textiles = document%children(roots(1), 'Textile')
+        call document%attribute(textiles(1), 'type', value, present)
+        knit = value == 'CTextileWeftKnit'
+        if (.not. knit) return
+        call document%attribute(textiles(1), 'YarnThickness', value, present)
+        read(value, *, iostat=stat(1)) thickness
+        call document%attribute(textiles(1), 'CourseWidth', value, present)
+        read(value, *, iostat=stat(2)) width
+        sized = all(stat == 0)
+        if (sized) return
+        thickness = 0.0_wp
+        width = 0.0_wp
+    end subroutine get_weft_knit_sizes
 
     !> Master nodes at the position of the one before (within `tolerance`) are dropped:
     !> TexGen accepts them, but their span has no length, nor a direction to sample.
