@@ -8,18 +8,23 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from yarnfort.calibrate import (CONDITION_LIMIT, IdentifiabilityWarning, _uncertainty,
-                                calibrate, plot_fit, read_measured, simulated_force,
+from yarnfort.calibrate import (CONDITION_LIMIT, IdentifiabilityWarning, _problems,
+                                _uncertainty, calibrate, plot_fit, read_measured, simulated_force,
                                 write_synthetic_curve)
 from yarnfort.results import Curve
-from yarnfort import program_path
+from yarnfort import LoadPath, Scene, program_path
 
 TOP = Path(__file__).resolve().parents[2]
 CAPSTAN = TOP / "inputs" / "capstan.nml"
+BELT = TOP / "inputs" / "belt.nml"
 MU = "contact[0].friction_coefficient"
 BETA = "contact[0].adhesion"
 TRUTH = {MU: 0.3, BETA: 0.05}
 START = {MU: (0.2, 0.01, 1.0), BETA: (0.1, 0.0, 0.5)}
+WD, SD = "contact[0].decay_start", "contact[0].decay_end"
+TRUTH_DECAY = {WD: 0.1, SD: 0.4}
+#: A knot of the belt's gap-factor table (0.8 in inputs/belt.nml).
+GAP = "fabric.gap_factor[1]"
 #: Uniform continuation steps: 20 loading and 20 unloading points.
 COARSE = {"solver.max_step": 0.05, "solver.initial_step": 0.05}
 #: Relative noise on the synthetic force, and the accepted relative error of a fit.
@@ -168,3 +173,82 @@ def test_uncertainty_of_a_known_jacobian():
     _, uncertainty, _ = _uncertainty(np.array([[1.0, 0.0], [1.0, 0.0]]), 0.5,
                                      CONDITION_LIMIT)
     assert np.isfinite(uncertainty[0]) and np.isinf(uncertainty[1])
+
+
+def test_problems_name_what_is_not_identifiable():
+    names = ("contact[0].friction_coefficient", "contact[0].adhesion")
+    correlation = np.array([[1.0, -0.999], [-0.999, 1.0]])
+    found = _problems(names, np.array([0.4, 0.01]), np.array([0.01, 0.02]), correlation,
+                      2 * CONDITION_LIMIT, CONDITION_LIMIT, np.array([0, 1]))
+    assert any("contact[0].adhesion = 0.01 has an uncertainty 0.02 larger than its value"
+               in text for text in found)
+    assert any("contact[0].adhesion = 0.01 is at its upper bound" in text for text in found)
+    assert any("near-singular" in text and "(-0.9990)" in text for text in found)
+    assert not any(text.startswith("contact[0].friction_coefficient") for text in found)
+
+
+def test_decaying_adhesion_fitted_over_two_cycles_in_lab_units(tmp_path):
+    # A Scene (not a file), two load cycles, the data in % and cN: fit w_d and s_d.
+    scene = Scene.read(CAPSTAN)
+    contact = scene.contacts[0]
+    contact.law, contact.adhesion = "decaying_adhesion", 0.2
+    contact.decay_start, contact.decay_end = TRUTH_DECAY[WD], TRUTH_DECAY[SD]
+    scene.path = LoadPath(time=[0, 1, 2, 3, 4], p_disp=[0, 1, 0, 1, 0])
+    scene.solver.update({"max_step": 0.1, "initial_step": 0.1})
+    # Strain = pull / yarn length: 0.3 m over about 5 m.
+    options = dict(support="pull", force_scale=-1.0, x_scale=0.06)
+    csv = write_synthetic_curve(scene, {}, tmp_path / "lab.csv", strain_unit="%",
+                                force_unit="cN", noise=NOISE, seed=2, **options)
+    header = [line for line in csv.read_text().splitlines() if not line.startswith("#")][0]
+    assert header == "strain (%),force (cN),branch"
+    fit = calibrate(scene, csv, {WD: (0.2, 0.0, 0.25), SD: (0.3, 0.26, 0.8)},
+                    errors="relative", **options)
+    truth = np.array([TRUTH_DECAY[name] for name in fit.names])
+    error = fit.values - truth
+    print(fit.summary())
+    assert fit.measured.n_branches == 4 and fit.measured.signs == [1, -1, 1, -1]
+    assert np.all(np.abs(error) <= COVERAGE * fit.uncertainty)
+    assert np.all(np.abs(error) <= 0.1 * truth)
+    assert not fit.problems
+    # Forces in the data's unit: the fitted curve is within a few % of the cN values
+    # (where the yarn has tension: it goes slack at the end of each release).
+    assert fit.force_unit == "cN" and "cN" in fit.summary()
+    loaded = fit.force != 0
+    assert np.median(np.abs(fit.fitted_force[loaded] / fit.force[loaded] - 1)) < 2 * NOISE
+    # sigma is the relative error of the points: about the noise.
+    assert 0.5 * NOISE < fit.sigma < 2 * NOISE
+
+
+def test_a_gap_factor_knot_is_fitted_on_the_belt(tmp_path, monkeypatch):
+    monkeypatch.chdir(TOP)  # the belt's tables are relative to the repository root
+    coarse = {"solver.max_step": 0.1}
+    csv = write_synthetic_curve(BELT, {GAP: 0.8, **coarse}, tmp_path / "belt.csv",
+                                strain_unit="%", force_unit="N/mm", noise=NOISE, seed=4)
+    fit = calibrate(BELT, csv, {GAP: (0.95, 0.3, 1.0)}, errors="relative", fixed=coarse)
+    print(fit.summary())
+    assert fit.measured.per_width and fit.force_unit == "N/mm"
+    assert abs(fit.values[0] - 0.8) <= COVERAGE * fit.uncertainty[0]
+    assert abs(fit.values[0] - 0.8) <= 0.05 * 0.8
+
+
+def test_a_parameter_without_effect_is_reported(synthetic):
+    # The pegs' stiffness: both ends of every peg are held, so the curve ignores it.
+    with pytest.warns(IdentifiabilityWarning, match="material\\[1\\].stiffness: the data "
+                      "do not determine it"):
+        fit = calibrate(CAPSTAN, synthetic, {MU: (0.25, 0.01, 1.0),
+                                             "material[1].stiffness": (10.0, 5.0, 20.0)},
+                        support="pull", force_scale=-1.0, fixed={**COARSE, BETA: 0.05},
+                        max_nfev=3)  # the verdict needs a Jacobian, not a converged fit
+    assert np.isinf(fit.uncertainty[1]) and np.isfinite(fit.uncertainty[0])
+    assert "NOT IDENTIFIABLE" in fit.summary()
+
+
+def test_force_per_sample_against_force_per_width_needs_the_width(tmp_path, monkeypatch):
+    monkeypatch.chdir(TOP)
+    csv = tmp_path / "sample.csv"
+    csv.write_text("strain (%),force (N)\n1,2\n2,4\n3,6\n")
+    with pytest.raises(ValueError, match="the model gives a force per width, the data a "
+                       "force \\(N\\): give the sample's width"):
+        calibrate(BELT, csv, {GAP: (0.9, 0.3, 1.0)})
+    with pytest.raises(ValueError, match="errors 'poisson'"):
+        calibrate(BELT, csv, {GAP: (0.9, 0.3, 1.0)}, width=0.01, errors="poisson")
