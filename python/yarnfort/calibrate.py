@@ -494,13 +494,19 @@ def simulated_force(curve: Curve, strain: np.ndarray, branch: np.ndarray, *,
 
 @contextlib.contextmanager
 def _scene_file(scene: Any) -> Iterator[Path]:
-    """A namelist path for a :class:`~yarnfort.Scene` (written to a temporary folder) or
-    for a path (as given)."""
+    """A namelist path for a :class:`~yarnfort.Scene` or an f90nml namelist (written to a
+    temporary folder), or for a path (as given)."""
     if isinstance(scene, (str, os.PathLike)):
         yield Path(scene)
         return
+    if not isinstance(scene, f90nml.Namelist) and not hasattr(scene, "to_namelist"):
+        raise TypeError(f"scene: expected a Scene, a namelist or a path, got "
+                        f"{type(scene).__name__}")
     with tempfile.TemporaryDirectory(prefix="yarnfort-scene-") as folder:
-        yield scene.write(Path(folder) / "scene.nml")
+        path = Path(folder) / "scene.nml"
+        nml = scene if isinstance(scene, f90nml.Namelist) else scene.to_namelist()
+        nml.write(str(path), force=True)
+        yield path
 
 
 def _conversion(measured: Measured, model_per_width: bool, width: float | None) -> float:
@@ -576,8 +582,9 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
 
     Parameters
     ----------
-    scene : Scene or path
-        The scene: a :class:`~yarnfort.Scene` or its namelist file.
+    scene : Scene, f90nml.Namelist or path
+        The scene: a :class:`~yarnfort.Scene`, a namelist (:func:`yarnfort.read_scene`)
+        or a namelist file.
     measured : path or Measured
         The measured curve (see :func:`read_measured`).
     parameters : dict
@@ -795,7 +802,7 @@ def write_synthetic_curve(scene: Any, values: Mapping[str, Any], path: str | os.
 
     Parameters
     ----------
-    scene : Scene or path
+    scene : Scene, f90nml.Namelist or path
         The scene.
     values : mapping
         Parameter address -> value of the "true" parameters.
