@@ -39,6 +39,16 @@ square, has no digit left) the directions below it count as undetermined (infini
 variance). An :class:`IdentifiabilityWarning` is issued, and the problems listed in
 :attr:`CalibrationResult.problems`, when an uncertainty exceeds its value, the
 condition number exceeds the limit, or a parameter ends at a bound.
+
+The derivative check
+--------------------
+A frictional curve can ripple with a parameter: nearby values take different load steps
+(step cuts) and find different nearby frictional equilibria. A forward difference at a
+small step then measures the ripple, not the trend, and the uncertainty from it can be
+far too small. So after the fit, J is computed again by central differences at
+:data:`CHECK_STEP_FACTOR` times ``diff_step`` (2 n more runs); the covariance comes from
+that one, and a parameter whose two derivative columns differ by more than
+:data:`SMOOTHNESS_TOLERANCE` is reported as not smooth.
 """
 from __future__ import annotations
 
@@ -75,6 +85,12 @@ CONDITION_LIMIT = 1.0 / np.sqrt(np.finfo(float).eps)
 #: With ``errors='relative'``, forces below this fraction of the largest count as that:
 #: relative errors of forces near zero would otherwise dominate the fit.
 RELATIVE_FLOOR = 1.0e-3
+#: The uncertainty comes from central differences at this many times ``diff_step``,
+#: checked against the fit's forward differences; a column differing by more than
+#: SMOOTHNESS_TOLERANCE (relative) means the curve ripples with the parameter
+#: (docs/decisions.md, "Calibration: the derivative check").
+CHECK_STEP_FACTOR = 10.0
+SMOOTHNESS_TOLERANCE = 0.1
 #: Names accepted for the branch column of a measured CSV.
 BRANCH_COLUMNS = ("branch", "direction", "sign")
 #: The model quantity of a fabric, and its abscissa.
@@ -84,7 +100,8 @@ _COMPONENTS = {"x": 0, "y": 1, "z": 2}
 
 class IdentifiabilityWarning(UserWarning):
     """A fitted parameter that the data do not determine: its uncertainty exceeds its
-    value, the Jacobian is near-singular, or it ended at a bound."""
+    value, the Jacobian is near-singular, it ended at a bound, or the curve ripples with
+    it (see the module notes)."""
 
 
 @dataclass
@@ -148,6 +165,9 @@ class CalibrationResult:
         Covariance sigma^2 (J^T J)^-1 of the fitted values, and the correlation matrix.
     condition_number : float
         Of the Jacobian with its columns scaled to unit length.
+    derivative_mismatch : numpy.ndarray
+        Per parameter, the relative difference of the curve's derivative at the fit's
+        finite-difference step and at the check's (see the module notes).
     problems : tuple of str
         Why a parameter is not identifiable (empty when all are); also warned about.
     residual_norm : float
@@ -182,6 +202,7 @@ class CalibrationResult:
     covariance: np.ndarray
     correlation: np.ndarray
     condition_number: float
+    derivative_mismatch: np.ndarray
     problems: tuple[str, ...]
     residual_norm: float
     sigma: float
@@ -245,7 +266,8 @@ class CalibrationResult:
                      f"{m.n_branches} branches ({cycles} loading), {self.n_runs} runs, "
                      f"{self.wall_time:.1f} s")
         lines.append(f"Jacobian condition number {self.condition_number:.3g} "
-                     "(columns scaled to unit length)")
+                     "(columns scaled to unit length); derivatives at two steps differ by "
+                     + ", ".join(f"{d:.1%}" for d in self.derivative_mismatch))
         lines += [f"NOT IDENTIFIABLE: {text}" for text in self.problems]
         return "\n".join(lines)
 
@@ -544,6 +566,24 @@ def _uncertainty(jac: np.ndarray, sigma2: float, limit: float
     return covariance, uncertainty, condition
 
 
+def _central_jacobian(residual: Any, z: np.ndarray, step: float) -> np.ndarray:
+    """Central differences of ``residual`` at ``z`` (within [0, 1]; one-sided at a
+    bound), 2 n evaluations."""
+    columns = []
+    for k in range(z.size):
+        up, down = z.copy(), z.copy()
+        up[k], down[k] = min(z[k] + step, 1.0), max(z[k] - step, 0.0)
+        columns.append((residual(up) - residual(down)) / (up[k] - down[k]))
+    return np.column_stack(columns)
+
+
+def _mismatch(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Per column, |a - b| / max(|a|, |b|) (0 for two zero columns)."""
+    difference = np.linalg.norm(first - second, axis=0)
+    size = np.maximum(np.linalg.norm(first, axis=0), np.linalg.norm(second, axis=0))
+    return np.divide(difference, size, out=np.zeros_like(size), where=size > 0)
+
+
 def _problems(names: tuple[str, ...], values: np.ndarray, uncertainty: np.ndarray,
               correlation: np.ndarray, condition: float, limit: float,
               active: np.ndarray) -> list[str]:
@@ -708,22 +748,31 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
                             xtol=tolerance, gtol=tolerance, verbose=verbose)
         values = lower + span * fit.x
         curve = simulate(values)
+        wide = _central_jacobian(residual, fit.x, CHECK_STEP_FACTOR * diff_step)
     ssr = float(fit.fun @ fit.fun)
     sigma2 = ssr / (m - n)
     fitted = model(curve)
-    covariance, uncertainty, condition = _uncertainty(fit.jac / span, sigma2,
-                                                      condition_limit)
+    mismatch = _mismatch(fit.jac, wide)
+    covariance, uncertainty, condition = _uncertainty(wide / span, sigma2, condition_limit)
     with np.errstate(divide="ignore", invalid="ignore"):
         correlation = covariance / np.outer(uncertainty, uncertainty)
     problems = _problems(names, values, uncertainty, correlation, condition,
                          condition_limit, fit.active_mask)
+    problems += [f"{name}: the curve does not change smoothly with it (derivatives at "
+                 f"steps {diff_step:g} and {CHECK_STEP_FACTOR * diff_step:g} of its range "
+                 f"differ by {difference:.0%}), so the fit may sit on a step-to-step "
+                 "ripple and the uncertainty is a rough guide; a fixed load step "
+                 "(solver.initial_step = solver.max_step) or tighter tolerances help"
+                 for name, difference in zip(names, mismatch)
+                 if difference > SMOOTHNESS_TOLERANCE]
     if problems:
         warnings.warn("calibration: " + "; ".join(problems), IdentifiabilityWarning,
                       stacklevel=2)
     x, force = _model_curve(curve, support, index, x_column, x_scale, force_scale)
     return CalibrationResult(
         names=names, values=values, uncertainty=uncertainty, covariance=covariance,
-        correlation=correlation, condition_number=condition, problems=tuple(problems),
+        correlation=correlation, condition_number=condition, derivative_mismatch=mismatch,
+        problems=tuple(problems),
         residual_norm=float(np.linalg.norm(fitted - target)), sigma=float(np.sqrt(sigma2)),
         errors=errors, n_runs=runs,
         wall_time=time.perf_counter() - started, success=bool(fit.success),
