@@ -194,6 +194,8 @@ class CalibrationResult:
     curve_strain, curve_force, curve_direction : numpy.ndarray
         The whole simulated curve with the fitted values (strain in SI, force in the
         data's unit).
+    width : float or None
+        The sample width (m) that converted between force and force per width.
     """
 
     names: tuple[str, ...]
@@ -216,6 +218,7 @@ class CalibrationResult:
     curve_strain: np.ndarray
     curve_force: np.ndarray
     curve_direction: np.ndarray
+    width: float | None = None
 
     @property
     def strain_unit(self) -> str:
@@ -761,8 +764,8 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
     problems += [f"{name}: the curve does not change smoothly with it (derivatives at "
                  f"steps {diff_step:g} and {CHECK_STEP_FACTOR * diff_step:g} of its range "
                  f"differ by {difference:.0%}), so the fit may sit on a step-to-step "
-                 "ripple and the uncertainty is a rough guide; a fixed load step "
-                 "(solver.initial_step = solver.max_step) or tighter tolerances help"
+                 "ripple and the uncertainty is a rough guide (smaller load steps or "
+                 "tighter solver tolerances may smooth the curve)"
                  for name, difference in zip(names, mismatch)
                  if difference > SMOOTHNESS_TOLERANCE]
     if problems:
@@ -777,12 +780,15 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
         errors=errors, n_runs=runs,
         wall_time=time.perf_counter() - started, success=bool(fit.success),
         message=str(fit.message), measured=data, fitted_force=fitted,
-        curve_strain=x, curve_force=to_data * force, curve_direction=curve["direction"])
+        curve_strain=x, curve_force=to_data * force, curve_direction=curve["direction"],
+        width=width if data.per_width != (support is None) else None)
 
 
-def _force_label(measured: Measured) -> str:
-    kind = "force per width" if measured.per_width else "force"
-    return f"{kind} ({measured.force_unit})"
+def _force_label(measured: Measured, width: float | None) -> str:
+    if measured.per_width:
+        return f"force per width ({measured.force_unit})"
+    sample = f" per sample {width * 1e3:.4g} mm wide" if width else ""
+    return f"force{sample} ({measured.force_unit})"
 
 
 def plot_fit(result: CalibrationResult, path: str | os.PathLike,
@@ -825,7 +831,7 @@ def plot_fit(result: CalibrationResult, path: str | os.PathLike,
     ax.set_title(f"{title}\n{fitted}", fontsize=9)
     unit = data.strain_unit
     ax.set_xlabel("strain" if unit in ("1", "", "-") else f"strain ({unit})")
-    ax.set_ylabel(_force_label(data))
+    ax.set_ylabel(_force_label(data, result.width))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     fig.tight_layout()
