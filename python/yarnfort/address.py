@@ -190,8 +190,8 @@ def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Name
 
     A variable the group lacks is added; a group the scene lacks is added for an address
     without an index (or index 0). An entry (``'fabric.gap_factor[1]'``) is set in a list
-    that the scene has; the other entries are kept. An integer given for a variable that holds a real is
-    stored as a real; numpy values become Python values.
+    that the scene has; the other entries are kept. An integer given for a variable that
+    holds a real is stored as a real; numpy values become Python values.
 
     Parameters
     ----------
@@ -210,7 +210,8 @@ def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Name
     Raises
     ------
     AddressError
-        If the address is malformed or selects no group.
+        If the address is malformed or selects no group, or names an entry of a list
+        that is not set or is shorter.
     """
     where = parse_address(address)
     value = _plain(value)

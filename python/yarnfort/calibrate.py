@@ -23,18 +23,18 @@ branch's simulated range take its end value.
 
 Uncertainty and identifiability
 -------------------------------
-Each residual evaluation is one run of the program (see :mod:`yarnfort.sweep`); the
-Jacobian J is by forward differences (``scipy.optimize.least_squares``) on the
-parameters mapped to [0, 1] over their bounds, so ``diff_step`` is a fraction of each
+Each residual evaluation is one run of the program (see :mod:`yarnfort.sweep`); the fit
+(``scipy.optimize.least_squares``) works on the parameters mapped to [0, 1] over their
+bounds with a forward-difference Jacobian, so ``diff_step`` is a fraction of each
 parameter's range. With sigma^2 = SSR / (m - n) (m points, n parameters) the covariance
-is sigma^2 (J^T J)^-1, from the SVD of J with its columns scaled to unit length; it
-assumes independent errors of equal variance and a model that fits. Errors that grow
-with the force (a load cell's relative accuracy, noise of a few % of the reading) break
-that assumption: the stated uncertainties are then too small where the large forces
-carry the information. ``errors='relative'`` divides each residual by its measured force
-(weighted least squares), so that sigma is a relative error and the covariance holds. The condition number
-of that scaled J measures how nearly one parameter's effect on the curve is a mix of the
-others'. Beyond :data:`CONDITION_LIMIT` (1/sqrt(epsilon): J^T J, whose condition is the
+is sigma^2 (J^T J)^-1, J from the derivative check below, through the SVD of J with its
+columns scaled to unit length; it assumes independent errors of equal variance and a
+model that fits. Errors that grow with the force (a load cell's relative accuracy, noise
+of a few % of the reading) break that assumption and misstate the uncertainties:
+``errors='relative'`` divides each residual by its measured force (weighted least
+squares), so that sigma is a relative error and the covariance holds. The condition
+number of the scaled J measures how nearly one parameter's effect on the curve is a mix
+of the others'. Beyond :data:`CONDITION_LIMIT` (1/sqrt(epsilon): J^T J, whose condition is the
 square, has no digit left) the directions below it count as undetermined (infinite
 variance). An :class:`IdentifiabilityWarning` is issued, and the problems listed in
 :attr:`CalibrationResult.problems`, when an uncertainty exceeds its value, the
@@ -357,10 +357,11 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     with open(path, newline="") as stream:
         numbered = [(number, line) for number, line in enumerate(stream, start=1)
                     if not line.startswith("#")]
-    reader = csv.reader(line for _, line in numbered)
-    rows = [row for row in reader if any(cell.strip() for cell in row)]
-    # The file line of each data row (the header is the first uncommented line).
-    lines = [number for number, line in numbered[1:] if line.strip()]
+    # Each non-blank row with its file line (the header is the first of them).
+    records = [(number, row) for number, line in numbered
+               for row in csv.reader([line]) if any(cell.strip() for cell in row)]
+    lines = [number for number, _ in records[1:]]
+    rows = [row for _, row in records]
     if len(rows) < 2:
         raise ValueError(f"{path}: no data rows")
     try:
@@ -382,14 +383,14 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     cycle_at = position.get("cycle")
     strain, force, signs, cycles = [], [], [], []
     for number, row in zip(lines, rows[1:]):
-        cell = (lambda k: row[k] if k < len(row) else "")
+        cell = row + [""] * (len(header) - len(row))  # a short row's missing cells
         try:
-            strain.append(_number(cell(position["strain"]), "strain"))
-            force.append(_number(cell(position["force"]), "force"))
+            strain.append(_number(cell[position["strain"]], "strain"))
+            force.append(_number(cell[position["force"]], "force"))
             if branch_at is not None:
-                signs.append(_branch_value(cell(branch_at)))
+                signs.append(_branch_value(cell[branch_at]))
             if cycle_at is not None:
-                cycles.append(_number(cell(cycle_at), "cycle"))
+                cycles.append(_number(cell[cycle_at], "cycle"))
         except ValueError as error:
             raise ValueError(f"{path}, line {number}: {error}") from None
     strain_array = s_factor * np.array(strain)

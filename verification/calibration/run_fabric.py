@@ -61,7 +61,8 @@ def belt_data(seed: int, path: Path) -> Path:
 
 
 def errors_in_u(result, truth) -> str:
-    return ", ".join(f"{name}: {(v - truth[name]) / u:+.2f} u ({(v - truth[name]) / truth[name]:+.2%})"
+    return ", ".join(f"{name}: {(v - truth[name]) / u:+.2f} u "
+                     f"({(v - truth[name]) / truth[name]:+.2%})"
                      for name, v, u in zip(result.names, result.values, result.uncertainty))
 
 
