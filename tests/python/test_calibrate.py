@@ -8,8 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from yarnfort.calibrate import (CONDITION_LIMIT, IdentifiabilityWarning, _problems,
-                                _uncertainty, calibrate, plot_fit, read_measured, simulated_force,
+from yarnfort.calibrate import (CONDITION_LIMIT, IdentifiabilityWarning,
+                                _central_jacobian, _mismatch, _problems, _uncertainty,
+                                calibrate, plot_fit, read_measured, simulated_force,
                                 write_synthetic_curve)
 from yarnfort.results import Curve
 from yarnfort import LoadPath, Scene, program_path
@@ -252,3 +253,23 @@ def test_force_per_sample_against_force_per_width_needs_the_width(tmp_path, monk
         calibrate(BELT, csv, {GAP: (0.9, 0.3, 1.0)})
     with pytest.raises(ValueError, match="errors 'poisson'"):
         calibrate(BELT, csv, {GAP: (0.9, 0.3, 1.0)}, width=0.01, errors="poisson")
+
+
+def test_the_derivative_check_differences_and_compares_columns():
+    # A quadratic residual: central differences are exact for it, one-sided ones at a
+    # bound are off by the step (d/dz of z^2 at 1 from [1 - h, 1]: 2 - h).
+    a = np.array([[1.0, 2.0], [3.0, -1.0], [0.5, 0.0]])
+
+    def residual(z):
+        return a @ z + np.array([0.0, 0.0, z[1] ** 2])
+
+    step = 0.01
+    inside = _central_jacobian(residual, np.array([0.3, 0.6]), step)
+    np.testing.assert_allclose(inside, a + [[0, 0], [0, 0], [0, 1.2]], rtol=1e-12,
+                               atol=1e-12)
+    at_bound = _central_jacobian(residual, np.array([0.3, 1.0]), step)
+    assert at_bound[2, 1] == pytest.approx(2.0 - step, rel=1e-9)
+    # Equal columns agree; a column against its negative differs by 2 (relative).
+    np.testing.assert_allclose(_mismatch(a, a), [0.0, 0.0])
+    np.testing.assert_allclose(_mismatch(a, a * [1.0, -1.0]), [0.0, 2.0])
+    assert _mismatch(np.zeros((2, 1)), np.zeros((2, 1)))[0] == 0.0
