@@ -368,7 +368,7 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
         header = [split_header(cell) for cell in rows[0]]
     except ValueError as error:
         raise ValueError(f"{path}: {error}") from None
-    position = {name: k for k, (name, _) in enumerate(header)}
+    position = {name.lower(): k for k, (name, _) in enumerate(header)}
     missing = [name for name in ("strain", "force") if name not in position]
     if missing:
         raise ValueError(f"{path}: missing column(s) {', '.join(missing)}")

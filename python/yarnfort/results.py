@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import csv
 import errno
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -151,10 +152,12 @@ class Curve:
         Raises
         ------
         ImportError
-            If pandas is not installed.
+            If pandas is not installed (the message names ``pip install
+            'yarnfort[pandas]'``).
         """
-        import pandas
+        from ._extras import import_extra
 
+        pandas = import_extra("pandas", "pandas", "Curve.to_dataframe")
         return pandas.DataFrame(self.columns)
 
 
@@ -334,7 +337,8 @@ def read_curve(path: str | Path) -> Curve:
     Returns
     -------
     Curve
-        Every column as floats; a file with only its header gives a curve of 0 rows.
+        The integer columns (``step``, ``direction``, counts) as integers, the others as
+        floats; a file with only its header gives a curve of 0 rows.
 
     Raises
     ------
@@ -345,6 +349,10 @@ def read_curve(path: str | Path) -> Curve:
         If the file cannot be read.
     """
     return _read_csv(_curve_file(path), ())
+
+
+#: A cell written as an integer.
+_INTEGER = re.compile(r"^\s*[+-]?\d+\s*$")
 
 
 def _read_csv(path: Path, text_columns: tuple[str, ...]) -> Curve:
@@ -378,6 +386,11 @@ def _read_csv(path: Path, text_columns: tuple[str, ...]) -> Curve:
         values.append(parsed)
     table = np.array(values, dtype=float).reshape(len(values), len(numeric))
     columns = {name: table[:, k].copy() for k, name in enumerate(numeric)}
+    # A column the program writes as integers (no point, no exponent) is one.
+    for k, name in enumerate(numeric):
+        cells = [row[header.index(name)] for row in rows[1:] if row]
+        if cells and all(_INTEGER.match(cell) for cell in cells):
+            columns[name] = table[:, k].astype(np.int64)
     columns.update({name: np.array(cells, dtype=str) for name, cells in texts.items()})
     return Curve({name: columns[name] for name in header}, path)
 
@@ -519,8 +532,9 @@ def read_states(folder: str | Path) -> list[State]:
                                           key=lambda p: int(p.stem[len("state_"):]))]
 
 
-def read_run(folder: str | Path) -> tuple[Curve, list[State]]:
-    """The curve and every written state of an output folder.
+def read_run(folder: str | Path) -> Any:
+    """An output folder as a :class:`~yarnfort.RunResult`, the type
+    :func:`~yarnfort.run_scene` returns: ``.curve``, ``.states``, ``.to_dataframe()``.
 
     Parameters
     ----------
@@ -529,7 +543,18 @@ def read_run(folder: str | Path) -> tuple[Curve, list[State]]:
 
     Returns
     -------
-    curve : Curve
-    states : list of State
+    RunResult
+        ``outcome`` is ``'read'`` (not run here), ``n_steps`` the rows of its curve.
+
+    Raises
+    ------
+    ResultError
+        If the folder holds no readable ``curve.csv``.
     """
-    return read_curve(folder), read_states(folder)
+    from .runner import RunResult
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ResultError(f"no output folder {str(folder)!r}")
+    curve = read_curve(folder)
+    return RunResult(folder.resolve(), len(curve), "read")

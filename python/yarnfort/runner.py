@@ -96,7 +96,8 @@ class RunResult:
         ``'done'`` (the load path's end reached), ``'max_steps'`` (stopped by
         ``&control max_steps``), ``'stopped'`` (stopped by the call-back),
         ``'interrupted'`` (Ctrl-C) or ``'failed'`` (a failed solve; see
-        :class:`~yarnfort.YarnfortError`).
+        :class:`~yarnfort.YarnfortError`); ``'read'`` for a folder read by
+        :func:`~yarnfort.read_run`.
     """
 
     folder: Path
@@ -265,5 +266,5 @@ def _warn_of_jumps(result: RunResult) -> None:
     if steps:
         warnings.warn(f"{len(steps)} step(s) ended in a jump after a slip instability "
                       f"(steps {', '.join(map(str, steps))}; curve.csv column 'jumped'; "
-                      "inputs/REFERENCE.md, Slip instabilities)", RuntimeWarning,
+                      "python -m yarnfort reference: Slip instabilities)", RuntimeWarning,
                       stacklevel=3)

@@ -233,9 +233,30 @@ GROUPS = [
         law_parameter('area', 'm^2', '> 0', ['neo_hookean'],
                       '`neo_hookean`: undeformed cross-section S(1).'),
         Var('table_file', 'character', '', length='path_length', adjust=False, laws=['table'],
-            doc='`table`: CSV file of (strain, force in N). The material code reads it. A '
+            doc='`table`: CSV file of (strain, force). The material code reads it. A '
                 "relative name is taken relative to the input file's folder (the working "
-                'directory when the input comes from standard input).'),
+                'directory when the input comes from standard input). Its units: the header '
+                '(`Elongation (%),Force (cN)`), `strain_unit` and `force_unit`, else 1 and N; '
+                'see *Table files* below.'),
+        Var('strain_unit', 'character', '', length=16, checked_by='table',
+            default_doc="`''` (the header's, else `'1'`)",
+            type_doc="character(16): `'1'`, `'-'`, `'%'`, `'permille'`, or a length: `'m'`, "
+                     "`'cm'`, `'mm'`, `'um'`",
+            doc='`table`: the unit of the strain column, as its header would state it; must '
+                'agree with a unit the header states. A length makes the column an '
+                'elongation, divided by `gauge_length`. Case-sensitive (`permille` in any '
+                'case).'),
+        Var('force_unit', 'character', '', length=16, checked_by='table',
+            default_doc="`''` (the header's, else `'N'`)",
+            type_doc="character(16): `'N'`, `'cN'`, `'mN'`, `'kN'`, `'gf'`, `'kgf'`, `'lbf'`",
+            doc='`table`: the unit of the force column, as its header would state it; must '
+                'agree with a unit the header states. Case-sensitive (`gf`, `kgf`, `lbf` in '
+                'any case).'),
+        Var('gauge_length', 'real', -1.0, unit='m', range='> 0', checked_by='table',
+            default_doc='`-1` (not set)',
+            doc='`table`: initial length of the tensile specimen; required when the strain '
+                'column is an elongation (a length unit), an error otherwise: strain = '
+                'elongation / gauge_length.'),
         Var('prestress', 'real', 0.0, unit='N', range='>= 0',
             doc='Pre-stress: every element of this yarn type starts with reference length L0 = l '
                 '/ lambda_p, where f(lambda_p) = prestress and l is its length in the initial '
@@ -392,6 +413,12 @@ GROUPS = [
           'Node positions and yarns from a plain text file instead of &nodes and &yarn groups.', [
         Var('file', 'character', '', length='path_length', adjust=False, default_doc="`''` (none)",
             doc='Geometry file with the nodes and yarns (format below).'),
+        Var('unit', 'character', '', length=16, checked_by='geometry',
+            default_doc="`''` (the file's, else `'m'`)",
+            type_doc="character(16): `'m'`, `'cm'`, `'mm'`, `'um'`",
+            doc="The length unit of the file's coordinates and `length0` values, converted to "
+                "m (the scene's unit); must agree with the file's `unit` line if it has one. "
+                'Case-sensitive. Requires `file`.'),
     ]),
     Group('yarn', 'repeatable',
           'One yarn, a polyline through node ids, split into elements.', [
