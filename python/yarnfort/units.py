@@ -51,7 +51,18 @@ def find_unit(text: str) -> str | None:
 
 
 def split_header(field: str) -> tuple[str, str | None]:
-    """A column header as (name, unit text), the unit None where it states none."""
+    """A column header as (name, unit text), the unit None where it states none.
+
+    Parameters
+    ----------
+    field : str
+        The header cell (``'Force (cN)'``, ``'strain [%]'``, ``'Force in cN'``).
+
+    Returns
+    -------
+    name : str
+    unit : str or None
+    """
     field = field.strip()
     match = _BRACKETS.match(field)
     if match:
@@ -67,6 +78,19 @@ def split_header(field: str) -> tuple[str, str | None]:
 
 def to_scene_unit(values: np.ndarray, unit: str, kind: str) -> np.ndarray:
     """``values`` in ``unit`` (a spelling of a unit of ``kind``) in the scene's unit.
+
+    Parameters
+    ----------
+    values : array_like
+        The values as given.
+    unit : str
+        Their unit.
+    kind : {'strain', 'force', 'length'}
+        What they are.
+
+    Returns
+    -------
+    numpy.ndarray
 
     Raises
     ------
@@ -85,6 +109,15 @@ def strain_factor(unit: str | None) -> float:
     """Factor from a strain in ``unit`` (``'%'``, ``'permille'``, ``'1'``; None is 1) to a
     strain of 1.
 
+    Parameters
+    ----------
+    unit : str or None
+        The unit.
+
+    Returns
+    -------
+    float
+
     Raises
     ------
     ValueError
@@ -96,6 +129,11 @@ def strain_factor(unit: str | None) -> float:
 def force_factor(unit: str | None) -> tuple[float, bool]:
     """Factor from a force (``'N'``, ``'cN'``, ``'gf'``, ...) or a force per width (a force
     unit over a width unit: ``'N/m'``, ``'cN/cm'``, ``'lbf/in'``) to N or N/m; None is N.
+
+    Parameters
+    ----------
+    unit : str or None
+        The unit.
 
     Returns
     -------
