@@ -50,6 +50,8 @@ module yarnfort_solver_problem
         !> Called by the Newton solver on a converged solution: a problem may reject it
         !> with an error (a spurious root outside its domain). Default: accept.
         procedure :: check_solution
+        !> The largest reference stiffness of the scene's material laws.
+        procedure :: get_max_reference_stiffness
     end type nonlinear_problem_type
 
     abstract interface
@@ -102,5 +104,14 @@ contains
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
     end subroutine check_solution
+
+    !> The largest reference stiffness of the scene's material laws (the Newton
+    !> solver's softened-yarn predictor starts below it).
+    real(wp) function get_max_reference_stiffness(self) result(stiffest)
+        class(nonlinear_problem_type), intent(in) :: self
+        integer :: m
+        stiffest = maxval([(self%scene%laws(m)%law%get_reference_stiffness(), &
+            m = 1, size(self%scene%laws))])
+    end function get_max_reference_stiffness
 
 end module yarnfort_solver_problem
