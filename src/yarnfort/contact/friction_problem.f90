@@ -6,55 +6,21 @@
 !>   stick passage: k (s - s_target), k = the scene's largest force / length_scale;
 !>   slip forward (T_after > T_before, s grows):    T_crit(T_before, alpha) - T_after;
 !>   slip backward (T_before > T_after, s shrinks): T_before - T_crit(T_after, alpha).
-!> (The signs make the residual continuous where the semismooth choice below switches
-!> a passage between stick and slip: there k ds = -g_f, resp. k ds = g_b.)
-!> Each slip row is divided by a weight w = max(1, dT_crit/dT_min), fixed for a Newton
-!> solve from its initial guess (`prepare_solve`), so that it measures the change of the
-!> low-side tension that would satisfy it. Unweighted, the row cannot reach the residual
-!> tolerance once exp(mu alpha) is large: T_min carries a rounding error of about
-!> EA*epsilon (from lambda - 1 near lambda = 1), which T_crit multiplies by
-!> dT_crit/dT_min (measured: mu alpha = 20 stalled at 5e-8 of the largest stiffness).
-!> Rows are judged (get_row_levels) against the forces at their node, the passage's
-!> larger tension / w for a slip row, the largest force for a stick row. With
-!> `semismooth` the weights stay 1 (the modes change within a solve).
 !> Tensions enter the friction conditions as max(T, 0) (a slack string pulls nothing).
-!> With `semismooth` (off by default) the mode of each passage is not fixed from outside
-!> but chosen at every evaluation from the current iterate, as in a primal-dual active
-!> set (semismooth Newton) method: with k ds the scaled flow increment and
-!> g_f = T_after - T_crit(T_before), g_b = T_before - T_crit(T_after),
-!>   forward slip if k ds + g_f > 0, else backward slip if -k ds + g_b > 0, else stick,
-!> which at a solution is exactly the stick/slip complementarity (ds >= 0, g_f <= 0,
-!> ds g_f = 0, and likewise backward). A whole slip front then moves in one Newton
-!> solve instead of one passage per active-set round. Measured on the woven benchmark
-!> net (benchmarks/bench_friction) it made KINSOL cycle on the first load step and cost
-!> 9.6 factorisations per step against 2.5 for the active-set rounds, so the stepper's
-!> rounds (semismooth off) are the default. `locked` forbids a direction (minimum
-!> reference length reached, or chatter damping).
-!> Viscous slip (`viscosity` > 0, off by default; only the slip-instability jump of
-!> friction_stepper sets it): each slip row gets eta (s - s_start) added, eta =
-!> viscosity * stick_scale and s_start = flow_target, so a slipping passage is held
-!> above its limit by an overstress eta ds >= 0 (forward; backward likewise): implicit
-!> Euler steps of a viscoplastic slip law. Where the stepper's rounds find no
-!> consistent stick/slip set for the rate-independent law (a slip instability), the
-!> viscous one is well posed, and the end state of such steps, where ds -> 0, is one
-!> of the exact law.
-!> Neutral modes: a set of slipping passages can let material run along a path without
-!> changing any tension (the yarn round a periodic cell, or a column of contact nodes
-!> sliding along a straight course whose heads and sinkers carry one tension); the
-!> Jacobian is then singular, the factorisation meets pivots of rounding size, and
-!> Newton's steps along the mode are set by rounding. Where it stops there is the same
-!> state of forces, but the flow increments, whose signs the stepper's active-set test
-!> reads, were arbitrary: passages were dropped at random, the rounds cycled, and on the
-!> planar 4 x 2 knit of inputs/knit3d.nml chatter damping ended steps beyond the limit
-!> (benchmarks/steps_results.md, section 7). So the tangent (never the residual) of
-!> each slip row gets neutral_shift times its largest flow derivative added to its own
-!> flow's entry, like the slack strings' spring: the converged answer is that of the
-!> exact law, and along a neutral mode the step now moves the flows as little as the
-!> shift allows instead of by rounding noise, so the solve keeps the flows of its start
-!> there (and the cell's symmetry). Relative 1e-12 is 1e4 times the rounding of a
-!> pivot and perturbs a regular step by 1e-12 of itself; 1e-8 (measured) was enough to
-!> let the stiff frictionless ring of test_defaults (EA = 1e6 times its load) stop at
-!> its residual tolerance 1e-7 away from the closed form instead of failing loudly.
+!> Each slip row is divided by w = max(1, dT_crit/dT_min), fixed per Newton solve
+!> (`prepare_solve`): unweighted, T_min's rounding times dT_crit/dT_min keeps the row
+!> above the tolerance once exp(mu alpha) is large (docs/decisions.md, 'Friction slip
+!> rows weighted per solve'). Rows are judged (get_row_levels) against the forces at
+!> their node, the passage's larger tension / w (slip) or the largest force (stick).
+!> `locked` forbids a direction (minimum reference length reached, or chatter damping).
+!> With `semismooth` (off) the modes are chosen at every evaluation instead
+!> (docs/decisions.md, 'Not kept: semismooth Newton for the slip modes').
+!> Viscous slip (`viscosity` > 0, set only by the stepper's slip-instability jump) adds
+!> eta (s - s_start) to each slip row: implicit Euler steps of a viscoplastic slip law,
+!> well posed where the rate-independent law has no consistent active set.
+!> The tangent (never the residual) of each slip row gets neutral_shift times its
+!> largest flow derivative on its own flow, so that Newton does not move along a
+!> neutral mode of a slipping set by rounding (docs/decisions.md, 'Neutral slip sets').
 module yarnfort_contact_friction_problem
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
