@@ -3,7 +3,6 @@
 !> the parameters of its friction law, and, when any &contact is given, one for every
 !> pair of yarn types that meet at a node.
 module yarnfort_input_contact_checks
-    use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, name_length
     use yarnfort_input_groups, only: check_contact_variables

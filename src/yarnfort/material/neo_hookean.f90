@@ -1,5 +1,6 @@
 ! SPDX-License-Identifier: MIT
-!> Incompressible neo-Hookean string (design notes, eq. 4 of the paper): Cauchy stress
+!> Incompressible neo-Hookean string (the paper's eq. 4, with the deformed cross-section
+!> of an incompressible string S1/lambda, as used here): Cauchy stress
 !> sigma = C*(lambda**2 - 1/lambda) on the deformed cross-section S1/lambda, so the
 !> tension is f = S1*C*(lambda - lambda**(-2)) for lambda > 1, zero when slack.
 module yarnfort_material_neo_hookean
