@@ -1,7 +1,7 @@
 ! SPDX-License-Identifier: MIT
-!> Incompressible neo-Hookean string (the paper's eq. 4, with the deformed cross-section
-!> of an incompressible string S1/lambda, as used here): Cauchy stress
-!> sigma = C*(lambda**2 - 1/lambda) on the deformed cross-section S1/lambda, so the
+!> Incompressible neo-Hookean string (the paper's eq. 4): Cauchy stress
+!> sigma = C*(lambda**2 - 1/lambda) on the deformed cross-section S1/lambda (that of an
+!> incompressible string, whatever the paper's eq. 4 prints), so the
 !> tension is f = S1*C*(lambda - lambda**(-2)) for lambda > 1, zero when slack.
 module yarnfort_material_neo_hookean
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
