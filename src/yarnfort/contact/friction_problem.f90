@@ -32,7 +32,7 @@ module yarnfort_contact_friction_problem
     use yarnfort_assembly_assemble, only: assemble_internal_force, add_element_tangents
     use yarnfort_assembly_scales, only: gather_node_force_levels, get_unknown_levels, &
         node_level_floor
-    use yarnfort_contact_geometry, only: get_wrap_angle
+    use yarnfort_contact_wrap_angle, only: get_wrap_angle
     use yarnfort_solver_problem, only: nonlinear_problem_type
     implicit none
     private

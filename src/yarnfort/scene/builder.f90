@@ -6,7 +6,7 @@ module yarnfort_scene_builder
     use yarnfort_input_config, only: config_type, material_config_type
     use yarnfort_scene_scene, only: scene_type, support_set_type
     use yarnfort_text, only: format_real
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     use yarnfort_material_linear, only: linear_law_type, new_linear_law
     use yarnfort_material_neo_hookean, only: neo_hookean_law_type, new_neo_hookean_law
     use yarnfort_material_table, only: table_law_type, read_table_law
