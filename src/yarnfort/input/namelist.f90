@@ -22,7 +22,6 @@ module yarnfort_input_namelist
     use yarnfort_input_geometry_file, only: read_geometry_file
     use yarnfort_text, only: format_integer, folder_of, resolve_path, open_to_read, join_names
     use yarnfort_input_validate, only: check_config
-    use yarnfort_generate_fabric, only: generate_fabric
     implicit none
     private
 
@@ -110,8 +109,6 @@ contains
                     return
                 end if
             end do
-            call generate_fabric(config, error)
-            if (allocated(error)) return
         end if
         if (.not. allocated(config%links)) allocate(config%links(0))
     end subroutine read_config

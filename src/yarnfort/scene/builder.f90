@@ -20,8 +20,8 @@ module yarnfort_scene_builder
         read_rate_table
     use yarnfort_text, only: resolve_path, quote_string
     use yarnfort_input_config, only: name_length
-    use yarnfort_input_contact_node_checks, only: get_contact_node_sets, find_node_contact
-    use yarnfort_input_channel_checks, only: get_channel_names, get_channel_factors, &
+    use yarnfort_scene_contact_nodes, only: get_contact_node_sets, find_node_contact
+    use yarnfort_scene_channels, only: get_channel_names, get_channel_factors, &
         find_channel, default_force_channel, default_displacement_channel
     implicit none
     private
