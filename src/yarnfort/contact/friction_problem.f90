@@ -33,7 +33,7 @@ module yarnfort_contact_friction_problem
     use yarnfort_assembly_scales, only: gather_node_force_levels, get_unknown_levels, &
         node_level_floor
     use yarnfort_contact_wrap_angle, only: get_wrap_angle
-    use yarnfort_solver_problem, only: nonlinear_problem_type
+    use yarnfort_solver_problem, only: nonlinear_problem_type, regularisation_type, chosen_law
     implicit none
     private
 
@@ -91,9 +91,9 @@ module yarnfort_contact_friction_problem
         !> per load step, the unknowns at every iterate.
         real(wp), allocatable :: x_prescribed(:, :), applied(:), load_factors(:)
         !> What the work arrays were last computed from (update_state): the unknowns, the
-        !> frozen positions, the load factors and the spring weight. A solve asks for the
-        !> same state several times (initial guess, row levels, the last iterate, the
-        !> solution check, the stepper's active-set test); it is computed once.
+        !> frozen positions, the load factors, the law's spring weight and cap. A solve asks
+        !> for the same state several times (initial guess, row levels, the last iterate,
+        !> the solution check, the stepper's active-set test); it is computed once.
         logical :: state_valid = .false.
         real(wp), allocatable :: state_u(:), state_u_frozen(:), state_factors(:)
         real(wp) :: state_spring = 0.0_wp, state_stiffness_cap = 0.0_wp
@@ -108,7 +108,8 @@ module yarnfort_contact_friction_problem
         procedure :: get_force_level
         !> Rounding error of an element's tension at the current state.
         procedure :: get_element_noise
-        !> Split unknowns into position unknowns and flows; set the work arrays.
+        !> Split unknowns into position unknowns and flows; set the work arrays (with
+        !> `law`, default the exact law).
         procedure :: update_state
         !> Tensions (clipped at 0) on both sides and the wrap angle of passage p.
         procedure :: get_passage_state
@@ -260,14 +261,17 @@ contains
     end function get_size
 
     !> Positions, reference lengths, internal forces and tensions for unknowns u.
-    subroutine update_state(self, u, error)
+    subroutine update_state(self, u, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
+        type(regularisation_type) :: used
 
+        used = chosen_law(law)
         if (self%state_valid) then
-            if (self%state_spring == self%spring .and. all(self%state_u == u) &
-                    .and. self%state_stiffness_cap == self%stiffness_cap &
+            if (self%state_spring == used%spring .and. all(self%state_u == u) &
+                    .and. self%state_stiffness_cap == used%stiffness_cap &
                     .and. all(self%state_factors == self%factors)) then
                 if (.not. self%positions_frozen) return
                 if (all(self%state_u_frozen == self%u_frozen)) return
@@ -287,15 +291,15 @@ contains
                     self%length0)
             end if
             call assemble_internal_force(scene, self%x, self%length0, self%internal, &
-                self%tension, self%stretch, error, self%spring, self%rounding, &
-                self%stiffness_cap)
+                self%tension, self%stretch, error, used%spring, self%rounding, &
+                used%stiffness_cap)
         end associate
         if (allocated(error)) return
         self%state_valid = size(u) == self%get_size()
         self%state_u = u
         self%state_factors = self%factors
-        self%state_spring = self%spring
-        self%state_stiffness_cap = self%stiffness_cap
+        self%state_spring = used%spring
+        self%state_stiffness_cap = used%stiffness_cap
         if (self%positions_frozen) self%state_u_frozen = self%u_frozen
     end subroutine update_state
 
@@ -365,14 +369,15 @@ contains
     !> overshot to L0 = -7 m "converged" with zero tension on both sides instead of the
     !> slip solution; the stepper then locked the passage at its minimum length). The
     !> failed solve makes the step be retried (fewer new slips, or a shorter step).
-    subroutine check_solution(self, u, error)
+    subroutine check_solution(self, u, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         integer :: e
         character(len=160) :: buffer
 
-        call self%update_state(u, error)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         if (all(self%length0 > 0.0_wp)) return
         e = findloc(self%length0 > 0.0_wp, .false., dim=1)
@@ -382,15 +387,16 @@ contains
     end subroutine check_solution
 
     !> Fix the slip rows' weights w = max(1, dT_crit/dT_min) at the initial guess u.
-    subroutine prepare_solve(self, u, error)
+    subroutine prepare_solve(self, u, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         integer :: p
         real(wp) :: t_before, t_after, angle, t_min, critical, dcrit_dt, dcrit_da
 
         self%slip_weight = 1.0_wp
-        call self%update_state(u, error)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         ! Stick rows in units of the scene's forces (it only scales the rows).
         self%stick_scale = self%get_force_level() / self%length_scale
@@ -422,17 +428,18 @@ contains
     !> the largest force (a flow to residual_tolerance * length_scale). Slip rows
     !> (T_crit - T_hi) / w: the passage's larger tension / w, floored like the nodes,
     !> and the rounding of T_crit - T_hi.
-    subroutine get_row_levels(self, u, level, noise, error)
+    subroutine get_row_levels(self, u, level, noise, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: level(:), noise(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         real(wp), allocatable :: node_level(:), node_noise(:)
         real(wp) :: max_force, t_before, t_after, angle, t_lo, critical, dcrit_dt, dcrit_da
         real(wp) :: noise_lo, noise_hi
         integer :: p, row, lo, hi
 
-        call self%update_state(u, error)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
         ! From the tensions and their rounding at this state (update_state), not evaluated
@@ -481,15 +488,16 @@ contains
         noise = self%rounding(e)
     end function get_element_noise
 
-    subroutine evaluate_residual(self, u, values, error)
+    subroutine evaluate_residual(self, u, values, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         integer :: p, row
         real(wp) :: t_before, t_after, angle, critical, dcrit_dt, dcrit_da, flow
 
-        call self%update_state(u, error)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         row = 0
         if (.not. self%positions_frozen) row = self%n_x
@@ -521,15 +529,18 @@ contains
         end do
     end subroutine evaluate_residual
 
-    subroutine evaluate_jacobian(self, u, values, error)
+    subroutine evaluate_jacobian(self, u, values, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         integer :: e, p, a, b, slot
         real(wp) :: dforce_dl0(3)
+        type(regularisation_type) :: used
 
-        call self%update_state(u, error)
+        used = chosen_law(law)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         if (self%semismooth) then
             if (self%positions_frozen) then
@@ -544,8 +555,8 @@ contains
                 ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2,
                 ! from the tangents' own evaluation of each element.
                 call add_element_tangents(scene, self%element_slot, self%x, self%length0, &
-                    values, error, self%spring, self%tangent_spring, self%dforce_dl0, &
-                    self%stiffness_cap)
+                    values, error, used%spring, used%tangent_spring, self%dforce_dl0, &
+                    used%stiffness_cap)
                 if (allocated(error)) return
                 do e = 1, net%n_elements()
                     ! L0 changes by share(e) times the flows bounding its segment.
@@ -626,10 +637,10 @@ contains
                     if (abs(lambda - 1.0_wp) > kink_round_off) return
                     t = 0.0_wp
                     dt = capped_stiffness(self%scene%laws(net%element_material(e))%law, &
-                        self%stiffness_cap)
+                        used%stiffness_cap)
                 else
                     call get_truss_tension(self%scene%laws(net%element_material(e))%law, &
-                        self%spring, lambda, t, dt, self%stiffness_cap)
+                        used%spring, lambda, t, dt, used%stiffness_cap)
                 end if
                 gradient(first:first + 2) = -dt / self%length0(e) * c
                 gradient(first + 3:first + 5) = dt / self%length0(e) * c

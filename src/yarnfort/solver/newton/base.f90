@@ -9,6 +9,7 @@ module yarnfort_solver_newton_base
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: solver_config_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_solver_problem, only: regularisation_type
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, analyse_counted, &
         factor_counted, solve_counted
     use yarnfort_solver_newton_stats, only: newton_stats_type
@@ -48,8 +49,7 @@ contains
     !> the tangent of slack strings regularised by slack_stiffness.
     subroutine set_exact_law(self)
         class(newton_base_type), intent(inout) :: self
-        self%problem%problem%spring = 0.0_wp
-        self%problem%problem%tangent_spring = self%options%slack_stiffness
+        self%problem%law = regularisation_type(tangent_spring=self%options%slack_stiffness)
     end subroutine set_exact_law
 
     !> KINSOL's residual scaling from the problem's row levels at the current iterate:
@@ -137,7 +137,7 @@ contains
         if (allocated(error)) return
         ! New row weights (prepare_solve): the kept factors no longer match them.
         self%kept_factorisation = -1
-        call self%problem%problem%prepare_solve(u, error)
+        call self%problem%problem%prepare_solve(u, error, self%problem%law)
         if (allocated(error)) return
         self%u = u
     end subroutine start_newton
@@ -206,7 +206,7 @@ contains
         stats%residual_history = history
         converged = .false.
         if (.not. (f <= self%options%residual_tolerance)) return
-        call self%problem%problem%check_solution(self%u, trial_error)
+        call self%problem%problem%check_solution(self%u, trial_error, self%problem%law)
         converged = .not. allocated(trial_error)
     end subroutine finish_chord
 

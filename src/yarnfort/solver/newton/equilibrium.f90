@@ -1,12 +1,13 @@
 ! SPDX-License-Identifier: MIT
-!> The problem as the Newton solver and KINSOL's callbacks see it: the problem, its
-!> row weights, the convergence history and the assembly's timing.
+!> The problem as the Newton solver and KINSOL's callbacks see it: the problem, the law
+!> it is evaluated with, its row weights, the convergence history and the assembly's
+!> timing.
 module yarnfort_solver_newton_equilibrium
     use, intrinsic :: iso_c_binding, only: c_double
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
-    use yarnfort_solver_problem, only: nonlinear_problem_type
+    use yarnfort_solver_problem, only: nonlinear_problem_type, regularisation_type
     use yarnfort_solver_timer, only: wall_time
     implicit none
     private
@@ -16,6 +17,8 @@ module yarnfort_solver_newton_equilibrium
     !> What KINSOL's callbacks see through their user-data pointer.
     type :: equilibrium_type
         class(nonlinear_problem_type), pointer :: problem => null()
+        !> The law the problem is evaluated with (the exact law, or a predictor's).
+        type(regularisation_type) :: law
         !> Order and nonzeros of the Jacobian (its pattern stays with the problem).
         integer(ik) :: n = 0, nnz = 0
         !> KINSOL's Jacobian matrix holds the pattern (written at its first evaluation).
@@ -50,10 +53,10 @@ contains
         real(wp) :: start
         start = wall_time()
         if (jacobian) then
-            call problem%problem%evaluate_jacobian(u, values, error)
+            call problem%problem%evaluate_jacobian(u, values, error, problem%law)
             problem%jacobian_time = problem%jacobian_time + (wall_time() - start)
         else
-            call problem%problem%evaluate_residual(u, values, error)
+            call problem%problem%evaluate_residual(u, values, error, problem%law)
             problem%residual_time = problem%residual_time + (wall_time() - start)
         end if
     end subroutine evaluate_timed
@@ -66,7 +69,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         real(wp) :: start
         start = wall_time()
-        call problem%problem%get_row_levels(u, level, noise, error)
+        call problem%problem%get_row_levels(u, level, noise, error, problem%law)
         problem%levels_time = problem%levels_time + (wall_time() - start)
     end subroutine get_levels_timed
 

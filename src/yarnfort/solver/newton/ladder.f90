@@ -10,6 +10,7 @@ module yarnfort_solver_newton_ladder
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_text, only: format_short
     use yarnfort_assembly_truss, only: no_stiffness_cap
+    use yarnfort_solver_problem, only: regularisation_type
     use yarnfort_solver_newton_stats, only: newton_stats_type, solve_options_type
     use yarnfort_solver_newton_equilibrium, only: evaluate_timed, get_levels_timed, &
         get_scaled_norm
@@ -89,12 +90,11 @@ contains
         real(wp), allocatable :: guess(:)
         real(wp) :: weight
 
-        associate(problem => self%problem%problem, spring => self%options%slack_stiffness)
+        associate(spring => self%options%slack_stiffness)
             guess = u
             weight = max(predictor_weight, spring)
             do
-                problem%spring = weight
-                problem%tangent_spring = 0.0_wp
+                self%problem%law = regularisation_type(spring=weight)
                 call solve_once(self, guess, .false., stats, error)
                 if (allocated(error)) then
                     call set_exact_law(self)
@@ -145,9 +145,9 @@ contains
             if (.not. tried) return
             guess = u
             do while (cap < stiffest)
-                problem%stiffness_cap = cap
+                self%problem%law%stiffness_cap = cap
                 call solve_once(self, guess, .false., stats, error)
-                problem%stiffness_cap = no_stiffness_cap
+                self%problem%law%stiffness_cap = no_stiffness_cap
                 if (allocated(error)) then
                     error%message = '; with the yarns softened to a stiffness of ' &
                         // format_short(cap, 4) // ' as predictor: ' // error%message
@@ -195,7 +195,7 @@ contains
             if (allocated(self%problem%error)) deallocate(self%problem%error)
             if (allocated(self%problem%kinsol_message)) deallocate(self%problem%kinsol_message)
             if (allocated(self%adapter%error)) deallocate(self%adapter%error)
-            call self%problem%problem%prepare_solve(u, error)
+            call self%problem%problem%prepare_solve(u, error, self%problem%law)
             if (allocated(error)) return
             self%u = u
             call set_row_weights(self, .true., error)
@@ -251,7 +251,7 @@ contains
             end if
             return
         end if
-        call self%problem%problem%check_solution(self%u, error)
+        call self%problem%problem%check_solution(self%u, error, self%problem%law)
         if (allocated(error)) return
         u = self%u
     end subroutine solve_once

@@ -57,7 +57,7 @@ contains
             if (any(diagonal == 0)) return
             call analyse_once(self, col_ptr, row_index, error)
             if (allocated(error)) return
-            call problem%prepare_solve(u, error)
+            call problem%prepare_solve(u, error, self%problem%law)
             if (allocated(error)) return
             self%u = u
             allocate(residual(n), step(n), level(n), noise(n), shift(n))
