@@ -3,9 +3,10 @@
 !> without sliding), driven by SUNDIALS KINSOL (line search globalisation) with the
 !> analytic sparse Jacobian and a yarnfort linear solver behind a Fortran
 !> SUNLinearSolver. Proxy module over solver/newton/: stats and options (stats.f90),
-!> KINSOL and its callbacks (kinsol.f90), the shared state and steps (base.f90), chord
-!> steps (chord.f90), the row update (row_update.f90), pseudo-transient continuation
-!> (transient.f90) and the fallback ladder (ladder.f90).
+!> KINSOL and its callbacks (kinsol.f90), the shared state and steps (base.f90), the
+!> chord paths (chord.f90), the row update, a low-rank solver of its own
+!> (row_update.f90), pseudo-transient continuation (transient.f90) and the fallback
+!> ladder (ladder.f90).
 !> Convergence: row i is converged when |F_i| <= residual_tolerance * level_i + noise_i,
 !> with the problem's row levels (the forces meeting at a node, a passage's tensions)
 !> and the rounding level of the row's evaluation; levels are taken at the initial
@@ -23,8 +24,7 @@ module yarnfort_solver_newton
     use yarnfort_solver_newton_kinsol, only: new_kinsol
     use yarnfort_solver_newton_base, only: newton_base_type, start_newton, newton_step, &
         set_exact_law
-    use yarnfort_solver_newton_chord, only: solve_chord
-    use yarnfort_solver_newton_row_update, only: solve_row_update
+    use yarnfort_solver_newton_chord, only: solve_chord, solve_row_update
     use yarnfort_solver_newton_ladder, only: solve_with_fallbacks
     implicit none
     private

@@ -16,11 +16,12 @@ module yarnfort_solver_newton_base
     use yarnfort_solver_newton_equilibrium, only: equilibrium_type, evaluate_timed, &
         get_levels_timed, get_scaled_norm
     use yarnfort_solver_newton_kinsol, only: kinsol_type
+    use yarnfort_solver_newton_row_update, only: row_update_type
     implicit none
     private
 
     public :: newton_base_type, set_row_weights, get_scaled_residual, analyse_once, &
-        start_newton, newton_step, take_chord_step, finish_chord, set_exact_law
+        start_newton, newton_step, take_chord_steps, finish_chord, set_exact_law
 
     !> Owns KINSOL, the arrays of its vectors and the linear solver for one problem.
     type :: newton_base_type
@@ -162,6 +163,37 @@ contains
         if (allocated(error)) return
         self%u = self%u + step
     end subroutine newton_step
+
+    !> Up to max_steps chord steps from self%u (its residual and scaled residual f) with the
+    !> factors the linear solver holds, or with `update` (those factors and replaced
+    !> rows), while each cuts f tenfold, until f meets the tolerance; residual, f and
+    !> history follow the accepted steps.
+    subroutine take_chord_steps(self, max_steps, residual, f, history, stats, update)
+        class(newton_base_type), intent(inout) :: self
+        integer, intent(in) :: max_steps
+        real(wp), intent(inout) :: residual(:), f
+        real(wp), allocatable, intent(inout) :: history(:)
+        type(newton_stats_type), intent(inout) :: stats
+        type(row_update_type), intent(inout), optional :: update
+        type(error_type), allocatable :: trial_error
+        real(wp), allocatable :: step(:)
+        integer :: k
+        logical :: accepted
+
+        allocate(step(size(residual)))
+        do k = 1, max_steps
+            if (f <= self%options%residual_tolerance) exit
+            step = -residual
+            if (present(update)) then
+                call update%solve(self%adapter, step, trial_error)
+            else
+                call solve_counted(self%adapter, step, trial_error)
+            end if
+            if (allocated(trial_error)) exit
+            call take_chord_step(self, step, residual, f, history, stats, accepted)
+            if (.not. accepted) exit
+        end do
+    end subroutine take_chord_steps
 
     !> self%u + step replaces self%u if it cuts the scaled residual tenfold (`accepted`;
     !> residual, f and history then follow it), else self%u stays.

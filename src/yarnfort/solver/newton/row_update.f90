@@ -1,31 +1,17 @@
 ! SPDX-License-Identifier: MIT
-!> The Jacobian of the last Newton step with a few rows replaced, solved with that step's
-!> factors and a low-rank (Sherman-Morrison-Woodbury) correction, and the chord steps of
-!> a problem whose rows changed (a friction step's active-set round) that use it.
+!> A linear solver of its own: the matrix whose factors a linear solver holds with a few
+!> rows replaced, solved with those factors and a low-rank (Sherman-Morrison-Woodbury)
+!> correction, without a factorisation.
 module yarnfort_solver_newton_row_update
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_linalg_backend_dense, only: dense_solver_type
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, solve_counted, &
         solve_columns_counted
-    use yarnfort_solver_newton_stats, only: newton_stats_type
-    use yarnfort_solver_newton_equilibrium, only: evaluate_timed
-    use yarnfort_solver_newton_base, only: newton_base_type, get_scaled_residual, &
-        take_chord_step, finish_chord
     implicit none
     private
 
-    public :: row_update_type, new_row_update, solve_row_update
-
-    !> Most rows that solve_row_update replaces (it stores as many vectors of the order
-    !> of the system).
-    integer, parameter :: max_update_rows = 16
-    !> Most chord steps of solve_row_update (each cuts the residual tenfold).
-    integer, parameter :: max_update_steps = 8
-    !> solve_row_update gives up at once (one residual evaluation) above this scaled
-    !> residual at its start: an update started far off mostly fails at its first step
-    !> (docs/decisions.md, 'Active-set rounds solved with the kept factors').
-    real(wp), parameter :: max_update_start = 1.0e-2_wp
+    public :: row_update_type, new_row_update
 
     !> J + U V, J the matrix the adapter's solver holds the factors of, U the unit
     !> columns of the replaced rows and V their new values less J's.
@@ -123,66 +109,5 @@ contains
             x = x - y(b) * self%z(:, b)
         end do
     end subroutine solve_updated
-
-    !> Chord steps from u for a problem that differs from the one of the last Newton
-    !> step in its rows `rows` only (a friction step's active-set round: passages turned
-    !> stick or slip), while the linear solver still holds that step's factors, with the
-    !> row update (row_update_type: no factorisation). The rows keep the weights of that
-    !> solve (no prepare_solve). Steps go on while each cuts the scaled residual tenfold,
-    !> until it meets the tolerance, as in solve_chord; `converged`: u is the solution,
-    !> else u is the best iterate (or the start) and the caller solves on as usual.
-    !> Nothing is tried (converged false, no evaluation) without kept factors or with
-    !> more than max_update_rows rows.
-    subroutine solve_row_update(self, u, rows, stats, converged, error)
-        class(newton_base_type), intent(inout) :: self
-        real(wp), intent(inout) :: u(:)
-        integer, intent(in) :: rows(:)
-        type(newton_stats_type), intent(out) :: stats
-        logical, intent(out) :: converged
-        type(error_type), allocatable, intent(out) :: error
-        type(error_type), allocatable :: trial_error
-        real(wp), allocatable :: residual(:), step(:), history(:), values(:)
-        type(row_update_type) :: update
-        integer :: k, n_rows
-        real(wp) :: f
-        logical :: accepted
-
-        converged = .false.
-        n_rows = size(rows)
-        if (n_rows == 0 .or. n_rows > max_update_rows) return
-        if (self%kept_factorisation /= self%adapter%n_factorisations) return
-        if (.not. allocated(self%kept_values)) return
-        associate(tol => self%options%residual_tolerance, n => size(u))
-            self%u = u
-            allocate(residual(n), step(n))
-            call get_scaled_residual(self, residual, f, trial_error)
-            stats%residual_evaluations = stats%residual_evaluations + 1
-            if (allocated(trial_error)) return
-            history = [f]
-            stats%residual_norm = f
-            stats%residual_history = history
-            if (f > max_update_start) return
-            if (f > tol) then
-                ! The new rows: the Jacobian at u.
-                allocate(values(self%problem%nnz))
-                call evaluate_timed(self%problem, self%u, .true., values, trial_error)
-                stats%jacobian_evaluations = stats%jacobian_evaluations + 1
-                if (allocated(trial_error)) return
-                call new_row_update(update, self%adapter, rows, self%problem%problem%col_ptr, &
-                    self%problem%problem%row_index, values, self%kept_values, trial_error)
-                if (allocated(trial_error)) return
-                deallocate(values)
-                do k = 1, max_update_steps
-                    if (f <= tol) exit
-                    step = -residual
-                    call update%solve(self%adapter, step, trial_error)
-                    if (allocated(trial_error)) exit
-                    call take_chord_step(self, step, residual, f, history, stats, accepted)
-                    if (.not. accepted) exit
-                end do
-            end if
-            call finish_chord(self, u, f, history, stats, converged)
-        end associate
-    end subroutine solve_row_update
 
 end module yarnfort_solver_newton_row_update
