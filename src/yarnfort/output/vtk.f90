@@ -1,40 +1,41 @@
 ! SPDX-License-Identifier: MIT
-!> Network states as VTK XML unstructured grids (.vtu, one per written step) for
-!> ParaView, and the states.pvd collection listing them with their pseudo-time.
+!> Network states as VTK XML unstructured grids for ParaView, and the states.pvd
+!> collection listing them with their pseudo-time.
 !>
-!> Each state holds the nodes (points: current positions) and, as cells, the yarn
-!> elements followed by the links (gap-holders and periodic images, so that a fabric
-!> shows connected). Arrays:
-!> - field data: time, step, the factor of each load channel (p_force, p_disp without
-!>   &path channels); for a fabric also strain and
-!>   force_per_width (as in curve.csv);
-!> - point data: displacement (from the initial position), position, and for scenes
-!>   with sliding passages contact_state (0 no passage, 1 all stick, 2 a passage slips),
-!>   passages (the number of sliding passages at the node), and the state of one of them
-!>   (see write_state): passage (its number, 0 none), mode (0 none, 1 stick, 2 forward,
-!>   3 backward, 4 locked), flow, tension_min, tension_max, critical_tension and
-!>   wrap_angle (as in contacts.csv; 0 at nodes without a passage);
-!> - cell data: kind (0 yarn element, 1 gap-holder, 2 periodic link), yarn and material
-!>   (1-based, in input order; 0 for links), tension (N; 0 for links), stretch
-!>   (current over reference length), L0 (reference length) and period (the current
-!>   lattice vector a link spans: a periodic link's, a gap-holder's to a periodic
-!>   image; zero for elements and links inside the cell).
+!> A state is up to four blocks (files), so that colouring by any array shows only what
+!> has it (ParaView draws a block without the array in one plain colour):
+!> - state_NNNNN.vtu, the yarns: points the nodes (current positions), cells the yarn
+!>   elements; point data displacement (from the initial position), position, and for
+!>   scenes with sliding passages contact_state (0 no passage, 1 all stick, 2 a passage
+!>   slips) and passages (their number at the node); cell data tension (N), stretch
+!>   (current over reference length), L0 (reference length), yarn and material
+!>   (1-based, input order);
+!> - holders_NNNNN.vtu, links_NNNNN.vtu: the gap-holders and the periodic links
+!>   (write_links);
+!> - passages_NNNNN.vtu: one point per sliding passage (write_passages), so that two
+!>   passages at one node both show.
+!> Every block has the field data time, step, the factor of each load channel (p_force,
+!> p_disp without &path channels), and for a fabric strain and force_per_width (as in
+!> curve.csv). states.pvd lists the yarns as part 0 and the other blocks the scene has
+!> as parts 1-3 of each time step (ParaView's PVD reader makes them one multiblock).
 !> The data are appended base64-encoded binary (VTK XML 1.0, UInt64 headers) by
 !> default, or inline ASCII (&output vtk_format).
 module yarnfort_output_vtk
     use, intrinsic :: iso_fortran_env, only: int8, int32, int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
-    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_scene, only: scene_type, get_applied_force
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_filesystem, only: rename_file, remove_file, open_new_file, &
         close_new_file
     use yarnfort_text, only: format_integer
+    use yarnfort_output_manifest, only: part_prefixes
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
     implicit none
     private
 
-    public :: vtk_writer_type, get_state_name, collection_file_name
+    public :: vtk_writer_type, get_state_name, get_part_name, collection_file_name
+    public :: part_holders, part_links, part_passages
 
     character(len=*), parameter :: collection_file_name = 'states.pvd'
 
@@ -47,14 +48,19 @@ module yarnfort_output_vtk
         real(wp), allocatable :: times(:)
         !> Entries of states.pvd when it was last rewritten.
         integer :: listed = -1
+        !> The blocks besides the yarns' that each state has (set_parts).
+        logical :: has_part(3) = .false.
     contains
+        procedure :: set_parts
         procedure :: write_state
         !> Rewrite states.pvd (atomically) with every state written so far.
         procedure :: write_collection
     end type vtk_writer_type
 
-    integer(int8), parameter :: vtk_line = 3_int8
-    integer, parameter :: kind_element = 0, kind_gap = 1, kind_periodic = 2
+    integer(int8), parameter :: vtk_vertex = 1_int8, vtk_line = 3_int8
+    !> The blocks of a state besides the yarns', by their place in part_prefixes;
+    !> states.pvd lists them as parts 1, 2, 3.
+    integer, parameter :: part_holders = 1, part_links = 2, part_passages = 3
     integer, parameter :: contact_none = 0, contact_stick = 1, contact_slip = 2
 
     !> states.pvd is rewritten after a state when it then misses more than this fraction
@@ -84,13 +90,36 @@ contains
         name = trim(buffer)
     end function get_state_name
 
-    !> Write the state file of `state` (`mode`, `flow`: stick/slip mode and flow of each
-    !> passage, may be empty), then states.pvd when due (collection_lag). A failed write
-    !> removes the incomplete state file and says why. A node with several passages shows
-    !> the one that matters most for stick/slip: a slipping one (forward or backward)
-    !> before a locked one before a stick one, and among those the one with the largest
-    !> tension_max (the first in passage order on a tie); `passages` tells how many there
-    !> are and contact_state whether any slips.
+    !> The file name of block `part` (part_holders, part_links, part_passages) of the
+    !> state file `name` (state_NNNNN.vtu): holders_NNNNN.vtu, links_..., passages_....
+    pure function get_part_name(name, part) result(part_name)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: part
+        character(len=:), allocatable :: part_name
+        part_name = trim(part_prefixes(part)) // name(len('state_') + 1:)
+    end function get_part_name
+
+    !> Which blocks the states of `scene` have (set before the first state or
+    !> write_collection): gap-holders, periodic links, sliding passages.
+    subroutine set_parts(self, scene)
+        class(vtk_writer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        integer :: n_links
+
+        n_links = 0
+        if (allocated(scene%link_nodes)) n_links = size(scene%link_nodes, 2)
+        self%has_part = .false.
+        if (n_links > 0) then
+            self%has_part(part_holders) = any(scene%link_is_gap)
+            self%has_part(part_links) = .not. all(scene%link_is_gap)
+        end if
+        self%has_part(part_passages) = scene%passages%size() > 0
+    end subroutine set_parts
+
+    !> Write the files of `state` (`mode`, `flow`: stick/slip mode and flow of each
+    !> passage, may be empty): its blocks first, the yarns' state file last (a whole
+    !> state file means a whole state), then states.pvd when due (collection_lag). A
+    !> failed write removes the incomplete file and says why.
     subroutine write_state(self, scene, state, mode, flow, error)
         class(vtk_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
@@ -98,61 +127,254 @@ contains
         integer, intent(in) :: mode(:)
         real(wp), intent(in) :: flow(:)
         type(error_type), allocatable, intent(out) :: error
-        type(vtu_builder_type) :: vtu
-        character(len=:), allocatable :: name, path
-        integer :: n_nodes, n_elements, n_links, n_cells, e, l, p, node, y
-        integer(int64), allocatable :: connectivity(:), offsets(:)
-        integer(int32), allocatable :: cell_kind(:), yarn(:), material(:), contact(:)
-        real(wp), allocatable :: tension(:), stretch(:), length0(:), period(:, :)
-        real(wp) :: now(3), before(3), p_disp
+        character(len=:), allocatable :: name
 
         name = get_state_name(state%step)
-        path = self%folder // '/' // name
+        call self%set_parts(scene)
+        if (self%has_part(part_holders) .or. self%has_part(part_links)) then
+            call write_links(self, scene, state, name, error)
+            if (allocated(error)) return
+        end if
+        if (self%has_part(part_passages)) then
+            call write_passages(self, scene, state, mode, flow, &
+                self%folder // '/' // get_part_name(name, part_passages), error)
+            if (allocated(error)) return
+        end if
+        call write_yarns(self, scene, state, mode, self%folder // '/' // name, error)
+        if (allocated(error)) return
+
+        if (.not. allocated(self%files)) allocate(self%files(0), self%times(0))
+        self%files = [self%files, [character(len=64) :: name]]
+        self%times = [self%times, state%time]
+        if (size(self%files) <= collection_always .or. &
+                real(size(self%files) - self%listed, wp) > collection_lag * size(self%files)) &
+            call self%write_collection(error)
+    end subroutine write_state
+
+    !> The yarns' block (state_NNNNN.vtu): the nodes and the yarn elements.
+    subroutine write_yarns(self, scene, state, mode, path, error)
+        class(vtk_writer_type), intent(in) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: mode(:)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        type(vtu_builder_type) :: vtu
+        integer :: n_nodes, n_elements, e, p, node, y
+        integer(int64), allocatable :: connectivity(:)
+        integer(int32), allocatable :: yarn(:), contact(:), count(:)
+
         n_nodes = size(state%position, 2)
         n_elements = size(state%tension)
-        n_links = 0
-        if (allocated(scene%link_nodes)) n_links = size(scene%link_nodes, 2)
-        n_cells = n_elements + n_links
-
-        allocate(connectivity(2 * n_cells), offsets(n_cells))
-        allocate(cell_kind(n_cells), yarn(n_cells), material(n_cells))
-        allocate(tension(n_cells), stretch(n_cells), length0(n_cells))
-        allocate(period(3, n_cells), source=0.0_wp)
-        p_disp = 0.0_wp
-        if (scene%dofs%gap_channel >= 1 .and. scene%dofs%gap_channel <= size(state%factors)) &
-            p_disp = state%factors(scene%dofs%gap_channel)
+        allocate(connectivity(2 * n_elements), yarn(n_elements))
         do e = 1, n_elements
             connectivity(2 * e - 1:2 * e) = scene%network%element_nodes(:, e) - 1
         end do
-        cell_kind(:n_elements) = kind_element
         do y = 1, scene%network%n_yarns()
             yarn(scene%network%yarn_first_element(y):scene%network%yarn_first_element(y + 1) &
                 - 1) = y
         end do
-        material(:n_elements) = scene%network%element_material
-        tension(:n_elements) = state%tension
-        stretch(:n_elements) = state%stretch
-        length0(:n_elements) = state%length0
+        call start_file(vtu, self%ascii, scene, state, n_nodes, n_elements)
+        call add_text(vtu, '<PointData Vectors="displacement">')
+        call add_reals(vtu, 'displacement', &
+            reshape(state%position - scene%network%position, [3 * n_nodes]), 3)
+        call add_reals(vtu, 'position', reshape(state%position, [3 * n_nodes]), 3)
+        if (scene%passages%size() > 0) then
+            allocate(contact(n_nodes), source=int(contact_none, int32))
+            allocate(count(n_nodes), source=0_int32)
+            do p = 1, scene%passages%size()
+                node = scene%passages%node(p)
+                count(node) = count(node) + 1
+                if (contact(node) == contact_none) contact(node) = contact_stick
+                if (p <= size(mode)) then
+                    if (mode(p) /= 0) contact(node) = contact_slip
+                end if
+            end do
+            call add_int32(vtu, 'contact_state', contact)
+            call add_int32(vtu, 'passages', count)
+        end if
+        call add_text(vtu, '</PointData>')
+        call add_text(vtu, '<CellData Scalars="tension">')
+        call add_reals(vtu, 'tension', state%tension, 1)
+        call add_reals(vtu, 'stretch', state%stretch, 1)
+        call add_reals(vtu, 'L0', state%length0, 1)
+        call add_int32(vtu, 'yarn', yarn)
+        call add_int32(vtu, 'material', int(scene%network%element_material, int32))
+        call add_text(vtu, '</CellData>')
+        call finish_file(vtu, state%position, connectivity, vtk_line, 2, path, error)
+    end subroutine write_yarns
+
+    !> The links' blocks. holders_NNNNN.vtu: each gap-holder a line from its leader to
+    !> its follower, or to the follower's image next to the leader when it holds the gap
+    !> to a periodic image (follower minus period), with cell data contact_force (N: the
+    !> force it pushes the follower away from the leader with, along the line; negative
+    !> when it pulls), force (the vector on the follower, N), stretch, L0, period, leader
+    !> and follower. links_NNNNN.vtu: each periodic link a vertex at the follower (the
+    !> leader's image; a line would lie along the yarn it continues), cell data period,
+    !> leader and follower. Node numbers 1-based.
+    subroutine write_links(self, scene, state, name, error)
+        class(vtk_writer_type), intent(in) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        type(vtu_builder_type) :: vtu
+        integer :: n_links, n_nodes, l, k, n, e, r
+        integer, allocatable :: chosen(:), link_of(:)
+        integer(int64), allocatable :: connectivity(:)
+        real(wp), allocatable :: net(:, :), carried(:, :), period(:, :), points(:, :), &
+            applied(:), along(:), stretch(:), length0(:)
+        real(wp) :: p_disp, now(3), before(3), pull(3)
+        logical :: gap
+
+        n_links = size(scene%link_nodes, 2)
+        n_nodes = size(state%position, 2)
+        p_disp = 0.0_wp
+        if (scene%dofs%gap_channel >= 1 .and. scene%dofs%gap_channel <= size(state%factors)) &
+            p_disp = state%factors(scene%dofs%gap_channel)
+        allocate(period(3, n_links))
         do l = 1, n_links
-            associate(pair => scene%link_nodes(:, l))
-                e = n_elements + l
-                connectivity(2 * e - 1:2 * e) = pair - 1
-                cell_kind(e) = merge(kind_gap, kind_periodic, scene%link_is_gap(l))
-                yarn(e) = 0
-                material(e) = 0
-                tension(e) = 0.0_wp
-                now = state%position(:, pair(2)) - state%position(:, pair(1))
-                before = scene%network%position(:, pair(2)) - scene%network%position(:, pair(1))
-                length0(e) = norm2(before)
-                stretch(e) = 1.0_wp
-                if (length0(e) > 0.0_wp) stretch(e) = norm2(now) / length0(e)
-                period(:, e) = scene%link_period(:, l) &
-                    * (1.0_wp + p_disp * scene%link_strain(:, l))
+            period(:, l) = scene%link_period(:, l) * (1.0_wp + p_disp * scene%link_strain(:, l))
+        end do
+        ! The force a link carries: what acts on its follower's node (element tensions,
+        ! applied load) and on the nodes that follow that node, down the chain of links.
+        allocate(applied(3 * n_nodes))
+        call get_applied_force(scene, state%factors, applied)
+        net = reshape(applied, [3, n_nodes])
+        do e = 1, size(state%tension)
+            associate(ends => scene%network%element_nodes(:, e))
+                pull = state%position(:, ends(2)) - state%position(:, ends(1))
+                if (norm2(pull) > 0.0_wp) pull = state%tension(e) * pull / norm2(pull)
+                net(:, ends(1)) = net(:, ends(1)) + pull
+                net(:, ends(2)) = net(:, ends(2)) - pull
             end associate
         end do
-        offsets = [(2_int64 * e, e = 1, n_cells)]
+        allocate(link_of(n_nodes), source=0)
+        do l = 1, n_links
+            link_of(scene%link_nodes(2, l)) = l
+        end do
+        allocate(carried(3, n_links), source=0.0_wp)
+        do n = 1, n_nodes
+            r = n
+            k = 0
+            do while (link_of(r) /= 0 .and. k < n_links)
+                carried(:, link_of(r)) = carried(:, link_of(r)) + net(:, n)
+                r = scene%link_nodes(1, link_of(r))
+                k = k + 1
+            end do
+        end do
 
-        vtu%ascii = self%ascii
+        do k = 1, 2
+            gap = k == 1
+            if (.not. self%has_part(merge(part_holders, part_links, gap))) cycle
+            chosen = pack([(l, l = 1, n_links)], scene%link_is_gap .eqv. gap)
+            if (gap) then
+                allocate(points(3, 2 * size(chosen)), connectivity(2 * size(chosen)))
+                allocate(along(size(chosen)), stretch(size(chosen)), length0(size(chosen)))
+                do l = 1, size(chosen)
+                    associate(pair => scene%link_nodes(:, chosen(l)))
+                        points(:, 2 * l - 1) = state%position(:, pair(1))
+                        points(:, 2 * l) = state%position(:, pair(2)) - period(:, chosen(l))
+                        now = points(:, 2 * l) - points(:, 2 * l - 1)
+                        before = scene%network%position(:, pair(2)) &
+                            - scene%link_period(:, chosen(l)) - scene%network%position(:, pair(1))
+                        length0(l) = norm2(before)
+                        stretch(l) = 1.0_wp
+                        if (length0(l) > 0.0_wp) stretch(l) = norm2(now) / length0(l)
+                        ! The link balances the follower: it pushes with -carried.
+                        along(l) = 0.0_wp
+                        if (norm2(now) > 0.0_wp) &
+                            along(l) = -dot_product(carried(:, chosen(l)), now) / norm2(now)
+                    end associate
+                end do
+                connectivity = [(int(l, int64), l = 0, 2 * size(chosen) - 1)]
+            else
+                allocate(points(3, size(chosen)), connectivity(size(chosen)))
+                do l = 1, size(chosen)
+                    points(:, l) = state%position(:, scene%link_nodes(2, chosen(l)))
+                end do
+                connectivity = [(int(l, int64), l = 0, size(chosen) - 1)]
+            end if
+            call start_file(vtu, self%ascii, scene, state, size(points, 2), size(chosen))
+            if (gap) then
+                call add_text(vtu, '<CellData Scalars="contact_force">')
+                call add_reals(vtu, 'contact_force', along, 1)
+                call add_reals(vtu, 'force', reshape(-carried(:, chosen), &
+                    [3 * size(chosen)]), 3)
+                call add_reals(vtu, 'stretch', stretch, 1)
+                call add_reals(vtu, 'L0', length0, 1)
+            else
+                call add_text(vtu, '<CellData>')
+            end if
+            call add_reals(vtu, 'period', reshape(period(:, chosen), [3 * size(chosen)]), 3)
+            call add_int32(vtu, 'leader', int(scene%link_nodes(1, chosen), int32))
+            call add_int32(vtu, 'follower', int(scene%link_nodes(2, chosen), int32))
+            call add_text(vtu, '</CellData>')
+            if (gap) then
+                call finish_file(vtu, points, connectivity, vtk_line, 2, self%folder // '/' &
+                    // get_part_name(name, part_holders), error)
+            else
+                call finish_file(vtu, points, connectivity, vtk_vertex, 1, self%folder // '/' &
+                    // get_part_name(name, part_links), error)
+            end if
+            if (allocated(error)) return
+            deallocate(points, connectivity)
+        end do
+    end subroutine write_links
+
+    !> The passages' block (passages_NNNNN.vtu): one vertex per sliding passage at its
+    !> node, with point data passage, node, yarn (1-based), mode (1 stick, 2 forward,
+    !> 3 backward, 4 locked; 0 when the step has no friction state), flow,
+    !> tension_min, tension_max, critical_tension and wrap_angle (as in contacts.csv).
+    subroutine write_passages(self, scene, state, mode, flow, path, error)
+        class(vtk_writer_type), intent(in) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: mode(:)
+        real(wp), intent(in) :: flow(:)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        type(vtu_builder_type) :: vtu
+        type(passage_state_type) :: ps
+        integer :: n, p
+        integer, allocatable :: nodes(:)
+
+        n = scene%passages%size()
+        nodes = [(scene%passages%node(p), p = 1, n)]
+        if (size(mode) == n .and. size(flow) == n) then
+            call get_passage_states(scene, state, mode, flow, ps)
+        else
+            allocate(ps%mode(n), source=0)
+            allocate(ps%flow(n), ps%tension_min(n), ps%tension_max(n), ps%critical(n), &
+                ps%angle(n), source=0.0_wp)
+        end if
+        call start_file(vtu, self%ascii, scene, state, n, n)
+        call add_text(vtu, '<PointData Scalars="mode">')
+        call add_int32(vtu, 'passage', [(int(p, int32), p = 1, n)])
+        call add_int32(vtu, 'node', int(nodes, int32))
+        call add_int32(vtu, 'yarn', [(int(scene%passages%yarn(p), int32), p = 1, n)])
+        call add_int32(vtu, 'mode', int(ps%mode, int32))
+        call add_reals(vtu, 'flow', ps%flow, 1)
+        call add_reals(vtu, 'tension_min', ps%tension_min, 1)
+        call add_reals(vtu, 'tension_max', ps%tension_max, 1)
+        call add_reals(vtu, 'critical_tension', ps%critical, 1)
+        call add_reals(vtu, 'wrap_angle', ps%angle, 1)
+        call add_text(vtu, '</PointData>')
+        call finish_file(vtu, state%position(:, nodes), [(int(p, int64), p = 0, n - 1)], &
+            vtk_vertex, 1, path, error)
+    end subroutine write_passages
+
+    !> Begin a file: the XML header, the field data (time, step, the load factors, a
+    !> fabric's strain and force per width) and the piece of `n_points` and `n_cells`.
+    subroutine start_file(vtu, ascii, scene, state, n_points, n_cells)
+        type(vtu_builder_type), intent(out) :: vtu
+        logical, intent(in) :: ascii
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: n_points, n_cells
+        integer :: l
+
+        vtu%ascii = ascii
         vtu%xml = '<?xml version="1.0"?>' // new_line('a') &
             // '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="' &
             // get_byte_order() // '" header_type="UInt64">' // new_line('a') &
@@ -172,42 +394,30 @@ contains
                 [state%reaction(1, scene%fabric_set) / scene%fabric_width], 1, field=.true.)
         end if
         call add_text(vtu, '</FieldData>')
-        call add_text(vtu, '<Piece NumberOfPoints="' // format_integer(n_nodes) &
+        call add_text(vtu, '<Piece NumberOfPoints="' // format_integer(n_points) &
             // '" NumberOfCells="' // format_integer(n_cells) // '">')
-        call add_text(vtu, '<PointData Vectors="displacement">')
-        call add_reals(vtu, 'displacement', &
-            reshape(state%position - scene%network%position, [3 * n_nodes]), 3)
-        call add_reals(vtu, 'position', reshape(state%position, [3 * n_nodes]), 3)
-        if (scene%passages%size() > 0) then
-            allocate(contact(n_nodes), source=int(contact_none, int32))
-            do p = 1, scene%passages%size()
-                node = scene%passages%node(p)
-                if (contact(node) == contact_none) contact(node) = contact_stick
-                if (p <= size(mode)) then
-                    if (mode(p) /= 0) contact(node) = contact_slip
-                end if
-            end do
-            call add_int32(vtu, 'contact_state', contact)
-            if (size(mode) == scene%passages%size() .and. size(flow) == size(mode)) &
-                call add_passage_data(vtu, scene, state, mode, flow, n_nodes)
-        end if
-        call add_text(vtu, '</PointData>')
-        call add_text(vtu, '<CellData Scalars="tension">')
-        call add_reals(vtu, 'tension', tension, 1)
-        call add_reals(vtu, 'stretch', stretch, 1)
-        call add_reals(vtu, 'L0', length0, 1)
-        call add_reals(vtu, 'period', reshape(period, [3 * n_cells]), 3)
-        call add_int32(vtu, 'kind', cell_kind)
-        call add_int32(vtu, 'yarn', yarn)
-        call add_int32(vtu, 'material', material)
-        call add_text(vtu, '</CellData>')
+    end subroutine start_file
+
+    !> End a file with its points and cells (all of type `cell_type`, `per_cell`
+    !> points each: `connectivity`, from 0) and write it to `path`.
+    subroutine finish_file(vtu, points, connectivity, cell_type, per_cell, path, error)
+        type(vtu_builder_type), intent(inout) :: vtu
+        real(wp), intent(in) :: points(:, :)
+        integer(int64), intent(in) :: connectivity(:)
+        integer(int8), intent(in) :: cell_type
+        integer, intent(in) :: per_cell
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        integer :: n_cells, c
+
+        n_cells = size(connectivity) / per_cell
         call add_text(vtu, '<Points>')
-        call add_reals(vtu, 'Points', reshape(state%position, [3 * n_nodes]), 3)
+        call add_reals(vtu, 'Points', reshape(points, [size(points)]), 3)
         call add_text(vtu, '</Points>')
         call add_text(vtu, '<Cells>')
         call add_int64(vtu, 'connectivity', connectivity)
-        call add_int64(vtu, 'offsets', offsets)
-        call add_uint8(vtu, 'types', spread(vtk_line, 1, n_cells))
+        call add_int64(vtu, 'offsets', [(int(per_cell, int64) * c, c = 1, n_cells)])
+        call add_uint8(vtu, 'types', spread(cell_type, 1, n_cells))
         call add_text(vtu, '</Cells>')
         call add_text(vtu, '</Piece>')
         call add_text(vtu, '</UnstructuredGrid>')
@@ -218,15 +428,7 @@ contains
         end if
         call add_text(vtu, '</VTKFile>')
         call write_text_file(path, vtu%xml, error)
-        if (allocated(error)) return
-
-        if (.not. allocated(self%files)) allocate(self%files(0), self%times(0))
-        self%files = [self%files, [character(len=64) :: name]]
-        self%times = [self%times, state%time]
-        if (size(self%files) <= collection_always .or. &
-                real(size(self%files) - self%listed, wp) > collection_lag * size(self%files)) &
-            call self%write_collection(error)
-    end subroutine write_state
+    end subroutine finish_file
 
     !> Write states.pvd.tmp and rename it over states.pvd.
     subroutine write_collection(self, error)
@@ -234,7 +436,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: text
         character(len=32) :: time
-        integer :: i
+        integer :: i, part
 
         if (.not. allocated(self%files)) allocate(self%files(0), self%times(0))
         text = '<?xml version="1.0"?>' // new_line('a') &
@@ -242,8 +444,14 @@ contains
             // '<Collection>' // new_line('a')
         do i = 1, size(self%files)
             write(time, '(es24.16e3)') self%times(i)
-            text = text // '<DataSet timestep="' // trim(adjustl(time)) // '" file="' &
+            text = text // '<DataSet timestep="' // trim(adjustl(time)) // '" part="0" file="' &
                 // trim(self%files(i)) // '"/>' // new_line('a')
+            do part = 1, size(self%has_part)
+                if (self%has_part(part)) text = text // '<DataSet timestep="' &
+                    // trim(adjustl(time)) // '" part="' // format_integer(part) &
+                    // '" file="' // get_part_name(trim(self%files(i)), part) // '"/>' &
+                    // new_line('a')
+            end do
         end do
         text = text // '</Collection></VTKFile>' // new_line('a')
         call write_text_file(self%folder // '/' // collection_file_name, text, error, &
@@ -316,48 +524,6 @@ contains
                 // encode_base64(bytes)
         end if
     end subroutine add_array
-
-    !> Point data of the passages: count, the shown passage (rule in write_state), its
-    !> mode code and values.
-    subroutine add_passage_data(vtu, scene, state, mode, flow, n_nodes)
-        type(vtu_builder_type), intent(inout) :: vtu
-        type(scene_type), intent(in) :: scene
-        type(step_state_type), intent(in) :: state
-        integer, intent(in) :: mode(:), n_nodes
-        real(wp), intent(in) :: flow(:)
-        !> Rank of each mode code for the choice of the shown passage (higher wins).
-        integer, parameter :: rank(0:4) = [0, 1, 3, 3, 2]
-        type(passage_state_type) :: ps
-        integer(int32), allocatable :: count(:), shown(:), code(:)
-        real(wp), allocatable :: values(:, :)
-        integer :: p, node, q
-
-        call get_passage_states(scene, state, mode, flow, ps)
-        allocate(count(n_nodes), shown(n_nodes), code(n_nodes), source=0_int32)
-        allocate(values(n_nodes, 5), source=0.0_wp)
-        do p = 1, scene%passages%size()
-            node = scene%passages%node(p)
-            count(node) = count(node) + 1
-            q = shown(node)
-            if (q > 0) then
-                if (rank(ps%mode(p)) < rank(ps%mode(q))) cycle
-                if (rank(ps%mode(p)) == rank(ps%mode(q)) .and. &
-                    .not. ps%tension_max(p) > ps%tension_max(q)) cycle
-            end if
-            shown(node) = int(p, int32)
-            code(node) = int(ps%mode(p), int32)
-            values(node, :) = [ps%flow(p), ps%tension_min(p), ps%tension_max(p), &
-                ps%critical(p), ps%angle(p)]
-        end do
-        call add_int32(vtu, 'passages', count)
-        call add_int32(vtu, 'passage', shown)
-        call add_int32(vtu, 'mode', code)
-        call add_reals(vtu, 'flow', values(:, 1), 1)
-        call add_reals(vtu, 'tension_min', values(:, 2), 1)
-        call add_reals(vtu, 'tension_max', values(:, 3), 1)
-        call add_reals(vtu, 'critical_tension', values(:, 4), 1)
-        call add_reals(vtu, 'wrap_angle', values(:, 5), 1)
-    end subroutine add_passage_data
 
     subroutine add_reals(vtu, label, values, components, field)
         type(vtu_builder_type), intent(inout) :: vtu

@@ -20,10 +20,12 @@ module yarnfort_output_writer
         get_reaction_rows
     use yarnfort_output_contacts, only: contacts_file_name, contacts_header, &
         get_contact_rows
-    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, collection_file_name
+    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, get_part_name, &
+        collection_file_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
         remove_file, open_new_file, close_new_file, get_links, refuse_link
-    use yarnfort_output_manifest, only: manifest_type, is_own_name, is_bookkeeping_name
+    use yarnfort_output_manifest, only: manifest_type, is_own_name, is_bookkeeping_name, &
+        part_prefixes
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_output_restart, only: write_restart, remove_restart, restart_file_name
     implicit none
@@ -147,6 +149,7 @@ contains
         self%node_reactions = scene%output%node_reactions
         self%contact_state = scene%output%contact_state .and. scene%passages%size() > 0
         self%vtk%ascii = trim(scene%output%vtk_format) == 'ascii'
+        call self%vtk%set_parts(scene)
         call self%lock(scene%output%folder, error)
         if (.not. allocated(error)) then
             self%vtk%folder = self%folder
@@ -174,7 +177,7 @@ contains
         integer :: i
 
         do i = 1, size(self%manifest%states)
-            call remove_file(self%folder // '/' // trim(self%manifest%states(i)), error)
+            call remove_state(self, self%manifest%states(i), error)
             if (allocated(error)) return
         end do
         do i = 1, size(self%manifest%files)
@@ -254,7 +257,7 @@ contains
             if (keep(i)) keep(i) = .not. any(self%manifest%states(i + 1:) &
                 == self%manifest%states(i))
             if (.not. keep(i)) then
-                call remove_file(self%folder // '/' // trim(self%manifest%states(i)), error)
+                call remove_state(self, self%manifest%states(i), error)
                 if (allocated(error)) return
             end if
         end do
@@ -268,6 +271,20 @@ contains
         call list_atomic_file(self, collection_file_name, error)
         if (.not. allocated(error)) call self%vtk%write_collection(error)
     end subroutine resume_files
+
+    !> Delete the state file `name` and its other blocks (those of any scene).
+    subroutine remove_state(self, name, error)
+        class(output_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        integer :: part
+
+        call remove_file(self%folder // '/' // trim(name), error)
+        do part = 1, size(part_prefixes)
+            if (.not. allocated(error)) call remove_file(self%folder // '/' &
+                // get_part_name(trim(name), part), error)
+        end do
+    end subroutine remove_state
 
     !> A restart that does not write the table `name`: delete it if a run of ours wrote
     !> it (listed), and list it no more; leave it alone otherwise.
