@@ -74,8 +74,10 @@ def wait_for_step(process: subprocess.Popen, step: int) -> None:
 
 
 def collection(folder: Path) -> list[tuple[str, str]]:
+    """The states listed (their yarns' files, part 0) and their times."""
     root = ET.parse(folder / "states.pvd").getroot()
-    return [(d.get("file"), d.get("timestep")) for d in root.iter("DataSet")]
+    return [(d.get("file"), d.get("timestep")) for d in root.iter("DataSet")
+            if d.get("part", "0") == "0"]
 
 
 def complete_rows(folder: Path) -> list[list[str]]:
