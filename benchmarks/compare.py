@@ -200,7 +200,7 @@ def thread_state(python):
         f'- OpenSeesPy libraries loaded: {ops_libs}',
         '- environment: ' + ', '.join(f'{k}={os.environ.get(k, "unset")}' for k in (
             'OMP_NUM_THREADS', 'OMP_THREAD_LIMIT', 'OPENBLAS_NUM_THREADS', 'OPENBLAS_CORETYPE')),
-        '- yarnfort thread policy (src/yarnfort/linalg/threads.f90; applies where the '
+        '- yarnfort thread policy (src/yarnfort/linalg/process/threads.f90; applies where the '
         'variables are unset): the libraries\' OpenMP regions and OpenBLAS on one thread',
         f'- load average at start: {" ".join(f"{x:.2f}" for x in os.getloadavg())}; '
         f'{os.cpu_count()} cores',

@@ -62,14 +62,19 @@ class YarnfortError(RuntimeError):
 
 @functools.cache
 def extension() -> ModuleType:
-    """The f2py extension module ``yarnfort._yarnfort``, imported once.
+    """The f2py extension module ``yarnfort._yarnfort``, imported once; the first import
+    also makes the process-wide settings of the solver libraries (threads, heap).
 
     Raises
     ------
     ImportError
         If the package was not built with its extension (install it with ``pip install``).
     """
-    return importlib.import_module(f"{__package__}._yarnfort")
+    module = importlib.import_module(f"{__package__}._yarnfort")
+    # The solver libraries' threads and heap, set once for the process as the program
+    # sets them at its start (the Fortran library's constructors leave them alone).
+    module.yarnfort_facade.process_settings()
+    return module
 
 
 def _facade() -> ModuleType:

@@ -236,7 +236,8 @@ def test_manifest_lists_only_what_the_run_wrote(tmp_path):
     listed = manifest_files(out)
     written = {p.name for p in out.iterdir()} - {".yarnfort-lock", ".yarnfort-manifest"}
     written -= {name for name in written if name.startswith("state_")}
-    assert written == {"curve.csv", "input.nml", "restart.dat", "states.pvd"}
+    # restart.sync: the restart file last flushed to disk (a second name of restart.dat).
+    assert written == {"curve.csv", "input.nml", "restart.dat", "restart.sync", "states.pvd"}
     assert listed == written | {name + ".tmp" for name in written} - {"curve.csv.tmp"}
     mine = {"reactions.csv": b"my,own\n1,2\n", "contacts.csv": b"measured\n3\n",
             "reactions.csv.tmp": b"draft"}

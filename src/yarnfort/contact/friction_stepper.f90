@@ -38,8 +38,8 @@ module yarnfort_contact_friction_stepper
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
         chosen_lu_name
-    use yarnfort_linalg_condensed, only: condensed_solver_type
-    use yarnfort_linalg_bordered, only: bordered_solver_type
+    use yarnfort_linalg_composite_condensed, only: condensed_solver_type
+    use yarnfort_linalg_composite_bordered, only: bordered_solver_type
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type, start_stepper, &

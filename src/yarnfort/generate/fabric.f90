@@ -5,7 +5,7 @@
 module yarnfort_generate_fabric
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: config_type, fabric_config_type
+    use yarnfort_input_config, only: config_type
     use yarnfort_input_groups, only: fabric_kind_choices, fabric_boundary_choices, &
         fabric_sides_choices
     use yarnfort_input_fields, only: check_range

@@ -1,16 +1,16 @@
 ! SPDX-License-Identifier: MIT
 !> File-system calls Fortran has no portable statement for, through the C library and a
-!> small C shim (filesystem_shim.c): folder creation, atomic rename, removal, fsync, and
-!> the exclusive lock of an output folder. No routine here writes, truncates or removes
-!> through a symbolic link: a link at a name the program writes is refused, so nothing
-!> outside the output folder is ever changed through one.
+!> small C shim (filesystem_shim.c): folder creation, atomic rename, hard links, removal,
+!> fsync, and the exclusive lock of an output folder. No routine here writes, truncates or
+!> removes through a symbolic link: a link at a name the program writes is refused, so
+!> nothing outside the output folder is ever changed through one.
 module yarnfort_output_filesystem
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_long_long
     use yarnfort_error, only: error_type, fatal_error
     implicit none
     private
 
-    public :: make_folder, rename_file, remove_file, sync_file
+    public :: make_folder, rename_file, link_file, remove_file, sync_file, sync_folder
     public :: folder_lock_type, get_links, refuse_link
     public :: close_checked, flush_checked, truncate_file, ignore_file_size_signal
     public :: open_append, open_new_file, close_new_file
@@ -65,6 +65,12 @@ module yarnfort_output_filesystem
             integer(c_int) :: status
         end function c_rename
 
+        function c_link(old, new) result(status) bind(C, name='yarnfort_link_file')
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: old(*), new(*)
+            integer(c_int) :: status
+        end function c_link
+
         function c_lock_file(path, fd, holder, holder_length) result(status) &
                 bind(C, name='yarnfort_lock_file')
             import :: c_int, c_char
@@ -105,8 +111,8 @@ module yarnfort_output_filesystem
     end interface
 
     abstract interface
-        !> yarnfort_sync_file, yarnfort_remove_file: 0 on success, -1 on failure (the
-        !> reason: c_last_error); yarnfort_file_kind, yarnfort_create_file,
+        !> yarnfort_sync_file, yarnfort_sync_folder, yarnfort_remove_file: 0 on success, -1
+        !> on failure (the reason: c_last_error); yarnfort_file_kind, yarnfort_create_file,
         !> yarnfort_remove_regular_file: see filesystem_shim.c.
         function path_status_interface(path) result(status) bind(C)
             import :: c_int, c_char
@@ -124,6 +130,7 @@ module yarnfort_output_filesystem
     end interface
 
     procedure(path_status_interface), bind(C, name='yarnfort_sync_file') :: c_sync_file
+    procedure(path_status_interface), bind(C, name='yarnfort_sync_folder') :: c_sync_folder
     procedure(path_status_interface), bind(C, name='yarnfort_remove_file') :: c_remove_file
     procedure(path_status_interface), bind(C, name='yarnfort_file_kind') :: c_file_kind
     procedure(path_status_interface), bind(C, name='yarnfort_create_file') :: c_create_file
@@ -250,6 +257,21 @@ contains
             "cannot rename '" // old // "' to '" // new // "'", error)
     end subroutine rename_file
 
+    !> Give the file `old` the second name `new` (a hard link: one file, two names;
+    !> renaming another file over `old` later leaves `new` as it is). `new` must not exist.
+    !> `linked` is false, and no error, on a file system without hard links.
+    subroutine link_file(old, new, error, linked)
+        character(len=*), intent(in) :: old, new
+        type(error_type), allocatable, intent(out) :: error
+        logical, intent(out) :: linked
+        integer(c_int) :: status
+
+        status = c_link(old // c_null_char, new // c_null_char)
+        linked = status == 0
+        if (status /= 1) call check_call(status, "cannot link '" // old // "' to '" // new &
+            // "'", error)
+    end subroutine link_file
+
     !> Remove `path` if it is a regular file; a symbolic link, a folder or anything else
     !> of that name is left alone (no file the program writes is ever one), and a
     !> missing file is fine.
@@ -270,6 +292,15 @@ contains
         call check_call(c_sync_file(path // c_null_char), &
             "cannot write '" // path // "' to disk", error)
     end subroutine sync_file
+
+    !> Flush the entries of the folder `path` (a rename in it) to its device.
+    subroutine sync_folder(path, error)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_call(c_sync_folder(path // c_null_char), &
+            "cannot write the entries of folder '" // path // "' to disk", error)
+    end subroutine sync_folder
 
     !> Cut the (closed) file `path` back to `bytes` bytes, e.g. to drop a line that could
     !> be written only in part.

@@ -105,6 +105,32 @@ int yarnfort_sync_file(const char *path)
     return close(file);
 }
 
+/* Flush a folder's entries (e.g. a rename in it) to the device. A file system that
+ * cannot fsync a folder (EINVAL) keeps its entries its own way: no error. */
+int yarnfort_sync_folder(const char *path)
+{
+    int folder = open(path, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    int status;
+    if (folder < 0) return -1;
+    status = fsync(folder);
+    if (status != 0 && errno != EINVAL) {
+        int saved = errno;
+        close(folder);
+        errno = saved;
+        return -1;
+    }
+    return close(folder);
+}
+
+/* Give the file `old` the second name `new` (a hard link). Returns 0, 1 when the file
+ * system has no hard links (FAT, some network shares), -1 on any other failure. */
+int yarnfort_link_file(const char *old, const char *new)
+{
+    if (link(old, new) == 0) return 0;
+    if (errno == EPERM || errno == ENOTSUP || errno == EOPNOTSUPP || errno == ENOSYS) return 1;
+    return -1;
+}
+
 /* Remove a file; a missing file is no error. */
 int yarnfort_remove_file(const char *path)
 {

@@ -38,7 +38,7 @@ module yarnfort_output_manifest
     character(len=*), parameter :: fixed_names(*) = [character(len=17) :: 'curve.csv', &
         'curve.csv.tmp', 'input.nml', 'input.nml.tmp', 'restart.dat', 'restart.dat.tmp', &
         'states.pvd', 'states.pvd.tmp', 'reactions.csv', 'reactions.csv.tmp', &
-        'contacts.csv', 'contacts.csv.tmp']
+        'contacts.csv', 'contacts.csv.tmp', 'restart.sync', 'restart.sync.tmp']
 
     !> The blocks of a state besides the yarns' (state_NNNNN.vtu), by the prefix that
     !> replaces 'state_' in their file names (yarnfort_output_vtk): gap-holders,
@@ -51,11 +51,18 @@ module yarnfort_output_manifest
 
     type :: manifest_type
         character(len=:), allocatable :: folder
-        !> Fixed files listed, and states with their step and pseudo-time.
+        !> Fixed files listed, and states with their step and pseudo-time (as loaded or
+        !> saved: add_state keeps the states it adds apart until save or settle).
         character(len=entry_length), allocatable :: files(:), states(:)
         integer, allocatable :: steps(:)
         real(wp), allocatable :: times(:)
         integer :: unit = -1
+        !> The states added since: the first n_added entries of arrays that grow by
+        !> doubling, so that adding one costs constant time on average.
+        character(len=entry_length), allocatable, private :: added_states(:)
+        integer, allocatable, private :: added_steps(:)
+        real(wp), allocatable, private :: added_times(:)
+        integer, private :: n_added = 0
     contains
         !> Read folder's manifest (none: empty); `found` tells whether there was one.
         procedure :: load
@@ -68,6 +75,8 @@ module yarnfort_output_manifest
         procedure :: add_file
         !> Whether a fixed name is listed (written by a run of ours).
         procedure :: has_file
+        !> Move the states added since the last save into states, steps and times.
+        procedure :: settle
         procedure :: close => close_manifest
     end type manifest_type
 
@@ -88,6 +97,7 @@ contains
         allocate(character(len=entry_length) :: self%files(0), self%states(0))
         self%steps = [integer :: ]
         self%times = [real(wp) :: ]
+        self%n_added = 0
         open(newunit=unit, file=folder // '/' // manifest_file_name, status='old', &
             action='read', iostat=status)
         found = status == 0
@@ -110,12 +120,11 @@ contains
                     step = huge(step)
                     time = 0.0_wp
                 end if
-                self%states = [self%states, name]
-                self%steps = [self%steps, step]
-                self%times = [self%times, time]
+                call add_entry(self, name, step, time)
             end select
         end do
         close(unit)
+        call self%settle()
     end subroutine load
 
     pure logical function has_file(self, name)
@@ -158,6 +167,7 @@ contains
         integer :: unit, status, i
 
         call self%close()
+        call self%settle()
         path = self%folder // '/' // manifest_file_name
         temporary = path // '.tmp'
         call open_new_file(unit, temporary, error)
@@ -206,10 +216,47 @@ contains
         end if
         call flush_checked(self%unit, self%folder // '/' // manifest_file_name, error)
         if (allocated(error)) return
-        self%states = [self%states, [character(len=entry_length) :: name]]
-        self%steps = [self%steps, step]
-        self%times = [self%times, time]
+        call add_entry(self, name, step, time)
     end subroutine add_state
+
+    !> Keep a state apart (settle moves it into the lists), doubling the room when full.
+    subroutine add_entry(self, name, step, time)
+        class(manifest_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: step
+        real(wp), intent(in) :: time
+        character(len=entry_length), allocatable :: states(:)
+        integer, allocatable :: steps(:)
+        real(wp), allocatable :: times(:)
+        integer :: room
+
+        if (.not. allocated(self%added_states)) &
+            allocate(self%added_states(16), self%added_steps(16), self%added_times(16))
+        if (self%n_added == size(self%added_states)) then
+            room = 2 * size(self%added_states)
+            allocate(states(room), steps(room), times(room))
+            states(:self%n_added) = self%added_states(:self%n_added)
+            steps(:self%n_added) = self%added_steps(:self%n_added)
+            times(:self%n_added) = self%added_times(:self%n_added)
+            call move_alloc(states, self%added_states)
+            call move_alloc(steps, self%added_steps)
+            call move_alloc(times, self%added_times)
+        end if
+        self%n_added = self%n_added + 1
+        self%added_states(self%n_added) = name
+        self%added_steps(self%n_added) = step
+        self%added_times(self%n_added) = time
+    end subroutine add_entry
+
+    subroutine settle(self)
+        class(manifest_type), intent(inout) :: self
+
+        if (self%n_added == 0) return
+        self%states = [self%states, self%added_states(:self%n_added)]
+        self%steps = [self%steps, self%added_steps(:self%n_added)]
+        self%times = [self%times, self%added_times(:self%n_added)]
+        self%n_added = 0
+    end subroutine settle
 
     subroutine put_state(unit, name, step, time, status, message)
         integer, intent(in) :: unit

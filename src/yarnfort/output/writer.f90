@@ -1,7 +1,8 @@
 ! SPDX-License-Identifier: MIT
 !> The step observer that writes a run's files: curve.csv after every converged step, a
 !> VTK state every `vtk_every` steps (and always the last one, written by `finish`), and
-!> the restart file of every converged step. It holds the output folder's lock from
+!> the restart file of every converged step, flushed to disk with the tables at most
+!> every `sync_interval` seconds and by `finish`. It holds the output folder's lock from
 !> `open` (or `lock`) to `finish`, and lists every file it writes in the folder's
 !> manifest (yarnfort_output_manifest), as it first creates it: a new run deletes only
 !> files listed there. A symbolic link at any name it writes is refused when the folder
@@ -9,6 +10,7 @@
 !> Every write is checked; a failed one ends the run with an error (`failed` is then
 !> set), and what was written before it stays.
 module yarnfort_output_writer
+    use, intrinsic :: iso_fortran_env, only: int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type
@@ -23,11 +25,12 @@ module yarnfort_output_writer
     use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, get_part_name, &
         collection_file_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
-        remove_file, open_new_file, close_new_file, get_links, refuse_link
-    use yarnfort_output_manifest, only: manifest_type, is_own_name, is_bookkeeping_name, &
-        part_prefixes
+        remove_file, open_new_file, close_new_file, get_links, refuse_link, sync_file
+    use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name, &
+        is_bookkeeping_name, part_prefixes
     use yarnfort_solver_restart, only: restart_type
-    use yarnfort_output_restart, only: write_restart, remove_restart, restart_file_name
+    use yarnfort_output_restart, only: write_restart, remove_restart, restart_file_name, &
+        sync_restart, synced_file_name
     implicit none
     private
 
@@ -35,6 +38,10 @@ module yarnfort_output_writer
 
     !> The effective input, echoed for provenance.
     character(len=*), parameter :: input_file_name = 'input.nml'
+    !> Least seconds between two flushes of the tables and restart.dat to disk (fsync): a
+    !> power cut loses about this much of a run, and a flush costs a few ms (docs/
+    !> decisions.md, "restart.dat is flushed to disk by time, not by step").
+    real(wp), parameter :: sync_interval = 10.0_wp
 
     type, extends(step_observer_type) :: output_writer_type
         character(len=:), allocatable :: folder
@@ -62,6 +69,10 @@ module yarnfort_output_writer
         character(len=16) :: input_hash = ''
         !> A write to the folder failed (the error of on_step or on_checkpoint).
         logical :: failed = .false.
+        !> The clock count of the last flush to disk (or of open), and whether a restart
+        !> file was written since.
+        integer(int64) :: synced_at = 0
+        logical :: unsynced = .false.
     contains
         !> Create the folder if needed and take its lock (also done by open).
         procedure :: lock => lock_writer
@@ -150,6 +161,7 @@ contains
         self%contact_state = scene%output%contact_state .and. scene%passages%size() > 0
         self%vtk%ascii = trim(scene%output%vtk_format) == 'ascii'
         call self%vtk%set_parts(scene)
+        call system_clock(self%synced_at)
         call self%lock(scene%output%folder, error)
         if (.not. allocated(error)) then
             self%vtk%folder = self%folder
@@ -193,8 +205,7 @@ contains
         self%manifest%files = self%manifest%files(:0)
         call self%manifest%save(error)
         if (allocated(error)) return
-        if (allocated(self%vtk%files)) deallocate(self%vtk%files, self%vtk%times)
-        allocate(self%vtk%files(0), self%vtk%times(0))
+        call self%vtk%set_files([character(len=1) :: ], [real(wp) :: ])
         call self%manifest%add_file(curve_file_name, error)
         if (.not. allocated(error)) call self%curve%open(self%folder, scene, error)
         if (allocated(error) .or. .not. self%node_reactions) return
@@ -266,8 +277,7 @@ contains
         self%manifest%times = pack(self%manifest%times, keep)
         call self%manifest%save(error)
         if (allocated(error)) return
-        self%vtk%files = self%manifest%states
-        self%vtk%times = self%manifest%times
+        call self%vtk%set_files(self%manifest%states, self%manifest%times)
         call list_atomic_file(self, collection_file_name, error)
         if (.not. allocated(error)) call self%vtk%write_collection(error)
     end subroutine resume_files
@@ -383,6 +393,7 @@ contains
         type(scene_type), intent(in) :: scene
         type(restart_type), intent(in) :: snapshot
         type(error_type), allocatable, intent(out) :: error
+        logical :: due
 
         if (allocated(snapshot%mode)) then
             self%last_mode = snapshot%mode
@@ -411,11 +422,48 @@ contains
             call write_last_state(self, scene, error)
             if (allocated(error)) return
         end if
+        ! Flushed when due: the tables first, so that the rows of the restart's step
+        ! are on disk when it is.
+        due = seconds_since(self%synced_at) >= sync_interval
         call list_atomic_file(self, restart_file_name, error)
+        if (.not. allocated(error)) call list_atomic_file(self, synced_file_name, error)
+        if (due .and. .not. allocated(error)) call sync_tables(self, error)
         if (.not. allocated(error)) &
-            call write_restart(self%folder, snapshot, self%input_hash, error)
-        if (allocated(error)) self%failed = .true.
+            call write_restart(self%folder, snapshot, self%input_hash, error, sync=due)
+        if (allocated(error)) then
+            self%failed = .true.
+            return
+        end if
+        self%unsynced = .not. due
+        if (due) call system_clock(self%synced_at)
     end subroutine on_checkpoint
+
+    !> Seconds since the clock count `start`.
+    real(wp) function seconds_since(start)
+        integer(int64), intent(in) :: start
+        integer(int64) :: now, rate
+
+        call system_clock(now, rate)
+        seconds_since = real(now - start, wp) / real(max(rate, 1_int64), wp)
+    end function seconds_since
+
+    !> Flush the per-step tables (their rows are already written and flushed to the
+    !> system) and the manifest to disk.
+    subroutine sync_tables(self, error)
+        class(output_writer_type), intent(inout) :: self
+        type(error_type), allocatable, intent(out) :: error
+
+        call sync_table(self%curve)
+        if (.not. allocated(error)) call sync_table(self%reactions)
+        if (.not. allocated(error)) call sync_table(self%contacts)
+        if (.not. allocated(error)) call sync_file(self%folder // '/' // manifest_file_name, &
+            error)
+    contains
+        subroutine sync_table(table)
+            type(curve_writer_type), intent(in) :: table
+            if (allocated(table%path)) call sync_file(table%path, error)
+        end subroutine sync_table
+    end subroutine sync_tables
 
     !> The VTK state of the last step: listed in the manifest, then written.
     subroutine write_last_state(self, scene, error)
@@ -447,22 +495,33 @@ contains
     end subroutine note_written
 
     !> Write the last converged state if it was skipped and states.pvd complete, close
-    !> the files and release the folder's lock.
+    !> the files, flush the tables and restart.dat to disk if they were not since the
+    !> last restart file, and release the folder's lock.
     subroutine finish(self, scene, error)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: sync_error
 
         if (.not. self%last_written .and. self%vtk_every > 0 .and. allocated(self%last%position)) &
             call write_last_state(self, scene, error)
         if (.not. allocated(error) .and. self%vtk_every > 0 .and. allocated(self%vtk%files)) then
-            if (self%vtk%listed /= size(self%vtk%files)) call self%vtk%write_collection(error)
+            if (self%vtk%listed /= self%vtk%n_files) call self%vtk%write_collection(error)
             if (allocated(error)) self%failed = .true.
         end if
         call close_table(self%curve)
         call close_table(self%contacts)
         call close_table(self%reactions)
         call self%manifest%close()
+        if (self%unsynced) then
+            call sync_tables(self, sync_error)
+            if (.not. allocated(sync_error)) call sync_restart(self%folder, sync_error)
+            if (allocated(sync_error) .and. .not. allocated(error)) then
+                self%failed = .true.
+                call move_alloc(sync_error, error)
+            end if
+            self%unsynced = .false.
+        end if
         call self%folder_lock%release()
     contains
         !> Close a CSV file; its error is the run's unless an earlier one is.

@@ -596,8 +596,7 @@ contains
         allocate(scene%passages%at_end(scene%network%n_elements()), source=0)
         allocate(scene%passages%share(scene%network%n_elements()), source=1.0_wp)
         ! At most every interior node of every yarn is a passage (filled below, trimmed
-        ! by store_passages; appending one at a time was quadratic: 20 s of the 29 s
-        ! set-up of the 100 x 100 knit, benchmarks/knit100.nml).
+        ! by store_passages; appending one at a time was quadratic in the passages).
         n_passages = sum([(max(size(config%yarns(y)%nodes) - 2, 0), y = 1, n_yarns)])
         allocate(yarn(n_passages), at_node(n_passages), before(n_passages), &
             after(n_passages), laws(n_passages))

@@ -32,7 +32,7 @@ module yarnfort_solver_newton
     use yarnfort_input_config, only: solver_config_type
     use yarnfort_solver_problem, only: nonlinear_problem_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_dense, only: dense_solver_type
+    use yarnfort_linalg_backend_dense, only: dense_solver_type
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc, &
         analyse_counted, factor_counted, solve_counted, solve_columns_counted
     use yarnfort_solver_timer, only: wall_time

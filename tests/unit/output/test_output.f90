@@ -49,8 +49,8 @@ contains
         type(error_type), allocatable, intent(out) :: error
         character(len=*), parameter :: own(*) = [character(len=24) :: 'curve.csv', &
             'input.nml', 'restart.dat', 'restart.dat.tmp', 'states.pvd', 'states.pvd.tmp', &
-            'state_00012.vtu', 'state_123456.vtu', 'holders_00012.vtu', 'links_123456.vtu', &
-            'passages_00000.vtu']
+            'restart.sync', 'restart.sync.tmp', 'state_00012.vtu', 'state_123456.vtu', &
+            'holders_00012.vtu', 'links_123456.vtu', 'passages_00000.vtu']
         character(len=*), parameter :: foreign(*) = [character(len=24) :: 'notes.txt', &
             '../curve.csv', 'sub/state_00001.vtu', 'state_1.vtu', 'state_0000x.vtu', &
             'holders_1.vtu', 'links_0000x.vtu', 'passages_.vtu', 'passages.vtu', &
