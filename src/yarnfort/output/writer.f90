@@ -18,10 +18,9 @@ module yarnfort_output_writer
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_observer_type, step_state_type
     use yarnfort_output_curve, only: curve_writer_type, curve_file_name
-    use yarnfort_output_reactions, only: reactions_file_name, reactions_header, &
-        get_reaction_rows
-    use yarnfort_output_contacts, only: contacts_file_name, contacts_header, &
-        get_contact_rows
+    use yarnfort_output_reactions, only: reactions_writer_type, reactions_file_name
+    use yarnfort_output_contacts, only: contacts_writer_type, contacts_file_name
+    use yarnfort_output_table, only: table_writer_type
     use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, get_part_name, &
         collection_file_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
@@ -47,12 +46,12 @@ module yarnfort_output_writer
         character(len=:), allocatable :: folder
         integer :: vtk_every = 1
         type(curve_writer_type) :: curve
-        !> reactions.csv (`&output node_reactions`), written like the curve.
-        type(curve_writer_type) :: reactions
+        !> reactions.csv (`&output node_reactions`).
+        type(reactions_writer_type) :: reactions
         logical :: node_reactions = .false.
-        !> contacts.csv (`&output contact_state` and sliding passages), written like the
-        !> curve, from the snapshot of each step (on_checkpoint).
-        type(curve_writer_type) :: contacts
+        !> contacts.csv (`&output contact_state` and sliding passages), from the snapshot
+        !> of each step (on_checkpoint).
+        type(contacts_writer_type) :: contacts
         logical :: contact_state = .false.
         type(vtk_writer_type) :: vtk
         type(manifest_type) :: manifest
@@ -210,8 +209,7 @@ contains
         if (.not. allocated(error)) call self%curve%open(self%folder, scene, error)
         if (allocated(error) .or. .not. self%node_reactions) return
         call self%manifest%add_file(reactions_file_name, error)
-        if (.not. allocated(error)) call self%reactions%open_table(self%folder, &
-            reactions_file_name, reactions_header, error)
+        if (.not. allocated(error)) call self%reactions%open(self%folder, error)
     end subroutine start_files
 
     !> Start contacts.csv when it is asked for.
@@ -221,8 +219,7 @@ contains
 
         if (.not. self%contact_state) return
         call self%manifest%add_file(contacts_file_name, error)
-        if (.not. allocated(error)) call self%contacts%open_table(self%folder, &
-            contacts_file_name, contacts_header, error)
+        if (.not. allocated(error)) call self%contacts%open(self%folder, error)
     end subroutine start_contacts
 
     !> A restart after `step`: keep curve rows and the listed states up to that step,
@@ -245,17 +242,15 @@ contains
         if (allocated(error)) return
         if (self%node_reactions) then
             call list_atomic_file(self, reactions_file_name, error)
-            if (.not. allocated(error)) call self%reactions%resume_table(self%folder, &
-                reactions_file_name, reactions_header, step, error, &
-                row_required=has_constrained_nodes(scene))
+            if (.not. allocated(error)) call self%reactions%resume(self%folder, scene, step, &
+                error)
         else
             call drop_file(self, reactions_file_name, error)
         end if
         if (allocated(error)) return
         if (self%contact_state) then
             call list_atomic_file(self, contacts_file_name, error)
-            if (.not. allocated(error)) call self%contacts%resume_table(self%folder, &
-                contacts_file_name, contacts_header, step, error)
+            if (.not. allocated(error)) call self%contacts%resume(self%folder, step, error)
         else
             call drop_file(self, contacts_file_name, error)
         end if
@@ -365,10 +360,8 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         call self%curve%write_step(scene, state, error)
-        if (.not. allocated(error) .and. self%node_reactions) then
-            if (has_constrained_nodes(scene)) &
-                call self%reactions%put_line(get_reaction_rows(scene, state), error)
-        end if
+        if (.not. allocated(error) .and. self%node_reactions) &
+            call self%reactions%write_step(scene, state, error)
         call note_written(self, error)
         if (allocated(error)) return
         if (self%contact_state .and. self%vtk_every <= 0) self%last = state
@@ -410,8 +403,8 @@ contains
                 call fatal_error(error, "cannot write '" // self%contacts%path // "': the " &
                     // 'step has no friction state')
             else
-                call self%contacts%put_line(get_contact_rows(scene, self%last, &
-                    snapshot%mode, snapshot%flow), error)
+                call self%contacts%write_step(scene, self%last, snapshot%mode, snapshot%flow, &
+                    error)
             end if
             if (allocated(error)) then
                 self%failed = .true.
@@ -460,7 +453,7 @@ contains
             error)
     contains
         subroutine sync_table(table)
-            type(curve_writer_type), intent(in) :: table
+            class(table_writer_type), intent(in) :: table
             if (allocated(table%path)) call sync_file(table%path, error)
         end subroutine sync_table
     end subroutine sync_tables
@@ -526,7 +519,7 @@ contains
     contains
         !> Close a CSV file; its error is the run's unless an earlier one is.
         subroutine close_table(table)
-            type(curve_writer_type), intent(inout) :: table
+            class(table_writer_type), intent(inout) :: table
             type(error_type), allocatable :: close_error
 
             call table%close(close_error)
@@ -536,16 +529,5 @@ contains
             end if
         end subroutine close_table
     end subroutine finish
-
-    !> Whether any support set prescribes a coordinate (reactions.csv has rows).
-    pure logical function has_constrained_nodes(scene)
-        type(scene_type), intent(in) :: scene
-        integer :: s
-
-        has_constrained_nodes = .false.
-        do s = 1, size(scene%supports)
-            if (size(scene%supports(s)%coordinates) > 0) has_constrained_nodes = .true.
-        end do
-    end function has_constrained_nodes
 
 end module yarnfort_output_writer
