@@ -18,16 +18,16 @@
 !> p_disp without &path channels), and for a fabric strain and force_per_width (as in
 !> curve.csv). states.pvd lists the yarns as part 0 and the other blocks the scene has
 !> as parts 1-3 of each time step (ParaView's PVD reader makes them one multiblock).
-!> The data are appended base64-encoded binary (VTK XML 1.0, UInt64 headers) by
-!> default, or inline ASCII (&output vtk_format).
+!> The files are built by yarnfort_output_vtu: appended base64-encoded binary by default,
+!> or inline ASCII (&output vtk_format).
 module yarnfort_output_vtk
     use, intrinsic :: iso_fortran_env, only: int8, int32, int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     use yarnfort_scene_scene, only: scene_type, get_applied_force
     use yarnfort_solver_continuation, only: step_state_type
-    use yarnfort_output_filesystem, only: rename_file, remove_file, open_new_file, &
-        close_new_file
+    use yarnfort_output_vtu, only: vtu_builder_type, start_vtu, finish_vtu, write_text_file, &
+        add_text, add_reals, add_int32, vtk_vertex, vtk_line
     use yarnfort_text, only: format_integer
     use yarnfort_output_manifest, only: part_prefixes
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
@@ -63,7 +63,6 @@ module yarnfort_output_vtk
         procedure :: write_collection
     end type vtk_writer_type
 
-    integer(int8), parameter :: vtk_vertex = 1_int8, vtk_line = 3_int8
     !> The blocks of a state besides the yarns', by their place in part_prefixes;
     !> states.pvd lists them as parts 1, 2, 3.
     integer, parameter :: part_holders = 1, part_links = 2, part_passages = 3
@@ -74,15 +73,6 @@ module yarnfort_output_vtk
     !> of the rewrites stays linear in the number of states.
     real(wp), parameter :: collection_lag = 0.05_wp
     integer, parameter :: collection_always = 100
-
-    character(len=64), parameter :: base64_alphabet = &
-        'ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/'
-
-    !> The XML text and appended data of one file being built.
-    type :: vtu_builder_type
-        logical :: ascii = .false.
-        character(len=:), allocatable :: xml, appended
-    end type vtu_builder_type
 
 contains
 
@@ -205,7 +195,7 @@ contains
         call add_int32(vtu, 'yarn', yarn)
         call add_int32(vtu, 'material', int(scene%network%element_material, int32))
         call add_text(vtu, '</CellData>')
-        call finish_file(vtu, state%position, connectivity, vtk_line, 2, path, error)
+        call finish_vtu(vtu, state%position, connectivity, vtk_line, 2, path, error)
     end subroutine write_yarns
 
     !> The links' blocks. holders_NNNNN.vtu: each gap-holder a line from its leader to
@@ -315,10 +305,10 @@ contains
             call add_int32(vtu, 'follower', int(scene%link_nodes(2, chosen), int32))
             call add_text(vtu, '</CellData>')
             if (gap) then
-                call finish_file(vtu, points, connectivity, vtk_line, 2, self%folder // '/' &
+                call finish_vtu(vtu, points, connectivity, vtk_line, 2, self%folder // '/' &
                     // get_part_name(name, part_holders), error)
             else
-                call finish_file(vtu, points, connectivity, vtk_vertex, 1, self%folder // '/' &
+                call finish_vtu(vtu, points, connectivity, vtk_vertex, 1, self%folder // '/' &
                     // get_part_name(name, part_links), error)
             end if
             if (allocated(error)) return
@@ -364,7 +354,7 @@ contains
         call add_reals(vtu, 'critical_tension', ps%critical, 1)
         call add_reals(vtu, 'wrap_angle', ps%angle, 1)
         call add_text(vtu, '</PointData>')
-        call finish_file(vtu, state%position(:, nodes), [(int(p, int64), p = 0, n - 1)], &
+        call finish_vtu(vtu, state%position(:, nodes), [(int(p, int64), p = 0, n - 1)], &
             vtk_vertex, 1, path, error)
     end subroutine write_passages
 
@@ -378,12 +368,8 @@ contains
         integer, intent(in) :: n_points, n_cells
         integer :: l
 
-        vtu%ascii = ascii
-        vtu%xml = '<?xml version="1.0"?>' // new_line('a') &
-            // '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="' &
-            // get_byte_order() // '" header_type="UInt64">' // new_line('a') &
-            // '<UnstructuredGrid>' // new_line('a') // '<FieldData>' // new_line('a')
-        vtu%appended = ''
+        call start_vtu(vtu, ascii)
+        call add_text(vtu, '<FieldData>')
         call add_reals(vtu, 'time', [state%time], 1, field=.true.)
         call add_int32(vtu, 'step', [int(state%step, int32)], field=.true.)
         do l = 1, size(state%factors)
@@ -401,38 +387,6 @@ contains
         call add_text(vtu, '<Piece NumberOfPoints="' // format_integer(n_points) &
             // '" NumberOfCells="' // format_integer(n_cells) // '">')
     end subroutine start_file
-
-    !> End a file with its points and cells (all of type `cell_type`, `per_cell`
-    !> points each: `connectivity`, from 0) and write it to `path`.
-    subroutine finish_file(vtu, points, connectivity, cell_type, per_cell, path, error)
-        type(vtu_builder_type), intent(inout) :: vtu
-        real(wp), intent(in) :: points(:, :)
-        integer(int64), intent(in) :: connectivity(:)
-        integer(int8), intent(in) :: cell_type
-        integer, intent(in) :: per_cell
-        character(len=*), intent(in) :: path
-        type(error_type), allocatable, intent(out) :: error
-        integer :: n_cells, c
-
-        n_cells = size(connectivity) / per_cell
-        call add_text(vtu, '<Points>')
-        call add_reals(vtu, 'Points', reshape(points, [size(points)]), 3)
-        call add_text(vtu, '</Points>')
-        call add_text(vtu, '<Cells>')
-        call add_int64(vtu, 'connectivity', connectivity)
-        call add_int64(vtu, 'offsets', [(int(per_cell, int64) * c, c = 1, n_cells)])
-        call add_uint8(vtu, 'types', spread(cell_type, 1, n_cells))
-        call add_text(vtu, '</Cells>')
-        call add_text(vtu, '</Piece>')
-        call add_text(vtu, '</UnstructuredGrid>')
-        if (.not. vtu%ascii) then
-            call add_text(vtu, '<AppendedData encoding="base64">')
-            vtu%xml = vtu%xml // '_' // vtu%appended // new_line('a')
-            call add_text(vtu, '</AppendedData>')
-        end if
-        call add_text(vtu, '</VTKFile>')
-        call write_text_file(path, vtu%xml, error)
-    end subroutine finish_file
 
     subroutine set_files(self, files, times)
         class(vtk_writer_type), intent(inout) :: self
@@ -523,182 +477,5 @@ contains
             used = used + len(piece)
         end subroutine put
     end subroutine write_collection
-
-    !> Write `text` to `path` (a stream, so lines of any length), checking every write
-    !> and the close; with `atomic`, through path.tmp renamed over path. On failure the
-    !> incomplete file is removed.
-    subroutine write_text_file(path, text, error, atomic)
-        character(len=*), intent(in) :: path, text
-        type(error_type), allocatable, intent(out) :: error
-        logical, intent(in), optional :: atomic
-        type(error_type), allocatable :: ignored
-        character(len=:), allocatable :: target
-        character(len=256) :: message
-        integer :: unit, status
-        logical :: through_temporary
-
-        through_temporary = .false.
-        if (present(atomic)) through_temporary = atomic
-        target = path
-        if (through_temporary) target = path // '.tmp'
-        call open_new_file(unit, target, error, stream=.true.)
-        if (allocated(error)) then
-            call remove_file(target, ignored)
-            return
-        end if
-        message = ''
-        write(unit, iostat=status, iomsg=message) text
-        call close_new_file(unit, target, error, status, message)
-        if (allocated(error) .or. .not. through_temporary) return
-        call rename_file(target, path, error)
-        if (allocated(error)) call remove_file(target, ignored)
-    end subroutine write_text_file
-
-    subroutine add_text(vtu, text)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: text
-        vtu%xml = vtu%xml // text // new_line('a')
-    end subroutine add_text
-
-    !> The DataArray element of an array: `values` inline as ASCII, or an offset into the
-    !> appended data (where the byte count and `bytes`, their binary form, go, each
-    !> base64-encoded).
-    subroutine add_array(vtu, type_name, label, components, n_tuples, field, bytes, values)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: type_name, label
-        integer, intent(in) :: components, n_tuples
-        logical, intent(in) :: field
-        integer(int8), intent(in) :: bytes(:)
-        class(*), intent(in) :: values(:)
-        character(len=:), allocatable :: attributes
-
-        attributes = '<DataArray type="' // type_name // '" Name="' // label // '"'
-        if (components > 1) attributes = attributes // ' NumberOfComponents="' &
-            // format_integer(components) // '"'
-        if (field) attributes = attributes // ' NumberOfTuples="' &
-            // format_integer(n_tuples) // '"'
-        if (vtu%ascii) then
-            call add_text(vtu, attributes // ' format="ascii">' // format_values(values) &
-                // '</DataArray>')
-        else
-            call add_text(vtu, attributes // ' format="appended" offset="' &
-                // format_integer(len(vtu%appended)) // '"/>')
-            vtu%appended = vtu%appended &
-                // encode_base64(transfer(int(size(bytes), int64), [0_int8])) &
-                // encode_base64(bytes)
-        end if
-    end subroutine add_array
-
-    subroutine add_reals(vtu, label, values, components, field)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: label
-        real(wp), intent(in) :: values(:)
-        integer, intent(in) :: components
-        logical, intent(in), optional :: field
-
-        call add_array(vtu, 'Float64', label, components, size(values) / components, &
-            is_field(field), transfer(values, [0_int8], 8 * size(values)), values)
-    end subroutine add_reals
-
-    subroutine add_int32(vtu, label, values, field)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: label
-        integer(int32), intent(in) :: values(:)
-        logical, intent(in), optional :: field
-
-        call add_integers(vtu, 'Int32', label, int(values, int64), &
-            transfer(values, [0_int8], 4 * size(values)), field)
-    end subroutine add_int32
-
-    subroutine add_int64(vtu, label, values)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: label
-        integer(int64), intent(in) :: values(:)
-
-        call add_integers(vtu, 'Int64', label, values, transfer(values, [0_int8], 8 * size(values)))
-    end subroutine add_int64
-
-    subroutine add_uint8(vtu, label, values)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: label
-        integer(int8), intent(in) :: values(:)
-
-        call add_integers(vtu, 'UInt8', label, int(values, int64), values)
-    end subroutine add_uint8
-
-    !> An integer array of VTK type `type_name`: `values` in ASCII, or `bytes`, their
-    !> binary form in that type, appended.
-    subroutine add_integers(vtu, type_name, label, values, bytes, field)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: type_name, label
-        integer(int64), intent(in) :: values(:)
-        integer(int8), intent(in) :: bytes(:)
-        logical, intent(in), optional :: field
-
-        call add_array(vtu, type_name, label, 1, size(values), is_field(field), bytes, values)
-    end subroutine add_integers
-
-    !> The ASCII form of a DataArray: ' v1 v2 ...', reals as es24.16e3, integers as i0.
-    function format_values(values) result(text)
-        class(*), intent(in) :: values(:)
-        character(len=:), allocatable :: text
-        integer :: status
-
-        select type (values)
-        type is (real(wp))
-            allocate(character(len=25 * size(values) + 1) :: text)
-            write(text, '(*(1x, es24.16e3))', iostat=status) values
-        type is (integer(int64))
-            allocate(character(len=21 * size(values) + 1) :: text)
-            write(text, '(*(1x, i0))', iostat=status) values
-        end select
-        text = trim(text)
-    end function format_values
-
-    pure logical function is_field(field)
-        logical, intent(in), optional :: field
-        is_field = .false.
-        if (present(field)) is_field = field
-    end function is_field
-
-    !> Base64 (RFC 4648, with '=' padding) of `bytes`.
-    pure function encode_base64(bytes) result(text)
-        integer(int8), intent(in) :: bytes(:)
-        character(len=:), allocatable :: text
-        integer :: i, j, n, b1, b2, b3, group
-
-        n = size(bytes)
-        allocate(character(len=4 * ((n + 2) / 3)) :: text)
-        j = 0
-        do i = 1, n, 3
-            b1 = iand(int(bytes(i)), 255)
-            b2 = 0
-            b3 = 0
-            if (i + 1 <= n) b2 = iand(int(bytes(i + 1)), 255)
-            if (i + 2 <= n) b3 = iand(int(bytes(i + 2)), 255)
-            group = ior(ior(ishft(b1, 16), ishft(b2, 8)), b3)
-            text(j + 1:j + 1) = base64_alphabet(ishft(group, -18) + 1:ishft(group, -18) + 1)
-            text(j + 2:j + 2) = base64_alphabet(iand(ishft(group, -12), 63) + 1: &
-                iand(ishft(group, -12), 63) + 1)
-            text(j + 3:j + 3) = base64_alphabet(iand(ishft(group, -6), 63) + 1: &
-                iand(ishft(group, -6), 63) + 1)
-            text(j + 4:j + 4) = base64_alphabet(iand(group, 63) + 1:iand(group, 63) + 1)
-            if (i + 1 > n) text(j + 3:j + 3) = '='
-            if (i + 2 > n) text(j + 4:j + 4) = '='
-            j = j + 4
-        end do
-    end function encode_base64
-
-    !> 'LittleEndian' or 'BigEndian': the byte order of this machine.
-    pure function get_byte_order() result(order)
-        character(len=:), allocatable :: order
-        integer(int8) :: bytes(4)
-        bytes = transfer(1_int32, bytes)
-        if (bytes(1) == 1_int8) then
-            order = 'LittleEndian'
-        else
-            order = 'BigEndian'
-        end if
-    end function get_byte_order
 
 end module yarnfort_output_vtk
