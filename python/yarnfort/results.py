@@ -8,7 +8,8 @@ A state is the yarns' file ``state_NNNNN.vtu`` (node positions, the two-node ele
 the field data ``step``, ``time``, load factors, a fabric's ``strain``, and every point
 and cell data array by name: ``tension``, ``stretch`` and ``L0`` are required) and, next
 to it, the blocks ``holders_NNNNN.vtu`` (gap-holders), ``links_NNNNN.vtu`` (periodic
-links) and ``passages_NNNNN.vtu`` (one point per sliding passage) when the scene has them.
+links) and ``passages_NNNNN.vtu`` (one point per sliding passage) when the scene has them;
+``state_NNNNN.vtm`` lists them by name, and ``states.pvd`` lists the ``.vtm`` files.
 """
 from __future__ import annotations
 
@@ -480,6 +481,20 @@ def _read_grid(path: Path, cell_type: str = "line"
         raise ResultError(f"{path}: not a readable yarnfort VTK state ({error})") from None
 
 
+def _yarns_block(path: Path) -> Path:
+    """The yarns' file of a state's multiblock file (``state_NNNNN.vtm``): its block
+    named ``yarns`` (or its first block)."""
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as error:
+        raise ResultError(f"{path}: not a readable multiblock file ({error})") from None
+    blocks = [d for d in root.iter("DataSet") if d.get("file")]
+    if not blocks:
+        raise ResultError(f"{path}: lists no block")
+    yarns = next((d for d in blocks if d.get("name") == "yarns"), blocks[0])
+    return path.with_name(yarns.get("file"))
+
+
 def read_state(path: str | Path) -> State:
     """Read one VTK state written by yarnfort: the yarns' file (``state_*.vtu``) and the
     blocks next to it (gap-holders, periodic links, passages) that exist.
@@ -487,7 +502,8 @@ def read_state(path: str | Path) -> State:
     Parameters
     ----------
     path : str or Path
-        The yarns' ``state_NNNNN.vtu`` file.
+        The yarns' ``state_NNNNN.vtu`` file, or the state's multiblock file
+        ``state_NNNNN.vtm``.
 
     Returns
     -------
@@ -502,6 +518,8 @@ def read_state(path: str | Path) -> State:
         ``L0`` cell data, or a block lacks the arrays yarnfort writes there.
     """
     path = Path(path)
+    if path.suffix == ".vtm":
+        path = _yarns_block(path)
     points, elements, point_data, cell_data, field_data = _read_grid(path)
     missing = [name for name in ("tension", "stretch", "L0") if name not in cell_data]
     if missing:
@@ -548,8 +566,9 @@ def read_states(folder: str | Path) -> list[State]:
     """The VTK states of an output folder, in step order.
 
     The states are those listed in the folder's ``states.pvd`` (the files of this run
-    only; the yarns' files, part 0, each read with its blocks); without a
-    ``states.pvd``, every ``state_*.vtu`` in name order.
+    only: each state's multiblock file, or in folders of earlier versions the yarns'
+    files, part 0, each read with its blocks); without a ``states.pvd``, every
+    ``state_*.vtu`` in name order.
 
     Parameters
     ----------

@@ -5,8 +5,10 @@ data tension, stretch, L0, yarn, material; only yarn elements, so that colouring
 tension shows yarn tensions), the gap-holders' block (drawn to the partner's image,
 contact_force from the equilibrium of the leader node) and the periodic links' block
 (a vertex at the leader's image), field data (time, step, load factors, a fabric's
-strain), appended base64 binary by default and inline ASCII on request, and states.pvd
-(times, one part per block)."""
+strain), appended base64 binary by default and inline ASCII on request, each state's
+multiblock file (read by VTK's XML multiblock reader, ParaView's own: its blocks by
+name, tension only in the yarns' block) and states.pvd (the multiblock files and their
+times)."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
@@ -74,29 +76,50 @@ def meshio_arrays(mesh) -> dict[str, np.ndarray]:
     return arrays
 
 
-def collection(folder: Path, part: str = "0") -> list[tuple[str, float]]:
-    """The files of one part of states.pvd (0: the yarns) and their times."""
-    root = ET.parse(folder / "states.pvd").getroot()
-    return [(d.get("file"), float(d.get("timestep"))) for d in root.iter("DataSet")
-            if d.get("part") == part]
+#: The blocks of a state's multiblock file by name, and the prefix of their files.
+BLOCKS = {"yarns": "state_", "gap_holders": "holders_", "periodic_links": "links_",
+          "passages": "passages_"}
 
 
-def check_parts(folder: Path, prefixes: list[str]) -> None:
-    """states.pvd lists, at every time, the yarns (part 0) and the blocks `prefixes`
-    (parts 1, 2, ...) of the same step; VTK's XML reader opens each."""
-    yarns = collection(folder)
+def multiblock(folder: Path) -> list[tuple[str, float]]:
+    """The files states.pvd lists (each state's multiblock file) and their times."""
     root = ET.parse(folder / "states.pvd").getroot()
-    parts = {d.get("part") for d in root.iter("DataSet")}
-    assert len(parts) == len(prefixes) + 1
-    for part in sorted(parts - {"0"}):
-        listed = collection(folder, part)
-        assert [t for _, t in listed] == [t for _, t in yarns]
-        prefix = listed[0][0].split("_")[0] + "_"
-        assert prefix in prefixes
-        assert [name for name, _ in listed] == [prefix + name[len("state_"):]
-                                                for name, _ in yarns]
-        for name, _ in listed:
-            assert vtk_read(folder / name).GetNumberOfCells() > 0
+    return [(d.get("file"), float(d.get("timestep"))) for d in root.iter("DataSet")]
+
+
+def blocks(path: Path) -> dict[str, str]:
+    """The blocks of a multiblock file: name -> file."""
+    root = ET.parse(path).getroot()
+    return {d.get("name"): d.get("file") for d in root.iter("DataSet")}
+
+
+def collection(folder: Path) -> list[tuple[str, float]]:
+    """The yarns' files of the states states.pvd lists, and their times."""
+    return [(blocks(folder / name)["yarns"], time) for name, time in multiblock(folder)]
+
+
+def check_parts(folder: Path, names: list[str]) -> None:
+    """Every state states.pvd lists is a multiblock file of the yarns and the blocks
+    `names`, their files those of the same step; VTK's XML multiblock reader (ParaView's)
+    opens it with the blocks by name, and only the yarns' block has `tension`."""
+    for name, _ in multiblock(folder):
+        assert name.startswith("state_") and name.endswith(".vtm")
+        step = name[len("state_"):-len(".vtm")]
+        listed = blocks(folder / name)
+        assert list(listed) == ["yarns"] + names
+        assert listed == {block: BLOCKS[block] + step + ".vtu" for block in listed}
+        reader = vtk.vtkXMLMultiBlockDataReader()
+        reader.SetFileName(str(folder / name))
+        reader.Update()
+        assert reader.GetErrorCode() == 0, name
+        data = reader.GetOutput()
+        assert data.GetNumberOfBlocks() == len(listed)
+        for i, block in enumerate(listed):
+            assert data.GetMetaData(i).Get(vtk.vtkCompositeDataSet.NAME()) == block
+            grid = data.GetBlock(i)
+            assert grid.GetNumberOfCells() > 0, (name, block)
+            assert grid.GetCellData().HasArray("tension") == (block == "yarns")
+            assert grid.GetPointData().HasArray("tension") == 0
 
 
 def components(n_points: int, pairs: np.ndarray) -> int:
@@ -261,7 +284,7 @@ def test_belt_is_connected_by_its_gap_holders(run_yarnfort, tmp_path):
     out = tmp_path / "out"
     curve = read_curve(out)
     listed = collection(out)
-    check_parts(out, ["holders_", "passages_"])
+    check_parts(out, ["gap_holders", "passages"])
     first = check_state(out / listed[0][0])
     initial = first["points"] - first["displacement"]
     for name, _ in (listed[0], listed[len(listed) // 2], listed[-1]):
@@ -299,7 +322,7 @@ def test_knit_cell_has_periodic_links(run_yarnfort, tmp_path):
     out = tmp_path / "out"
     listed = collection(out)
     curve = read_curve(out)
-    check_parts(out, ["holders_", "links_", "passages_"])
+    check_parts(out, ["gap_holders", "periodic_links", "passages"])
     first = check_state(out / listed[0][0])
     name = listed[len(listed) // 4][0]
     arrays = check_state(out / name, first["points"] - first["displacement"])
@@ -352,6 +375,8 @@ def test_states_pvd_of_a_long_path_lists_every_state(run_yarnfort, tmp_path):
         np.testing.assert_allclose([t for _, t in listed], np.array(expected_steps) / steps,
                                    rtol=0, atol=tolerance)
         assert sorted(p.name for p in out.glob("state_*.vtu")) == names
+        assert sorted(p.name for p in out.glob("state_*.vtm")) == [
+            name[:-len(".vtu")] + ".vtm" for name in names]
         for name in names:
             assert (out / name).read_bytes().endswith(b"</VTKFile>\n"), name
 

@@ -8,8 +8,9 @@
 !>     file <name>
 !>     state <name> <step> <time>
 !>
-!> A state entry (state_NNNNN.vtu) stands for its other blocks too (holders_NNNNN.vtu,
-!> links_..., passages_...: yarnfort_output_vtk), written before it.
+!> A state entry (state_NNNNN.vtu) stands for its multiblock file and its other blocks
+!> too (state_NNNNN.vtm, holders_NNNNN.vtu, links_..., passages_...: yarnfort_output_vtk),
+!> written before it.
 !> A name is listed when the run is about to create it (add_file, add_state), before the
 !> file exists: a kill in between leaves a listed file that is incomplete or missing,
 !> never an unlisted one. Only names this program writes are ever taken from the file
@@ -282,12 +283,18 @@ contains
         is_bookkeeping_name = any(bookkeeping_names == name)
     end function is_bookkeeping_name
 
-    !> A name this program writes into an output folder: a fixed name, a state file or
-    !> one of a state's other blocks (holders_, links_, passages_ + the state's digits).
+    !> A name this program writes into an output folder: a fixed name, a state file, its
+    !> multiblock file (state_NNNNN.vtm) or one of its other blocks (holders_, links_,
+    !> passages_ + the state's digits).
     pure logical function is_own_name(name)
         character(len=*), intent(in) :: name
         integer :: part, n
         is_own_name = any(fixed_names == name) .or. is_state_name(name)
+        n = len(name)
+        if (n > len('.vtm')) then
+            if (name(n - 3:) == '.vtm') is_own_name = is_own_name &
+                .or. is_state_name(name(:n - 4) // '.vtu')
+        end if
         do part = 1, size(part_prefixes)
             n = len_trim(part_prefixes(part))
             if (len(name) <= n) cycle

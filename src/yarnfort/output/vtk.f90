@@ -16,8 +16,9 @@
 !>   passages at one node both show.
 !> Every block has the field data time, step, the factor of each load channel (p_force,
 !> p_disp without &path channels), and for a fabric strain and force_per_width (as in
-!> curve.csv). states.pvd lists the yarns as part 0 and the other blocks the scene has
-!> as parts 1-3 of each time step (ParaView's PVD reader makes them one multiblock).
+!> curve.csv). The multiblock file state_NNNNN.vtm lists the blocks of a state by name
+!> (ParaView and VTK's XML multiblock reader open it as one dataset), and states.pvd
+!> the multiblock files with their pseudo-time.
 !> The files are built by yarnfort_output_vtu: appended base64-encoded binary by default,
 !> or inline ASCII (&output vtk_format).
 module yarnfort_output_vtk
@@ -34,7 +35,8 @@ module yarnfort_output_vtk
     implicit none
     private
 
-    public :: vtk_writer_type, get_state_name, get_part_name, collection_file_name
+    public :: vtk_writer_type, get_state_name, get_part_name, get_multiblock_name
+    public :: collection_file_name
     public :: part_holders, part_links, part_passages
 
     character(len=*), parameter :: collection_file_name = 'states.pvd'
@@ -66,6 +68,9 @@ module yarnfort_output_vtk
     !> The blocks of a state besides the yarns', by their place in part_prefixes;
     !> states.pvd lists them as parts 1, 2, 3.
     integer, parameter :: part_holders = 1, part_links = 2, part_passages = 3
+    !> The names of the blocks in a state's .vtm (ParaView's block tree), yarns first.
+    character(len=*), parameter :: block_names(0:3) = [character(len=14) :: 'yarns', &
+        'gap_holders', 'periodic_links', 'passages']
     integer, parameter :: contact_none = 0, contact_stick = 1, contact_slip = 2
 
     !> states.pvd is rewritten after a state when it then misses more than this fraction
@@ -95,6 +100,13 @@ contains
         part_name = trim(part_prefixes(part)) // name(len('state_') + 1:)
     end function get_part_name
 
+    !> The multiblock file of the state file `name` (state_NNNNN.vtu): state_NNNNN.vtm.
+    pure function get_multiblock_name(name) result(multiblock_name)
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: multiblock_name
+        multiblock_name = name(:len(name) - len('.vtu')) // '.vtm'
+    end function get_multiblock_name
+
     !> Which blocks the states of `scene` have (set before the first state or
     !> write_collection): gap-holders, periodic links, sliding passages.
     subroutine set_parts(self, scene)
@@ -113,9 +125,10 @@ contains
     end subroutine set_parts
 
     !> Write the files of `state` (`mode`, `flow`: stick/slip mode and flow of each
-    !> passage, may be empty): its blocks first, the yarns' state file last (a whole
-    !> state file means a whole state), then states.pvd when due (collection_lag). A
-    !> failed write removes the incomplete file and says why.
+    !> passage, may be empty): its blocks and the multiblock file that lists them first,
+    !> the yarns' state file last (a whole state file means a whole state), then
+    !> states.pvd when due (collection_lag). A failed write removes the incomplete file
+    !> and says why.
     subroutine write_state(self, scene, state, mode, flow, error)
         class(vtk_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
@@ -136,6 +149,8 @@ contains
                 self%folder // '/' // get_part_name(name, part_passages), error)
             if (allocated(error)) return
         end if
+        call write_multiblock(self, name, error)
+        if (allocated(error)) return
         call write_yarns(self, scene, state, mode, self%folder // '/' // name, error)
         if (allocated(error)) return
 
@@ -144,6 +159,33 @@ contains
                 real(self%n_files - self%listed, wp) > collection_lag * self%n_files) &
             call self%write_collection(error)
     end subroutine write_state
+
+    !> The multiblock file of the state file `name` (state_NNNNN.vtm): its blocks by
+    !> name (block_names), the yarns first, so that ParaView shows each in its tree.
+    subroutine write_multiblock(self, name, error)
+        class(vtk_writer_type), intent(in) :: self
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        integer :: part, index
+
+        text = '<?xml version="1.0"?>' // new_line('a') &
+            // '<VTKFile type="vtkMultiBlockDataSet" version="1.0">' // new_line('a') &
+            // '<vtkMultiBlockDataSet>' // new_line('a') &
+            // '<DataSet index="0" name="' // trim(block_names(0)) // '" file="' // name &
+            // '"/>' // new_line('a')
+        index = 0
+        do part = 1, size(self%has_part)
+            if (.not. self%has_part(part)) cycle
+            index = index + 1
+            text = text // '<DataSet index="' // format_integer(index) // '" name="' &
+                // trim(block_names(part)) // '" file="' // get_part_name(name, part) // '"/>' &
+                // new_line('a')
+        end do
+        text = text // '</vtkMultiBlockDataSet>' // new_line('a') // '</VTKFile>' &
+            // new_line('a')
+        call write_text_file(self%folder // '/' // get_multiblock_name(name), text, error)
+    end subroutine write_multiblock
 
     !> The yarns' block (state_NNNNN.vtu): the nodes and the yarn elements.
     subroutine write_yarns(self, scene, state, mode, path, error)
@@ -423,8 +465,9 @@ contains
         self%times(self%n_files) = time
     end subroutine add_file
 
-    !> Write states.pvd.tmp and rename it over states.pvd. The text is built in one
-    !> buffer sized for every entry, so a rewrite costs time linear in its entries.
+    !> Write states.pvd.tmp and rename it over states.pvd: each state's multiblock file
+    !> with its pseudo-time. The text is built in one buffer sized for every entry, so a
+    !> rewrite costs time linear in its entries.
     subroutine write_collection(self, error)
         class(vtk_writer_type), intent(inout) :: self
         type(error_type), allocatable, intent(out) :: error
@@ -433,37 +476,24 @@ contains
             // achar(10)
         character(len=*), parameter :: tail = '</Collection></VTKFile>' // achar(10)
         character(len=*), parameter :: before_time = '<DataSet timestep="', &
-            before_part = '" part="', before_file = '" file="', after_file = '"/>' // achar(10)
-        !> The longest entry: its fixed text, a time (es24.16e3), a part (one digit) and a
-        !> file name (a block's prefix is at most 3 longer than 'state_').
-        integer, parameter :: entry_length = len(before_time) + 24 + len(before_part) + 1 &
-            + len(before_file) + state_name_length + 3 + len(after_file)
+            before_file = '" file="', after_file = '"/>' // achar(10)
+        !> The longest entry: its fixed text, a time (es24.16e3) and a file name.
+        integer, parameter :: entry_length = len(before_time) + 24 + len(before_file) &
+            + state_name_length + len(after_file)
         character(len=:), allocatable :: text
         character(len=24) :: time
-        integer :: i, used, part
+        integer :: i, used
 
-        allocate(character(len=len(head) + entry_length * (1 + size(self%has_part)) &
-            * self%n_files + len(tail)) :: text)
+        allocate(character(len=len(head) + entry_length * self%n_files + len(tail)) :: text)
         used = 0
         call put(head)
         do i = 1, self%n_files
             write(time, '(es24.16e3)') self%times(i)
-            do part = 0, size(self%has_part)
-                if (part > 0) then
-                    if (.not. self%has_part(part)) cycle
-                end if
-                call put(before_time)
-                call put(trim(adjustl(time)))
-                call put(before_part)
-                call put(achar(iachar('0') + part))
-                call put(before_file)
-                if (part == 0) then
-                    call put(trim(self%files(i)))
-                else
-                    call put(get_part_name(trim(self%files(i)), part))
-                end if
-                call put(after_file)
-            end do
+            call put(before_time)
+            call put(trim(adjustl(time)))
+            call put(before_file)
+            call put(get_multiblock_name(trim(self%files(i))))
+            call put(after_file)
         end do
         call put(tail)
         call write_text_file(self%folder // '/' // collection_file_name, text(:used), error, &

@@ -22,7 +22,7 @@ module yarnfort_output_writer
     use yarnfort_output_contacts, only: contacts_writer_type, contacts_file_name
     use yarnfort_output_table, only: table_writer_type
     use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, get_part_name, &
-        collection_file_name
+        get_multiblock_name, collection_file_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
         remove_file, open_new_file, close_new_file, get_links, refuse_link, sync_file
     use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name, &
@@ -277,7 +277,8 @@ contains
         if (.not. allocated(error)) call self%vtk%write_collection(error)
     end subroutine resume_files
 
-    !> Delete the state file `name` and its other blocks (those of any scene).
+    !> Delete the state file `name`, its multiblock file and its other blocks (those of
+    !> any scene).
     subroutine remove_state(self, name, error)
         class(output_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: name
@@ -285,6 +286,8 @@ contains
         integer :: part
 
         call remove_file(self%folder // '/' // trim(name), error)
+        if (.not. allocated(error)) call remove_file(self%folder // '/' &
+            // get_multiblock_name(trim(name)), error)
         do part = 1, size(part_prefixes)
             if (.not. allocated(error)) call remove_file(self%folder // '/' &
                 // get_part_name(trim(name), part), error)

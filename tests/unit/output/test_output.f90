@@ -50,10 +50,11 @@ contains
         character(len=*), parameter :: own(*) = [character(len=24) :: 'curve.csv', &
             'input.nml', 'restart.dat', 'restart.dat.tmp', 'states.pvd', 'states.pvd.tmp', &
             'restart.sync', 'restart.sync.tmp', 'state_00012.vtu', 'state_123456.vtu', &
-            'holders_00012.vtu', 'links_123456.vtu', 'passages_00000.vtu']
+            'holders_00012.vtu', 'links_123456.vtu', 'passages_00000.vtu', 'state_00012.vtm']
         character(len=*), parameter :: foreign(*) = [character(len=24) :: 'notes.txt', &
             '../curve.csv', 'sub/state_00001.vtu', 'state_1.vtu', 'state_0000x.vtu', &
             'holders_1.vtu', 'links_0000x.vtu', 'passages_.vtu', 'passages.vtu', &
+            'state_1.vtm', 'holders_00012.vtm', '.vtm', &
             'state_00001.vtu.bak', 'state_00001.vtk', '.yarnfort-lock', 'measured.csv', '']
         integer :: i
 
