@@ -101,8 +101,9 @@ def collection(folder: Path) -> list[tuple[str, float]]:
 def check_parts(folder: Path, names: list[str]) -> None:
     """Every state states.pvd lists is a multiblock file of the yarns and the blocks
     `names`, their files those of the same step; VTK's XML multiblock reader (ParaView's)
-    opens it with the blocks by name, and only the yarns' block has `tension`."""
-    for name, _ in multiblock(folder):
+    opens it with the blocks by name, each of the state's step and time, and only the
+    yarns' block has `tension`."""
+    for name, time in multiblock(folder):
         assert name.startswith("state_") and name.endswith(".vtm")
         step = name[len("state_"):-len(".vtm")]
         listed = blocks(folder / name)
@@ -120,6 +121,10 @@ def check_parts(folder: Path, names: list[str]) -> None:
             assert grid.GetNumberOfCells() > 0, (name, block)
             assert grid.GetCellData().HasArray("tension") == (block == "yarns")
             assert grid.GetPointData().HasArray("tension") == 0
+            # Every block is of the state's step and time (17 digits in states.pvd).
+            field = grid.GetFieldData()
+            assert field.GetArray("step").GetValue(0) == int(step)
+            assert field.GetArray("time").GetValue(0) == time
 
 
 def components(n_points: int, pairs: np.ndarray) -> int:
@@ -138,15 +143,22 @@ def components(n_points: int, pairs: np.ndarray) -> int:
     return len({root(i) for i in used})
 
 
-def check_state(path: Path, initial: np.ndarray | None = None) -> dict[str, np.ndarray]:
-    """Read a state with both readers, check they agree with each other and with the
-    geometry of the file (displacement from `initial`, lengths); return the arrays."""
+def read_both(path: Path):
+    """A file read with meshio and with VTK, which must give the same arrays: the meshio
+    mesh, the VTK grid and the arrays by name."""
     mesh = meshio.read(path)
     grid = vtk_read(path)
     a, b = meshio_arrays(mesh), vtk_arrays(grid)
     assert set(a) == set(b)
     for name in a:
         np.testing.assert_array_equal(a[name].ravel(), b[name].ravel(), err_msg=name)
+    return mesh, grid, b
+
+
+def check_state(path: Path, initial: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Read a state with both readers, check they agree with each other and with the
+    geometry of the file (displacement from `initial`, lengths); return the arrays."""
+    mesh, grid, b = read_both(path)
     points = vtk_to_numpy(grid.GetPoints().GetData())
     np.testing.assert_array_equal(points, mesh.points)
     assert grid.GetNumberOfCells() == sum(len(c.data) for c in mesh.cells)
@@ -243,12 +255,7 @@ def check_holders(path: Path, arrays: dict[str, np.ndarray], free: np.ndarray) -
     one the leader's yarn takes (equilibrium of a leader in `free`: no support, load
     or other link), contact_force its component along the line. Returns the block's
     arrays and the (leader, follower) pairs (from 0)."""
-    mesh = meshio.read(path)
-    grid = vtk_read(path)
-    a, b = meshio_arrays(mesh), vtk_arrays(grid)
-    assert set(a) == set(b)
-    for name in a:
-        np.testing.assert_array_equal(a[name].ravel(), b[name].ravel(), err_msg=name)
+    mesh, _, b = read_both(path)
     assert {c.type for c in mesh.cells} == {"line"}
     leader, follower = b["leader"] - 1, b["follower"] - 1
     points = arrays["points"]
