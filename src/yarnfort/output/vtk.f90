@@ -37,7 +37,6 @@ module yarnfort_output_vtk
 
     public :: vtk_writer_type, get_state_name, get_part_name, get_multiblock_name
     public :: collection_file_name
-    public :: part_holders, part_links, part_passages
 
     character(len=*), parameter :: collection_file_name = 'states.pvd'
     !> Longest state file name kept (get_state_name's are far shorter).
@@ -57,7 +56,8 @@ module yarnfort_output_vtk
         !> The blocks besides the yarns' that each state has (set_parts).
         logical :: has_part(3) = .false.
     contains
-        procedure :: set_parts
+        !> Which blocks the states of a scene have.
+        procedure, private :: set_parts
         procedure :: write_state
         !> Start the list of states anew with `files` and their `times`.
         procedure :: set_files
@@ -65,8 +65,7 @@ module yarnfort_output_vtk
         procedure :: write_collection
     end type vtk_writer_type
 
-    !> The blocks of a state besides the yarns', by their place in part_prefixes;
-    !> states.pvd lists them as parts 1, 2, 3.
+    !> The blocks of a state besides the yarns', by their place in part_prefixes.
     integer, parameter :: part_holders = 1, part_links = 2, part_passages = 3
     !> The names of the blocks in a state's .vtm (ParaView's block tree), yarns first.
     character(len=*), parameter :: block_names(0:3) = [character(len=14) :: 'yarns', &
@@ -107,8 +106,8 @@ contains
         multiblock_name = name(:len(name) - len('.vtu')) // '.vtm'
     end function get_multiblock_name
 
-    !> Which blocks the states of `scene` have (set before the first state or
-    !> write_collection): gap-holders, periodic links, sliding passages.
+    !> Which blocks the states of `scene` have: gap-holders, periodic links, sliding
+    !> passages.
     subroutine set_parts(self, scene)
         class(vtk_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene

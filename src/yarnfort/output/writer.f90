@@ -159,7 +159,6 @@ contains
         self%node_reactions = scene%output%node_reactions
         self%contact_state = scene%output%contact_state .and. scene%passages%size() > 0
         self%vtk%ascii = trim(scene%output%vtk_format) == 'ascii'
-        call self%vtk%set_parts(scene)
         call system_clock(self%synced_at)
         call self%lock(scene%output%folder, error)
         if (.not. allocated(error)) then
