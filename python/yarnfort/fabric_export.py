@@ -405,12 +405,23 @@ def _abaqus(all_curves: Sequence[ComponentCurves], scale: _Scale, name: str,
               "** strain up to its peak on the loading curve, one after the other."]
     for curves in all_curves:
         lines += _describe(curves, scale, "**")
+    for curves in all_curves:
+        branches = [curves.loading] + (curves.unloading if unloading else [])
+        lowest = min(float(branch.strain.min()) for branch in branches)
+        if lowest < 0:
+            raise FabricExportError(
+                f"run {str(curves.run)!r}, component {curves.component}: strain {lowest:.6g}"
+                " < 0 (compression); the Abaqus curves are written as tension data"
+                " (DIRECTION=TENSION, positive strains): export a run that stays in"
+                " tension, or use --format csv")
     lines += [f"*MATERIAL, NAME={name}", "*FABRIC"]
     for curves in all_curves:
         lines.append(f"*UNIAXIAL, COMPONENT={ABAQUS_COMPONENT[curves.component]}")
         damage = unloading and bool(curves.unloading)
-        lines.append("*LOADING DATA, TYPE=DAMAGE, DIRECTION=TENSION" if damage
-                     else "*LOADING DATA, DIRECTION=TENSION")
+        # REGULARIZE=OFF: Abaqus uses the points as given (the run's steps), not a
+        # regularized table (default RTOL=0.03); it applies to the unloading data too.
+        lines.append("*LOADING DATA, TYPE=DAMAGE, DIRECTION=TENSION, REGULARIZE=OFF"
+                     if damage else "*LOADING DATA, DIRECTION=TENSION, REGULARIZE=OFF")
         loading = curves.loading
         for stress, strain in zip(scale.stress(loading.force_per_width), loading.strain):
             lines.append(f"{_number(stress)}, {_number(strain)}")
