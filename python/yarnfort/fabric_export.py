@@ -371,7 +371,7 @@ def _number(value: float) -> str:
 def _describe(curves: ComponentCurves, scale: _Scale, comment: str) -> list[str]:
     """Comment lines: where each component's curves come from."""
     loading = curves.loading
-    lines = [f"{comment} component {curves.component}: run {curves.run.resolve()},"
+    lines = [f"{comment} component {curves.component}: run {curves.run},"
              f" columns {curves.columns[0]} and {curves.columns[1]}",
              f"{comment}   loading: steps {int(loading.steps[0])}-{int(loading.steps[-1])},"
              f" strain {loading.strain[0]:.6g} to {loading.peak_strain:.6g}; force per"
@@ -459,8 +459,8 @@ def _lsdyna(all_curves: Sequence[ComponentCurves], scale: _Scale, first_id: int,
             title = (f"yarnfort component {curves.component} loading" if k == 0 else
                      f"yarnfort component {curves.component} unloading {k} from strain"
                      f" {branch.peak_strain:.6g}")
-            lines += ["*DEFINE_CURVE_TITLE", title[:80],
-                      f"$ {directions[curves.component]}: {'loading' if k == 0 else 'unloading'}",
+            lines += [f"$ {directions[curves.component]}: {title}",
+                      "*DEFINE_CURVE_TITLE", title[:80],
                       "$" + "".join(name.rjust(LSDYNA_HEADER_WIDTH) for name in
                                     ("LCID", "SIDR", "SFA", "SFO", "OFFA", "OFFO",
                                      "DATTYP"))[1:],

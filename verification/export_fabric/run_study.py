@@ -29,8 +29,10 @@ COMMAND = ["-m", "yarnfort", "export-fabric", "out/export_fabric", "--component"
 def main() -> None:
     start = time.perf_counter()
     with open(HERE / "knit_cycles.nml") as scene:
-        subprocess.run([str(yarnfort.program_path())], stdin=scene, cwd=TOP, check=True,
-                       stdout=subprocess.DEVNULL)
+        done = subprocess.run([str(yarnfort.program_path())], stdin=scene, cwd=TOP,
+                              capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit(f"the run of knit_cycles.nml failed:\n{done.stderr}")
     run_time = time.perf_counter() - start
     lines = [f"run of knit_cycles.nml: {run_time:.1f} s"]
     for suffix, fmt in ((".inp", "abaqus"), (".k", "lsdyna"), (".csv", "csv")):
