@@ -365,6 +365,10 @@ def _parser() -> argparse.ArgumentParser:
     export.add_argument("-o", "--out", type=Path, required=True, metavar="FILE",
                         help="file to write (refused if it exists, unless --force)")
     export.add_argument("--force", action="store_true", help="overwrite an existing FILE")
+    export.add_argument("--uniaxial", action="store_true",
+                        help="components 1 and 2 from strain and force_per_width (the"
+                        " cell's x direction) even where curve.csv has e11/n11, e22/n22:"
+                        " a cell turned by 90 degrees given as component 2")
     export.add_argument("--no-unloading", action="store_true",
                         help="write the loading curves only")
     export.add_argument("--name", default="YARNFORT_FABRIC",
@@ -402,7 +406,8 @@ def export_fabric_command(args: argparse.Namespace) -> Path:
                            " membrane columns)")
     return export_fabric(list(zip(components, runs)), args.out, format=args.format,
                          thickness=args.thickness, units=args.units,
-                         unloading=not args.no_unloading, name=args.name,
+                         unloading=not args.no_unloading, uniaxial=args.uniaxial,
+                         name=args.name,
                          first_curve_id=args.first_curve_id, overwrite=args.force)
 
 

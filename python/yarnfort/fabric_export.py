@@ -149,9 +149,12 @@ def _check_periodic(folder: Path) -> None:
                                 " width includes its edges, export a periodic cell")
 
 
-def _columns(curve: Curve, component: str, folder: Path) -> tuple[str, str]:
+def _columns(curve: Curve, component: str, folder: Path, uniaxial: bool) -> tuple[str, str]:
     strain, force = MEMBRANE_COLUMNS[component]
-    if strain in curve.columns and force in curve.columns:
+    if uniaxial and component == "12":
+        raise FabricExportError("the uniaxial columns (strain, force_per_width) are a"
+                                " normal direction: they cannot give component 12")
+    if not uniaxial and strain in curve.columns and force in curve.columns:
         return strain, force
     if component != "12" and all(name in curve.columns for name in UNIAXIAL_COLUMNS):
         return UNIAXIAL_COLUMNS
@@ -195,7 +198,8 @@ def _primary_and_unloading(strain: np.ndarray) -> tuple[list[int], list[list[int
     return loading, unloadings, skipped
 
 
-def fabric_curves(folder: str | Path, component: str = "1") -> ComponentCurves:
+def fabric_curves(folder: str | Path, component: str = "1", *,
+                  uniaxial: bool = False) -> ComponentCurves:
     """The loading and unloading curves of one component of a periodic-cell run.
 
     Parameters
@@ -204,6 +208,10 @@ def fabric_curves(folder: str | Path, component: str = "1") -> ComponentCurves:
         The run's output folder (curve.csv and input.nml).
     component : str
         ``'1'``, ``'2'`` or ``'12'`` (see the module notes for the columns used).
+    uniaxial : bool
+        Read ``strain`` and ``force_per_width`` (the cell stretched along x) for
+        component 1 or 2 even where curve.csv has the membrane columns: the run of a
+        cell turned by 90 degrees given as component 2.
 
     Returns
     -------
@@ -226,7 +234,7 @@ def fabric_curves(folder: str | Path, component: str = "1") -> ComponentCurves:
         raise FabricExportError(f"no output folder {str(folder)!r}")
     _check_periodic(folder)
     curve = read_curve(folder)
-    strain_column, force_column = _columns(curve, component, folder)
+    strain_column, force_column = _columns(curve, component, folder, uniaxial)
     if len(curve) < 2:
         raise FabricExportError(f"run {str(folder)!r}: curve.csv has {len(curve)} rows,"
                                 " a curve needs at least 2 steps")
@@ -241,7 +249,9 @@ def fabric_curves(folder: str | Path, component: str = "1") -> ComponentCurves:
         raise FabricExportError(
             f"run {str(folder)!r}, component {component}: {strain_column} never grows"
             f" beyond its first value {strain[0]:.6g} (the run loads another component or"
-            " is compressed); give the run that loads this component")
+            " is compressed); give the run that loads this component"
+            + ("" if strain_column == UNIAXIAL_COLUMNS[0] or component == "12" else
+               ", or read a turned cell's x direction with --uniaxial"))
 
     def branch(kind: str, rows: list[int], peak: int) -> Branch:
         index = np.array(rows)
@@ -370,10 +380,12 @@ def _number(value: float) -> str:
 
 def _describe(curves: ComponentCurves, scale: _Scale, comment: str) -> list[str]:
     """Comment lines: where each component's curves come from."""
+    from .__main__ import _ranges  # '0-20, 51-60': one formatter of step lists
+
     loading = curves.loading
     lines = [f"{comment} component {curves.component}: run {curves.run},"
              f" columns {curves.columns[0]} and {curves.columns[1]}",
-             f"{comment}   loading: steps {int(loading.steps[0])}-{int(loading.steps[-1])},"
+             f"{comment}   loading: steps {_ranges([int(s) for s in loading.steps])},"
              f" strain {loading.strain[0]:.6g} to {loading.peak_strain:.6g}; force per"
              f" width at the first step {loading.force_per_width[0]:.6g} N/m"]
     for k, branch in enumerate(curves.unloading, start=1):
@@ -521,7 +533,8 @@ def _write_atomic(path: Path, text: str, overwrite: bool) -> None:
 def export_fabric(runs: Mapping[str, str | Path] | Iterable[tuple[str, str | Path]],
                   out: str | Path, *, format: str = "abaqus",
                   thickness: str | None = None, units: str = "N,mm",
-                  unloading: bool = True, name: str = "YARNFORT_FABRIC",
+                  unloading: bool = True, uniaxial: bool = False,
+                  name: str = "YARNFORT_FABRIC",
                   first_curve_id: int = 1, overwrite: bool = False) -> Path:
     """Write the effective curves of a fabric's periodic-cell runs for a macro model.
 
@@ -549,6 +562,9 @@ def export_fabric(runs: Mapping[str, str | Path] | Iterable[tuple[str, str | Pat
     unloading : bool
         Write the unloading curves; each component's run must then have at least one
         unloading from its primary loading curve.
+    uniaxial : bool
+        Components 1 and 2 from ``strain`` and ``force_per_width`` of each run, even
+        where curve.csv has the membrane columns (see :func:`fabric_curves`).
     name : str
         The Abaqus material name.
     first_curve_id : int
@@ -593,7 +609,7 @@ def export_fabric(runs: Mapping[str, str | Path] | Iterable[tuple[str, str | Pat
             raise FabricExportError(f"component {component} given twice (runs"
                                     f" {str(seen[component])!r} and {str(folder)!r})")
         seen[component] = Path(folder)
-        curves = fabric_curves(folder, component)
+        curves = fabric_curves(folder, component, uniaxial=uniaxial)
         if curves.columns == UNIAXIAL_COLUMNS:
             # The uniaxial columns are one direction of one run: never two components.
             same = [c for c in all_curves if c.run.resolve() == curves.run.resolve()]

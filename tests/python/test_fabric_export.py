@@ -282,3 +282,52 @@ def test_cli_writes_and_refuses_overwrite(runs, tmp_path):
                 "-o", str(tmp_path / "c.csv"), "--format", "csv")
     assert done.returncode == 2 and "one --component per RUN" in done.stderr
     assert not list(tmp_path.glob("*.tmp")) and not list(tmp_path.glob(".*.tmp"))
+
+
+def test_membrane_columns_give_all_components(runs, tmp_path):
+    """A curve.csv with the membrane columns (as periodic runs write them once issue 40's
+    biaxial part lands) gives components 1, 2 and 12 from one run, each from its own
+    pair. The columns here are the knit run's, scaled by known factors, so that each
+    component's points are told apart by hand."""
+    folder = tmp_path / "membrane"
+    shutil.copytree(runs["cycles"], folder)
+    with open(folder / "curve.csv", newline="") as stream:
+        rows = list(csv.DictReader(stream))
+    factors = {"e11": ("strain", 1.0), "n11": ("force_per_width", 1.0),
+               "e22": ("strain", 0.5), "n22": ("force_per_width", 2.0),
+               "gamma12": ("strain", 0.1), "n12": ("force_per_width", 0.3)}
+    for row in rows:
+        for name, (source, factor) in factors.items():
+            row[name] = repr(factor * float(row[source]))
+    with open(folder / "curve.csv", "w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    out = tmp_path / "all.inp"
+    done = _cli(str(folder), "--component", "1", "2", "12", "--thickness", "0.6mm",
+                "--units", "N,mm", "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    written = read_abaqus(out)
+    assert sorted(written) == ["1", "2", "SHEAR"]
+    expected = segments(runs["cycles"])
+    for component, (e, n) in (("1", (1.0, 1.0)), ("2", (0.5, 2.0)), ("SHEAR", (0.1, 0.3))):
+        for branch in ("loading", "unloading"):
+            assert len(written[component][branch]) == len(expected[branch])
+            for points, rows_ in zip(written[component][branch], expected[branch]):
+                assert_points_match(np.column_stack([points[:, 1] / e,
+                                                     points[:, 0] * 1e6 * THICKNESS_M / n]),
+                                    rows_)
+    # A cell turned by 90 degrees, given as component 2: its e22 does not grow, the
+    # message points to --uniaxial, which reads its x direction (strain).
+    for row in rows:
+        row["e22"] = "0.0"
+    with open(folder / "curve.csv", "w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    with pytest.raises(FabricExportError, match="--uniaxial"):
+        export_fabric({"2": folder}, tmp_path / "turned.csv", format="csv")
+    export_fabric({"2": folder}, tmp_path / "turned.csv", format="csv", uniaxial=True)
+    with open(tmp_path / "turned.csv", newline="") as stream:
+        strains = [float(r["strain"]) for r in csv.DictReader(stream)]
+    assert max(strains) == pytest.approx(1.0, rel=1e-12)   # the cell's x strain
