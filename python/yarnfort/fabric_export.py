@@ -426,6 +426,18 @@ def _abaqus(all_curves: Sequence[ComponentCurves], scale: _Scale, name: str,
                 " < 0 (compression); the Abaqus curves are written as tension data"
                 " (DIRECTION=TENSION, positive strains): export a run that stays in"
                 " tension, or use --format csv")
+        # Abaqus' damage unloading curves run from zero strain up to their peak and a new
+        # curve begins where the strain drops: a partial release fits neither.
+        start = float(curves.loading.strain[0])
+        tolerance = STRAIN_NOISE * max(1.0, curves.loading.peak_strain)
+        for k, branch in enumerate(curves.unloading if unloading else [], start=1):
+            if branch.strain.min() > start + tolerance:
+                raise FabricExportError(
+                    f"run {str(curves.run)!r}, component {curves.component}: unloading {k}"
+                    f" (from strain {branch.peak_strain:.6g}) stops at strain"
+                    f" {branch.strain.min():.6g}, not at the start {start:.6g}; Abaqus'"
+                    " interpolated unloading curves run down to zero strain: release the"
+                    " cell fully, or use --format lsdyna or csv")
     lines += [f"*MATERIAL, NAME={name}", "*FABRIC"]
     for curves in all_curves:
         lines.append(f"*UNIAXIAL, COMPONENT={ABAQUS_COMPONENT[curves.component]}")

@@ -64,6 +64,7 @@ def runs(tmp_path_factory) -> dict[str, Path]:
     where = tmp_path_factory.mktemp("export")
     shutil.copytree(TOP / "inputs" / "data", where / "inputs" / "data")
     return {
+        "partial": _run(where, "partial", strain=0.6, time="0, 1, 2", p_disp="0, 1, 0.5"),
         "cycles": _run(where, "cycles", strain=1.0, time="0, 1, 2, 3, 4, 5, 6",
                        p_disp="0, 0.5, 0, 1, 0, 0.6, 0"),
         "other": _run(where, "other", strain=0.6, time="0, 1, 2", p_disp="0, 1, 0"),
@@ -331,3 +332,15 @@ def test_membrane_columns_give_all_components(runs, tmp_path):
     with open(tmp_path / "turned.csv", newline="") as stream:
         strains = [float(r["strain"]) for r in csv.DictReader(stream)]
     assert max(strains) == pytest.approx(1.0, rel=1e-12)   # the cell's x strain
+
+
+def test_partial_release_refused_for_abaqus_only(runs, tmp_path):
+    """A release to half the peak strain is an unloading curve for LS-DYNA and CSV, but
+    not one Abaqus' interpolated curves (from zero strain up) can hold."""
+    with pytest.raises(FabricExportError, match="stops at strain 0.3"):
+        export_fabric({"1": runs["partial"]}, tmp_path / "a.inp", thickness="1mm")
+    assert not (tmp_path / "a.inp").exists()
+    curves = read_lsdyna(export_fabric({"1": runs["partial"]}, tmp_path / "a.k",
+                                       format="lsdyna", thickness="1mm"))
+    assert len(curves) == 2
+    np.testing.assert_allclose(curves[1][2][[0, -1], 0], [0.3, 0.6], rtol=1e-12)
