@@ -40,7 +40,7 @@ import numpy as np
 
 from .namelist import read_scene
 from .results import Curve, read_curve
-from .units import UNITS, find_unit
+from .units import UNITS, WIDTH_UNITS, find_unit
 
 __all__ = ["FabricExportError", "Branch", "ComponentCurves", "fabric_curves",
            "export_fabric", "parse_units", "parse_length", "FORMATS", "COMPONENTS"]
@@ -285,14 +285,14 @@ def parse_units(text: str) -> tuple[str, str]:
         Unless the text is a force unit then a length unit (the message lists them).
     """
     parts = [part.strip() for part in re.split(r"[,\s/]+", text.strip()) if part.strip()]
-    kinds = [UNITS[find_unit(part)][0] if find_unit(part) else None for part in parts]
-    if len(parts) != 2 or kinds != ["force", "length"]:
+    force = find_unit(parts[0]) if parts else None
+    if (len(parts) != 2 or force is None or UNITS[force][0] != "force"
+            or parts[1] not in WIDTH_UNITS):
         forces = ", ".join(u for u, (k, _, _) in UNITS.items() if k == "force")
-        lengths = ", ".join(u for u, (k, _, _) in UNITS.items() if k == "length")
         raise FabricExportError(
             f"--units {text!r}: give the macro model's force unit then its length unit,"
-            f" e.g. 'N,mm' (force: {forces}; length: {lengths})")
-    return find_unit(parts[0]), find_unit(parts[1])
+            f" e.g. 'N,mm' (force: {forces}; length: {', '.join(WIDTH_UNITS)})")
+    return force, parts[1]
 
 
 def parse_length(text: str | float, what: str = "--thickness") -> float:
@@ -321,18 +321,16 @@ def parse_length(text: str | float, what: str = "--thickness") -> float:
         raise FabricExportError(f"{what} {text!r}: give the length with its unit, e.g."
                                 " '0.6mm' (a bare number would mix the run's metres with"
                                 " the model's length unit)")
-    unit = find_unit(match.group(2))
-    if unit is None or UNITS[unit][0] != "length":
-        lengths = ", ".join(u for u, (k, _, _) in UNITS.items() if k == "length")
-        raise FabricExportError(f"{what} {text!r}: {match.group(2)!r} is not a length unit"
-                                f" ({lengths})")
+    unit = match.group(2)
+    if unit not in WIDTH_UNITS:
+        raise FabricExportError(f"{what} {text!r}: {unit!r} is not a length unit"
+                                f" ({', '.join(WIDTH_UNITS)})")
     try:
         value = float(match.group(1))
     except ValueError:
         raise FabricExportError(f"{what} {text!r}: {match.group(1)!r} is not a number"
                                 ) from None
-    _, numerator, denominator = UNITS[unit]
-    metres = value * numerator / denominator
+    metres = value * WIDTH_UNITS[unit]
     if not (np.isfinite(metres) and metres > 0):
         raise FabricExportError(f"{what} {text!r}: a thickness must be positive and finite")
     return metres
@@ -352,7 +350,7 @@ class _Scale:
 
     @property
     def metres(self) -> float:
-        return UNITS[self.length_unit][1] / UNITS[self.length_unit][2]
+        return WIDTH_UNITS[self.length_unit]
 
     def force_per_width(self, values: np.ndarray) -> np.ndarray:
         """N/m in force unit per length unit."""
@@ -570,7 +568,8 @@ def export_fabric(runs: Mapping[str, str | Path] | Iterable[tuple[str, str | Pat
         are stress against strain).
     units : str
         The macro model's force and length units, ``'N,mm'`` (stress in MPa), ``'N,m'``
-        (Pa), ...: every unit of :data:`yarnfort.units.UNITS` of those kinds.
+        (Pa), ``'lbf,in'`` (psi): the force units of :data:`yarnfort.units.UNITS`
+        and the lengths of :data:`yarnfort.units.WIDTH_UNITS` (with the inch).
     unloading : bool
         Write the unloading curves; each component's run must then have at least one
         unloading from its primary loading curve.

@@ -213,6 +213,23 @@ def test_csv_round_trip(runs, tmp_path):
             assert_points_match(points, want)
 
 
+def test_inch_units(runs, tmp_path):
+    """lbf and in (psi): the conversion by hand with the exact pound-force and inch."""
+    out = export_fabric({"1": runs["other"]}, tmp_path / "knit.csv", format="csv",
+                        thickness="0.025in", units="lbf,in")
+    with open(out, newline="") as stream:
+        rows = list(csv.DictReader(stream))
+    psi = np.array([float(r["stress (lbf/in^2)"]) for r in rows])
+    width = np.array([float(r["force_per_width (lbf/in)"]) for r in rows])
+    n = psi * 4.4482216152605 / 0.0254 ** 2 * (0.025 * 0.0254)    # -> Pa -> N/m
+    np.testing.assert_allclose(width * 4.4482216152605 / 0.0254, n, rtol=1e-11)
+    expected = segments(runs["other"])
+    assert_points_match(np.column_stack([[float(r["strain"]) for r in rows if
+                                          r["branch"] == "loading"],
+                                         n[[r["branch"] == "loading" for r in rows]]]),
+                        expected["loading"][0])
+
+
 def test_shear_and_missing_components(runs, tmp_path):
     with pytest.raises(FabricExportError, match="no data for component 12"):
         export_fabric({"12": runs["cycles"]}, tmp_path / "a.inp", thickness="1mm")
