@@ -7,7 +7,7 @@
 !> shows connected). Arrays:
 !> - field data: time, step, the factor of each load channel (p_force, p_disp without
 !>   &path channels); for a fabric also strain and
-!>   force_per_width (as in curve.csv);
+!>   force_per_width (as in curve.csv); for a periodic cell e11 ... n12 (as in curve.csv);
 !> - point data: displacement (from the initial position), position, and for scenes
 !>   with sliding passages contact_state (0 no passage, 1 all stick, 2 a passage slips),
 !>   passages (the number of sliding passages at the node), and the state of one of them
@@ -31,6 +31,7 @@ module yarnfort_output_vtk
         close_new_file
     use yarnfort_text, only: format_integer
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
+    use yarnfort_output_membrane, only: membrane_names, get_membrane
     implicit none
     private
 
@@ -110,7 +111,7 @@ contains
         integer(int64), allocatable :: connectivity(:), offsets(:)
         integer(int32), allocatable :: cell_kind(:), yarn(:), material(:), contact(:)
         real(wp), allocatable :: tension(:), stretch(:), length0(:), period(:, :)
-        real(wp) :: now(3), before(3), p_disp
+        real(wp) :: now(3), before(3), p_disp, membrane(6)
 
         name = get_state_name(state%step)
         path = self%folder // '/' // name
@@ -177,6 +178,10 @@ contains
             call add_reals(vtu, 'force_per_width', &
                 [state%reaction(1, scene%fabric_set) / scene%fabric_width], 1, field=.true.)
         end if
+        if (scene%periodic_cell) membrane = get_membrane(scene, state)
+        do l = 1, merge(size(membrane_names), 0, scene%periodic_cell)
+            call add_reals(vtu, trim(membrane_names(l)), [membrane(l)], 1, field=.true.)
+        end do
         call add_text(vtu, '</FieldData>')
         call add_text(vtu, '<Piece NumberOfPoints="' // format_integer(n_nodes) &
             // '" NumberOfCells="' // format_integer(n_cells) // '">')

@@ -76,6 +76,13 @@ contains
             scene%fabric_width = config%fabric_width
             scene%fabric_strain = config%fabric%strain
             if (config%fabric_support > 0) scene%fabric_set = config%fabric_support
+            ! A periodic cell's periods are its longest lattice vectors along x and y
+            ! (images lie one period away; a corner image both).
+            scene%periodic_cell = config%fabric%boundary == 'periodic'
+            if (scene%periodic_cell) then
+                scene%cell_period = maxval(abs(scene%cell_lattice(1:2, :)), dim=2)
+                scene%cell_strain = [config%fabric%strain, config%fabric%lateral_strain]
+            end if
         end if
         scene%path%time = config%path%time
         scene%path%channel = get_channel_names(config%path)
@@ -385,7 +392,7 @@ contains
         integer :: n_nodes, l, n, r, k, c, cr, hops, displacement_channel, s, i
         integer, allocatable :: leader(:), link_of(:), stretch_coordinates(:)
         integer, allocatable :: set_of(:), place_of(:)
-        real(wp) :: offset(3), macro(3), gap(3), step(3)
+        real(wp) :: offset(3), macro(3), gap(3), step(3), lattice(3)
         character(len=200) :: buffer
 
         n_nodes = scene%network%n_nodes()
@@ -399,6 +406,7 @@ contains
         end if
         allocate(scene%link_nodes(2, 0), scene%link_is_gap(0))
         allocate(scene%link_period(3, 0), scene%link_strain(3, 0))
+        allocate(scene%cell_lattice(3, n_nodes), source=0.0_wp)
         if (.not. allocated(config%links)) return
         if (size(config%links) == 0) return
         scene%link_nodes = reshape([(config%links(l)%leader, config%links(l)%follower, &
@@ -449,6 +457,7 @@ contains
             offset = 0.0_wp
             macro = 0.0_wp
             gap = 0.0_wp
+            lattice = 0.0_wp
             r = n
             hops = 0
             do while (leader(r) /= 0)
@@ -464,12 +473,15 @@ contains
                     if (link%gap) then
                         gap = gap + step - link%period
                         macro = macro + link%strain * link%period
+                        lattice = lattice + link%period
                     else
                         macro = macro + link%strain * step
+                        lattice = lattice + step
                     end if
                 end associate
                 r = leader(r)
             end do
+            scene%cell_lattice(:, n) = lattice
             do k = 1, 3
                 c = 3 * (n - 1) + k
                 cr = 3 * (r - 1) + k

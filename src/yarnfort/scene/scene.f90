@@ -81,6 +81,14 @@ module yarnfort_scene_scene
         !> initial offset, a gap-holder's period (zero inside the cell); at factor p of
         !> dofs%gap_channel it is link_period * (1 + p * link_strain), componentwise.
         real(wp), allocatable :: link_period(:, :), link_strain(:, :)
+        !> A periodic cell (&fabric boundary = 'periodic'): each node's lattice vector at
+        !> p_disp = 0 (3, n_nodes; zero for a node that follows no periodic image), the
+        !> reference periods along x and y (m) and their engineering strains at p_disp = 1.
+        !> A node's position is its root's plus lattice * (1 + p_disp * cell_strain),
+        !> componentwise (yarnfort_output_membrane).
+        logical :: periodic_cell = .false.
+        real(wp), allocatable :: cell_lattice(:, :)
+        real(wp) :: cell_period(2) = 0.0_wp, cell_strain(2) = 0.0_wp
     end type scene_type
 
 contains

@@ -1,0 +1,128 @@
+# SPDX-License-Identifier: MIT
+"""Membrane strains and forces of periodic cells (curve.csv e11 ... n12), checked by a
+work balance that does not use their definition, and by symmetry.
+
+Work balance. Along a load path the work of the membrane forces,
+
+    W = A0 * sum over steps of the trapezoid of (1 + e22) n11 de11 + (1 + e11) n22 de22
+
+(A0 = L10 L20 the reference cell area; F_1x dL1 + F_2y dL2 with F_1x = n11 L2 the x
+force across the cell), equals the change of the yarns' stored energy plus the energy
+dissipated by sliding at the passages. The stored energy is computed here from the VTK
+states: for a linear law, U = sum over elements of L0 EA (lambda - 1)^2 / 2 (lambda > 1).
+Sliding moves reference length between the elements of a yarn at fixed positions; the
+energy it releases is D = -sum_e dU/dL0_e dL0_e with dU/dL0_e = W_e - lambda_e T_e (W_e
+the energy per reference length), which is zero for a bonded cell (no L0 changes) and
+for a frictionless one (equal tensions, hence equal stretches, on both sides of every
+passage). Both are exact checks: what is left is the trapezoid rule's error, which falls
+with the square of the step (halving the step divides it by about 4).
+
+Symmetry. A plain weave of equal yarns in a square cell is its own image under a turn by
+90 degrees that swaps warp and weft: its run with the strains swapped has n11 and n22
+swapped.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fabric_scenes import TOP, patched_scene
+from yarnfort import read_curve
+from yarnfort.results import read_states
+
+#: Axial stiffness of every yarn in these scenes (N): a linear law, so that the stored
+#: energy has a closed form.
+EA = 50.0
+#: Bonded and frictionless contacts (every law parameter reset first).
+CLEAR = {"friction_coefficient": None, "adhesion": None, "decay_start": None,
+         "decay_end": None}
+
+
+def linear_materials(n: int) -> dict:
+    return {k: v for m in range(n) for k, v in {
+        f"material[{m}].law": "linear", f"material[{m}].table_file": None,
+        f"material[{m}].stiffness": EA}.items()}
+
+
+def contacts(n: int, kind: str) -> dict:
+    values = {}
+    for c in range(n):
+        values.update({f"contact[{c}].{k}": v for k, v in CLEAR.items()})
+        if kind == "bonded":
+            values[f"contact[{c}].law"] = "bonded"
+        else:
+            values[f"contact[{c}].law"] = "coulomb"
+            values[f"contact[{c}].friction_coefficient"] = 0.0
+    return values
+
+
+#: Periodic cells: base input, values, reference periods (m) from the input by hand.
+CELLS = {
+    # knit.nml: 2 x 2 wales x courses, spacing 1.0 mm x 0.8 mm.
+    "knit": ("inputs/knit.nml", {**linear_materials(2)}, 2, (2 * 1.0e-3, 2 * 0.8e-3)),
+    # belt.nml turned into a 2 x 2 periodic plain weave, spacing 1.0 mm x 0.5 mm; no gap
+    # factor (a prescribed change of the gap would do work of its own).
+    "plain": ("inputs/belt.nml", {
+        "fabric.kind": "plain", "fabric.boundary": "periodic", "fabric.cells": [2, 2],
+        "fabric.sides": None, "fabric.gap_factor": None, "fabric.gap_factor_p_disp": None,
+        **linear_materials(2)}, 1, (2 * 1.0e-3, 2 * 0.5e-3)),
+}
+
+
+def run_cell(run_yarnfort, folder, cell: str, kind: str, step: float,
+             strain: float = 0.3, lateral: float = 0.1, extra: dict | None = None):
+    base, values, n_contacts, periods = CELLS[cell]
+    values = {**values, **contacts(n_contacts, kind), "fabric.strain": strain,
+              "fabric.lateral_strain": lateral,
+              "path.time": [0.0, 1.0], "path.p_disp": [0.0, 1.0],
+              "solver.initial_step": step, "solver.max_step": step,
+              "output.vtk_every": 1, **(extra or {})}
+    result = run_yarnfort(patched_scene(base, values, folder), cwd=TOP)
+    assert result.returncode == 0, result.stderr
+    return read_curve(folder), read_states(folder), periods
+
+
+def stored_energy(state) -> float:
+    stretch = np.maximum(state.stretch - 1.0, 0.0)
+    return float(np.sum(state.length0 * EA * stretch ** 2 / 2))
+
+
+def membrane_work(curve, periods) -> np.ndarray:
+    """Cumulative work of the membrane forces (J), trapezoid rule over the steps."""
+    area0 = periods[0] * periods[1]
+    e11, e22, n11, n22 = (np.asarray(curve[c]) for c in ("e11", "e22", "n11", "n22"))
+    rate11 = (1 + e22) * n11
+    rate22 = (1 + e11) * n22
+    pieces = 0.5 * (rate11[1:] + rate11[:-1]) * np.diff(e11) \
+        + 0.5 * (rate22[1:] + rate22[:-1]) * np.diff(e22)
+    return area0 * np.concatenate([[0.0], np.cumsum(pieces)])
+
+
+def balance_residual(run_yarnfort, folder, cell, kind, step) -> tuple[float, float]:
+    """|W - dU| at the end of the path, and the work W, of one run."""
+    curve, states, periods = run_cell(run_yarnfort, folder, cell, kind, step)
+    assert len(states) == len(curve["step"])
+    # The reference periods by hand are those of the cell's links at p_disp = 0.
+    found = states[0].periods()
+    assert np.allclose(np.abs(found[:, :2]).max(axis=1), periods, rtol=1e-12)
+    energy = np.array([stored_energy(s) for s in states])
+    work = membrane_work(curve, periods)
+    if kind == "bonded":
+        # No sliding: every reference length stays.
+        assert np.array_equal(states[0].length0, states[-1].length0)
+    return abs(work[-1] - (energy[-1] - energy[0])), work[-1]
+
+
+@pytest.mark.parametrize("kind", ["bonded", "frictionless"])
+@pytest.mark.parametrize("cell", sorted(CELLS))
+def test_work_balance_converges_with_the_square_of_the_step(run_yarnfort, tmp_path, cell,
+                                                            kind):
+    residual = []
+    for step in (0.2, 0.1):
+        r, work = balance_residual(run_yarnfort, tmp_path / f"{step}", cell, kind, step)
+        assert work > 0
+        residual.append(r / work)
+    # Second order: halving the step divides the residual by about 4 (3 to 5 allows for
+    # the next term of the error).
+    assert 3.0 < residual[0] / residual[1] < 5.0, residual
+    assert residual[1] < 1e-2, residual
