@@ -126,3 +126,64 @@ def test_work_balance_converges_with_the_square_of_the_step(run_yarnfort, tmp_pa
     # the next term of the error).
     assert 3.0 < residual[0] / residual[1] < 5.0, residual
     assert residual[1] < 1e-2, residual
+
+
+def dissipation(states) -> np.ndarray:
+    """Cumulative energy released by sliding (J): -sum_e dU/dL0_e dL0_e, with
+    dU/dL0_e = W_e - lambda_e T_e of the linear law, trapezoid rule over the steps."""
+    def release(state):
+        strain = np.maximum(state.stretch - 1.0, 0.0)
+        energy = EA * strain ** 2 / 2
+        return energy - state.stretch * EA * strain
+    pieces = [-np.sum(0.5 * (release(a) + release(b)) * (b.length0 - a.length0))
+              for a, b in zip(states[:-1], states[1:])]
+    return np.concatenate([[0.0], np.cumsum(pieces)])
+
+
+def test_frictionless_knit_slides_without_dissipation(run_yarnfort, tmp_path):
+    """The frictionless knit does slide (the balance above is not that of a stuck cell),
+    and the energy sliding releases is zero to rounding: equal tensions both sides."""
+    curve, states, periods = run_cell(run_yarnfort, tmp_path, "knit", "frictionless", 0.1)
+    assert np.abs(states[-1].length0 - states[0].length0).max() > 1e-3 * np.mean(
+        states[0].length0)
+    work = membrane_work(curve, periods)[-1]
+    assert abs(dissipation(states)[-1]) <= 1e-9 * work
+
+
+def test_work_balance_with_friction(run_yarnfort, tmp_path):
+    """The knit with Coulomb friction (mu = 0.3) at its passages: the work of the
+    membrane forces is the change of stored energy plus the energy dissipated by sliding,
+    to the trapezoid rule's order (a quarter of the step: residual / 16, here at least
+    / 10; first order would give / 4)."""
+    residual = []
+    for step in (0.1, 0.025):
+        curve, states, periods = run_cell(run_yarnfort, tmp_path / f"{step}", "knit",
+                                          "frictionless", step,
+                                          extra={"contact[0].friction_coefficient": 0.3,
+                                                 "contact[1].friction_coefficient": 0.3})
+        energy = np.array([stored_energy(s) for s in states])
+        work = membrane_work(curve, periods)[-1]
+        dissipated = dissipation(states)[-1]
+        residual.append(abs(work - (energy[-1] - energy[0]) - dissipated) / work)
+    # The dissipation is real: much larger than what is left of the balance.
+    assert dissipated > 100 * residual[-1] * work, (dissipated / work, residual)
+    assert residual[0] / residual[1] > 10, residual
+
+
+def test_plain_weave_turned_by_90_degrees_swaps_11_and_22(run_yarnfort, tmp_path):
+    """A square plain-weave cell of equal yarns turned by 90 degrees is the cell mirrored
+    through its mid-plane (the yarn over at a crossing becomes the one under), which the
+    string model cannot tell apart: swapping the prescribed strains swaps n11 and n22."""
+    square = {"fabric.spacing": [1.0e-3, 1.0e-3]}
+    one, _, _ = run_cell(run_yarnfort, tmp_path / "a", "plain", "bonded", 0.1, 0.3, 0.1,
+                         extra=square)
+    turned, _, _ = run_cell(run_yarnfort, tmp_path / "b", "plain", "bonded", 0.1, 0.1, 0.3,
+                            extra=square)
+    scale = max(np.abs(one["n11"]).max(), np.abs(one["n22"]).max())
+    # Both runs converge to the Newton tolerance (1e-10 of the forces at a node).
+    assert np.array_equal(one["e11"], turned["e22"])
+    assert np.abs(one["n11"] - turned["n22"]).max() <= 1e-9 * scale
+    assert np.abs(one["n22"] - turned["n11"]).max() <= 1e-9 * scale
+    assert np.abs(one["n11"] - one["n22"]).max() > 0.1 * scale   # not trivially equal
+    # The square cell carries no shear force under normal strains.
+    assert np.abs(one["n12"]).max() <= 1e-9 * scale
