@@ -66,6 +66,13 @@ CELLS = {
         "fabric.kind": "plain", "fabric.boundary": "periodic", "fabric.cells": [2, 2],
         "fabric.sides": None, "fabric.gap_factor": None, "fabric.gap_factor_p_disp": None,
         **linear_materials(2)}, 1, (2 * 1.0e-3, 2 * 0.5e-3)),
+    # The same as a 4 x 4 periodic 2/2 twill.
+    "twill": ("inputs/belt.nml", {
+        "fabric.kind": "twill", "fabric.boundary": "periodic", "fabric.cells": [4, 4],
+        "fabric.sides": None, "fabric.gap_factor": None, "fabric.gap_factor_p_disp": None,
+        **linear_materials(2)}, 1, (4 * 1.0e-3, 4 * 0.5e-3)),
+    # texgen_weave.tg3: a plain weave whose yarns repeat every 2 mm along x and y.
+    "texgen_plain": ("inputs/texgen_weave.nml", {**linear_materials(2)}, 1, (2e-3, 2e-3)),
 }
 
 
