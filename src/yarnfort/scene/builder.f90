@@ -4,7 +4,7 @@ module yarnfort_scene_builder
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
     use yarnfort_input_config, only: config_type, material_config_type
-    use yarnfort_scene_scene, only: scene_type, support_set_type
+    use yarnfort_scene_scene, only: scene_type, support_set_type, lateral_channel_name
     use yarnfort_text, only: format_real
     use yarnfort_material_law, only: force_law_type
     use yarnfort_material_linear, only: linear_law_type, new_linear_law
@@ -52,6 +52,17 @@ contains
             end if
         end do
         scene%path%channel = get_channel_names(config%path)
+        ! A force-controlled y period of a periodic cell: e22 is the factor of a channel
+        ! of its own (the path leaves it at 0; the outer iteration sets it).
+        if (len_trim(config%fabric%kind) > 0 .and. config%fabric%boundary == 'periodic' &
+                .and. config%fabric%lateral_control /= 'strain') then
+            scene%path%channel = [character(len=name_length) :: scene%path%channel, &
+                lateral_channel_name]
+            scene%lateral_channel = size(scene%path%channel)
+            scene%lateral_control = config%fabric%lateral_control
+            scene%lateral_force = config%fabric%lateral_force
+            scene%force_ratio = config%fabric%force_ratio
+        end if
         call build_network(scene, config, error)
         if (allocated(error)) return
         call apply_prestress(scene, config, error)
@@ -87,6 +98,16 @@ contains
         scene%path%time = config%path%time
         scene%path%channel = get_channel_names(config%path)
         scene%path%factor = get_channel_factors(config%path)
+        if (scene%lateral_channel > 0) then
+            scene%path%channel = [character(len=name_length) :: scene%path%channel, &
+                lateral_channel_name]
+            block
+                real(wp), allocatable :: factor(:, :)
+                allocate(factor(size(scene%path%time), scene%lateral_channel), source=0.0_wp)
+                factor(:, :scene%lateral_channel - 1) = scene%path%factor
+                call move_alloc(factor, scene%path%factor)
+            end block
+        end if
         scene%length_scale = sum(scene%network%length0) / size(scene%network%length0)
     end subroutine new_scene
 
@@ -499,6 +520,10 @@ contains
                     scene%dofs%delta(c, displacement_channel) = macro(k)
                 end if
                 scene%dofs%gap(c) = gap(k)
+                ! A force-controlled y period: y = root + lattice_y * (1 + e22).
+                if (k == 2 .and. scene%lateral_channel > 0) &
+                    scene%dofs%delta(c, scene%lateral_channel) = &
+                    scene%dofs%delta(c, scene%lateral_channel) + lattice(2)
                 if (scene%dofs%unknown(cr) == 0 .and. set_of(cr) > 0) then
                     associate(set => scene%supports(set_of(cr)))
                         set%followers = [set%followers, c]
