@@ -194,3 +194,69 @@ def test_plain_weave_turned_by_90_degrees_swaps_11_and_22(run_yarnfort, tmp_path
     assert np.abs(one["n11"] - one["n22"]).max() > 0.1 * scale   # not trivially equal
     # The square cell carries no shear force under normal strains.
     assert np.abs(one["n12"]).max() <= 1e-9 * scale
+
+
+#: A force-controlled axis holds its force to 100 * residual_tolerance (1e-10) of the
+#: forces present (yarnfort_solver_lateral_control).
+HOLD = 100 * 1e-10
+
+
+def test_lateral_force_is_held_at_every_step(run_yarnfort, tmp_path):
+    """The knit example's cell (table laws, adhesion), stretched to e11 = 0.3 and
+    released with n22 held at 20 N/m: every step holds it; the cell narrows."""
+    values = {"fabric.lateral_control": "force", "fabric.lateral_force": 20.0,
+              "path.time": [0.0, 1.0, 2.0], "path.p_disp": [0.0, 0.3, 0.0],
+              "output.vtk_every": 0}
+    result = run_yarnfort(patched_scene("inputs/knit.nml", values, tmp_path), cwd=TOP)
+    assert result.returncode == 0, result.stderr
+    curve = read_curve(tmp_path)
+    n11, n22, e22 = (np.asarray(curve[c]) for c in ("n11", "n22", "e22"))
+    scale = np.maximum(20.0, np.abs(n11))
+    assert np.all(np.abs(n22 - 20.0) <= HOLD * scale), np.abs(n22 - 20.0).max()
+    # e22 is the unknown: the cell narrows as it is stretched (and n11 grows).
+    assert e22[np.argmax(curve["e11"])] < e22[0] - 0.05
+    assert np.array_equal(curve["lateral"], e22)
+
+
+def test_force_ratio_is_held_at_every_step(run_yarnfort, tmp_path):
+    """The knit with n22 = 0.5 n11 at every step, loaded and unloaded."""
+    values = {"fabric.lateral_control": "ratio", "fabric.force_ratio": 0.5,
+              "path.time": [0.0, 1.0, 2.0], "path.p_disp": [0.0, 0.3, 0.0],
+              "output.vtk_every": 0}
+    result = run_yarnfort(patched_scene("inputs/knit.nml", values, tmp_path), cwd=TOP)
+    assert result.returncode == 0, result.stderr
+    curve = read_curve(tmp_path)
+    n11, n22 = np.asarray(curve["n11"]), np.asarray(curve["n22"])
+    assert np.all(np.abs(n22 - 0.5 * n11) <= HOLD * np.abs(n11))
+    assert n11.max() > 2 * n11[0]
+
+
+def test_work_balance_with_a_held_lateral_force(run_yarnfort, tmp_path):
+    """A bonded knit stretched with n22 held: e22 is found by the outer iteration, and
+    the balance, now with its n22 de22 term, still converges with the square of the step."""
+    residual = []
+    # Steps fine enough for the asymptotic order: e22 bends sharply at the start (at steps
+    # 0.2, 0.1, 0.05 the ratios measured were 2.5 and 3.0, then 3.8 and 4.05).
+    for step in (0.025, 0.0125):
+        curve, states, periods = run_cell(
+            run_yarnfort, tmp_path / f"{step}", "knit", "bonded", step, strain=0.1,
+            lateral=0.0,
+            extra={"fabric.lateral_control": "force", "fabric.lateral_force": 20.0})
+        e22 = np.asarray(curve["e22"])
+        assert np.ptp(e22) > 0.01
+        energy = np.array([stored_energy(s) for s in states])
+        work = membrane_work(curve, periods)[-1]
+        residual.append(abs(work - (energy[-1] - energy[0])) / work)
+    assert 3.0 < residual[0] / residual[1] < 5.0, residual
+
+
+def test_lateral_collapse_is_refused(run_yarnfort, tmp_path):
+    """n22 held at 0: the yarns across the cell are slack and the y period is free to
+    shrink: no state, so no curve (exit 1, the message names the mechanism)."""
+    values = {"fabric.lateral_control": "force", "fabric.lateral_force": 0.0,
+              "path.time": [0.0, 1.0], "path.p_disp": [0.0, 0.3], "output.vtk_every": 0}
+    result = run_yarnfort(patched_scene("inputs/knit.nml", values, tmp_path), cwd=TOP)
+    assert result.returncode == 1
+    assert "Lateral collapse" in result.stderr
+    assert "no resistance to lateral compaction" in result.stderr
+    assert len(read_curve(tmp_path)) == 0
