@@ -65,6 +65,11 @@ module yarnfort_output_restart
     !> Load factors of a restart file and of the path at its time may differ by this,
     !> relative to the path's largest factor (they are computed the same way).
     real(wp), parameter :: factor_tolerance = 64 * epsilon(1.0_wp)
+    !> Echo lines of variables added after restart files were first written, at their
+    !> defaults: left out of the fingerprint, so that a restart file of an input without
+    !> them stays valid (one that sets them is another input).
+    character(len=*), parameter :: unhashed_defaults(3) = [character(len=32) :: &
+        "    lateral_control = 'strain'", '    lateral_force = 0.0', '    force_ratio = 1.0']
     !> Bytes read at a time when an input file's content is hashed.
     integer, parameter :: hash_chunk = 65536
 
@@ -541,6 +546,7 @@ contains
                 read(unit, '(a)', advance='no', size=n, iostat=status) chunk
                 if (is_iostat_end(status)) exit
                 if (status /= 0 .and. .not. is_iostat_eor(status)) exit
+                if (is_iostat_eor(status) .and. any(chunk(:n) == unhashed_defaults)) cycle
                 call add_bytes(transfer(chunk(:n), [0_int8], n))
                 if (is_iostat_eor(status)) call add_bytes([10_int8])
             end do
