@@ -260,3 +260,13 @@ def test_lateral_collapse_is_refused(run_yarnfort, tmp_path):
     assert "Lateral collapse" in result.stderr
     assert "no resistance to lateral compaction" in result.stderr
     assert len(read_curve(tmp_path)) == 0
+
+
+def test_equibiaxial_strain_of_a_square_plain_weave(run_yarnfort, tmp_path):
+    """Equibiaxial strain (lateral_strain = strain) of the square plain-weave cell: e11 =
+    e22, and by the 90-degree symmetry n11 = n22 at every step."""
+    curve, _, _ = run_cell(run_yarnfort, tmp_path, "plain", "bonded", 0.1, 0.2, 0.2,
+                           extra={"fabric.spacing": [1.0e-3, 1.0e-3]})
+    assert np.array_equal(curve["e11"], curve["e22"])
+    scale = np.abs(curve["n11"]).max()
+    assert np.abs(curve["n11"] - curve["n22"]).max() <= 1e-9 * scale
