@@ -6,8 +6,6 @@
 !>   stick passage: k (s - s_target), k = the scene's largest force / length_scale;
 !>   slip forward (T_after > T_before, s grows):    T_crit(T_before, alpha) - T_after;
 !>   slip backward (T_before > T_after, s shrinks): T_before - T_crit(T_after, alpha).
-!> (The signs make the residual continuous where the semismooth choice below switches
-!> a passage between stick and slip: there k ds = -g_f, resp. k ds = g_b.)
 !> Each slip row is divided by a weight w = max(1, dT_crit/dT_min), fixed for a Newton
 !> solve from its initial guess (`prepare_solve`), so that it measures the change of the
 !> low-side tension that would satisfy it. Unweighted, the row cannot reach the residual
@@ -15,21 +13,10 @@
 !> EA*epsilon (from lambda - 1 near lambda = 1), which T_crit multiplies by
 !> dT_crit/dT_min (measured: mu alpha = 20 stalled at 5e-8 of the largest stiffness).
 !> Rows are judged (get_row_levels) against the forces at their node, the passage's
-!> larger tension / w for a slip row, the largest force for a stick row. With
-!> `semismooth` the weights stay 1 (the modes change within a solve).
+!> larger tension / w for a slip row, the largest force for a stick row.
 !> Tensions enter the friction conditions as max(T, 0) (a slack string pulls nothing).
-!> With `semismooth` (off by default) the mode of each passage is not fixed from outside
-!> but chosen at every evaluation from the current iterate, as in a primal-dual active
-!> set (semismooth Newton) method: with k ds the scaled flow increment and
-!> g_f = T_after - T_crit(T_before), g_b = T_before - T_crit(T_after),
-!>   forward slip if k ds + g_f > 0, else backward slip if -k ds + g_b > 0, else stick,
-!> which at a solution is exactly the stick/slip complementarity (ds >= 0, g_f <= 0,
-!> ds g_f = 0, and likewise backward). A whole slip front then moves in one Newton
-!> solve instead of one passage per active-set round. Measured on the woven benchmark
-!> net (benchmarks/bench_friction) it made KINSOL cycle on the first load step and cost
-!> 9.6 factorisations per step against 2.5 for the active-set rounds, so the stepper's
-!> rounds (semismooth off) are the default. `locked` forbids a direction (minimum
-!> reference length reached, or chatter damping).
+!> The active set is the stepper's (yarnfort_contact_friction_stepper); `locked` forbids
+!> a direction (minimum reference length reached, or chatter damping).
 !> Viscous slip (`viscosity` > 0, off by default; only the slip-instability jump of
 !> friction_stepper sets it): each slip row gets eta (s - s_start) added, eta =
 !> viscosity * stick_scale and s_start = flow_target, so a slipping passage is held
@@ -95,8 +82,6 @@ module yarnfort_contact_friction_problem
         real(wp), allocatable :: flow_target(:)
         !> Divisor of each slip row, fixed per Newton solve (module notes).
         real(wp), allocatable :: slip_weight(:)
-        !> Choose modes from the iterate (semismooth Newton) instead of keeping `mode`.
-        logical :: semismooth = .false.
         !> Viscous slip, in units of stick_scale (module notes; 0: the exact law).
         real(wp) :: viscosity = 0.0_wp
         !> Direction a passage may not slip in (mode_forward or mode_backward), both
@@ -145,8 +130,6 @@ module yarnfort_contact_friction_problem
         procedure :: update_state
         !> Tensions (clipped at 0) on both sides and the wrap angle of passage p.
         procedure :: get_passage_state
-        !> Modes from the current state and flows (semismooth Newton).
-        procedure :: choose_modes
     end type friction_problem_type
 
 contains
@@ -364,33 +347,6 @@ contains
         end associate
     end subroutine get_passage_state
 
-    subroutine choose_modes(self, flow)
-        class(friction_problem_type), intent(inout) :: self
-        real(wp), intent(in) :: flow(:)
-        integer :: p
-        real(wp) :: t_before, t_after, angle, forward, backward, increment, d1, d2
-
-        do p = 1, self%n_p
-            call self%get_passage_state(p, t_before, t_after, angle)
-            associate(law => self%scene%friction(self%scene%passages%law(p))%law)
-                call law%get_critical_tension(t_before, angle, forward, d1, d2)
-                call law%get_critical_tension(t_after, angle, backward, d1, d2)
-            end associate
-            forward = t_after - forward
-            backward = t_before - backward
-            increment = self%stick_scale * (flow(p) - self%flow_target(p))
-            if (increment + forward > 0.0_wp .and. self%locked(p) /= mode_forward &
-                    .and. self%locked(p) /= locked_both) then
-                self%mode(p) = mode_forward
-            else if (-increment + backward > 0.0_wp .and. self%locked(p) /= mode_backward &
-                    .and. self%locked(p) /= locked_both) then
-                self%mode(p) = mode_backward
-            else
-                self%mode(p) = mode_stick
-            end if
-        end do
-    end subroutine choose_modes
-
     !> Reject a solution whose flows leave an element a reference length <= 0. Newton's
     !> iterates may pass there (forbidding it made KINSOL's five step halvings too few on
     !> test_friction's bollard), but a string with L0 <= 0 counts as slack, so such a
@@ -428,7 +384,7 @@ contains
         ! Stick rows in units of the scene's forces (it only scales the rows).
         self%stick_scale = self%get_force_level() / self%length_scale
         if (.not. (self%stick_scale > 0.0_wp)) self%stick_scale = 1.0_wp / self%length_scale
-        if (self%semismooth .or. all(self%mode == mode_stick)) return
+        if (all(self%mode == mode_stick)) return
         do p = 1, self%n_p
             if (self%mode(p) == mode_stick) cycle
             call self%get_passage_state(p, t_before, t_after, angle)
@@ -525,9 +481,6 @@ contains
         call self%update_state(u, error)
         if (allocated(error)) return
         row = 0
-        if (.not. self%positions_frozen) row = self%n_x
-        if (self%semismooth) call self%choose_modes(u(row + 1:))
-        row = 0
         if (.not. self%positions_frozen) then
             ! The applied forces at these factors: update_state (set_load).
             call self%scene%dofs%gather(self%internal - self%applied, values(1:self%n_x))
@@ -564,13 +517,6 @@ contains
 
         call self%update_state(u, error)
         if (allocated(error)) return
-        if (self%semismooth) then
-            if (self%positions_frozen) then
-                call self%choose_modes(u)
-            else
-                call self%choose_modes(u(self%n_x + 1:))
-            end if
-        end if
         values = 0.0_wp
         associate(scene => self%scene, net => self%scene%network)
             if (.not. self%positions_frozen) then

@@ -47,6 +47,7 @@ module yarnfort_contact_friction_stepper
     use yarnfort_solver_restart, only: restart_type, stepper_friction
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
         mode_stick, mode_forward, mode_backward, locked_both, node_level_floor
+    use yarnfort_contact_slip_front, only: propagate_slips
     implicit none
     private
 
@@ -319,7 +320,7 @@ contains
     !> set: measured on the 32 x 32 free-sided clamped knit (benchmarks/
     !> steps_results.md, sections 23 and 24), mirror pairs of passages flip for ever
     !> (slipping, their flows go back; stuck, they exceed their limit, by an amount
-    !> proportional to the step), the semismooth mode's line search stalls, and
+    !> proportional to the step), a semismooth Newton method's line search stalls, and
     !> changing one passage per round (least index first) does not settle either.
     !> From the accepted state, viscous slip steps at the load `factors`
     !> (friction_problem's viscosity: implicit Euler steps of a viscoplastic law, whose
@@ -436,6 +437,7 @@ contains
         logical, allocatable :: locked_forward(:), locked_backward(:)
         integer :: round, n_x, changed, cap, new_slips, outcome, provisional_rounds, pass
         integer :: failed_before, q
+        logical, allocatable :: marched(:), good_marched(:)
         !> Active set of the last Newton step's factors (try_chord, take_newton_step).
         integer, allocatable :: factored_mode(:), passage_index(:)
         logical :: have_good, guessed, full_retry, sign_tried, stopped, solved, moved, chorded
@@ -479,7 +481,7 @@ contains
             end select
             allocate(flips(size(self%flow)), source=0)
             allocate(locked_forward(size(self%flow)), locked_backward(size(self%flow)), &
-                source=.false.)
+                marched(size(self%flow)), source=.false.)
             passage_index = [(q, q = 1, size(self%flow))]
             iterations = 0
             problem%locked = 0
@@ -533,15 +535,14 @@ contains
                 ! inputs/knit_clamped.nml 2.20 -> 2.12; periodic cells equal; residual
                 ! evaluations per step up to +11 % (8 x 8 default cycle 9.40 -> 10.43);
                 ! same steps, forces within 1e-12 of the peak on 28 scenes.
-                if (round > 1 .and. allocated(factored_mode) .and. .not. (full_retry &
-                        .or. problem%semismooth)) then
+                if (round > 1 .and. allocated(factored_mode) .and. .not. full_retry) then
                     call self%newton_full%try_row_update(unknowns, n_x + pack(passage_index, &
                         self%mode_trial /= factored_mode), stats, solved, step_error)
                     if (allocated(step_error)) solved = .false.
                     carried = stats
                 end if
                 if (provisional_rounds < max_provisional_rounds .and. .not. (full_retry &
-                        .or. problem%semismooth .or. solved)) then
+                        .or. solved)) then
                     ! Each pass is one Newton step: with the solve after them, within
                     ! max_iterations (a solve's limit).
                     do pass = 1, min(provisional_passes, scene%solver%max_iterations - 1)
@@ -659,6 +660,7 @@ contains
                         unknowns = good_unknowns
                         self%mode_trial = good_mode
                         flips = good_flips
+                        marched = good_marched
                         call problem%update_state(unknowns, error)
                         if (allocated(error)) return
                         call update_active_set(problem, unknowns(n_x + 1:), self%flow, &
@@ -689,10 +691,6 @@ contains
                 end if
                 call problem%update_state(unknowns, error)
                 if (allocated(error)) return
-                if (problem%semismooth) then
-                    call problem%choose_modes(unknowns(n_x + 1:))
-                    self%mode_trial = problem%mode
-                end if
                 have_good = .true.
                 ! A failed round halves the cap on new slips (above); two solved rounds in
                 ! a row double it again. Without that the cap kept its lowest value for
@@ -710,9 +708,10 @@ contains
                 good_unknowns = unknowns
                 good_mode = self%mode_trial
                 good_flips = flips
+                good_marched = marched
                 call update_active_set(problem, unknowns(n_x + 1:), self%flow, self%mode_trial, &
                     flips, locked_forward, locked_backward, changed, cap, new_slips, &
-                    at_limit=self%at_limit_trial)
+                    at_limit=self%at_limit_trial, propagate=.true., marched=marched)
                 call record_changes(self%trace, good_mode, self%mode_trial)
                 if (changed == 0) then
                     call check_damped(problem, flips, locked_forward, locked_backward, error)
@@ -740,7 +739,7 @@ contains
             !> count of the last new slips (for halving) stays.
             integer, intent(in), optional :: cap_here
             integer, allocatable :: trial_mode(:), trial_flips(:), saved_locked(:)
-            logical, allocatable :: trial_forward(:), trial_backward(:)
+            logical, allocatable :: trial_forward(:), trial_backward(:), trial_marched(:)
             real(wp), allocatable :: saved_target(:)
             type(error_type), allocatable :: state_error
             integer :: trial_new_slips, max_new_slips
@@ -752,13 +751,15 @@ contains
             trial_flips = flips
             trial_forward = locked_forward
             trial_backward = locked_backward
+            trial_marched = marched
             saved_locked = problem%locked
             saved_target = problem%flow_target
             max_new_slips = cap
             if (present(cap_here)) max_new_slips = cap_here
             call update_active_set(problem, flow, self%flow, trial_mode, trial_flips, &
                 trial_forward, trial_backward, changed, max_new_slips, &
-                trial_new_slips, provisional_band * residual)
+                trial_new_slips, provisional_band * residual, propagate=.true., &
+                marched=trial_marched)
             if (changed == 0) then
                 problem%locked = saved_locked
                 problem%flow_target = saved_target
@@ -769,6 +770,7 @@ contains
             flips = trial_flips
             locked_forward = trial_forward
             locked_backward = trial_backward
+            marched = trial_marched
             if (.not. present(cap_here)) new_slips = trial_new_slips
         end subroutine judge_provisional
     end subroutine try_monolithic
@@ -856,10 +858,6 @@ contains
                     if (allocated(error)) return
                     call sliding%update_state(self%flow_trial, error)
                     if (allocated(error)) return
-                    if (sliding%semismooth) then
-                        call sliding%choose_modes(self%flow_trial)
-                        self%mode_trial = sliding%mode
-                    end if
                     call update_active_set(sliding, self%flow_trial, self%flow, &
                         self%mode_trial, flips, locked_forward, locked_backward, changed, &
                         huge(1), new_slips)
@@ -1035,7 +1033,8 @@ contains
     !> was called at the solution). `flow` are the solved flows, `accepted` those at the
     !> start of the step. Returns the number of passages whose mode changed.
     subroutine update_active_set(problem, flow, accepted, mode, flips, locked_forward, &
-            locked_backward, changed, max_new_slips, new_slips, residual, at_limit)
+            locked_backward, changed, max_new_slips, new_slips, residual, at_limit, propagate, &
+            marched)
         type(friction_problem_type), intent(inout) :: problem
         real(wp), intent(in) :: flow(:), accepted(:)
         integer, intent(inout) :: mode(:), flips(:)
@@ -1051,7 +1050,14 @@ contains
         !> The stick test's at_limit flag of each passage that was stick (on entry), at
         !> this state without `residual` (predict_modes' test of an accepted state).
         logical, allocatable, intent(inout), optional :: at_limit(:)
+        !> March the new slips' fronts along their yarns (propagate_slips).
+        logical, intent(in), optional :: propagate
+        !> Passages whose slip a march predicted (propagate_slips) in this step: they
+        !> count no flip, and neither does their stop.
+        logical, intent(inout), optional :: marched(:)
         integer :: p, new_mode, before, after, n_candidates, k, direction_p
+        integer, allocatable :: predicted_mode(:)
+        logical, allocatable :: started(:), predicted(:)
         integer :: unlocked_direction
         real(wp) :: min_before, min_after, increment, floor, measure, unlocked_measure
         integer, allocatable :: candidate(:), direction(:)
@@ -1122,12 +1128,35 @@ contains
                 call set_mode(p, new_mode)
             end do
             ! Stick passages that start to slip: the most violated first, up to the cap.
+            allocate(started(size(mode)), predicted(size(mode)), source=.false.)
             do k = 1, min(n_candidates, max_new_slips)
                 p = maxloc(violation(1:n_candidates), dim=1)
                 call set_mode(candidate(p), direction(p))
+                started(candidate(p)) = mode(candidate(p)) /= mode_stick
                 violation(p) = -huge(1.0_wp)
                 new_slips = new_slips + 1
             end do
+            ! Their fronts along the yarns (yarnfort_contact_slip_front), with no cap in
+            ! force (after a failed round the rounds go one front step at a time).
+            if (present(propagate) .and. max_new_slips >= huge(1) / 2) then
+                if (propagate .and. any(started)) then
+                    predicted_mode = mode
+                    call propagate_slips(problem, started, scene%solver%friction_tolerance, &
+                        locked_forward .or. flips > max_flips, &
+                        locked_backward .or. flips > max_flips, predicted_mode, predicted)
+                    do p = 1, size(mode)
+                        if (.not. predicted(p)) cycle
+                        if (present(marched)) then
+                            mode(p) = predicted_mode(p)
+                            marched(p) = .true.
+                            changed = changed + 1
+                        else
+                            call set_mode(p, predicted_mode(p))
+                        end if
+                        new_slips = new_slips + 1
+                    end do
+                end if
+            end if
         end associate
     contains
         subroutine add_candidate(new_direction, measure)
@@ -1143,6 +1172,13 @@ contains
             integer, intent(in) :: passage, new_mode
             if (new_mode == mode(passage)) return
             mode(passage) = new_mode
+            if (present(marched)) then
+                if (marched(passage)) then
+                    marched(passage) = .false.
+                    changed = changed + 1
+                    return
+                end if
+            end if
             flips(passage) = flips(passage) + 1
             changed = changed + 1
             if (flips(passage) > max_flips) then
@@ -1179,7 +1215,8 @@ contains
         integer :: p, direction
         real(wp) :: floor, measure
         real(wp), allocatable :: trial_factors(:)
-        logical, allocatable :: at_limit(:)
+        logical, allocatable :: at_limit(:), started(:), blocked_forward(:), &
+            blocked_backward(:), predicted(:)
 
         changed = .false.
         if (present(accepted_limits)) then
@@ -1202,15 +1239,27 @@ contains
         if (allocated(error)) return
         floor = node_level_floor * problem%get_force_level()
         associate(passages => problem%scene%passages)
+            allocate(started(size(mode)), predicted(size(mode)), source=.false.)
+            allocate(blocked_forward(size(mode)), blocked_backward(size(mode)))
             do p = 1, size(mode)
+                blocked_forward(p) = at_limit(p) &
+                    .or. is_at_min_length(problem, passages%element_before(p))
+                blocked_backward(p) = at_limit(p) &
+                    .or. is_at_min_length(problem, passages%element_after(p))
                 if (mode(p) /= mode_stick .or. at_limit(p)) cycle
-                call get_slip_tendency(problem, p, floor, &
-                    is_at_min_length(problem, passages%element_before(p)), &
-                    is_at_min_length(problem, passages%element_after(p)), direction, measure)
+                call get_slip_tendency(problem, p, floor, blocked_forward(p), &
+                    blocked_backward(p), direction, measure)
                 if (direction == mode_stick) cycle
                 mode(p) = direction
+                started(p) = .true.
                 changed = .true.
             end do
+            ! Their fronts along the yarns, as in the rounds (update_active_set).
+            if (changed) then
+                call propagate_slips(problem, started, &
+                    problem%scene%solver%friction_tolerance, blocked_forward, &
+                    blocked_backward, mode, predicted)
+            end if
         end associate
     end subroutine predict_modes
 
