@@ -53,6 +53,7 @@ contains
         predicted = .false.
         do p = 1, size(mode)
             if (.not. started(p) .or. mode(p) == mode_stick) cycle
+            if (.not. is_held(p)) cycle
             do side = side_before, side_after
                 call march(p, side)
             end do
@@ -70,7 +71,7 @@ contains
             do
                 q = get_next(p, side)
                 if (q == 0) return
-                if (mode(q) /= mode_stick) return
+                if (mode(q) /= mode_stick .or. .not. is_held(q)) return
                 call problem%get_passage_state(q, t_before, t_after, angle)
                 ! q's side of the segment it shares with p: the opposite side.
                 if (side == side_before) then
@@ -87,6 +88,14 @@ contains
                 p = q
             end do
         end subroutine march
+
+        !> Passage p's node has a prescribed position (an obstacle's pin, a support).
+        pure logical function is_held(p)
+            integer, intent(in) :: p
+            associate(node => problem%scene%passages%node(p))
+                is_held = all(problem%scene%dofs%unknown(3 * node - 2:3 * node) == 0)
+            end associate
+        end function is_held
 
         !> The passage at the other end of p's segment on `side` (0: none).
         pure integer function get_next(p, side) result(q)
