@@ -47,7 +47,8 @@ module yarnfort_contact_friction_stepper
     use yarnfort_solver_restart, only: restart_type, stepper_friction
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
         mode_stick, mode_forward, mode_backward, locked_both, node_level_floor
-    use yarnfort_contact_slip_front, only: propagate_slips
+    use yarnfort_contact_slip_front, only: propagate_slips, is_at_held_node
+    use yarnfort_contact_passages, only: is_at_minimum_length
     implicit none
     private
 
@@ -142,9 +143,6 @@ module yarnfort_contact_friction_stepper
     !> Outcomes of the predictor (predict).
     integer, parameter :: predicted_state = 1, reversed = -1
 
-    !> Round-off of a reference length locked at its minimum, relative to its initial
-    !> length (the lock sets L0 = initial length - flow to the minimum).
-    real(wp), parameter :: length_round_off = 64 * epsilon(1.0_wp)
 
     type, extends(load_stepper_type) :: friction_stepper_type
         logical :: staggered = .false.
@@ -711,7 +709,8 @@ contains
                 good_marched = marched
                 call update_active_set(problem, unknowns(n_x + 1:), self%flow, self%mode_trial, &
                     flips, locked_forward, locked_backward, changed, cap, new_slips, &
-                    at_limit=self%at_limit_trial, propagate=.true., marched=marched)
+                    at_limit=self%at_limit_trial, propagate=.true., marched=marched, &
+                    start_mode=self%mode)
                 call record_changes(self%trace, good_mode, self%mode_trial)
                 if (changed == 0) then
                     call check_damped(problem, flips, locked_forward, locked_backward, error)
@@ -759,7 +758,7 @@ contains
             call update_active_set(problem, flow, self%flow, trial_mode, trial_flips, &
                 trial_forward, trial_backward, changed, max_new_slips, &
                 trial_new_slips, provisional_band * residual, propagate=.true., &
-                marched=trial_marched)
+                marched=trial_marched, start_mode=self%mode)
             if (changed == 0) then
                 problem%locked = saved_locked
                 problem%flow_target = saved_target
@@ -1034,7 +1033,7 @@ contains
     !> start of the step. Returns the number of passages whose mode changed.
     subroutine update_active_set(problem, flow, accepted, mode, flips, locked_forward, &
             locked_backward, changed, max_new_slips, new_slips, residual, at_limit, propagate, &
-            marched)
+            marched, start_mode)
         type(friction_problem_type), intent(inout) :: problem
         real(wp), intent(in) :: flow(:), accepted(:)
         integer, intent(inout) :: mode(:), flips(:)
@@ -1055,11 +1054,13 @@ contains
         !> Passages whose slip a march predicted (propagate_slips) in this step: they
         !> count no flip, and neither does their stop.
         logical, intent(inout), optional :: marched(:)
+        !> The modes at the start of the step.
+        integer, intent(in), optional :: start_mode(:)
         integer :: p, new_mode, before, after, n_candidates, k, direction_p
         integer, allocatable :: predicted_mode(:)
         logical, allocatable :: started(:), predicted(:)
         integer :: unlocked_direction
-        real(wp) :: min_before, min_after, increment, floor, measure, unlocked_measure
+        real(wp) :: min_before, min_after, increment, floor, measure, unlocked_measure, still
         integer, allocatable :: candidate(:), direction(:)
         real(wp), allocatable :: violation(:)
         associate(scene => problem%scene, passages => problem%scene%passages)
@@ -1086,6 +1087,17 @@ contains
                 min_after = scene%solver%min_length_ratio * scene%network%length0(after)
                 new_mode = mode(p)
                 increment = flow(p) - accepted(p)
+                ! A slipping passage at a held node must move beyond the solve's accuracy
+                ! of a flow (a stick row's tolerance), else it sticks: its flow is its only
+                ! motion, so one that stays at its limit without moving is stuck, as the
+                ! exact law has it (a march, or the last step's set, may slip a passage
+                ! that sits at its limit). At a free node a tiny flow can carry a large
+                ! change of tension (a stiff ring: measured, it then chattered).
+                still = 0.0_wp
+                if (present(start_mode)) then
+                    if (is_at_held_node(problem, p)) still = scene%solver%residual_tolerance &
+                        * problem%length_scale
+                end if
                 select case (mode(p))
                 case (mode_stick)
                     ! An element locked at its minimum length in an earlier step stays so.
@@ -1106,7 +1118,7 @@ contains
                     end if
                     if (direction_p /= mode_stick) call add_candidate(direction_p, measure)
                 case (mode_forward)
-                    if (flows_back(mode(p), increment)) new_mode = mode_stick
+                    if (flows_back(mode(p), increment - still)) new_mode = mode_stick
                     ! Forward flow shortens the element before the node.
                     if (problem%length0(before) < min_before) then
                         new_mode = mode_stick
@@ -1116,7 +1128,7 @@ contains
                             - min_before) / passages%share(before)
                     end if
                 case (mode_backward)
-                    if (flows_back(mode(p), increment)) new_mode = mode_stick
+                    if (flows_back(mode(p), increment + still)) new_mode = mode_stick
                     if (problem%length0(after) < min_after) then
                         new_mode = mode_stick
                         locked_backward(p) = .true.
@@ -1263,14 +1275,16 @@ contains
         end associate
     end subroutine predict_modes
 
-    !> Element e's reference length (in `problem`) is at its minimum, min_length_ratio
-    !> times its initial one, within rounding.
+    !> Element e's reference length (in `problem`) is at its minimum
+    !> (is_at_minimum_length).
     pure logical function is_at_min_length(problem, e)
         type(friction_problem_type), intent(in) :: problem
         integer, intent(in) :: e
-        associate(initial => problem%scene%network%length0(e))
-            is_at_min_length = problem%length0(e) <= problem%scene%solver%min_length_ratio &
-                * initial + length_round_off * initial
+        associate(scene => problem%scene)
+            is_at_min_length = is_at_minimum_length(problem%length0(e), &
+                scene%network%length0(e), scene%passages%share(e), &
+                scene%solver%min_length_ratio, &
+                scene%solver%residual_tolerance * scene%length_scale)
         end associate
     end function is_at_min_length
 

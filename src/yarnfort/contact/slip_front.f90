@@ -25,7 +25,7 @@ module yarnfort_contact_slip_front
     implicit none
     private
 
-    public :: propagate_slips
+    public :: propagate_slips, is_at_held_node
 
     !> Sides of a passage along its yarn.
     integer, parameter :: side_before = 1, side_after = 2
@@ -89,12 +89,9 @@ contains
             end do
         end subroutine march
 
-        !> Passage p's node has a prescribed position (an obstacle's pin, a support).
         pure logical function is_held(p)
             integer, intent(in) :: p
-            associate(node => problem%scene%passages%node(p))
-                is_held = all(problem%scene%dofs%unknown(3 * node - 2:3 * node) == 0)
-            end associate
+            is_held = is_at_held_node(problem, p)
         end function is_held
 
         !> The passage at the other end of p's segment on `side` (0: none).
@@ -147,6 +144,15 @@ contains
             end associate
         end function get_limit_side
     end subroutine propagate_slips
+
+    !> Passage p's node has a prescribed position (an obstacle's pin, a support).
+    pure logical function is_at_held_node(problem, p)
+        type(friction_problem_type), intent(in) :: problem
+        integer, intent(in) :: p
+        associate(node => problem%scene%passages%node(p))
+            is_at_held_node = all(problem%scene%dofs%unknown(3 * node - 2:3 * node) == 0)
+        end associate
+    end function is_at_held_node
 
     !> The low-side tension T_min >= 0 with T_crit(T_min, angle) = `high` (0 where even
     !> T_min = 0 gives at least `high`), by bisection on [0, high] (T_crit(T) >= T).
