@@ -12,7 +12,7 @@ The capstan rig: a yarn (linear, EA = 10 N) from A = (-1, -1) up to K pins of an
 spaced), down to B = (1, -1); A held, B pulled down 0.3 m and released (`&path` 0 -> 1
 -> 0), Coulomb friction mu = 0.25 at the pins, total wrap angle pi (the two straight
 ends are vertical). No &solver group: default settings. Columns: the load steps'
-Newton iterations, factorisations and CPU (the continuation alone, process CPU) summed
+Newton iterations, factorisations and CPU ms (the continuation alone, process CPU) summed
 over the run (step 0, the unloaded state, apart), and each over the K = 4 row.
 The knits: steps_table.knit_scene's periodic cell and the clamped sample with free
 sides (default edge threads), loading to strain 1 (20 steps) and one stretch cycle;
@@ -99,7 +99,7 @@ def main():
     print(f'OPENBLAS_CORETYPE {core}')
     for name, binary in builds:
         print(f'\n### Capstan rig over K pins ({name})\n')
-        print('| K | steps | Newton | factorisations | CPU s | Newton / K=4 '
+        print('| K | steps | Newton | factorisations | CPU ms | Newton / K=4 '
               '| factorisations / K=4 | CPU / K=4 |')
         print('|---:|---:|---:|---:|---:|---:|---:|---:|')
         first = None
@@ -113,11 +113,11 @@ def main():
                 continue
             steps = row['steps']
             whole = (row['newton'] * steps, row['factorisations'] * steps,
-                     row['cpu_ms'] * steps / 1e3)
+                     row["cpu_ms"] * steps)
             first = first or whole
             print(f'| {k} | {int(steps)}' + (f' ({int(row["cuts"])} cuts)' if row['cuts']
                                              else '')
-                  + f' | {whole[0]:.0f} | {whole[1]:.0f} | {whole[2]:.3f} | '
+                  + f' | {whole[0]:.0f} | {whole[1]:.0f} | {whole[2]:.2f} | '
                   + ' | '.join(f'{a / b:.2f}' for a, b in zip(whole, first)) + ' |',
                   flush=True)
         print(f'\n### Knits: clamped (free sides) against periodic ({name})\n')

@@ -10,7 +10,11 @@
 !> Active-set rules, per passage, after each solve:
 !>   stick -> slip forward  if T_after  > T_crit(T_before, alpha) (beyond tolerance);
 !>   stick -> slip backward if T_before > T_crit(T_after, alpha);
-!>   slip -> stick if the flow increment of the step has the wrong sign.
+!>   slip -> stick if the flow increment of the step has the wrong sign (at a held node:
+!>   is not beyond the flows' accuracy in the right one);
+!>   and the stick passages that the new slips' fronts pass along their yarns, by the
+!>   capstan relation, start to slip in the same round (yarnfort_contact_slip_front;
+!>   docs/decisions.md, "Slip fronts: the capstan march").
 !> A step starts from the predicted state (secant, or the parabola through three states of
 !> one active set; reversed secant across a turn) with the stick passages that it takes
 !> across their limit slipping (predict_modes), or all-stick when it is the first load
