@@ -147,7 +147,6 @@ module yarnfort_contact_friction_stepper
     !> Outcomes of the predictor (predict).
     integer, parameter :: predicted_state = 1, reversed = -1
 
-
     type, extends(load_stepper_type) :: friction_stepper_type
         logical :: staggered = .false.
         type(friction_problem_type), pointer :: full => null(), sliding => null()
@@ -713,8 +712,7 @@ contains
                 good_marched = marched
                 call update_active_set(problem, unknowns(n_x + 1:), self%flow, self%mode_trial, &
                     flips, locked_forward, locked_backward, changed, cap, new_slips, &
-                    at_limit=self%at_limit_trial, propagate=.true., marched=marched, &
-                    start_mode=self%mode)
+                    at_limit=self%at_limit_trial, propagate=.true., marched=marched)
                 call record_changes(self%trace, good_mode, self%mode_trial)
                 if (changed == 0) then
                     call check_damped(problem, flips, locked_forward, locked_backward, error)
@@ -762,7 +760,7 @@ contains
             call update_active_set(problem, flow, self%flow, trial_mode, trial_flips, &
                 trial_forward, trial_backward, changed, max_new_slips, &
                 trial_new_slips, provisional_band * residual, propagate=.true., &
-                marched=trial_marched, start_mode=self%mode)
+                marched=trial_marched)
             if (changed == 0) then
                 problem%locked = saved_locked
                 problem%flow_target = saved_target
@@ -1037,7 +1035,7 @@ contains
     !> start of the step. Returns the number of passages whose mode changed.
     subroutine update_active_set(problem, flow, accepted, mode, flips, locked_forward, &
             locked_backward, changed, max_new_slips, new_slips, residual, at_limit, propagate, &
-            marched, start_mode)
+            marched)
         type(friction_problem_type), intent(inout) :: problem
         real(wp), intent(in) :: flow(:), accepted(:)
         integer, intent(inout) :: mode(:), flips(:)
@@ -1056,10 +1054,9 @@ contains
         !> March the new slips' fronts along their yarns (propagate_slips).
         logical, intent(in), optional :: propagate
         !> Passages whose slip a march predicted (propagate_slips) in this step: they
-        !> count no flip, and neither does their stop.
+        !> count no flip, and neither does their stop. Given (the monolithic rounds), a
+        !> slipping passage at a held node must also move (`still` below).
         logical, intent(inout), optional :: marched(:)
-        !> The modes at the start of the step.
-        integer, intent(in), optional :: start_mode(:)
         integer :: p, new_mode, before, after, n_candidates, k, direction_p
         integer, allocatable :: predicted_mode(:)
         logical, allocatable :: started(:), predicted(:)
@@ -1098,7 +1095,7 @@ contains
                 ! that sits at its limit). At a free node a tiny flow can carry a large
                 ! change of tension (a stiff ring: measured, it then chattered).
                 still = 0.0_wp
-                if (present(start_mode)) then
+                if (present(marched)) then
                     if (is_at_held_node(problem, p)) still = scene%solver%residual_tolerance &
                         * problem%length_scale
                 end if
