@@ -21,14 +21,14 @@ module bench_floor
     use yarnfort_error, only: error_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
-    use yarnfort_linalg_cholmod, only: supernodal_switch
-    use yarnfort_linalg_cholmod_binding, only: yarnfort_cholmod_metis_order, cholmod_ok
-    use yarnfort_linalg_umfpack_binding, only: umfpack_control, umfpack_info, umfpack_irstep, &
+    use yarnfort_linalg_backend_cholmod, only: supernodal_switch
+    use yarnfort_linalg_binding_cholmod, only: yarnfort_cholmod_metis_order, cholmod_ok
+    use yarnfort_linalg_binding_umfpack, only: umfpack_control, umfpack_info, umfpack_irstep, &
         umfpack_prl, umfpack_a, umfpack_ok, umfpack_strategy_used, umfpack_dl_defaults, &
         umfpack_dl_symbolic, umfpack_dl_numeric, umfpack_dl_wsolve, &
         umfpack_dl_free_symbolic, umfpack_dl_free_numeric, umfpack_lnz, umfpack_unz, &
         umfpack_ordering, umfpack_ordering_metis
-    use yarnfort_linalg_klu_binding, only: klu_l_common, klu_l_defaults, klu_l_analyze, &
+    use yarnfort_linalg_binding_klu, only: klu_l_common, klu_l_defaults, klu_l_analyze, &
         klu_l_factor, klu_l_refactor, klu_l_solve, klu_l_free_symbolic, klu_l_free_numeric, &
         klu_l_numeric_sizes, klu_l_analyze_given
     implicit none

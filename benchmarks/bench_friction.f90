@@ -67,7 +67,7 @@ end module bench_friction_counter
 !> Then, when the monolithic solver eliminates stick flows, a line `reduced:` (the
 !> reduced system at the final state, as the `factors:` line, the reductions per step,
 !> and KLU's predicted flops per factor nonzero with the solver they chose:
-!> yarnfort_linalg_lu_choice, and whether it was handed METIS' order), before it a line
+!> yarnfort_linalg_composite_lu_choice, and whether it was handed METIS' order), before it a line
 !> `variants:` (bare KLU on the reduced system with scale 0 and 1, with METIS' order of
 !> A + A^T, with AMD without aggressive absorption and with AMD's dense threshold 1:
 !> nonzeros of L + U and CPU ms of refactor + solve; bench_floor's with_variants), and a
@@ -94,13 +94,13 @@ program bench_friction
     use bench_floor, only: floor_type, measure_floor
     use yarnfort_kinds, only: ik
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
-    use yarnfort_solver_problem, only: nonlinear_problem_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
-    use yarnfort_linalg_condensed, only: condensed_solver_type
-    use yarnfort_linalg_lu_choice, only: lu_choice_solver_type
-    use yarnfort_linalg_bordered, only: bordered_solver_type
+    use yarnfort_linalg_composite_condensed, only: condensed_solver_type
+    use yarnfort_linalg_composite_lu_choice, only: lu_choice_solver_type
+    use yarnfort_linalg_composite_bordered, only: bordered_solver_type
     use yarnfort_input_namelist, only: read_config_from_file, check_config
+    use yarnfort_linalg_process, only: apply_process_settings
     implicit none
 
     type(config_type) :: config
@@ -122,6 +122,7 @@ program bench_friction
         'benchmarks/bench_friction.f90)'
 
     call stop_if_help(usage)
+    call apply_process_settings()
     call get_command_argument(1, argument)
     if (trim(argument) == '--header') then
         write(output_unit, '(a)') '    scheme  unknowns  passages  steps  newton/step' // &

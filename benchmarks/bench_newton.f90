@@ -35,13 +35,14 @@ program bench_newton
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
-    use yarnfort_linalg_umfpack, only: umfpack_solver_type, umfpack_memory_type
+    use yarnfort_linalg_backend_umfpack, only: umfpack_solver_type, umfpack_memory_type
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_timer, only: wall_time
     use bench_common, only: peak_memory_mib, fail, number_grid_nodes, fail_usage, &
         stop_if_help, read_integer_argument
     use bench_floor, only: floor_type, measure_floor
+    use yarnfort_linalg_process, only: apply_process_settings
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
@@ -65,6 +66,7 @@ program bench_newton
         '[max_setup_calls] [neo_hookean | linear]'
 
     call stop_if_help(usage)
+    call apply_process_settings()
     call get_command_argument(1, argument)
     if (trim(argument) == '--header') then
         write(output_unit, '(a)') 'solver  setup  unknowns       nnz  iters  facts' // &

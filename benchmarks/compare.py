@@ -200,7 +200,7 @@ def thread_state(python):
         f'- OpenSeesPy libraries loaded: {ops_libs}',
         '- environment: ' + ', '.join(f'{k}={os.environ.get(k, "unset")}' for k in (
             'OMP_NUM_THREADS', 'OMP_THREAD_LIMIT', 'OPENBLAS_NUM_THREADS', 'OPENBLAS_CORETYPE')),
-        '- yarnfort thread policy (src/yarnfort/linalg/threads.f90; applies where the '
+        '- yarnfort thread policy (src/yarnfort/linalg/process/threads.f90; applies where the '
         'variables are unset): the libraries\' OpenMP regions and OpenBLAS on one thread',
         f'- load average at start: {" ".join(f"{x:.2f}" for x in os.getloadavg())}; '
         f'{os.cpu_count()} cores',
@@ -225,7 +225,9 @@ def main():
         run_opensees(int(args.opensees[0]), args.opensees[1])
         return
     sides = args.sides or (QUICK if args.quick else SIDES)
-    subprocess.run([str(TOP / 'tools' / 'bootstrap')], stdin=subprocess.DEVNULL, check=True)
+    # --tests: the benchmark programs are built with the unit tests.
+    subprocess.run([str(TOP / 'tools' / 'bootstrap'), '--tests'], stdin=subprocess.DEVNULL,
+                   check=True)
     python = ensure_venv()
     print('# yarnfort against the SuiteSparse floor and OpenSeesPy (benchmarks/compare.py)')
     print(time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime()))

@@ -109,7 +109,9 @@ def main():
     args = parser.parse_args()
     blas_env.apply()
     sides = args.sides or (QUICK if args.quick else SIDES)
-    subprocess.run([str(TOP / 'tools' / 'bootstrap')], stdin=subprocess.DEVNULL, check=True)
+    # --tests: the benchmark programs are built with the unit tests.
+    subprocess.run([str(TOP / 'tools' / 'bootstrap'), '--tests'], stdin=subprocess.DEVNULL,
+                   check=True)
     blas = subprocess.run(['ldd', args.bench], capture_output=True, text=True).stdout
     blas = re.search(r'libblas\.so\S* => (\S+)', blas)
     print('# Friction tables (benchmarks/friction_table.py '

@@ -109,6 +109,7 @@ program steps_trace
     use bench_woven_net, only: make_woven_net, skew_net
     use bench_iteration, only: time_elastic_iteration
     use steps_trace_observer, only: trace_observer_type
+    use yarnfort_linalg_process, only: apply_process_settings
     implicit none
 
     type(config_type) :: config
@@ -127,6 +128,7 @@ program steps_trace
     real(wp) :: elastic_ms, per_step
 
     call stop_if_help(usage)
+    call apply_process_settings()
     woven = .false.
     skewed = .false.
     scheme = ''

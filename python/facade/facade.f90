@@ -16,10 +16,11 @@ module yarnfort_facade
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     use yarnfort_facade_laws, only: get_force_law_values, get_critical_tensions
+    use yarnfort_linalg_process, only: apply_library_settings => apply_process_settings
     implicit none
     private
 
-    public :: force_law_eval, friction_critical_tension
+    public :: force_law_eval, friction_critical_tension, process_settings
     ! For run_scene_file (outside the module); not wrapped by f2py.
     public :: set_status, cut_text
 
@@ -31,6 +32,13 @@ module yarnfort_facade
     character(len=*), parameter :: cut_marker = ' [...]'
 
 contains
+
+    !> Make the process-wide settings of the solver libraries (threads, heap) as the
+    !> program does at its start; yarnfort._native calls it once, when it loads the
+    !> extension. Only the first call does anything.
+    subroutine process_settings()
+        call apply_library_settings()
+    end subroutine process_settings
 
     !> Tension, its derivative with respect to stretch and the energy per unit reference
     !> length of a force law at each stretch. `law`: 'linear' (p1 = EA in N),

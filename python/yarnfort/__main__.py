@@ -1,13 +1,18 @@
 # SPDX-License-Identifier: MIT
 """Command line:
 
-- ``python -m yarnfort plot <output folder> [--support NAME] [--out FILE]`` writes a PNG
-  with the force–displacement (hysteresis) plot of one support set (for a generated
-  fabric: force per unit width against strain) and the final deformed network coloured
-  by tension;
+- ``python -m yarnfort plot <output folder> [--channel NAME] [--step N] [--support NAME]
+  [--out FILE]`` writes a PNG (:func:`plot_folder`): force against displacement of what
+  drives the run, the network at the peak coloured by tension, the history of rings and
+  obstacles;
 - ``python -m yarnfort plot-states <output folder> [-o FILE] [--strains 0 0.5 1] ...``
   writes a PNG of the deformed states nearest to the given strains, coloured by tension
-  on one scale (:func:`yarnfort.plots.plot_states`).
+  on one scale (:func:`yarnfort.plots.plot_states`);
+- ``python -m yarnfort examples DIR [--force]`` writes the example scenes with their
+  tables and models into ``DIR/inputs/`` (run one there: ``cd DIR && yarnfort <
+  inputs/vnet.nml``);
+- ``python -m yarnfort reference`` prints the input reference (``inputs/REFERENCE.md``:
+  every group and variable, checks, output files).
 
 Exit codes: 0 success, 2 bad arguments, a missing or unreadable output folder, an
 unknown support set, or strains the run does not reach.
@@ -17,6 +22,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -106,15 +112,14 @@ def _dominant_projection(position: np.ndarray) -> str:
     return "xyz"[keep[0]] + "xyz"[keep[1]]
 
 
-def plot_folder(folder: Path, support: str | None = None, out: Path | None = None) -> Path:
-    """Write the summary plot of an output folder.
+def plot_folder(folder: Path, support: str | None = None, out: Path | None = None, *,
+                channel: str | None = None, step: int | None = None) -> Path:
+    """Write the summary plot of an output folder (:func:`summary_figure`).
 
     Parameters
     ----------
-    folder : Path
-        A run's output folder (holds curve.csv).
-    support : str, optional
-        Support set to plot (default: the first that moves).
+    folder, support, channel, step
+        As in :func:`summary_figure`.
     out : Path, optional
         PNG to write (default ``<folder>/plot.png``).
 
@@ -126,7 +131,47 @@ def plot_folder(folder: Path, support: str | None = None, out: Path | None = Non
     Raises
     ------
     CommandError
-        For a missing folder or curve, a curve without rows or an unknown support.
+        As :func:`summary_figure`.
+    """
+    from .plots import save_figure
+
+    figure = summary_figure(folder, support, channel=channel, step=step)
+    return save_figure(figure, out if out is not None else folder / DEFAULT_PLOT)
+
+
+def summary_figure(folder: Path, support: str | None = None, *, channel: str | None = None,
+                   step: int | None = None) -> Any:
+    """The summary plot of an output folder.
+
+    Panels: the force against the displacement of what drives the run (a moving support
+    or a load; a fabric: force per unit width against strain), force positive in
+    tension; the network at the step of the largest force (or ``step``), coloured by
+    tension; for a scene with rings or obstacles, their history (ring position, obstacle
+    reaction) against the load. Lengths in mm, as ``plot-states``.
+
+    Parameters
+    ----------
+    folder : Path
+        A run's output folder (holds curve.csv and input.nml).
+    support : str, optional
+        Support set whose force is drawn (default: the driver's own).
+    channel : str, optional
+        The load channel whose driver gives the abscissa (default: the channel that
+        changes in the most steps).
+    step : int, optional
+        The step of the network panel (default: the saved step of the largest force).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Its first Axes is the force-displacement panel (the step shown marked by the
+        line of gid ``'shown_step'``), the second the network; then the history panels.
+
+    Raises
+    ------
+    CommandError
+        For a missing folder or curve, a curve without rows, an unknown support,
+        channel or step.
     """
     if not folder.is_dir():
         raise CommandError(f"no output folder {str(folder)!r}")
@@ -135,36 +180,105 @@ def plot_folder(folder: Path, support: str | None = None, out: Path | None = Non
                            " folder")
     from matplotlib.figure import Figure
 
-    from .plots import plot_fabric_hysteresis, plot_hysteresis, plot_network, save_figure
+    from .plots import (DEFAULT_UNIT, LENGTH_UNITS, choose_driver, driver_response, load_drivers,
+                        peak_step, plot_fabric_hysteresis, plot_history, plot_hysteresis,
+                        plot_load_displacement, plot_network)
 
     curve = read_curve(folder)
     if len(curve) == 0:
         raise CommandError(f"{folder / 'curve.csv'} has no rows (only its header): the run"
                            " wrote no converged step, nothing to plot")
     states = read_states(folder)
-    figure = Figure(figsize=(11, 4.5), layout="constrained")
-    left, right = figure.subplots(1, 2)
-    if support is None and "force_per_width" in curve.names:
-        # A generated fabric: its effective curve.
+    scene = _scene(folder)
+    if support is not None:
+        choose_support(curve, folder, support)  # a clear error for an unknown name
+    drivers = load_drivers(curve, scene)
+    try:
+        driver = choose_driver(curve, drivers, channel)
+    except ValueError as error:
+        raise CommandError(str(error)) from None
+    fabric = support is None and channel is None and "force_per_width" in curve.names
+    history = 0
+    if driver is not None and not fabric and scene is not None:
+        history = int(bool(scene.get("ring"))) + int(any(
+            f"{o.get('name')}_rx" in curve.names for o in _groups(scene, "obstacle")))
+    panels = 2 + history
+    figure = Figure(figsize=(5.2 * panels, 4.6), layout="constrained")
+    axes = list(figure.subplots(1, panels))
+    left, right = axes[0], axes[1]
+    if fabric:
         plot_fabric_hysteresis(curve, ax=left)
         left.set_title("effective curve of the fabric")
+        force = curve["force_per_width"]
+        abscissa = curve["strain"]
+    elif driver is not None:
+        plot_load_displacement(curve, driver, ax=left, support=support)
+        left.set_title(f"load-displacement ({driver.channel})")
+        displacement, force = driver_response(curve, driver, support)
+        abscissa = displacement / LENGTH_UNITS[DEFAULT_UNIT]
+        if history:
+            plot_history(curve, states, driver, scene, axes[2:])
     else:
+        # Nothing moves or pushes (a prestressed net): a reaction against the factors.
         name = choose_support(curve, folder, support)
         component = _dominant_component(curve, name)
-        # The abscissa: p_disp if it moves, else the first load channel that does.
         channels = curve.channels
         moving = [c for c in channels if np.ptp(curve[c]) > 0]
-        x = "p_disp" if "p_disp" in moving else (moving or channels or ["time"])[0]
+        x = (moving or channels or ["time"])[0]
         plot_hysteresis(curve, name, component=component, x=x, ax=left)
         left.set_title(f"reaction of '{name}'")
-    if states:
-        final = states[-1]
-        plot_network(final, ax=right, projection=_dominant_projection(final.position))
-        right.set_title(f"final state (step {int(curve['step'][-1])})")
+        force = curve.reaction(name)[:, "xyz".index(component)]
+        abscissa = curve[x]
+    saved = [state.step for state in states if state.step is not None]
+    if states and saved:
+        if step is None:
+            shown = peak_step(curve, force, saved)
+        elif step in saved:
+            shown = step
+        else:
+            raise CommandError(f"no saved state of step {step}; saved steps: "
+                               + _ranges(saved))
+        state = next(s for s in states if s.step == shown)
+        plot_network(state, ax=right, projection=_dominant_projection(state.position),
+                     unit=DEFAULT_UNIT)
+        row = int(np.flatnonzero(curve["step"] == shown)[0])
+        left.plot(abscissa[row], force[row], "o", color="black", markersize=6,
+                  label=f"step {shown} (right)", gid="shown_step")
+        left.legend()
+        right.set_title(("largest force" if step is None else "chosen step")
+                        + f": step {shown}")
     else:
         right.set_axis_off()
         right.text(0.5, 0.5, "no states written", ha="center", va="center")
-    return save_figure(figure, out if out is not None else folder / DEFAULT_PLOT)
+    return figure
+
+
+def _scene(folder: Path) -> Any:
+    """The run's effective input, or None if unreadable (only hints are lost)."""
+    try:
+        return read_scene(folder / "input.nml")
+    except Exception:
+        return None
+
+
+def _groups(scene: Any, name: str) -> list[Any]:
+    found = scene.get(name, []) if scene is not None else []
+    return list(found) if isinstance(found, list) else [found]
+
+
+def _ranges(steps: list[int]) -> str:
+    """'0-12, 15' for a list of steps."""
+    ordered = sorted(set(steps))
+    parts = []
+    start = previous = ordered[0]
+    for step in ordered[1:] + [None]:
+        if step is not None and step == previous + 1:
+            previous = step
+            continue
+        parts.append(str(start) if start == previous else f"{start}-{previous}")
+        if step is not None:
+            start = previous = step
+    return ", ".join(parts)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -173,12 +287,22 @@ def _parser() -> argparse.ArgumentParser:
         description="yarnfort result tools: plot a run's output folder.")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     plot = commands.add_parser(
-        "plot", help="write a PNG: force-displacement loop and final network",
-        description="Write a PNG with the force-displacement (hysteresis) plot of a"
-        " support set and the final deformed network coloured by tension.")
+        "plot", help="write a PNG: force-displacement loop, network at the peak, history",
+        description="Write a PNG with the force against the displacement (mm) of what"
+        " drives the run (a moving support or a load; a fabric: force per width against"
+        " strain), force positive in tension; the network at the step of the largest force"
+        " coloured by tension; and for rings and obstacles their history against the"
+        " load.")
     plot.add_argument("folder", type=Path, help="output folder of a run (holds curve.csv)")
     plot.add_argument("--support", metavar="NAME",
-                      help="support set to plot (default: the first that moves)")
+                      help="support set whose force is drawn (default: the one that moves,"
+                      " or the load)")
+    plot.add_argument("--channel", metavar="NAME",
+                      help="load channel whose support or load gives the displacement axis"
+                      " (default: the channel that changes in the most steps)")
+    plot.add_argument("--step", type=int, metavar="N",
+                      help="step of the network panel (default: the saved step of the"
+                      " largest force)")
     plot.add_argument("--out", type=Path, metavar="FILE",
                       help=f"PNG to write (default: <folder>/{DEFAULT_PLOT})")
     states = commands.add_parser(
@@ -204,6 +328,18 @@ def _parser() -> argparse.ArgumentParser:
     states.add_argument("--depth-scale", type=float, default=1.0, metavar="F",
                         help="draw z this many times stretched (default 1)")
     states.add_argument("--title", help="figure title")
+    examples = commands.add_parser(
+        "examples", help="write the example scenes and their tables into a folder",
+        description="Write the example scenes (inputs/*.nml), their tables (inputs/data/)"
+        " and TexGen models into FOLDER/inputs/; run one there with"
+        " `cd FOLDER && yarnfort < inputs/vnet.nml`.")
+    examples.add_argument("folder", type=Path, help="folder to write into (made if missing)")
+    examples.add_argument("--force", action="store_true",
+                          help="overwrite example files that exist there")
+    commands.add_parser(
+        "reference", help="print the input reference (inputs/REFERENCE.md)",
+        description="Print the input reference: every namelist group and variable with"
+        " default, unit and range, the checks, the output files (Markdown).")
     return parser
 
 
@@ -233,8 +369,22 @@ def main(argv: list[str] | None = None) -> int:
     """
     args = _parser().parse_args(argv)
     try:
+        if args.command == "reference":
+            from .resources import reference_text
+
+            sys.stdout.write(reference_text())
+            return 0
+        if args.command == "examples":
+            from .resources import write_examples
+
+            written = write_examples(args.folder, overwrite=args.force)
+            print(f"yarnfort: wrote {len(written)} example files into"
+                  f" {args.folder / 'inputs'}; run one with: cd {args.folder} &&"
+                  " yarnfort < inputs/vnet.nml")
+            return 0
         if args.command == "plot":
-            path = plot_folder(args.folder, args.support, args.out)
+            path = plot_folder(args.folder, args.support, args.out, channel=args.channel,
+                               step=args.step)
         else:
             path = plot_states_command(args)
         print(f"yarnfort: wrote {path}")

@@ -62,14 +62,19 @@ class YarnfortError(RuntimeError):
 
 @functools.cache
 def extension() -> ModuleType:
-    """The f2py extension module ``yarnfort._yarnfort``, imported once.
+    """The f2py extension module ``yarnfort._yarnfort``, imported once; the first import
+    also makes the process-wide settings of the solver libraries (threads, heap).
 
     Raises
     ------
     ImportError
         If the package was not built with its extension (install it with ``pip install``).
     """
-    return importlib.import_module(f"{__package__}._yarnfort")
+    module = importlib.import_module(f"{__package__}._yarnfort")
+    # The solver libraries' threads and heap, set once for the process as the program
+    # sets them at its start (the Fortran library's constructors leave them alone).
+    module.yarnfort_facade.process_settings()
+    return module
 
 
 def _facade() -> ModuleType:
@@ -125,7 +130,8 @@ def force_law(law: str, stretch: ArrayLike, **params: float | str | os.PathLike
     ----------
     law : str
         ``'linear'`` (``stiffness`` = EA in N), ``'neo_hookean'`` (``modulus`` C in Pa,
-        ``area`` S1 in m**2) or ``'table'`` (``table_file``: CSV of strain, force in N).
+        ``area`` S1 in m**2) or ``'table'`` (``table_file``: CSV of strain, force, in the
+        units its header states, else 1 and N).
     stretch : array_like
         Stretches lambda = l/L0, any shape.
     **params

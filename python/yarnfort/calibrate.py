@@ -33,6 +33,7 @@ from ._native import YarnfortError
 from .results import Curve
 from .address import parse_address
 from .sweep import _check_support, run_patched
+from .units import split_header, to_scene_unit
 
 __all__ = ["CalibrationResult", "calibrate", "read_measured", "simulated_force",
            "plot_fit", "write_synthetic_curve"]
@@ -145,7 +146,9 @@ def read_measured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.n
     """Read a measured curve: CSV with a header, columns ``strain`` and ``force`` and
     optionally a branch column (``branch``: loading/unloading, or ``direction``/``sign``:
     +1/-1). Without one, the branch follows the sign of the strain increments. Lines
-    starting with ``#`` are comments.
+    starting with ``#`` are comments. A column header may state its unit as in a table
+    file (``strain (%)``, ``force (cN)``; :mod:`yarnfort.units`): the values are
+    converted to 1 and N; without one they are taken as 1 and N.
 
     Parameters
     ----------
@@ -160,8 +163,8 @@ def read_measured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.n
     Raises
     ------
     ValueError
-        For a file without data rows or the columns, or a cell that is not a number
-        (the message names the file and line).
+        For a file without data rows or the columns, a cell that is not a number (the
+        message names the file and line), or an unknown unit (it names the column).
     """
     with open(path, newline="") as stream:
         numbered = [(number, line) for number, line in enumerate(stream, start=1)
@@ -172,10 +175,12 @@ def read_measured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.n
     lines = [number for number, line in numbered[1:] if line.strip()]
     if not rows:
         raise ValueError(f"{path}: no data rows")
-    header = {name.strip().lower(): name for name in rows[0]}
+    header = {split_header(name)[0].lower(): name for name in rows[0]}
     missing = [name for name in ("strain", "force") if name not in header]
     if missing:
         raise ValueError(f"{path}: missing column(s) {', '.join(missing)}")
+    units = {name: split_header(header[name])[1] or default
+             for name, default in (("strain", "1"), ("force", "N"))}
     column = next((header[name] for name in BRANCH_COLUMNS if name in header), None)
     strain, force, signs = [], [], []
     for number, row in zip(lines, rows):
@@ -186,9 +191,13 @@ def read_measured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.n
                 signs.append(_branch_value(row[column] or ""))
         except ValueError as error:
             raise ValueError(f"{path}, line {number}: {error}") from None
-    strain_array = np.array(strain)
+    try:
+        strain_array = to_scene_unit(np.array(strain), units["strain"], "strain")
+        force_array = to_scene_unit(np.array(force), units["force"], "force")
+    except ValueError as error:
+        raise ValueError(f"{path}: {error}") from None
     branch = _infer_branch(strain_array) if column is None else np.array(signs)
-    return strain_array, np.array(force), branch
+    return strain_array, force_array, branch
 
 
 def _number(text: str | None, name: str) -> float:

@@ -11,7 +11,9 @@ files hold is drawn.
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 import numpy as np
@@ -19,13 +21,15 @@ from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
-from matplotlib.ticker import MaxNLocator
+from matplotlib.ticker import MaxNLocator, ScalarFormatter
 
 from .results import GAP_HOLDER, Curve, ResultError, State, read_curve, read_states
 
 __all__ = ["plot_curve", "plot_hysteresis", "plot_fabric_hysteresis", "plot_network",
            "plot_states", "nearest_states", "plot_fan", "save_figure", "supports",
-           "reaction_component"]
+           "reaction_component", "Driver", "load_drivers", "choose_driver",
+           "driver_response", "plot_load_displacement", "plot_history", "peak_step",
+           "tension_norm"]
 
 #: Index of each Cartesian component in a reaction or position row.
 COMPONENTS: dict[str, int] = {"x": 0, "y": 1, "z": 2}
@@ -227,6 +231,8 @@ PANEL_WIDTH = 4.2
 ROW_HEIGHT = 3.6
 #: Length units of the state plots: name -> metres per unit.
 LENGTH_UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "um": 1e-6}
+#: Length unit of every plot of positions and displacements (both plot commands).
+DEFAULT_UNIT = "mm"
 #: ``mode`` point data of a node whose passage slips (forward, backward).
 SLIP_MODES = (2, 3)
 
@@ -259,7 +265,8 @@ def _image_shifts(state: State, images: tuple[int, ...]) -> np.ndarray:
 
 def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
                  cmap: str = "viridis", colorbar: bool = True, norm: Normalize | None = None,
-                 images: tuple[int, ...] = (1, 1), unit: str = "m", gap_holders: bool = True,
+                 images: tuple[int, ...] = (1, 1), unit: str = DEFAULT_UNIT,
+                 gap_holders: bool = True,
                  nodes: bool = True, slipping: bool = False, depth_scale: float = 1.0) -> Axes:
     """The deformed network of ``state`` as line segments coloured by element tension.
 
@@ -276,11 +283,12 @@ def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
     colorbar : bool
         Add a colorbar labelled "tension (N)".
     norm : Normalize, optional
-        The tension range of the colours (default: this state's minimum to maximum).
+        The tension range of the colours (default: this state's minimum to maximum,
+        :func:`tension_norm`).
     images : tuple of int
         Periodic images drawn along each period of a periodic cell (its periodic links,
         :meth:`State.periods`), e.g. ``(3, 3)``; ``(1, 1)``: the cell alone.
-    unit : {'m', 'mm', 'um'}
+    unit : {'mm', 'm', 'um'}
         Length unit of the axes.
     gap_holders : bool
         Draw the gap-holders as thin grey lines.
@@ -318,8 +326,7 @@ def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
     elements = (state.elements[None, :, :] + offsets).reshape(-1, 2)
     tension = np.tile(np.asarray(state.tension, dtype=float), len(shifts))
     if norm is None:
-        low, high = (float(tension.min()), float(tension.max())) if tension.size else (0, 1)
-        norm = Normalize(low, high if high > low else low + 1.0)
+        norm = tension_norm(tension)
     if three_d:
         from mpl_toolkits.mplot3d.art3d import Line3DCollection
         collection = Line3DCollection
@@ -376,8 +383,9 @@ def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
         elif columns[0] == 2:
             aspect = 1.0 / depth_scale
         ax.set_aspect(aspect, adjustable="datalim")
+        readable_ticks(ax)
     if colorbar:
-        ax.figure.colorbar(lines, ax=ax, label="tension (N)")
+        readable_colorbar(ax.figure.colorbar(lines, ax=ax, label="tension (N)"))
     return ax
 
 
@@ -538,10 +546,8 @@ def plot_states(folder: str | Path, strains: tuple[float, ...] = (0.0, 0.5, 1.0)
     chosen = nearest_states(folder, strains, by=by, of_peak=of_peak)
     for projection in projections:  # before any drawing: a clear error
         _check_projection(projection)
-    tensions = np.concatenate([np.asarray(state.tension, dtype=float)
-                               for state, _ in chosen])
-    low, high = float(tensions.min()), float(tensions.max())
-    norm = Normalize(low, high if high > low else low + 1.0)
+    norm = tension_norm(np.concatenate([np.asarray(state.tension, dtype=float)
+                                        for state, _ in chosen]))
     figure = Figure(figsize=(PANEL_WIDTH * len(chosen) + 1.2, ROW_HEIGHT * len(projections)),
                     layout="constrained")
     label = "strain" if by == "strain" else by
@@ -563,7 +569,8 @@ def plot_states(folder: str | Path, strains: tuple[float, ...] = (0.0, 0.5, 1.0)
         heights.append(ROW_HEIGHT if projection == "3d" else _row_height(row_axes[0]))
     # Rows as tall as their drawings (a flat weave seen from the side is a thin strip).
     figure.set_size_inches(PANEL_WIDTH * len(chosen) + 1.2, sum(heights))
-    figure.colorbar(lines, ax=figure.axes, label="tension (N)", shrink=0.8)
+    readable_colorbar(figure.colorbar(lines, ax=figure.axes, label="tension (N)",
+                                      shrink=0.8))
     if title:
         figure.suptitle(title)
     return figure
@@ -639,3 +646,373 @@ def save_figure(fig: Figure | Axes, path: str | Path, dpi: int = 150) -> Path:
     finally:
         partial.unlink(missing_ok=True)
     return path
+
+
+# -- the summary of a run (``python -m yarnfort plot``) ----------------------------------
+#: A tension range narrower than this fraction of its magnitude is one value (rounding):
+#: the colour bar is widened by :data:`FLAT_PAD` of it instead of showing noise.
+FLAT_RANGE = 1e-6
+FLAT_PAD = 0.05
+#: Ticks on the axes of a network panel (labels of lengths in mm stay apart).
+NETWORK_TICKS = 5
+
+
+@dataclass
+class Driver:
+    """What a load channel does to the scene: moves a support set or pushes a load.
+
+    Attributes
+    ----------
+    channel : str
+        The load channel (a column of ``curve.csv``).
+    kind : {'displacement', 'force'}
+        A ``&support`` with a prescribed displacement, or a ``&load``.
+    name : str
+        The support set, or ``'load_<k>'`` (``&load`` number k, from 1).
+    direction : numpy.ndarray
+        Unit vector of the displacement or force at factor 1.
+    magnitude : float
+        Length (m) of that displacement, or of the force on each node (N).
+    nodes : int
+        Nodes of the set.
+    """
+
+    channel: str
+    kind: str
+    name: str
+    direction: np.ndarray
+    magnitude: float
+    nodes: int
+
+    @property
+    def label(self) -> str:
+        return (f"support '{self.name}'" if self.kind == "displacement"
+                else f"&load {self.name[5:]}")
+
+
+def _groups(scene: Any, name: str) -> list[Any]:
+    found = scene.get(name, []) if scene is not None else []
+    return list(found) if isinstance(found, list) else [found]
+
+
+def load_drivers(curve: Curve, scene: Any) -> list[Driver]:
+    """The supports that move and the loads that push, with their channels.
+
+    Parameters
+    ----------
+    curve : Curve
+        The run's curve (its columns name the channels and the sets).
+    scene : f90nml.Namelist or None
+        The run's effective input (``input.nml``, :func:`yarnfort.read_scene`).
+
+    Returns
+    -------
+    list of Driver
+        Supports with a nonzero displacement, then loads with a nonzero force, in input
+        order; only those whose channel and displacement columns are in the curve. Then
+        the support sets of the curve that the input does not list (a generated fabric's)
+        and that move: along their displacement at its largest, on the channel that
+        moves supports (``p_disp`` without ``&path channels``).
+    """
+    default = {"displacement": "p_disp", "force": "p_force"}
+    found = []
+    for kind, group, key in (("displacement", "support", "displacement"),
+                             ("force", "load", "force")):
+        for number, entry in enumerate(_groups(scene, group), start=1):
+            vector = np.zeros(3)
+            values = [0.0 if v is None else float(v)
+                      for v in np.atleast_1d(entry.get(key, [0.0] * 3))]
+            vector[:min(3, len(values))] = values[:3]
+            size = float(np.linalg.norm(vector))
+            name = str(entry.get("name", "")) if kind == "displacement" else f"load_{number}"
+            channel = str(entry.get("channel", "") or "") or default[kind]
+            if size == 0.0 or channel not in curve.names or f"{name}_ux" not in curve.names:
+                continue
+            nodes = len(np.atleast_1d(entry.get("nodes", [])))
+            found.append(Driver(channel, kind, name, vector / size, size, max(nodes, 1)))
+    listed = {str(entry.get("name", "")) for entry in _groups(scene, "support")}
+    channel = "p_disp" if "p_disp" in curve.channels else None
+    for name in supports(curve):
+        if name in listed or channel is None or f"{name}_ux" not in curve.names:
+            continue
+        moved = curve.displacement(name)
+        lengths = np.linalg.norm(moved, axis=1)
+        if len(lengths) and lengths.max() > 0.0:
+            largest = moved[int(np.argmax(lengths))]
+            found.append(Driver(channel, "displacement", name, largest / lengths.max(),
+                                float(lengths.max()), 1))
+    return found
+
+
+def _changes(values: np.ndarray) -> int:
+    return int(np.count_nonzero(np.diff(values))) if len(values) > 1 else 0
+
+
+def choose_driver(curve: Curve, drivers: list[Driver], channel: str | None = None
+                  ) -> Driver | None:
+    """The driver to plot: of ``channel`` if given, else of the channel that changes in
+    the most steps (the last stage of a staged path: the sideways cycles of a ring pulled
+    down first), a moving support before a load.
+
+    Parameters
+    ----------
+    curve : Curve
+        The run's curve.
+    drivers : list of Driver
+        From :func:`load_drivers`.
+    channel : str, optional
+        The load channel wanted.
+
+    Returns
+    -------
+    Driver or None
+        None if nothing drives the run (no support moves, no load pushes).
+
+    Raises
+    ------
+    ValueError
+        If ``channel`` drives nothing (the message lists the channels that do).
+    """
+    if channel is not None:
+        of_channel = [d for d in drivers if d.channel == channel]
+        if not of_channel:
+            driving = sorted({d.channel for d in drivers})
+            raise ValueError(f"channel {channel!r} moves no support and pushes no load;"
+                             f" channels that do: {', '.join(driving) or 'none'}")
+        return of_channel[0]
+    if not drivers:
+        return None
+    return max(drivers, key=lambda d: (_changes(curve[d.channel]),
+                                       d.kind == "displacement"))
+
+
+def driver_response(curve: Curve, driver: Driver, support: str | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Displacement and force of a driver, per step, both along its direction.
+
+    Parameters
+    ----------
+    curve : Curve
+        The run's curve.
+    driver : Driver
+        From :func:`load_drivers`.
+    support : str, optional
+        Another support set whose force is wanted instead: its reaction on the net along
+        the driver's direction.
+
+    Returns
+    -------
+    displacement : numpy.ndarray
+        Of the driver's set along its direction (m).
+    force : numpy.ndarray
+        N, positive in tension: a moving support's reaction on the net along its motion
+        (a pull is positive, a push negative); a load's applied force on all its nodes.
+    """
+    displacement = curve.displacement(driver.name) @ driver.direction
+    if support is not None and support != driver.name:
+        force = curve.reaction(support) @ driver.direction
+    elif driver.kind == "displacement":
+        force = curve.reaction(driver.name) @ driver.direction
+    else:
+        force = curve[driver.channel] * driver.magnitude * driver.nodes
+    return displacement, force
+
+
+def plot_load_displacement(curve: Curve, driver: Driver, ax: Axes | None = None,
+                           support: str | None = None, unit: str = DEFAULT_UNIT) -> Axes:
+    """Force against displacement of a driver (a moving support or a load), loading and
+    unloading drawn as in :func:`plot_hysteresis`, force positive in tension.
+
+    Parameters
+    ----------
+    curve : Curve
+        The run's curve.
+    driver : Driver
+        From :func:`load_drivers` / :func:`choose_driver`.
+    ax : Axes, optional
+        Where to draw; a new figure when omitted.
+    support : str, optional
+        Draw this support set's force against the driver (:func:`driver_response`).
+    unit : {'mm', 'm', 'um'}
+        Length unit of the displacement.
+
+    Returns
+    -------
+    Axes
+    """
+    if unit not in LENGTH_UNITS:
+        raise ValueError(f"unit must be one of {', '.join(LENGTH_UNITS)}, not {unit!r}")
+    ax = _axes(ax)
+    displacement, force = driver_response(curve, driver, support)
+    _plot_branches(ax, displacement / LENGTH_UNITS[unit], force, curve["direction"])
+    ax.set_xlabel(f"displacement of {driver.label} along {_direction_text(driver.direction)}"
+                  f" ({unit})")
+    ax.set_ylabel(force_label(driver, support))
+    ax.grid(True, alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend()
+    return ax
+
+
+def force_label(driver: Driver, support: str | None = None) -> str:
+    """Axis label of :func:`driver_response`'s force, with its sign convention."""
+    if support not in (None, driver.name):
+        return (f"reaction of support '{support}' on the net along"
+                f" {_direction_text(driver.direction)} (N)")
+    if driver.kind == "displacement":
+        return f"pulling force of {driver.label} (N, + = tension)"
+    return f"applied force of {driver.label} along {_direction_text(driver.direction)} (N)"
+
+
+def _direction_text(direction: np.ndarray) -> str:
+    """'+x', '-y', or the unit vector for an oblique direction."""
+    axis = int(np.argmax(np.abs(direction)))
+    if abs(abs(direction[axis]) - 1.0) <= FLAT_RANGE:
+        return ("+" if direction[axis] > 0 else "-") + "xyz"[axis]
+    return "(" + ", ".join(f"{v:.2g}" for v in direction) + ")"
+
+
+def tension_norm(tension: np.ndarray) -> Normalize:
+    """The colour range of tensions: their minimum to maximum, widened by
+    :data:`FLAT_PAD` of their magnitude when they are one value to rounding (a uniform
+    string is one colour mid-bar, not a bar of rounding noise).
+
+    Parameters
+    ----------
+    tension : array_like
+        Element tensions (N).
+
+    Returns
+    -------
+    Normalize
+    """
+    tension = np.asarray(tension, dtype=float)
+    if tension.size == 0:
+        return Normalize(0.0, 1.0)
+    low, high = float(tension.min()), float(tension.max())
+    scale = max(abs(low), abs(high))
+    if high - low <= FLAT_RANGE * scale or scale == 0.0:
+        pad = FLAT_PAD * scale if scale > 0.0 else 1.0
+        return Normalize(low - pad, high + pad)
+    return Normalize(low, high)
+
+
+def readable_colorbar(colorbar: Any) -> None:
+    """Plain tick labels on a colour bar: no offset ('1e-13+2e-2'), powers of ten only
+    outside 1e-3 .. 1e4."""
+    formatter = ScalarFormatter(useOffset=False)
+    formatter.set_powerlimits((-3, 4))
+    colorbar.formatter = formatter
+    colorbar.update_ticks()
+
+
+def readable_ticks(ax: Axes, count: int = NETWORK_TICKS) -> None:
+    """At most ``count`` ticks per axis, without offsets, so labels stay apart."""
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_locator(MaxNLocator(count))
+        formatter = ScalarFormatter(useOffset=False)
+        formatter.set_powerlimits((-3, 5))
+        axis.set_major_formatter(formatter)
+
+
+def peak_step(curve: Curve, force: np.ndarray, steps: list[int]) -> int:
+    """The step of largest |force| among ``steps`` (those with a saved state); the
+    earliest on a tie.
+
+    Parameters
+    ----------
+    curve : Curve
+        The run's curve.
+    force : numpy.ndarray
+        One value per row of the curve.
+    steps : list of int
+        The candidate steps.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ValueError
+        If none of ``steps`` is in the curve.
+    """
+    index = {int(step): k for k, step in enumerate(curve["step"])}
+    candidates = [step for step in steps if step in index]
+    if not candidates:
+        raise ValueError("no saved state of a step of the curve")
+    return max(candidates, key=lambda step: (abs(force[index[step]]), -step))
+
+
+def plot_history(curve: Curve, states: list[State], driver: Driver, scene: Any,
+                 axes: list[Axes], unit: str = DEFAULT_UNIT) -> list[Axes]:
+    """History of the rings and obstacles against the driver's load: the position of
+    every ``&ring`` node (the components that move, from the saved states) and the
+    reaction of every ``&obstacle`` (its components that are nonzero), drawn against
+    the driver's force (a load) or displacement (a moving support).
+
+    Parameters
+    ----------
+    curve, states
+        The run's curve and saved states.
+    driver : Driver
+        The abscissa's driver.
+    scene : f90nml.Namelist
+        The effective input (``&ring`` nodes, ``&obstacle`` names).
+    axes : list of Axes
+        One for the rings (if the scene has any), then one for the obstacles.
+    unit : {'mm', 'm', 'um'}
+        Length unit.
+
+    Returns
+    -------
+    list of Axes
+        Those drawn on.
+    """
+    displacement, force = driver_response(curve, driver)
+    by_step = {int(step): k for k, step in enumerate(curve["step"])}
+    if driver.kind == "force":
+        abscissa, x_label = force, force_label(driver)
+    else:
+        abscissa = displacement / LENGTH_UNITS[unit]
+        x_label = (f"displacement of {driver.label} along"
+                   f" {_direction_text(driver.direction)} ({unit})")
+    used = []
+    pending = list(axes)
+    rings = _groups(scene, "ring")
+    if rings and pending:
+        ax = pending.pop(0)
+        kept = [s for s in states if s.step in by_step]
+        rows = [by_step[s.step] for s in kept]
+        for ring in rings:
+            for node in np.atleast_1d(ring.get("nodes", [])):
+                path = np.array([s.position[int(node) - 1] for s in kept])
+                for k in range(3):
+                    if len(path) and np.ptp(path[:, k]) > 0.0:
+                        ax.plot(abscissa[rows], path[:, k] / LENGTH_UNITS[unit], ".-",
+                                markersize=3,
+                                label=f"ring '{ring.get('name')}' node {int(node)}: {'xyz'[k]}")
+        ax.set_xlabel(x_label)
+        ax.set_ylabel(f"ring position ({unit})")
+        ax.set_title("ring history")
+        ax.grid(True, alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize="small")
+        used.append(ax)
+    obstacles = [o for o in _groups(scene, "obstacle") if f"{o.get('name')}_rx" in curve.names]
+    if obstacles and pending:
+        ax = pending.pop(0)
+        for obstacle in obstacles:
+            reaction = curve.reaction(str(obstacle.get("name")))
+            for k in range(3):
+                if np.any(reaction[:, k] != 0.0):
+                    ax.plot(abscissa, reaction[:, k],
+                            label=f"obstacle '{obstacle.get('name')}': R{'xyz'[k]}")
+        ax.set_xlabel(x_label)
+        ax.set_ylabel("reaction on the net (N)")
+        ax.set_title("obstacle history")
+        ax.grid(True, alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize="small")
+        used.append(ax)
+    return used

@@ -15,6 +15,8 @@ yarn or material ids, contact state, ...) are kept in :attr:`State.point_data` a
 from __future__ import annotations
 
 import csv
+import errno
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -150,10 +152,12 @@ class Curve:
         Raises
         ------
         ImportError
-            If pandas is not installed.
+            If pandas is not installed (the message names ``pip install
+            'yarnfort[pandas]'``).
         """
-        import pandas
+        from ._extras import import_extra
 
+        pandas = import_extra("pandas", "pandas", "Curve.to_dataframe")
         return pandas.DataFrame(self.columns)
 
 
@@ -333,7 +337,8 @@ def read_curve(path: str | Path) -> Curve:
     Returns
     -------
     Curve
-        Every column as floats; a file with only its header gives a curve of 0 rows.
+        The integer columns (``step``, ``direction``, counts) as integers, the others as
+        floats; a file with only its header gives a curve of 0 rows.
 
     Raises
     ------
@@ -344,6 +349,10 @@ def read_curve(path: str | Path) -> Curve:
         If the file cannot be read.
     """
     return _read_csv(_curve_file(path), ())
+
+
+#: A cell written as an integer.
+_INTEGER = re.compile(r"^\s*[+-]?\d+\s*$")
 
 
 def _read_csv(path: Path, text_columns: tuple[str, ...]) -> Curve:
@@ -377,6 +386,11 @@ def _read_csv(path: Path, text_columns: tuple[str, ...]) -> Curve:
         values.append(parsed)
     table = np.array(values, dtype=float).reshape(len(values), len(numeric))
     columns = {name: table[:, k].copy() for k, name in enumerate(numeric)}
+    # A column the program writes as integers (no point, no exponent) is one.
+    for k, name in enumerate(numeric):
+        cells = [row[header.index(name)] for row in rows[1:] if row]
+        if cells and all(_INTEGER.match(cell) for cell in cells):
+            columns[name] = table[:, k].astype(np.int64)
     columns.update({name: np.array(cells, dtype=str) for name, cells in texts.items()})
     return Curve({name: columns[name] for name in header}, path)
 
@@ -439,19 +453,27 @@ def read_state(path: str | Path) -> State:
 
     Raises
     ------
+    FileNotFoundError
+        If there is no such file (with either reader).
     ResultError
         If the file is not a state of line cells with ``tension``, ``stretch`` and
         ``L0`` cell data.
     """
     path = Path(path)
+    # Checked here, not left to meshio, whose ReadError is no OSError.
+    if not path.exists():
+        raise FileNotFoundError(errno.ENOENT, "no such VTK state file", str(path))
     try:
         import meshio
     except ImportError:
         meshio = None
+    unreadable: tuple[type[Exception], ...] = (ET.ParseError, KeyError, ValueError)
+    if meshio is not None:
+        unreadable += (meshio.ReadError,)
     try:
         points, elements, point_data, cell_data, field_data = (
             _read_meshio(meshio, path) if meshio is not None else _read_ascii(path))
-    except (ET.ParseError, KeyError, ValueError) as error:
+    except unreadable as error:
         if isinstance(error, ResultError):
             raise
         raise ResultError(f"{path}: not a readable yarnfort VTK state ({error})") from None
@@ -490,6 +512,13 @@ def read_states(folder: str | Path) -> list[State]:
     Returns
     -------
     list of State
+
+    Raises
+    ------
+    FileNotFoundError
+        If a state the collection lists is missing.
+    ResultError
+        If the collection or a state is not readable as yarnfort wrote it.
     """
     folder = Path(folder)
     collection = folder / "states.pvd"
@@ -503,8 +532,9 @@ def read_states(folder: str | Path) -> list[State]:
                                           key=lambda p: int(p.stem[len("state_"):]))]
 
 
-def read_run(folder: str | Path) -> tuple[Curve, list[State]]:
-    """The curve and every written state of an output folder.
+def read_run(folder: str | Path) -> Any:
+    """An output folder as a :class:`~yarnfort.RunResult`, the type
+    :func:`~yarnfort.run_scene` returns: ``.curve``, ``.states``, ``.to_dataframe()``.
 
     Parameters
     ----------
@@ -513,7 +543,18 @@ def read_run(folder: str | Path) -> tuple[Curve, list[State]]:
 
     Returns
     -------
-    curve : Curve
-    states : list of State
+    RunResult
+        ``outcome`` is ``'read'`` (not run here), ``n_steps`` the rows of its curve.
+
+    Raises
+    ------
+    ResultError
+        If the folder holds no readable ``curve.csv``.
     """
-    return read_curve(folder), read_states(folder)
+    from .runner import RunResult
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ResultError(f"no output folder {str(folder)!r}")
+    curve = read_curve(folder)
+    return RunResult(folder.resolve(), len(curve), "read")

@@ -96,7 +96,8 @@ class RunResult:
         ``'done'`` (the load path's end reached), ``'max_steps'`` (stopped by
         ``&control max_steps``), ``'stopped'`` (stopped by the call-back),
         ``'interrupted'`` (Ctrl-C) or ``'failed'`` (a failed solve; see
-        :class:`~yarnfort.YarnfortError`).
+        :class:`~yarnfort.YarnfortError`); ``'read'`` for a folder read by
+        :func:`~yarnfort.read_run`.
     """
 
     folder: Path
@@ -188,7 +189,13 @@ def run_scene(scene: str | os.PathLike | Any, *,
         solve (``status`` 1; the converged steps are kept and ``result`` describes them).
     RunInterrupted
         After Ctrl-C, once the step being solved is complete on disk.
+    TypeError
+        If ``progress`` is neither a bool nor a callable (before anything runs).
     """
+    # Anything else ('yes', 42, None) would run silently: refused, not guessed.
+    if not (isinstance(progress, bool) or callable(progress)):
+        raise TypeError(f"run_scene: progress must be a bool or a callable taking a Step, "
+                        f"not {type(progress).__name__} {progress!r}")
     if hasattr(scene, "to_namelist"):
         with tempfile.TemporaryDirectory(prefix="yarnfort-scene-") as folder:
             path = Path(folder) / "scene.nml"
@@ -259,5 +266,5 @@ def _warn_of_jumps(result: RunResult) -> None:
     if steps:
         warnings.warn(f"{len(steps)} step(s) ended in a jump after a slip instability "
                       f"(steps {', '.join(map(str, steps))}; curve.csv column 'jumped'; "
-                      "inputs/REFERENCE.md, Slip instabilities)", RuntimeWarning,
+                      "python -m yarnfort reference: Slip instabilities)", RuntimeWarning,
                       stacklevel=3)

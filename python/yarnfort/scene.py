@@ -8,11 +8,17 @@ settings. It writes the namelist that ``yarnfort < scene.nml`` reads
 writing it again gives the same effective input), and runs in process
 (:meth:`Scene.run`, see :func:`yarnfort.run_scene`).
 
-Validation has two layers. Building an object checks what Python can see alone: types,
-array shapes, names, references between groups (a yarn's material must exist, a
-support's nodes must be nodes of the scene). :meth:`Scene.check` then hands the scene to
-the library's own reader and checker (the program's ``&control check_only``), which
-knows every rule of ``inputs/REFERENCE.md``; :meth:`Scene.run` does the same before it
+Validation has two layers. Building an object checks what Python can see alone, against
+the one description of the input that also makes the library's reader (every group and
+variable with its type, shape, range and choices; installed with the package): a
+variable its group does not have is an :class:`UnknownVariableError` (a
+:class:`SceneError` and a :class:`TypeError`) that suggests the name meant; types, array
+shapes, ranges, names and references between groups (a yarn's material must exist, a
+support's nodes must be nodes of the scene) are checked. An unset parameter is None,
+never a marker value a real input could collide with. :meth:`Scene.check` then hands the
+scene to the library's own reader and checker (the program's ``&control check_only``),
+which knows every rule of the input reference (``python -m yarnfort reference``;
+``inputs/REFERENCE.md`` in the repository); :meth:`Scene.run` does the same before it
 solves. Messages name the group and variable.
 
 Node ids are the namelist's: 1..n in the order of ``nodes``. Variables this module does
@@ -24,7 +30,8 @@ files, the output folder) are taken from the working directory of the run, as fo
 
 Example
 -------
-A V-shaped string under a point load (``inputs/vnet.nml`` built in Python)::
+A V-shaped string under a point load (``inputs/vnet.nml`` built in Python; ``python -m
+yarnfort examples DIR`` writes the example scenes)::
 
     import numpy as np, yarnfort
     scene = yarnfort.Scene("V-net", output={"folder": "out/vnet_py"})
@@ -38,6 +45,7 @@ A V-shaped string under a point load (``inputs/vnet.nml`` built in Python)::
 """
 from __future__ import annotations
 
+import difflib
 import os
 import re
 import tempfile
@@ -50,9 +58,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .namelist import make_namelist, read_scene
+from .resources import input_description
 
-__all__ = ["Scene", "SceneError", "Material", "Contact", "Yarn", "Support", "Load",
-           "LoadPath", "Fabric", "Geometry", "Obstacle", "Ring"]
+__all__ = ["Scene", "SceneError", "UnknownVariableError", "Material", "Contact", "Yarn",
+           "Support", "Load", "LoadPath", "Fabric", "Geometry", "Obstacle", "Ring"]
 
 _NAME = re.compile(r"^[A-Za-z0-9_.\-]+$")
 _FIX = re.compile(r"^(?!.*(.).*\1)[xyzXYZ]{1,3}$")
@@ -60,6 +69,98 @@ _FIX = re.compile(r"^(?!.*(.).*\1)[xyzXYZ]{1,3}$")
 
 class SceneError(ValueError):
     """A scene that cannot be written as input; the message names group and variable."""
+
+
+class UnknownVariableError(SceneError, TypeError):
+    """A variable that its group does not have (a typo: the message suggests the name
+    meant); also a :class:`TypeError`, as an unexpected keyword argument is."""
+
+
+def _known_variables(group: str) -> dict[str, dict[str, Any]]:
+    """The variables of ``&group`` in the one description of the input
+    (:func:`yarnfort.resources.input_description`), by name."""
+    for entry in input_description()["groups"]:
+        if entry["name"] == group:
+            return {var["name"]: var for var in entry["variables"]}
+    raise KeyError(group)
+
+
+#: Bounds of the description's ranges: '> 0', '>= 1', '(0, 1)', '[a, b]'.
+_BOUND = re.compile(r"^(>=?)\s*(\S+)$")
+_INTERVAL = re.compile(r"^([\[(])\s*([^,]+),\s*([^\])]+)([\])])$")
+
+
+def _in_range(value: float, rule: str | None) -> bool:
+    if rule is None or rule == "finite":
+        return bool(np.isfinite(value))
+    if match := _BOUND.match(rule):
+        bound = float(match[2])
+        return value >= bound if match[1] == ">=" else value > bound
+    if match := _INTERVAL.match(rule):
+        low, high = float(match[2]), float(match[3])
+        above = value >= low if match[1] == "[" else value > low
+        below = value <= high if match[4] == "]" else value < high
+        return above and below
+    return True  # a rule in words: the library checks it
+
+
+def _check_value(group: str, var: dict[str, Any], value: Any, where: str) -> None:
+    """One variable's type, shape, range and choices as the description gives them."""
+    name = var["name"]
+    if value is None:
+        return
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    shape = var["shape"]
+    entries = value if isinstance(value, (list, tuple)) else [value]
+    if shape is None and isinstance(value, (list, tuple)):
+        raise SceneError(f"{where} {name}: expected one value, got {len(entries)}")
+    if isinstance(shape, int) and len(entries) > shape:
+        raise SceneError(f"{where} {name}: at most {shape} values, got {len(entries)}")
+    kind = var["type"]
+    for entry in entries:
+        if entry is None:
+            continue  # an entry left unset (its default)
+        if kind == "character":
+            if not isinstance(entry, str):
+                raise SceneError(f"{where} {name}: expected a string, got {entry!r}")
+            if len(entry) > var["length"]:
+                raise SceneError(f"{where} {name}: {entry!r} is longer than"
+                                 f" {var['length']} characters")
+            choices = var["choices"]
+            folded = entry.lower() if var["lower"] else entry
+            if choices and not var["checked_by"] and folded not in choices:
+                raise SceneError(f"{where} {name}: {entry!r} is not one of "
+                                 + ", ".join(repr(c) for c in choices))
+        elif kind == "logical":
+            if not isinstance(entry, (bool, np.bool_)):
+                raise SceneError(f"{where} {name}: expected True or False, got {entry!r}")
+        else:
+            if isinstance(entry, (bool, np.bool_)) or not isinstance(
+                    entry, (int, float, np.integer, np.floating)):
+                raise SceneError(f"{where} {name}: expected a number, got {entry!r}")
+            if kind == "integer" and not isinstance(entry, (int, np.integer)):
+                raise SceneError(f"{where} {name}: expected an integer, got {entry!r}")
+            rule = None if var["checked_by"] else var["range"]
+            if not _in_range(float(entry), rule or "finite"):
+                unit = f" {var['unit']}" if var["unit"] not in ("", "1") else ""
+                raise SceneError(f"{where} {name} = {entry!r}{unit}: must be "
+                                 + (rule or "finite"))
+
+
+def _check_group(group: str, variables: dict[str, Any], where: str) -> None:
+    """Every variable of one group against the description: a name the group does not
+    have is an :class:`UnknownVariableError` that suggests the name meant; types, shapes,
+    ranges and choices are checked as the library's reader does."""
+    known = _known_variables(group)
+    for key, value in variables.items():
+        if key not in known:
+            close = difflib.get_close_matches(key, list(known), n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise UnknownVariableError(
+                f"{where}: &{group} has no variable {key!r}{hint} (it has:"
+                f" {', '.join(known)}; python -m yarnfort reference)")
+        _check_value(group, known[key], value, where)
 
 
 def _name(value: Any, where: str) -> str:
@@ -145,6 +246,15 @@ def _split(group: f90nml.Namelist, names: tuple[str, ...]) -> tuple[dict, dict]:
     return known, extra
 
 
+def _without_unset_markers(group: str, variables: dict[str, Any]) -> dict[str, Any]:
+    """Variables as read from a namelist, without the law parameters that hold the file
+    format's 'not set' value (their default, e.g. ``stiffness = -1.0`` in an echoed
+    input): in Python an unset parameter is None, and every given value is checked."""
+    known = _known_variables(group)
+    return {key: value for key, value in variables.items()
+            if not (key in known and known[key]["laws"] and value == known[key]["default"])}
+
+
 #: Array variables whose unset entries take the default 0 (``displacement(2) = -0.3``
 #: leaves the first and third at 0), with the length they have.
 _ZERO_FILLED: dict[tuple[str, str], int | None] = {
@@ -179,7 +289,9 @@ class Material:
         Unique name, referred to by yarns and contacts.
     law : str
         ``'linear'`` (``stiffness`` EA, N), ``'neo_hookean'`` (``modulus`` C, Pa, and
-        ``area`` S1, m**2) or ``'table'`` (``table_file``: CSV of strain, force in N).
+        ``area`` S1, m**2) or ``'table'`` (``table_file``: CSV of strain, force; in the
+        units its header states, else 1 and N; ``extra`` may hold ``strain_unit``,
+        ``force_unit``, ``gauge_length``).
     prestress : float, optional
         Initial tension of every element of this type (N).
     extra : dict
@@ -202,6 +314,7 @@ class Material:
         for key in ("stiffness", "modulus", "area", "prestress"):
             setattr(self, key, _optional_float(getattr(self, key),
                                                f"&material '{self.name}' {key}"))
+        _check_group("material", _variables(self), f"&material '{self.name}'")
 
 
 @dataclass
@@ -250,6 +363,7 @@ class Contact:
         self.materials = tuple(_name(name, "&contact materials") for name in pair)
         for key in ("friction_coefficient", "adhesion", "decay_start", "decay_end"):
             setattr(self, key, _optional_float(getattr(self, key), f"&contact {key}"))
+        _check_group("contact", _variables(self), "&contact")
 
 
 @dataclass
@@ -298,6 +412,7 @@ class Yarn:
             if not np.all(array > 0.0):
                 raise SceneError(f"&yarn ({self.material}) {key}: every value must be > 0")
             setattr(self, key, array)
+        _check_group("yarn", _variables(self), f"&yarn ({self.material})")
 
 
 @dataclass
@@ -340,6 +455,7 @@ class Support:
             self.channel = None          # the default channel, as an echoed input has it
         if self.channel is not None:
             _name(self.channel, f"&support '{self.name}' channel")
+        _check_group("support", _variables(self), f"&support '{self.name}'")
 
 
 @dataclass
@@ -364,6 +480,7 @@ class Obstacle:
     def __post_init__(self) -> None:
         _name(self.name, "&obstacle name")
         self.nodes = _ids(self.nodes, f"&obstacle '{self.name}' nodes")
+        _check_group("obstacle", _variables(self), f"&obstacle '{self.name}'")
 
 
 @dataclass
@@ -387,6 +504,7 @@ class Ring:
     def __post_init__(self) -> None:
         _name(self.name, "&ring name")
         self.nodes = _ids(self.nodes, f"&ring '{self.name}' nodes")
+        _check_group("ring", _variables(self), f"&ring '{self.name}'")
 
 
 @dataclass
@@ -417,6 +535,7 @@ class Load:
             self.channel = None
         if self.channel is not None:
             _name(self.channel, "&load channel")
+        _check_group("load", _variables(self), "&load")
 
 
 @dataclass
@@ -481,6 +600,7 @@ class LoadPath:
             self.factors = array.reshape(shape)
         elif self.factors is not None:
             raise SceneError("&path factors: given without channels")
+        _check_group("path", _variables(self), "&path")
 
 
 @dataclass
@@ -490,7 +610,8 @@ class Geometry:
     Parameters
     ----------
     file : str or path
-        The file (format in ``inputs/REFERENCE.md``); relative to the run's working
+        The file (format in the input reference, ``python -m yarnfort reference``);
+        relative to the run's working
         directory.
     extra : dict
         Further ``&geometry`` variables.
@@ -498,6 +619,9 @@ class Geometry:
 
     file: str | os.PathLike
     extra: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        _check_group("geometry", _variables(self), "&geometry")
 
 
 @dataclass
@@ -510,7 +634,7 @@ class Fabric:
         ``'knit'``, ``'plain'`` or ``'twill'``.
     extra : dict
         The other ``&fabric`` variables (``cells``, ``spacing``, ``boundary``,
-        ``strain``, ``knit_material``, ``gap``, ...; see ``inputs/REFERENCE.md``), also
+        ``strain``, ``knit_material``, ``gap``, ...; see ``python -m yarnfort reference``), also
         given as keywords: ``Fabric('knit', cells=[2, 2], spacing=[1e-3, 1e-3])``.
     """
 
@@ -523,6 +647,7 @@ class Fabric:
             raise SceneError(f"&fabric kind: expected a string, got {kind!r}")
         self.kind = kind
         self.extra = {**(extra or {}), **variables}
+        _check_group("fabric", {"kind": kind, **self.extra}, "&fabric")
 
 
 #: Group name -> (class, repeated) for the groups with their own class.
@@ -581,6 +706,14 @@ class Scene:
         self.control: dict[str, Any] = dict(control or {})
         if title is not None:
             self.control["title"] = title
+        self._check_settings()
+
+    def _check_settings(self) -> None:
+        """The settings dicts (and the extras of &nodes) against the description: they
+        can change after construction, so :meth:`validate` checks them again."""
+        for group in _SETTINGS:
+            _check_group(group, getattr(self, group), f"Scene {group}")
+        _check_group("nodes", self.nodes_extra, "&nodes")
 
     def __repr__(self) -> str:
         source = ("fabric" if self.fabric is not None else "geometry"
@@ -594,7 +727,8 @@ class Scene:
     # -- building -------------------------------------------------------------------
     @property
     def nodes(self) -> np.ndarray | None:
-        """Node positions, shape (n, 3) (m); set from any array of n*3 numbers."""
+        """Node positions, shape (n, 3) (m); set from an (n, 3) array or a flat list of
+        x1, y1, z1, x2, ... (as ``&nodes xyz``)."""
         return self._nodes
 
     @nodes.setter
@@ -603,6 +737,11 @@ class Scene:
             self._nodes = None
             return
         array = _reals(value, "&nodes xyz")
+        # (n, 3) rows, or the namelist's flat x1, y1, z1, x2, ...: nothing else is
+        # reshaped (a (3, 2) array is no set of points).
+        if array.ndim == 2 and array.shape[1] != 3 or array.ndim > 2:
+            raise SceneError(f"&nodes xyz: expected shape (n, 3) (one row x, y, z per"
+                             f" node), got {array.shape}")
         if array.size == 0 or array.size % 3:
             raise SceneError(f"&nodes xyz: {array.size} numbers are not (x, y, z) triplets")
         self._nodes = array.reshape(-1, 3)
@@ -815,6 +954,17 @@ class Scene:
         SceneError
             Naming the first problem. The library's checks (:meth:`check`) cover the rest.
         """
+        self._check_settings()
+        # Objects can be changed after construction (material.stiffness = -1.0): every
+        # variable is checked again against the description.
+        for group, attribute in _LISTS.items():
+            for item in getattr(self, attribute):
+                _check_group(group, _variables(item), f"&{group}")
+        for group in ("path", "geometry"):
+            if getattr(self, group) is not None:
+                _check_group(group, _variables(getattr(self, group)), f"&{group}")
+        if self.fabric is not None:
+            _check_group("fabric", {"kind": self.fabric.kind, **self.fabric.extra}, "&fabric")
         sources = [name for name, present in (("&nodes", self._nodes is not None),
                    ("&geometry", self.geometry is not None),
                    ("&fabric", self.fabric is not None)) if present]
@@ -918,6 +1068,7 @@ class Scene:
                 objects = []
                 for group in groups:
                     known, extra = _split(group, names)
+                    known = _without_unset_markers(key, known)
                     if key == "contact" and "at" in known:
                         known.setdefault("materials", ())
                     objects.append(kind(**_defaults_filled(key, known), extra=extra))
@@ -926,7 +1077,10 @@ class Scene:
                 else:
                     setattr(scene, key, objects[0])
             else:
-                raise SceneError(f"&{key}: not a yarnfort group")
+                groups_known = [g["name"] for g in input_description()["groups"]]
+                close = difflib.get_close_matches(key, groups_known, n=1)
+                raise SceneError(f"&{key}: not a yarnfort group"
+                                 + (f"; did you mean &{close[0]}?" if close else ""))
         return scene
 
     @classmethod

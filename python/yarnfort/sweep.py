@@ -371,8 +371,10 @@ def run_sweep(scene_path: str | os.PathLike,
     bar = _Progress(len(tasks), progress)
     try:
         if scheduler is not None:
-            from distributed import Client
-            with Client(scheduler) as client:
+            from ._extras import import_extra
+
+            distributed = import_extra("distributed", "dask", "run_sweep(scheduler=...)")
+            with distributed.Client(scheduler) as client:
                 rows = _run_tasks(tasks, client.get_executor(), bar)
         else:
             with cf.ProcessPoolExecutor(max_workers=workers) as executor:

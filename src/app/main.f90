@@ -14,6 +14,7 @@ program yarnfort_main
     use yarnfort_driver, only: solve_with_outputs, get_linear_solver_name
     use yarnfort_app_progress, only: progress_writer_type
     use yarnfort_output_filesystem, only: ignore_file_size_signal
+    use yarnfort_linalg_process, only: apply_process_settings
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
@@ -28,6 +29,8 @@ program yarnfort_main
     call handle_arguments()
     ! A write past a file size limit then fails like any other write (exit 1, message).
     call ignore_file_size_signal()
+    ! Threads and heap of the solver libraries, once for the process.
+    call apply_process_settings()
 
     call system_clock(clock_start, clock_rate)
     call read_config_from_stdin(config, error)
@@ -107,6 +110,9 @@ contains
             'Load channels: each &load and &support names a channel (&path channels, one', &
             'column of &path factors per channel); default: p_force and p_disp.', &
             'Per-element reference lengths: &yarn length0 or stretch (one per element).', &
+            'Table files state their units: a header such as "Elongation (%),Force (cN)"', &
+            'or &material strain_unit, force_unit (an elongation in mm: gauge_length);', &
+            'none: strain and N. &geometry unit (or a unit line) converts a file to m.', &
             'Examples: inputs/*.nml.', &
             ''
         write(output_unit, '(a)') (trim(input_help_lines(i)), i = 1, size(input_help_lines))

@@ -4,6 +4,7 @@ module yarnfort_app_progress
     use, intrinsic :: iso_fortran_env, only: error_unit
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
+    use yarnfort_text, only: format_short
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_writer, only: output_writer_type
@@ -31,7 +32,7 @@ contains
         type(step_state_type), intent(in) :: state
         type(error_type), allocatable, intent(out) :: error
 
-        integer :: c
+        integer :: c, k
 
         call self%output_writer_type%on_step(scene, state, error)
         if (allocated(error)) return
@@ -43,8 +44,9 @@ contains
             write(error_unit, '("  ", a, " = ", f8.4)', advance='no') &
                 trim(scene%path%channel(c)), state%factors(c)
         end do
-        write(error_unit, '("  newton ", i3, "  residual ", es9.2, "  ", f8.3, " s")', &
-            advance='no') state%newton_iterations, state%newton%residual_norm, state%wall_time
+        write(error_unit, '("  newton ", i3, "  residual ", a, "  ", f8.3, " s")', &
+            advance='no') state%newton_iterations, format_short(state%newton%residual_norm), &
+            state%wall_time
         if (state%n_passages > 0) then
             write(error_unit, '("  slipping ", i0, "/", i0)', advance='no') state%n_slipping, &
                 state%n_passages
@@ -58,8 +60,9 @@ contains
         else
             write(error_unit, '()')
         end if
-        if (self%residual_history) write(error_unit, '("  residuals", *(1x, es9.2))') &
-            state%newton%residual_history
+        if (self%residual_history) write(error_unit, '("  residuals", *(1x, a))') &
+            (format_short(state%newton%residual_history(k)), &
+            k = 1, size(state%newton%residual_history))
     end subroutine on_step
 
     subroutine on_cut(self, time, step, reason)
@@ -68,8 +71,8 @@ contains
         character(len=*), intent(in) :: reason
 
         if (.not. self%progress) return
-        write(error_unit, '("  cut: step of ", es9.2, " from t = ", f9.5, " failed: ", a)') &
-            step, time, reason
+        write(error_unit, '("  cut: step of ", a, " from t = ", f9.5, " failed: ", a)') &
+            format_short(step), time, reason
     end subroutine on_cut
 
     subroutine on_resume(self, step, time)

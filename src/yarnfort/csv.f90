@@ -52,19 +52,25 @@ contains
     !> Read the rows of a two-column CSV file, checking each with `check` as it is read.
     !> `names` are the columns (for messages: 'expected "strain,force"'); `first`, `second`
     !> the values, `lines` the line of each row. Messages start with `context` (e.g.
-    !> "table 'cotton.csv'") and name the line.
-    subroutine read_csv_pairs(path, context, names, check, first, second, lines, error)
+    !> "table 'cotton.csv'") and name the line. `header` is the last header line before
+    !> the first row (the column names; '' if none) and `header_line` its line (0 if none).
+    subroutine read_csv_pairs(path, context, names, check, first, second, lines, error, &
+            header, header_line)
         character(len=*), intent(in) :: path, context
         character(len=*), intent(in) :: names(2)
         procedure(row_check_interface) :: check
         real(wp), allocatable, intent(out) :: first(:), second(:)
         integer, allocatable, intent(out) :: lines(:)
         type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable, intent(out), optional :: header
+        integer, intent(out), optional :: header_line
         character(len=:), allocatable :: line, message
         character(len=512) :: iomsg
         type(csv_row_type) :: row, previous
         integer :: unit, stat, line_number, nrow, outcome
 
+        if (present(header)) header = ''
+        if (present(header_line)) header_line = 0
         if (is_folder(path)) then
             call fatal_error(error, context // ': is a folder, not a file')
             return
@@ -92,7 +98,11 @@ contains
             call parse_line(line, names, row, outcome, message)
             if (outcome == line_skip) cycle
             if (outcome == line_bad) then
-                if (nrow == 0 .and. is_header(line)) cycle
+                if (nrow == 0 .and. is_header(line)) then
+                    if (present(header)) header = clean_line(line)
+                    if (present(header_line)) header_line = line_number
+                    cycle
+                end if
                 call fatal_error(error, context // ', line ' // format_integer(line_number) &
                     // ': ' // message)
                 exit

@@ -6,7 +6,9 @@ module yarnfort_driver
     use yarnfort_error, only: error_type, prefix_error
     use yarnfort_input_config, only: config_type
     use yarnfort_output_writer, only: output_writer_type
-    use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash
+    use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash, &
+        restart_file_name, synced_file_name
+    use yarnfort_text, only: format_integer
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
@@ -102,13 +104,19 @@ contains
             if (allocated(error)) return
             stage = 'restart'
             call read_restart(trim(config%output%folder), restart, error)
-            if (.not. allocated(error)) call check_restart(restart, scene, writer%input_hash, &
-                trim(config%output%folder), error)
+            if (allocated(error)) then
+                call add_synced_hint(trim(config%output%folder), -1, error)
+                return
+            end if
+            call check_restart(restart, scene, writer%input_hash, trim(config%output%folder), &
+                error)
             if (allocated(error)) return
             call writer%on_resume(restart%step, restart%time)
             stage = 'output'
             call writer%open(scene, error, resume_step=restart%step, resume_time=restart%time, &
                 resume_previous_time=restart%time_old)
+            if (allocated(error)) call add_synced_hint(trim(config%output%folder), &
+                restart%step, error)
         else
             stage = 'output'
             call writer%open(scene, error)
@@ -138,5 +146,25 @@ contains
             call move_alloc(finish_error, error)
         end if
     end subroutine solve_with_outputs
+
+    !> After a power cut, restart.dat may be damaged, or on disk further than curve.csv;
+    !> restart.sync, the restart file of the last flush to disk, is then one the tables
+    !> hold. Say so in `error` when that file is readable and of an earlier step than
+    !> restart.dat's `step` (-1: restart.dat is unreadable).
+    subroutine add_synced_hint(folder, step, error)
+        character(len=*), intent(in) :: folder
+        integer, intent(in) :: step
+        type(error_type), intent(inout) :: error
+        type(restart_type) :: synced
+        type(error_type), allocatable :: unreadable
+
+        call read_restart(folder, synced, unreadable, name=synced_file_name)
+        if (allocated(unreadable)) return
+        if (step >= 0 .and. synced%step >= step) return
+        error%message = error%message // " (after a power cut: '" // folder // '/' &
+            // synced_file_name // "' is the restart file last flushed to disk, of step " &
+            // format_integer(synced%step) // '; rename it to ' // restart_file_name &
+            // ' to go on from there)'
+    end subroutine add_synced_hint
 
 end module yarnfort_driver

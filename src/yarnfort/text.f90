@@ -11,6 +11,7 @@ module yarnfort_text
     private
 
     public :: string_type, read_line, to_lower, format_integer, format_real, quote_string
+    public :: format_short
     public :: split_words, parse_integer, parse_real, edit_distance, closest_name
     public :: join_names, folder_of, resolve_path, is_folder, max_line_length
     public :: drop_byte_order_mark, remove_characters, read_file_text, open_to_read
@@ -169,6 +170,37 @@ contains
         digits = digits // repeat('0', max(point + 1 - len(digits), 0))
         text = minus // digits(:point) // '.' // digits(point + 1:) // suffix
     end function format_real
+
+    !> A real for a message, rounded to `digits` significant digits (default 3), always
+    !> with its exponent: '1.80e308', '4.94e-324', '-2.50e-3', '1.00e0'; 'NaN', 'Infinity'
+    !> and '-Infinity' as such. (An ES edit descriptor without an exponent width drops
+    !> the 'E' of a three-digit exponent: 1.80+308.)
+    pure function format_short(value, digits) result(text)
+        real(wp), intent(in) :: value
+        integer, intent(in), optional :: digits
+        character(len=:), allocatable :: text
+        character(len=40) :: buffer, form
+        integer :: shown, mark, exponent
+
+        if (ieee_is_nan(value)) then
+            text = 'NaN'
+            return
+        else if (.not. ieee_is_finite(value)) then
+            text = trim(merge('-', ' ', value < 0.0_wp)) // 'Infinity'
+            return
+        end if
+        shown = 3
+        if (present(digits)) shown = min(max(digits, 1), 17)
+        ! Four exponent digits hold every double's exponent, subnormals included.
+        write(form, '("(es40.", i0, "e4)")') shown - 1
+        write(buffer, form) value
+        buffer = adjustl(buffer)
+        mark = index(buffer, 'E')
+        read(buffer(mark + 1:), *) exponent
+        ! ES with no decimals writes '2.E+0308': no point without digits after it.
+        if (buffer(mark - 1:mark - 1) == '.') mark = mark - 1
+        text = buffer(:mark - 1) // 'e' // format_integer(exponent)
+    end function format_short
 
     !> Drop the UTF-8 byte order mark some editors put at the start of a file: it is not
     !> text of the file.

@@ -215,6 +215,250 @@ def test_restart_file_of_another_program_is_left_alone(tmp_path):
     assert (out / "restart.dat").read_bytes().startswith(b"yarnfort-restart")
 
 
+# ------------------------------------------------------------------ the manifest (issue 39)
+
+def manifest_files(folder: Path) -> set[str]:
+    """The fixed names the folder's manifest lists (its 'file' lines)."""
+    lines = (folder / ".yarnfort-manifest").read_text().splitlines()
+    return {line.split()[1] for line in lines if line.startswith("file ")}
+
+
+def test_manifest_lists_only_what_the_run_wrote(tmp_path):
+    """A run lists the names it wrote (and their temporaries), not every name it may
+    write: vnet asks for no reactions.csv and has no sliding passages (no contacts.csv).
+    Tables of one's own of those names survive the next run; a reactions.csv the run
+    did write is deleted by a run that writes none (it would be stale)."""
+    out = tmp_path / "out"
+    first = run(with_output(VNET, "out", control="max_steps = 2"), tmp_path)
+    assert first.returncode == 0, first.stderr
+    listed = manifest_files(out)
+    written = {p.name for p in out.iterdir()} - {".yarnfort-lock", ".yarnfort-manifest"}
+    written -= {name for name in written if name.startswith("state_")}
+    # restart.sync: the restart file last flushed to disk (a second name of restart.dat).
+    assert written == {"curve.csv", "input.nml", "restart.dat", "restart.sync", "states.pvd"}
+    assert listed == written | {name + ".tmp" for name in written} - {"curve.csv.tmp"}
+    mine = {"reactions.csv": b"my,own\n1,2\n", "contacts.csv": b"measured\n3\n",
+            "reactions.csv.tmp": b"draft"}
+    for name, data in mine.items():
+        (out / name).write_bytes(data)
+    second = run(with_output(VNET, "out", control="max_steps = 2"), tmp_path)
+    assert second.returncode == 0, second.stderr
+    for name, data in mine.items():
+        assert (out / name).read_bytes() == data, name
+    # A run that writes reactions.csv replaces it (a name it writes) and lists it ...
+    third = run(with_output(VNET, "out", control="max_steps = 2",
+                            output="node_reactions = .true."), tmp_path)
+    assert third.returncode == 0, third.stderr
+    assert (out / "reactions.csv").read_bytes().startswith(b"step,")
+    assert "reactions.csv" in manifest_files(out)
+    # ... so a later run without it deletes it, and only it.
+    fourth = run(with_output(VNET, "out", control="max_steps = 2"), tmp_path)
+    assert fourth.returncode == 0, fourth.stderr
+    assert not (out / "reactions.csv").exists()
+    assert (out / "contacts.csv").read_bytes() == mine["contacts.csv"]
+    assert (out / "reactions.csv.tmp").read_bytes() == mine["reactions.csv.tmp"]
+
+
+def test_restart_keeps_tables_it_never_wrote(tmp_path):
+    """A restart that writes no reactions.csv or contacts.csv deletes them only when a
+    run of ours wrote them (listed): one's own stay."""
+    out = tmp_path / "out"
+    first = run(with_output(VNET, "out", control="max_steps = 2"), tmp_path)
+    assert first.returncode == 0, first.stderr
+    mine = {"reactions.csv": b"my,own\n", "contacts.csv": b"measured\n"}
+    for name, data in mine.items():
+        (out / name).write_bytes(data)
+    again = run(with_output(VNET, "out", control="restart = .true."), tmp_path)
+    assert again.returncode == 0, again.stderr
+    for name, data in mine.items():
+        assert (out / name).read_bytes() == data, name
+    # Written by the first run, not by its restart: deleted.
+    first = run(with_output(VNET, "own", control="max_steps = 2",
+                            output="node_reactions = .true."), tmp_path)
+    assert first.returncode == 0, first.stderr
+    assert (tmp_path / "own" / "reactions.csv").exists()
+    again = run(with_output(VNET, "own", control="restart = .true."), tmp_path)
+    assert again.returncode == 0, again.stderr
+    assert not (tmp_path / "own" / "reactions.csv").exists()
+    assert "reactions.csv" not in manifest_files(tmp_path / "own")
+
+
+# ------------------------------------------------------------------ links (issue 39)
+
+#: Every name the program writes in an output folder (vnet writes all but the
+#: reactions.csv ones with node_reactions; the capstan scene writes contacts.csv).
+WRITTEN_NAMES = ("curve.csv", "curve.csv.tmp", "input.nml", "input.nml.tmp", "restart.dat",
+                 "restart.dat.tmp", "states.pvd", "states.pvd.tmp", "reactions.csv",
+                 "reactions.csv.tmp", "contacts.csv", "contacts.csv.tmp", "state_00000.vtu",
+                 "state_00003.vtu", ".yarnfort-manifest", ".yarnfort-manifest.tmp",
+                 ".yarnfort-lock", ".yarnfort-write-test")
+
+
+def symlinks_supported(tmp_path: Path) -> None:
+    try:
+        os.symlink("target", tmp_path / "probe-link")
+    except (OSError, NotImplementedError) as error:
+        pytest.skip(f"cannot create symbolic links here: {error}")
+    (tmp_path / "probe-link").unlink()
+
+
+def tree(folder: Path) -> dict[str, object]:
+    """Every entry under `folder`, not following links: a file's bytes, a link's target,
+    None for a folder (the lock file's line, rewritten by every run, left out)."""
+    content: dict[str, object] = {}
+    for top, folders, files in os.walk(folder):        # (never into a linked folder)
+        for entry in sorted([*folders, *files]):
+            path = Path(top) / entry
+            name = str(path.relative_to(folder))
+            if path.is_symlink():
+                content[name] = ("link", os.readlink(path))
+            elif path.is_dir():
+                content[name] = None
+            elif entry != ".yarnfort-lock":
+                content[name] = path.read_bytes()
+    return content
+
+
+@pytest.mark.parametrize("dangling", [False, True], ids=["to-a-file", "dangling"])
+@pytest.mark.parametrize("name", WRITTEN_NAMES)
+def test_link_at_a_written_name_is_refused(tmp_path, name, dangling):
+    """A symbolic link at any name the program writes, pointing out of the folder (to a
+    file, or to none yet): exit 2 before the first step, the link named; the file it
+    points to is neither written, truncated nor created, and the folder (an earlier
+    run's files, the link) stays as it was."""
+    symlinks_supported(tmp_path)
+    scene = CAPSTAN if name.startswith("contacts") else VNET
+    outside = tmp_path / "outside.txt"
+    if not dangling:
+        outside.write_bytes(b"precious, outside the output folder\n")
+    first = run(with_output(scene, "out", control="max_steps = 1"), tmp_path)
+    assert first.returncode == 0, first.stderr
+    out = tmp_path / "out"
+    link = out / name
+    if link.exists():
+        link.unlink()
+    os.symlink(outside, link)
+    before = tree(tmp_path)
+    proc = run(with_output(scene, "out", output="node_reactions = .true."), tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert f"'out/{name}' is a symbolic link" in proc.stderr, proc.stderr
+    assert tree(tmp_path) == before
+    if dangling:
+        assert not outside.exists()
+
+
+def test_link_at_the_lock_is_refused_in_a_new_folder(tmp_path):
+    """Item 2 of issue 39: .yarnfort-lock linked to a file outside: that file keeps its
+    bytes (it was overwritten with 'pid ... host ... since ...')."""
+    symlinks_supported(tmp_path)
+    outside = tmp_path / "outside.txt"
+    outside.write_bytes(b"precious\n")
+    (tmp_path / "out").mkdir()
+    os.symlink("../outside.txt", tmp_path / "out" / ".yarnfort-lock")
+    proc = run(with_output(VNET, "out"), tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert "'out/.yarnfort-lock' is a symbolic link" in proc.stderr
+    assert outside.read_bytes() == b"precious\n"
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [".yarnfort-lock"]
+
+
+def test_link_at_the_write_probe_is_refused(tmp_path):
+    """Item 3 of issue 39: .yarnfort-write-test linked to a file outside: that file is
+    not truncated."""
+    symlinks_supported(tmp_path)
+    outside = tmp_path / "outside.txt"
+    outside.write_bytes(b"precious\n")
+    (tmp_path / "out").mkdir()
+    os.symlink(outside, tmp_path / "out" / ".yarnfort-write-test")
+    proc = run(with_output(VNET, "out"), tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert "'out/.yarnfort-write-test' is a symbolic link" in proc.stderr
+    assert outside.read_bytes() == b"precious\n"
+    assert (tmp_path / "out" / ".yarnfort-write-test").is_symlink()
+
+
+def test_hard_link_at_the_lock_is_refused(tmp_path):
+    """The run's line is written into the lock file: one with another name (a hard link
+    to a file outside the folder) is refused."""
+    outside = tmp_path / "outside.txt"
+    outside.write_bytes(b"precious\n")
+    (tmp_path / "out").mkdir()
+    try:
+        os.link(outside, tmp_path / "out" / ".yarnfort-lock")
+    except OSError as error:
+        pytest.skip(f"cannot create hard links here: {error}")
+    proc = run(with_output(VNET, "out"), tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert "'out/.yarnfort-lock' is not a regular file of its own" in proc.stderr
+    assert outside.read_bytes() == b"precious\n"
+
+
+def test_hard_links_at_written_names_keep_their_content(tmp_path):
+    """A file the run writes gets a new file under its name: another name of the old
+    one (a hard link to a file outside) keeps its content."""
+    outside = {name: tmp_path / f"outside_{name}" for name in
+               ("curve.csv", "state_00000.vtu", "restart.dat", "input.nml.tmp")}
+    (tmp_path / "out").mkdir()
+    try:
+        for name, path in outside.items():
+            path.write_bytes(b"precious " + name.encode())
+            os.link(path, tmp_path / "out" / name)
+    except OSError as error:
+        pytest.skip(f"cannot create hard links here: {error}")
+    proc = run(with_output(VNET, "out", control="max_steps = 2"), tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    for name, path in outside.items():
+        assert path.read_bytes() == b"precious " + name.encode(), name
+    assert (tmp_path / "out" / "curve.csv").read_bytes().startswith(b"step,")
+
+
+def test_links_of_other_names_are_left_alone(tmp_path):
+    """Links of one's own in the output folder at names the program never writes are
+    no reason to refuse, and the run leaves them (and what they point to) alone."""
+    symlinks_supported(tmp_path)
+    outside = tmp_path / "outside.txt"
+    outside.write_bytes(b"precious\n")
+    (tmp_path / "out").mkdir()
+    for name in ("data.csv", "state_1.vtu", "curve.csv.bak"):
+        os.symlink(outside, tmp_path / "out" / name)
+    proc = run(with_output(VNET, "out", control="max_steps = 2"), tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    for name in ("data.csv", "state_1.vtu", "curve.csv.bak"):
+        assert os.readlink(tmp_path / "out" / name) == str(outside)
+    assert outside.read_bytes() == b"precious\n"
+
+
+def test_output_folder_reached_through_a_link(tmp_path):
+    """The &output folder's own path may lead through a link (the folder one named):
+    the files go to where it leads, the link stays."""
+    symlinks_supported(tmp_path)
+    (tmp_path / "scratch" / "out").mkdir(parents=True)
+    os.symlink(tmp_path / "scratch", tmp_path / "results")
+    proc = run(with_output(VNET, "results/out", control="max_steps = 1"), tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "results").is_symlink()
+    assert (tmp_path / "scratch" / "out" / "curve.csv").is_file()
+
+
+# ------------------------------------------------------------------ folder names (issue 39)
+
+@pytest.mark.parametrize("existing", ["", "kept/"])
+def test_refused_folder_name_leaves_no_parent_behind(tmp_path, existing):
+    """Item 10 of issue 39: a folder name with a 300-character component is refused
+    (exit 2, the reason named) and the folders on the way to it that the run created
+    are removed again; one that was there stays."""
+    if existing:
+        (tmp_path / existing).mkdir()
+    folder = existing + "new/deeper/" + "x" * 300 + "/out"
+    proc = run(with_output(VNET, folder), tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert f"folder '{folder}' cannot be created or written: " in proc.stderr
+    assert "too long" in proc.stderr.lower()      # ENAMETOOLONG, in the C library's words
+    assert sorted(p.name for p in tmp_path.iterdir()) == ([existing[:-1]] if existing else [])
+    if existing:
+        assert list((tmp_path / existing).iterdir()) == []
+
+
 # ------------------------------------------------------------------ kills
 
 @pytest.mark.parametrize("signal_number", [signal.SIGKILL, signal.SIGTERM])

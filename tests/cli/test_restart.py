@@ -253,6 +253,47 @@ def test_new_run_removes_an_old_restart_file(run_yarnfort, tmp_path):
     run = run_yarnfort(with_output(broken, "out"))
     assert run.returncode == 1
     assert not (tmp_path / "out" / "restart.dat").exists()
+    assert not (tmp_path / "out" / "restart.sync").exists()
+
+
+def test_restart_after_a_power_cut(run_yarnfort, tmp_path):
+    """After a power cut restart.dat may be damaged, or on disk further than curve.csv
+    (it is replaced every step, flushed to disk only every 10 s).
+    restart.sync, the restart file of the last flush, is one the tables hold: the
+    refusal names it, and renamed to restart.dat it goes on to the uninterrupted curve.
+    The cut is made by hand: the files flushed at the end of a first piece of 10 steps,
+    then curve.csv rows up to step 15 and the restart.dat of step 20 of a second."""
+    full = run_yarnfort(with_output(CAPSTAN, "full"))
+    assert full.returncode == 0, full.stderr
+    parts = tmp_path / "parts"
+    first = run_yarnfort(with_output(CAPSTAN, "parts", control="max_steps = 10"))
+    assert first.returncode == 0, first.stderr
+    # The end of a run flushes: restart.sync is restart.dat (one file, two names).
+    assert (parts / "restart.sync").samefile(parts / "restart.dat")
+    synced = (parts / "restart.sync").read_bytes()
+    second = run_yarnfort(with_output(CAPSTAN, "parts",
+                                      control="max_steps = 10, restart = .true."))
+    assert second.returncode == 0, second.stderr
+    (parts / "restart.sync").unlink()
+    (parts / "restart.sync").write_bytes(synced)
+    curve = parts / "curve.csv"
+    curve.write_text("".join(curve.read_text().splitlines(keepends=True)[:1 + 16]))
+    hint = ("(after a power cut: 'parts/restart.sync' is the restart file last flushed to "
+            "disk, of step 10; rename it to restart.dat to go on from there)")
+    ahead = run_yarnfort(with_output(CAPSTAN, "parts", control="restart = .true."))
+    assert ahead.returncode == 2
+    assert "has no row for step 20" in ahead.stderr and hint in ahead.stderr
+    restart = parts / "restart.dat"
+    restart.write_bytes(restart.read_bytes()[:-20])
+    damaged = run_yarnfort(with_output(CAPSTAN, "parts", control="restart = .true."))
+    assert damaged.returncode == 2
+    assert "is cut short or unreadable" in damaged.stderr and hint in damaged.stderr
+    os.replace(parts / "restart.sync", restart)
+    again = run_yarnfort(with_output(CAPSTAN, "parts", control="restart = .true."))
+    assert again.returncode == 0, again.stderr
+    assert "restarting after step 10" in again.stderr
+    compare_curves(read_rows(tmp_path / "full"), read_rows(parts))
+    assert state_list(parts) == state_list(tmp_path / "full")
 
 
 def test_max_steps_must_not_be_negative(run_yarnfort, tmp_path):

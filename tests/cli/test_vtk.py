@@ -224,3 +224,47 @@ def test_knit_cell_has_periodic_links(run_yarnfort, tmp_path):
     step = int(arrays["step"][0])
     assert arrays["strain"][0] == curve["strain"][step]
     assert np.count_nonzero(arrays["contact_state"]) > 0
+
+
+def test_states_pvd_of_a_long_path_lists_every_state(run_yarnfort, tmp_path):
+    """states.pvd at the end of a long path lists every state, in step order, with its
+    time, and nothing else. A two-element yarn pulled in 512 equal steps (exact in
+    binary: step k ends at pseudo-time k / 512), a state every 3 steps, in two pieces:
+    301 steps (the last one, not due, is written at the stop), then a restart to the end
+    (the last step, 512, is written too). Past 100 states the file is rewritten only
+    when it lags; the end and the restart write it whole."""
+    steps, every, first = 512, 3, 301
+    text = f"""&material name = 'yarn', law = 'linear', stiffness = 10.0 /
+&nodes xyz = 0 0 0, 0.5 0 0, 1 0 0 /
+&yarn material = 'yarn', nodes = 1, 2, 3 /
+&support name = 'a', nodes = 1 /
+&support name = 'b', nodes = 3, displacement = 0.1 0 0 /
+&support name = 'm', nodes = 2, fix = 'yz' /
+&path time = 0 1, p_disp = 0 1 /
+&solver max_step = {1 / steps}, initial_step = {1 / steps} /
+&output folder = 'out', vtk_every = {every}, progress = .false. /
+"""
+    out = tmp_path / "out"
+    # Path length 1: times agree with k / steps to the round-off of a sum of steps.
+    tolerance = steps * np.finfo(float).eps
+
+    def check(expected_steps: list[int]) -> None:
+        listed = collection(out)
+        names = [f"state_{k:05d}.vtu" for k in expected_steps]
+        assert [name for name, _ in listed] == names
+        np.testing.assert_allclose([t for _, t in listed], np.array(expected_steps) / steps,
+                                   rtol=0, atol=tolerance)
+        assert sorted(p.name for p in out.glob("state_*.vtu")) == names
+        for name in names:
+            assert (out / name).read_bytes().endswith(b"</VTKFile>\n"), name
+
+    run = run_yarnfort(text.replace("&material", f"&control max_steps = {first} /\n"
+                                                 "&material", 1), timeout=TIMEOUT)
+    assert run.returncode == 0, run.stderr
+    check(list(range(0, first, every)) + [first])
+    run = run_yarnfort(text.replace("&material", "&control restart = .true. /\n&material", 1),
+                       timeout=TIMEOUT)
+    assert run.returncode == 0, run.stderr
+    check(list(range(0, first, every)) + [first] + list(range(first + 2, steps, every))
+          + [steps])
+    assert len(read_curve(out)["time"]) == steps + 1

@@ -246,7 +246,14 @@ def test_scene_validation_names_the_problem(workdir):
         scene.write(workdir / "x.nml")
     bad = vnet_scene()
     bad.materials[0].stiffness = -1.0
-    with pytest.raises(YarnfortError, match="stiffness") as info:
+    # A value out of range is found in Python, also after construction (and -1 is no
+    # 'not set' marker there).
+    with pytest.raises(yarnfort.SceneError, match=r"stiffness = -1.0 N: must be > 0"):
+        bad.check()
+    # A rule across variables is the library's: a parameter of another law.
+    bad.materials[0].stiffness = 100.0
+    bad.materials[0].modulus = 5.0
+    with pytest.raises(YarnfortError, match="modulus") as info:
         bad.check()
     assert info.value.category == "bad_input"
     vnet_scene().check()
@@ -350,6 +357,21 @@ def test_pip_install_in_a_fresh_venv(tmp_path):
     version = subprocess.run([str(venv / "bin" / "yarnfort"), "--version"],
                              capture_output=True, text=True, check=True).stdout
     assert version.startswith("yarnfort ")
+    # It stands alone: the reference and the runnable examples come with it.
+    reference = subprocess.run([str(python), "-m", "yarnfort", "reference"], cwd=tmp_path,
+                               capture_output=True, text=True, check=True).stdout
+    assert reference == (TOP / "inputs" / "REFERENCE.md").read_text()
+    subprocess.run([str(python), "-m", "yarnfort", "examples", "ex"], cwd=tmp_path,
+                   check=True)
+    with open(tmp_path / "ex" / "inputs" / "knit.nml") as scene:
+        subprocess.run([str(venv / "bin" / "yarnfort")], stdin=scene, cwd=tmp_path / "ex",
+                       capture_output=True, check=True, timeout=600)
+    # Only the runtime dependencies are installed: an extra's function names the extra.
+    code = ("import yarnfort\ntry:\n    yarnfort.read_run('ex/out/knit').to_dataframe()\n"
+            "except ImportError as error:\n    print(error)")
+    out = subprocess.run([str(python), "-c", code], cwd=tmp_path, capture_output=True,
+                         text=True, check=True).stdout
+    assert "pip install 'yarnfort[pandas]'" in out
 
 
 INTERRUPTED_RUN = r"""

@@ -47,7 +47,8 @@ def assert_png(path: Path) -> None:
 
 
 def test_plot_functions_write_pngs(capstan, tmp_path):
-    curve, states = read_run(capstan)
+    run = read_run(capstan)
+    curve, states = run.curve, run.states
     axes = {
         "curve": plot_curve(curve, "pull"),
         "norm": plot_curve(curve, "pull", component="norm", x="time"),
@@ -73,7 +74,7 @@ def test_hysteresis_branches_distinct(capstan):
 
 
 def test_plot_network_has_colorbar(capstan):
-    _, states = read_run(capstan)
+    states = read_run(capstan).states
     ax = plot_network(states[-1], projection="xy")
     assert len(ax.collections[0].get_segments()) == len(states[-1].elements)
     assert len(ax.figure.axes) == 2  # the network and its colorbar

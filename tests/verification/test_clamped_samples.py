@@ -154,7 +154,7 @@ def test_large_sample_opens_its_slip_zone_in_one_step(run_yarnfort, tmp_path):
     the stick test; a round that admits them all fails, and the rounds admit half as
     many at each failure (most violated first). Before the cap on new slips grew again
     after solved rounds, it stayed at 2 for the rest of the step, which did not settle
-    in 200 rounds and was cut (benchmarks/steps_results.md, section 23). Checked on the
+    in 200 rounds and was cut (docs/decisions.md, 'Slip cap doubled'). Checked on the
     step's converged state: not cut; every passage admissible against the closed form
     of the adhesion law (stick within T_crit(T_min), slip at it); the reactions balance;
     and the state is mapped onto itself by the sample's half turn (the capped rounds

@@ -22,8 +22,8 @@ d = 0.05 m and stay taut; a full release to d = 0 is tested separately).
 Friction law at C (T_min, T_max the smaller and larger tension; stick iff
 T_max <= T_crit(T_min, alpha)):
 - coulomb: T_crit = T_min exp(mu alpha);
-- adhesion, T' = max(mu T, beta) (paper eq. 35 with design.md's reading
-  alpha* = 1/mu - T0/beta, T0 = T_min), three branches of T0:
+- adhesion, T' = max(mu T, beta) (paper eq. 35 with alpha* = 1/mu - T0/beta, T0 =
+  T_min: the wrap angle at which T' = beta brings T0 to beta/mu), three branches of T0:
     (L) T0 <= tau_1 = (beta/mu)(1 - mu alpha):  T_crit = T0 + beta alpha,
     (M) tau_1 < T0 < tau_2 = beta/mu:          T_crit = (beta/mu) exp(mu alpha - 1 + mu T0/beta),
     (E) T0 >= tau_2:                           T_crit = T0 exp(mu alpha).

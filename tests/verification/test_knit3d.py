@@ -237,7 +237,7 @@ def test_unloading_branch_does_not_depend_on_the_step(run_yarnfort, tmp_path):
     mode (the yarn running round the loop); a far solution of that set meets every
     stick/slip condition and once took the 1 x 1 cell at 1/80 onto another branch,
     15 % of the peak force away for a third of the release
-    (benchmarks/steps_results.md, section 5)."""
+    (docs/decisions.md, 'Rounds with slipping passages: fast Newton solves')."""
     curves = {}
     for cells, step in [(1, 0.025), (1, 0.0125), (1, 0.00625), (2, 0.0125)]:
         folder = run(run_yarnfort, {"fabric.cells": [cells, cells], "solver.max_step": step,
@@ -256,7 +256,7 @@ def test_planar_4x2_cycle_does_not_depend_on_the_step(run_yarnfort, tmp_path):
     (the contact node columns sliding along the straight courses): rounding along them
     once dropped passages at random, chatter damping then ended steps beyond the
     capstan limit, and the runs at 1/40 and 1/80 followed another branch, 0.7 % of the
-    release force away (benchmarks/steps_results.md, section 7). Tolerance: SOLVED of
+    release force away (docs/decisions.md, 'Neutral slip sets'). Tolerance: SOLVED of
     the peak, as for the 1 x 1 and 2 x 2 cells above (the branches were 3e-4 of the
     peak apart at the peak itself)."""
     spacing = [1.0e-3, 0.8e-3]

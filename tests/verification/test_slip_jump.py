@@ -5,7 +5,7 @@ The 32 x 32 free-sided clamped knit (inputs/knit.nml with inlay, stretched to 2x
 back, benchmarks/steps_table.py's scene) reaches, at strain 0.147 of the release
 (t = 1.85276), a state from which the quasi-static path has no continuation: mirror
 pairs of passages flip between stick and slip in every round at every step size down
-to min_step (benchmarks/steps_results.md, sections 23 and 24). yarnfort used to stop
+to min_step (docs/decisions.md, 'Slip instabilities: a jump'). yarnfort used to stop
 there with exit code 1. It now jumps (friction_stepper try_jump, inputs/REFERENCE.md
 *Slip instabilities*): viscous slip steps relax the net at that load, and the exact
 law's rounds solve it from there.

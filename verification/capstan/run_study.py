@@ -59,7 +59,8 @@ def capstan_text(k: int, contact: dict, steps: int = 40) -> str:
 
 
 def critical(law: str, t0: float, angle: float) -> float:
-    """Closed forms (paper eqs. 20, 35 with design.md's reading of alpha*)."""
+    """Closed forms (paper eqs. 20, 35; alpha* = 1/mu - t0/beta, where T' = beta brings
+    t0 to beta/mu)."""
     if law == "coulomb" or t0 >= BETA / MU:
         return t0 * np.exp(MU * angle)
     star = 1 / MU - t0 / BETA

@@ -5,7 +5,8 @@ Runs the scene of ``tests/verification/test_hysteresis.py`` (fixed end A, fixed 
 end B pulled along C->B and released twice, constant wrap angle) for several friction
 coefficients and both the Coulomb and the adhesion law, with both friction schemes,
 and compares every converged step with the piecewise closed form derived there.
-Writes ``hysteresis.png`` next to this script and prints the error table.
+Writes ``hysteresis.png`` and ``results.txt`` (the error table) next to this script and
+prints the table.
 
     .venv/bin/python verification/hysteresis/run_study.py   (after ./yarnfort has built once;
     YARNFORT_EXE picks another binary)
@@ -106,28 +107,30 @@ def main() -> None:
     fig.tight_layout()
     fig.savefig(HERE / "hysteresis.png", dpi=120)
 
-    print(f"{'law':9} {'mu':>4} {'scheme':10} {'steps':>5} {'max rel err F':>14} "
-          f"{'rel err area':>13} {'rel err s':>10} {'|d alpha|':>9} branches  "
-          f"area per cycle (steps | fine) mJ   s after release mm")
+    lines = [f"{'law':9} {'mu':>4} {'scheme':10} {'steps':>5} {'max rel err F':>14} "
+             f"{'rel err area':>13} {'rel err s':>10} {'|d alpha|':>9} branches  "
+             f"area per cycle (steps | fine) mJ   s after release mm"]
     for r in rows:
-        print(f"{r['law']:9} {r['mu']:4.1f} {r['scheme']:10} {r['steps']:5d} "
-              f"{r['force']:14.2e} {r['area']:13.2e} {r['s']:10.2e} {r['alpha']:9.1e} "
-              f"{r['branches']:9} "
-              + " ".join(f"{a * 1e3:.3f}" for a in r["areas"]) + " | "
-              + " ".join(f"{a * 1e3:.3f}" for a in r["areas_fine"]) + "   "
-              + " ".join(f"{s * 1e3:.4f}" for s in r["s_left"]))
+        lines.append(f"{r['law']:9} {r['mu']:4.1f} {r['scheme']:10} {r['steps']:5d} "
+                     f"{r['force']:14.2e} {r['area']:13.2e} {r['s']:10.2e} "
+                     f"{r['alpha']:9.1e} {r['branches']:9} "
+                     + " ".join(f"{a * 1e3:.3f}" for a in r["areas"]) + " | "
+                     + " ".join(f"{a * 1e3:.3f}" for a in r["areas_fine"]) + "   "
+                     + " ".join(f"{s * 1e3:.4f}" for s in r["s_left"]))
     worst = max(r["force"] for r in rows)
-    print(f"worst force error {worst:.2e}")
+    lines.append(f"worst force error {worst:.2e}")
 
-    # The default slack regularisation (a zero-rest-length spring of slack_stiffness * EA
-    # in every string) is not part of the exact law: its bias, for the record.
+    # The default slack regularisation (a spring in the Newton tangent of slack strings
+    # only) must leave the exact law's answer: its effect, for the record.
     for law in ("coulomb", "adhesion"):
         case = Case(law=law, mu=0.3, beta=BETA if law == "adhesion" else 0.0,
                     max_step=MAX_STEP, slack_stiffness=1e-6)
         cmp = run(case)
-        print(f"default slack_stiffness = 1e-6, {law}, mu = 0.3: max rel err F "
-              f"{cmp.force_error():.2e}, max abs err F "
-              f"{np.max(np.abs(cmp.force - cmp.force_exact)):.2e} N")
+        lines.append(f"default slack_stiffness = 1e-6, {law}, mu = 0.3: max rel err F "
+                     f"{cmp.force_error():.2e}, max abs err F "
+                     f"{np.max(np.abs(cmp.force - cmp.force_exact)):.2e} N")
+    (HERE / "results.txt").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
     if worst > 1e-6:
         sys.exit(1)
 

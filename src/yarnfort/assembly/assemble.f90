@@ -5,6 +5,7 @@ module yarnfort_assembly_assemble
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_text, only: format_short
     use yarnfort_scene_scene, only: scene_type, get_applied_force
     use yarnfort_assembly_truss, only: get_truss_response
     use yarnfort_assembly_pattern, only: pattern_type
@@ -68,9 +69,10 @@ contains
             real(wp), intent(in) :: element_stretch
             character(len=200) :: buffer
             write(buffer, '("element ", i0, " (material ''", a, "''): its tension at stretch ", &
-                &es10.3, " is not a finite number (the force law''s scale is too large ", &
+                &a, " is not a finite number (the force law''s scale is too large ", &
                 &"for double precision)")') element, &
-                trim(scene%laws(scene%network%element_material(element))%name), element_stretch
+                trim(scene%laws(scene%network%element_material(element))%name), &
+                format_short(element_stretch, 4)
             call fatal_error(error, trim(buffer))
         end subroutine overflow
     end subroutine assemble_internal_force
@@ -183,7 +185,7 @@ contains
             length = norm2(x2 - x1)
             if (.not. (length > degenerate_length_ratio * length0(e))) then
                 write(buffer, '("element ", i0, " (nodes ", i0, ", ", i0, ") has length ", &
-                    & es10.3)') e, scene%network%element_nodes(:, e), length
+                    & a)') e, scene%network%element_nodes(:, e), format_short(length, 4)
                 call fatal_error(error, trim(buffer))
                 return
             end if

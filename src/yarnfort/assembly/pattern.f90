@@ -2,7 +2,7 @@
 !> Sparsity pattern of the equilibrium Jacobian in compressed sparse column form, built
 !> once per topology, with the map from each element's 6x6 tangent to value slots.
 module yarnfort_assembly_pattern
-    use yarnfort_kinds, only: wp, ik
+    use yarnfort_kinds, only: ik
     use yarnfort_network_network, only: network_type
     use yarnfort_network_dof_map, only: dof_map_type
     use yarnfort_sort, only: sort_index

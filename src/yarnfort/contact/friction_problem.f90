@@ -45,6 +45,7 @@
 module yarnfort_contact_friction_problem
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_text, only: format_short
     use yarnfort_scene_scene, only: scene_type, get_applied_force, get_loaded_nodes, &
         get_force_scale
     use yarnfort_assembly_truss, only: get_truss_tension, capped_stiffness
@@ -366,7 +367,7 @@ contains
         if (all(self%length0 > 0.0_wp)) return
         e = findloc(self%length0 > 0.0_wp, .false., dim=1)
         write(buffer, '("Newton converged to a spurious state: sliding left element ", i0, &
-            &" a reference length of ", es10.3)') e, self%length0(e)
+            &" a reference length of ", a)') e, format_short(self%length0(e), 4)
         call fatal_error(error, trim(buffer))
     end subroutine check_solution
 

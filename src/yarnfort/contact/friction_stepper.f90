@@ -37,12 +37,13 @@
 module yarnfort_contact_friction_stepper
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
+    use yarnfort_text, only: format_short
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
         chosen_lu_name
-    use yarnfort_linalg_condensed, only: condensed_solver_type
-    use yarnfort_linalg_bordered, only: bordered_solver_type
+    use yarnfort_linalg_composite_condensed, only: condensed_solver_type
+    use yarnfort_linalg_composite_bordered, only: bordered_solver_type
     use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type, start_stepper, &
@@ -395,8 +396,8 @@ contains
                 // 'law did not settle after the viscous relaxation')
         else
             write(buffer, '("slip instability: the viscous relaxation did not come to rest (", &
-                &i0, " viscous steps solved, viscosity ", es9.2, ", overstress ", es9.2, ")")') &
-                solved_steps, viscosity, overstress
+                &i0, " viscous steps solved, viscosity ", a, ", overstress ", a, ")")') &
+                solved_steps, format_short(viscosity), format_short(overstress)
             call fatal_error(error, trim(buffer))
         end if
         if (.not. allocated(error)) self%jump_steps_trial = solved_steps
@@ -1375,8 +1376,8 @@ contains
         end do
         if (n_beyond == 0) return
         write(buffer, '("stick/slip active set did not settle: ", i0, " passages held in &
-            &stick after more than ", i0, " flips are beyond their limit (up to ", es9.2, &
-            &" of the critical tension)")') n_beyond, max_flips, worst
+            &stick after more than ", i0, " flips are beyond their limit (up to ", a, &
+            &" of the critical tension)")') n_beyond, max_flips, format_short(worst)
         call fatal_error(error, trim(buffer))
     end subroutine check_damped
 

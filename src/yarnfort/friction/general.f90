@@ -30,7 +30,9 @@ module yarnfort_friction_general
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
-    use yarnfort_text, only: format_integer, format_real
+    use yarnfort_text, only: format_integer, format_real, quote_string, string_type
+    use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &
+        get_header_units, force_kind
     use yarnfort_friction_law, only: friction_law_type, tension_limit, rate_limit, no_kink, &
         scaled_exp, capped_product, capped_quotient, expm1, cap_critical_tension
     implicit none
@@ -221,20 +223,30 @@ contains
     !> the input asks of every friction law: the first row is T = 0 with g >= 0, T
     !> increases strictly, g > 0 at every T > 0, all finite, and the last piece does not
     !> fall (the rate continues with it beyond the table and would reach zero). Messages
-    !> name the file, the line and the value.
+    !> name the file, the line and the value. A header may state the units of the columns
+    !> as a `&material table_file` does: a force unit for T, that unit per radian for g
+    !> ('T (cN),g (cN/rad)'); they are converted to N and N/rad.
     subroutine read_rate_table(self, path, error)
         type(table_law_type), intent(out) :: self
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
-        character(len=:), allocatable :: context
+        character(len=:), allocatable :: context, header
         real(wp), allocatable :: tension(:), rate(:)
         integer, allocatable :: lines(:)
-        integer :: n
+        type(unit_type) :: units(2)
+        integer :: n, header_line
 
         context = "rate_table '" // path // "'"
         call read_csv_pairs(path, context, [character(len=1) :: 'T', 'g'], check_rate_row, &
-            tension, rate, lines, error)
+            tension, rate, lines, error, header, header_line)
         if (allocated(error)) return
+        call get_rate_units(header, header_line, units, error)
+        if (allocated(error)) then
+            error%message = context // error%message
+            return
+        end if
+        tension = to_scene_unit(tension, units(1))
+        rate = to_scene_unit(rate, units(2))
         n = size(tension)
         if (n < 2) then
             call fatal_error(error, context // ': found ' // format_integer(n) // ' data rows, at ' &
@@ -251,6 +263,42 @@ contains
         call new_table_law(self, tension, rate, error)
         if (allocated(error)) error%message = context // ': ' // error%message
     end subroutine read_rate_table
+
+    !> The units a rate table's header states: a force unit for T, the same per radian
+    !> for g ('N/rad', 'cN/rad'; a bare force unit too, radians being dimensionless);
+    !> N where none is stated. Messages start with ', line L, column C'.
+    subroutine get_rate_units(header, header_line, units, error)
+        character(len=*), intent(in) :: header
+        integer, intent(in) :: header_line
+        type(unit_type), intent(out) :: units(2)
+        type(error_type), allocatable, intent(out) :: error
+        type(string_type) :: fields(2), texts(2)
+        character(len=:), allocatable :: text
+        logical :: stated(2), found
+        integer :: c
+
+        call get_header_units(header, fields, texts, stated)
+        do c = 1, 2
+            text = 'N'
+            if (stated(c) .and. header_line > 0) text = texts(c)%text
+            if (c == 2 .and. len(text) > 4) then
+                if (text(len(text) - 3:) == '/rad') text = text(:len(text) - 4)
+            end if
+            call find_unit(text, units(c), found)
+            if (found) found = units(c)%kind == force_kind
+            if (.not. found) then
+                if (c == 1) then
+                    text = 'force unit (' // unit_names(force_kind) // ')'
+                else
+                    text = 'force unit per rad (' // unit_names(force_kind) // ', then /rad)'
+                end if
+                call fatal_error(error, ', line ' // format_integer(header_line) &
+                    // ', column ' // format_integer(c) // ' (' // quote_string(fields(c)%text) &
+                    // '): ' // quote_string(texts(c)%text) // ' is not a known ' // text)
+                return
+            end if
+        end do
+    end subroutine get_rate_units
 
     !> One row of a rate table on its own (the first: T = 0, g >= 0) or after the previous.
     pure subroutine check_rate_row(row, previous, error)

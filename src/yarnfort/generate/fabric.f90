@@ -5,10 +5,11 @@
 module yarnfort_generate_fabric
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: config_type, fabric_config_type
+    use yarnfort_input_config, only: config_type
     use yarnfort_input_groups, only: fabric_kind_choices, fabric_boundary_choices, &
         fabric_sides_choices
     use yarnfort_input_fields, only: check_range
+    use yarnfort_input_network_checks, only: coincidence_tolerance
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_knit, only: generate_knit
     use yarnfort_generate_woven, only: generate_woven
@@ -371,6 +372,18 @@ contains
                         return
                     end if
                 end do
+                ! A holder gap * factor shorter than coincidence_tolerance * gap is a zero
+                ! length by the rule for elements (the gap is below the scene's size): the
+                ! holder collapses its two nodes (docs/decisions.md, Smallest gap factor).
+                k = findloc(f > 0.0_wp .and. f < coincidence_tolerance, .true., dim=1)
+                if (k > 0) then
+                    call fatal_error(error, label // 'gap_factor(' // format_integer(k) &
+                        // ') = ' // format_real(f(k)) // ' is below ' &
+                        // format_real(coincidence_tolerance) // ' (100 * epsilon): it ' &
+                        // 'collapses the gap-holders to zero length (give a factor that ' &
+                        // 'keeps a gap)')
+                    return
+                end if
                 if (.not. below_spacing) then
                     if (any(.not. (f > 0.0_wp .and. f < huge(1.0_wp)))) then
                         call fatal_error(error, label // 'gap_factor values must be positive ' &

@@ -32,6 +32,8 @@ module yarnfort_generate_texgen
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_xml_subset, only: xml_document_type, read_xml_file
     use yarnfort_sort, only: sort_index
+    use yarnfort_text, only: format_real, format_integer
+    use yarnfort_input_magnitudes, only: max_coordinate
     implicit none
     private
 
@@ -171,6 +173,9 @@ contains
             do k = 1, size(nodes)
                 call read_vector(document, nodes(k), 'Position', master(:, k), .true., error)
                 if (allocated(error)) goto 200
+                call check_reach('master node ' // format_integer(k - 1) // ': Position', &
+                    master(:, k), scale, error)
+                if (allocated(error)) goto 200
                 up(:, k) = [0.0_wp, 0.0_wp, 1.0_wp]
                 call read_vector(document, nodes(k), 'Up', vector, .false., error)
                 if (allocated(error)) goto 200
@@ -207,6 +212,9 @@ contains
             do k = 1, size(repeats)
                 call read_vector(document, repeats(k), 'value', lattice(:, k), .true., error)
                 if (allocated(error)) goto 200
+                call check_reach('Repeat ' // format_integer(k) // ': value', lattice(:, k), &
+                    scale, error)
+                if (allocated(error)) goto 200
             end do
             if (y == 1) then
                 call get_cell(lattice, first_lattice, error)
@@ -236,6 +244,19 @@ contains
         return
 200     error%message = trim(buffer) // ' ' // error%message
     end subroutine read_model
+
+    !> A position or repeat vector of the model (in its unit; `scale` m per unit) within
+    !> the coordinate limit of every scene (yarnfort_input_magnitudes).
+    subroutine check_reach(what, vector, scale, error)
+        character(len=*), intent(in) :: what
+        real(wp), intent(in) :: vector(3), scale
+        type(error_type), allocatable, intent(out) :: error
+
+        if (all(abs(vector) * scale <= max_coordinate)) return
+        call fatal_error(error, what // ' ' // format_real(maxval(abs(vector))) // ' (' &
+            // format_real(maxval(abs(vector)) * scale) // ' m) is above ' &
+            // format_real(max_coordinate) // ' m, where squared lengths overflow')
+    end subroutine check_reach
 
     !> The cell of a yarn's repeat vectors: one along x, one along y; a second call
     !> (vector_pair given) checks that the repeats are those.

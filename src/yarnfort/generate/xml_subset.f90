@@ -3,17 +3,27 @@
 !> with attributes. Text content, comments, processing instructions (<?...?>),
 !> declarations (<!...>) and CDATA sections are skipped; the five predefined entities and
 !> numeric character references below 128 are decoded in attribute values. The whole file
-!> becomes a flat list of elements, each with its parent, queried by name.
+!> becomes a flat list of elements, each with its parent, queried by name. Reading takes
+!> time linear in the file's size; a tag with more attributes, or an attribute name or
+!> value longer, than the limits below is an error (docs/decisions.md, "XML reader of
+!> TexGen files").
 !>
 !> Neither Debian nor PyPI offers a maintained XML library for Fortran, and the program
 !> must read the file without Python, so this is the one XML reader of the project.
 module yarnfort_generate_xml_subset
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_text, only: read_file_text
+    use yarnfort_text, only: read_file_text, format_integer
     implicit none
     private
 
     public :: xml_document_type, read_xml_file, parse_xml
+    public :: max_attributes, max_attribute_length
+
+    !> Most attributes one tag may have: TexGen writes at most about 50 (its <Textile>).
+    integer, parameter :: max_attributes = 1000
+    !> Longest attribute name or value (characters, as written): TexGen's longest are
+    !> vectors of three numbers, about 60 characters.
+    integer, parameter :: max_attribute_length = 2**20
 
     type :: xml_text_type
         character(len=:), allocatable :: text
@@ -23,12 +33,17 @@ module yarnfort_generate_xml_subset
         character(len=:), allocatable :: name
         !> Index of the enclosing element (0 for the root).
         integer :: parent = 0
+        !> The first element directly inside this one, and the next one inside its parent
+        !> (0: none), so that children are found in time linear in their number.
+        integer :: first_child = 0, next_sibling = 0
         type(xml_text_type), allocatable :: attribute_names(:), attribute_values(:)
     end type xml_element_type
 
     type :: xml_document_type
         integer :: n_elements = 0
         type(xml_element_type), allocatable :: elements(:)
+        !> The first top-level element (0: none).
+        integer :: first_root = 0
     contains
         !> Indices of the elements named `name` directly inside `parent` (0: the top level).
         procedure :: children
@@ -82,12 +97,12 @@ contains
                 if (.not. closed_by(2, '>', "a closing tag is not closed ('>')")) return
                 name = trim(adjustl(text(i + 2:close_at - 1)))
                 if (current == 0) then
-                    call fail(i, "closing tag </" // name // "> without an open element")
+                    call fail(i, "closing tag </" // shown(name) // "> without an open element")
                     return
                 end if
                 if (name /= document%elements(current)%name) then
-                    call fail(i, "closing tag </" // name // "> does not match <" &
-                        // document%elements(current)%name // ">")
+                    call fail(i, "closing tag </" // shown(name) // "> does not match <" &
+                        // shown(document%elements(current)%name) // ">")
                     return
                 end if
                 current = document%elements(current)%parent
@@ -105,7 +120,7 @@ contains
         end do
         if (current /= 0) then
             call fatal_error(error, 'the file ends inside element <' &
-                // document%elements(current)%name // '> (not closed)')
+                // shown(document%elements(current)%name) // '> (not closed)')
             return
         end if
         if (document%n_elements == 0) call fail(1, 'no elements (not an XML file?)')
@@ -163,9 +178,10 @@ contains
             integer, intent(out) :: close_at
             logical, intent(out) :: self_closing
             type(xml_element_type) :: element
-            integer :: j, name_start, value_end
+            type(xml_text_type), allocatable :: names(:), values(:)
+            integer :: j, name_start, value_end, count
             character(len=1) :: quote
-            character(len=:), allocatable :: attribute_name, decoded
+            character(len=:), allocatable :: attribute_name
 
             j = at + 1
             name_start = j
@@ -179,12 +195,13 @@ contains
             end if
             element%name = text(name_start:j - 1)
             element%parent = current
-            allocate(element%attribute_names(0), element%attribute_values(0))
+            allocate(names(8), values(8))
+            count = 0
             self_closing = .false.
             do
                 call skip_blanks(j)
                 if (j > n) then
-                    call fail(at, "tag <" // element%name // " is not closed ('>')")
+                    call fail(at, "tag <" // shown(element%name) // " is not closed ('>')")
                     return
                 end if
                 if (text(j:j) == '>') exit
@@ -198,10 +215,17 @@ contains
                     if (is_name_end(text(j:j)) .or. text(j:j) == '=') exit
                     j = j + 1
                 end do
+                if (j - name_start > max_attribute_length) then
+                    call fail(at, "tag <" // shown(element%name) // ">: the name of an " &
+                        // "attribute is longer than " // format_integer(max_attribute_length) &
+                        // " characters (the limit of this reader)")
+                    return
+                end if
                 attribute_name = text(name_start:j - 1)
                 call skip_blanks(j)
                 if (len(attribute_name) == 0 .or. j >= n .or. text(j:j) /= '=') then
-                    call fail(at, "tag <" // element%name // ">: an attribute without '=value'")
+                    call fail(at, "tag <" // shown(element%name) &
+                        // ">: an attribute without '=value'")
                     return
                 end if
                 j = j + 1
@@ -209,29 +233,48 @@ contains
                 quote = ' '
                 if (j <= n) quote = text(j:j)
                 if (quote /= '"' .and. quote /= "'") then
-                    call fail(at, "tag <" // element%name // ">: attribute " // attribute_name &
-                        // " has no quoted value")
+                    call fail(at, "tag <" // shown(element%name) // ">: attribute " &
+                        // shown(attribute_name) // " has no quoted value")
                     return
                 end if
                 value_end = find_from(j + 1, quote)
                 if (value_end == 0) then
-                    call fail(at, "tag <" // element%name // ">: the value of attribute " &
-                        // attribute_name // " is not closed")
+                    call fail(at, "tag <" // shown(element%name) // ">: the value of attribute " &
+                        // shown(attribute_name) // " is not closed")
                     return
                 end if
-                decoded = decode(text(j + 1:value_end - 1))
-                call append_text(element%attribute_names, attribute_name)
-                call append_text(element%attribute_values, decoded)
+                if (value_end - j - 1 > max_attribute_length) then
+                    call fail(at, "tag <" // shown(element%name) // ">: the value of attribute " &
+                        // shown(attribute_name) // " is longer than " &
+                        // format_integer(max_attribute_length) &
+                        // " characters (the limit of this reader)")
+                    return
+                end if
+                if (count == max_attributes) then
+                    call fail(at, "tag <" // shown(element%name) // "> has more than " &
+                        // format_integer(max_attributes) &
+                        // " attributes (the limit of this reader)")
+                    return
+                end if
+                if (count == size(names)) call grow(names, values)
+                count = count + 1
+                call move_alloc(attribute_name, names(count)%text)
+                values(count)%text = decode(text(j + 1:value_end - 1))
                 j = value_end + 1
             end do
             close_at = j
+            allocate(element%attribute_names(count), element%attribute_values(count))
+            do j = 1, count
+                call move_alloc(names(j)%text, element%attribute_names(j)%text)
+                call move_alloc(values(j)%text, element%attribute_values(j)%text)
+            end do
             call add_element(document, element)
         end subroutine read_tag
     end subroutine parse_xml
 
     subroutine add_element(document, element)
         type(xml_document_type), intent(inout) :: document
-        type(xml_element_type), intent(in) :: element
+        type(xml_element_type), intent(inout) :: element
         type(xml_element_type), allocatable :: grown(:)
         integer :: k
 
@@ -243,7 +286,17 @@ contains
             call move_alloc(grown, document%elements)
         end if
         document%n_elements = document%n_elements + 1
-        document%elements(document%n_elements) = element
+        associate(new => document%elements(document%n_elements))
+            call move_alloc_element(element, new)
+            ! Prepended to its parent's list: children() reverses it.
+            if (new%parent == 0) then
+                new%next_sibling = document%first_root
+                document%first_root = document%n_elements
+            else
+                new%next_sibling = document%elements(new%parent)%first_child
+                document%elements(new%parent)%first_child = document%n_elements
+            end if
+        end associate
     end subroutine add_element
 
     subroutine move_alloc_element(from, to)
@@ -251,23 +304,39 @@ contains
         type(xml_element_type), intent(out) :: to
         call move_alloc(from%name, to%name)
         to%parent = from%parent
+        to%first_child = from%first_child
+        to%next_sibling = from%next_sibling
         call move_alloc(from%attribute_names, to%attribute_names)
         call move_alloc(from%attribute_values, to%attribute_values)
     end subroutine move_alloc_element
 
-    subroutine append_text(list, text)
-        type(xml_text_type), allocatable, intent(inout) :: list(:)
-        character(len=*), intent(in) :: text
-        type(xml_text_type), allocatable :: grown(:)
+    !> Twice the room for attribute names and values (geometric growth: linear time).
+    subroutine grow(names, values)
+        type(xml_text_type), allocatable, intent(inout) :: names(:), values(:)
+        type(xml_text_type), allocatable :: grown_names(:), grown_values(:)
         integer :: k
 
-        allocate(grown(size(list) + 1))
-        do k = 1, size(list)
-            call move_alloc(list(k)%text, grown(k)%text)
+        allocate(grown_names(2 * size(names)), grown_values(2 * size(names)))
+        do k = 1, size(names)
+            call move_alloc(names(k)%text, grown_names(k)%text)
+            call move_alloc(values(k)%text, grown_values(k)%text)
         end do
-        grown(size(grown))%text = text
-        call move_alloc(grown, list)
-    end subroutine append_text
+        call move_alloc(grown_names, names)
+        call move_alloc(grown_values, values)
+    end subroutine grow
+
+    !> A name as shown in a message: at most 40 characters of it.
+    pure function shown(name) result(text)
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: text
+        integer, parameter :: longest = 40
+
+        if (len(name) <= longest) then
+            text = name
+        else
+            text = name(:longest) // '...'
+        end if
+    end function shown
 
     pure logical function is_blank(c)
         character(len=1), intent(in) :: c
@@ -280,33 +349,46 @@ contains
     end function is_name_end
 
     !> Attribute text with the predefined entities and &#N; / &#xN; (N < 128) decoded;
-    !> anything else is kept as it is.
+    !> anything else is kept as it is. Written into one buffer (never longer than the raw
+    !> text): linear time.
     pure function decode(raw) result(value)
         character(len=*), intent(in) :: raw
         character(len=:), allocatable :: value
-        integer :: i, semicolon, code, stat
+        character(len=len(raw)) :: buffer
+        integer :: i, m, semicolon, code, stat, amp
 
-        value = ''
+        m = 0
         i = 1
         do while (i <= len(raw))
-            semicolon = 0
-            if (raw(i:i) == '&') semicolon = index(raw(i:), ';')
-            if (semicolon == 0 .or. semicolon > 8) then
-                value = value // raw(i:i)
+            amp = index(raw(i:), '&')
+            if (amp == 0) then
+                buffer(m + 1:m + len(raw) - i + 1) = raw(i:)
+                m = m + len(raw) - i + 1
+                exit
+            end if
+            buffer(m + 1:m + amp - 1) = raw(i:i + amp - 2)
+            m = m + amp - 1
+            i = i + amp - 1
+            ! raw(i:i) is '&': an entity ends at a ';' within 8 characters.
+            semicolon = index(raw(i:min(i + 7, len(raw))), ';')
+            if (semicolon == 0) then
+                m = m + 1
+                buffer(m:m) = '&'
                 i = i + 1
                 cycle
             end if
+            m = m + 1
             select case (raw(i:i + semicolon - 1))
             case ('&lt;')
-                value = value // '<'
+                buffer(m:m) = '<'
             case ('&gt;')
-                value = value // '>'
+                buffer(m:m) = '>'
             case ('&amp;')
-                value = value // '&'
+                buffer(m:m) = '&'
             case ('&quot;')
-                value = value // '"'
+                buffer(m:m) = '"'
             case ('&apos;')
-                value = value // "'"
+                buffer(m:m) = "'"
             case default
                 stat = 1
                 code = -1
@@ -318,13 +400,15 @@ contains
                     end if
                 end if
                 if (stat == 0 .and. code >= 0 .and. code < 128) then
-                    value = value // achar(code)
+                    buffer(m:m) = achar(code)
                 else
-                    value = value // raw(i:i + semicolon - 1)
+                    buffer(m:m + semicolon - 1) = raw(i:i + semicolon - 1)
+                    m = m + semicolon - 1
                 end if
             end select
             i = i + semicolon
         end do
+        value = buffer(:m)
     end function decode
 
     function children(self, parent, name) result(found)
@@ -332,13 +416,33 @@ contains
         integer, intent(in) :: parent
         character(len=*), intent(in) :: name
         integer, allocatable :: found(:)
-        integer :: k
+        integer :: k, count
 
-        allocate(found(0))
-        do k = 1, self%n_elements
-            if (self%elements(k)%parent /= parent) cycle
-            if (self%elements(k)%name == name) found = [found, k]
+        count = 0
+        k = first_of(parent)
+        do while (k > 0)
+            if (self%elements(k)%name == name) count = count + 1
+            k = self%elements(k)%next_sibling
         end do
+        allocate(found(count))
+        ! The list runs from the last child to the first.
+        k = first_of(parent)
+        do while (k > 0)
+            if (self%elements(k)%name == name) then
+                found(count) = k
+                count = count - 1
+            end if
+            k = self%elements(k)%next_sibling
+        end do
+    contains
+        integer function first_of(parent)
+            integer, intent(in) :: parent
+            if (parent == 0) then
+                first_of = self%first_root
+            else
+                first_of = self%elements(parent)%first_child
+            end if
+        end function first_of
     end function children
 
     subroutine attribute(self, element, name, value, found)

@@ -11,13 +11,15 @@ module yarnfort_input_channel_checks
     use yarnfort_input_config, only: config_type, path_config_type, name_length
     use yarnfort_input_fields, only: check_name, quoted_list
     use yarnfort_input_network_checks, only: check_defined
-    use yarnfort_text, only: format_integer, parse_integer
+    use yarnfort_text, only: format_integer
+    use yarnfort_sort, only: sort_text_index
     implicit none
     private
 
     public :: get_channel_names, get_channel_factors, find_channel, check_channels
     public :: default_force_channel, default_displacement_channel, fixed_curve_columns
-    public :: load_column_prefix
+    public :: load_column_prefix, get_curve_columns, curve_column_length
+    public :: column_fixed, column_channel, column_set, column_load
 
     character(len=*), parameter :: default_force_channel = 'p_force'
     character(len=*), parameter :: default_displacement_channel = 'p_disp'
@@ -27,6 +29,11 @@ module yarnfort_input_channel_checks
         'step', 'time', 'strain', 'force_per_width', 'direction', 'slipping', 'held', &
         'jumped', 'passages', &
         'newton_iterations', 'residual', 'step_cuts', 'wall_time']
+
+    !> Longest name of a curve.csv column: a support set's name and a suffix ('_rx').
+    integer, parameter :: curve_column_length = name_length + 3
+    !> What makes a column of curve.csv (get_curve_columns).
+    integer, parameter :: column_fixed = 1, column_channel = 2, column_set = 3, column_load = 4
 
 contains
 
@@ -196,71 +203,166 @@ contains
 
     end subroutine check_channels
 
-    !> No two columns of curve.csv with one name. Support names are unique and the fixed
-    !> columns end in no support suffix, so a clash needs a channel named like a fixed,
-    !> support or load column (e.g. 'a_rx' with a support 'a'), or a support named like a
-    !> load's columns ('load_2' with two loads): linear in the number of columns.
+    !> The columns of curve.csv, in order: step, time, the factor of each channel, rx, ry,
+    !> rz of each support set (the &support groups, then the &obstacle groups that hold
+    !> a coordinate), ux, uy, uz of each set, load_<k>_ux, _uy, _uz of each of n_loads
+    !> &load groups, strain and force_per_width for a fabric, then the step's counters.
+    !> What makes column j: `kind(j)` = column_fixed, column_channel (channel item(j)),
+    !> column_set (set item(j)) or column_load (&load #item(j)). The one list of names:
+    !> the header of the curve file is these names, and the input check finds clashes in it.
+    subroutine get_curve_columns(channels, sets, n_loads, fabric, names, kind, item)
+        character(len=*), intent(in) :: channels(:), sets(:)
+        integer, intent(in) :: n_loads
+        logical, intent(in) :: fabric
+        character(len=curve_column_length), allocatable, intent(out) :: names(:)
+        integer, allocatable, intent(out) :: kind(:), item(:)
+        character(len=3), parameter :: suffixes(6) = ['_rx', '_ry', '_rz', '_ux', '_uy', '_uz']
+        integer :: n, k, j, half
+
+        n = size(channels) + 6 * size(sets) + 3 * n_loads + size(fixed_curve_columns)
+        allocate(names(n), kind(n), item(n))
+        n = 0
+        call add_fixed(1, 2)
+        do k = 1, size(channels)
+            call add(trim(channels(k)), column_channel, k)
+        end do
+        do half = 0, 1
+            do k = 1, size(sets)
+                do j = 1, 3
+                    call add(trim(sets(k)) // suffixes(3 * half + j), column_set, k)
+                end do
+            end do
+        end do
+        do k = 1, n_loads
+            do j = 4, 6
+                call add(load_column_prefix(k) // suffixes(j), column_load, k)
+            end do
+        end do
+        ! fixed_curve_columns(3:4) are the fabric's.
+        if (fabric) call add_fixed(3, 4)
+        call add_fixed(5, size(fixed_curve_columns))
+        names = names(:n)
+        kind = kind(:n)
+        item = item(:n)
+
+    contains
+
+        subroutine add(name, what, which)
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: what, which
+            n = n + 1
+            names(n) = name
+            kind(n) = what
+            item(n) = which
+        end subroutine add
+
+        subroutine add_fixed(first, last)
+            integer, intent(in) :: first, last
+            integer :: i
+            do i = first, last
+                call add(trim(fixed_curve_columns(i)), column_fixed, 0)
+            end do
+        end subroutine add_fixed
+
+    end subroutine get_curve_columns
+
+    !> No two columns of curve.csv with one name, whatever makes them (a channel named
+    !> like a support's or an obstacle's column, 'a_rx' with a support 'a'; a support or
+    !> obstacle named like a load's columns, 'load_2' with two loads): the columns of
+    !> get_curve_columns, sorted (n log n); the message names both makers.
     subroutine check_curve_columns(config, names, error)
         type(config_type), intent(in) :: config
         character(len=*), intent(in) :: names(:)
         type(error_type), allocatable, intent(out) :: error
-        character(len=3), parameter :: suffixes(6) = ['_rx', '_ry', '_rz', '_ux', '_uy', '_uz']
-        integer :: k, j, n_loads, length
-        character(len=:), allocatable :: name, stem
+        character(len=curve_column_length), allocatable :: columns(:)
+        character(len=name_length), allocatable :: sets(:)
+        character(len=:), allocatable :: rename
+        integer, allocatable :: kind(:), item(:), order(:)
+        integer :: n_loads, i, first, second
 
         n_loads = 0
         if (allocated(config%loads)) n_loads = size(config%loads)
-        do k = 1, size(names)
-            name = trim(names(k))
-            length = len(name)
-            if (length <= 3) cycle
-            if (.not. any(suffixes == name(length - 2:))) cycle
-            stem = name(:length - 3)
-            if (allocated(config%supports)) then
-                if (any(config%supports%name == stem)) then
-                    call fatal_error(error, "curve.csv would have two columns '" // name &
-                        // "' (the factor of channel " // name // " and &support '" // stem &
-                        // "'): rename one")
-                    return
-                end if
-            end if
-            j = load_number(stem, n_loads)
-            if (j > 0 .and. any(suffixes(4:) == name(length - 2:))) then
-                call fatal_error(error, "curve.csv would have two columns '" // name &
-                    // "' (the factor of channel " // name // ' and &load #' &
-                    // format_integer(j) // '): rename the channel')
-                return
+        sets = get_support_set_names(config)
+        call get_curve_columns(names, sets, n_loads, config%fabric_support > 0, &
+            columns, kind, item)
+        order = sort_text_index(columns)
+        ! Of all clashes, the one whose later column comes first in the file.
+        second = 0
+        do i = 2, size(order)
+            if (columns(order(i)) /= columns(order(i - 1))) cycle
+            if (second == 0 .or. order(i) < second) then
+                first = order(i - 1)
+                second = order(i)
             end if
         end do
-        if (allocated(config%supports)) then
-            do k = 1, size(config%supports)
-                j = load_number(trim(config%supports(k)%name), n_loads)
-                if (j > 0) then
-                    call fatal_error(error, "curve.csv would have two columns '" &
-                        // trim(config%supports(k)%name) // "_ux' (&support '" &
-                        // trim(config%supports(k)%name) // "' and &load #" &
-                        // format_integer(j) // '): rename the support')
-                    return
-                end if
-            end do
+        if (second == 0) return
+        ! The one to rename: a channel, else a support or obstacle (load columns are numbered).
+        rename = 'one'
+        if (kind(first) == column_channel .or. kind(second) == column_channel) then
+            if (kind(first) /= kind(second)) rename = 'the channel'
+        else if (kind(second) == column_load .and. kind(first) == column_set) then
+            rename = 'the ' // trim(set_group(item(first)))
         end if
+        call fatal_error(error, "curve.csv would have two columns '" // trim(columns(first)) &
+            // "' (" // maker(first) // ' and ' // maker(second) // '): rename ' // rename)
+
+    contains
+
+        !> What makes column j of `columns`.
+        function maker(j) result(text)
+            integer, intent(in) :: j
+            character(len=:), allocatable :: text
+
+            select case (kind(j))
+            case (column_channel)
+                text = 'the factor of channel ' // trim(names(item(j)))
+            case (column_set)
+                text = '&' // trim(set_group(item(j))) // " '" // trim(sets(item(j))) // "'"
+            case (column_load)
+                text = '&load #' // format_integer(item(j))
+            case default
+                text = 'a column of every curve.csv'
+            end select
+        end function maker
+
+        !> 'support' or 'obstacle': the group of support set s.
+        function set_group(s) result(group)
+            integer, intent(in) :: s
+            character(len=8) :: group
+
+            group = 'obstacle'
+            if (allocated(config%supports)) then
+                if (s <= size(config%supports)) group = 'support'
+            end if
+        end function set_group
+
     end subroutine check_curve_columns
 
-    !> k if `text` is load_column_prefix(k) of one of n_loads loads, else 0. (A module
-    !> procedure: as an internal one it needed a trampoline, so an executable stack.)
-    integer function load_number(text, n_loads)
-        character(len=*), intent(in) :: text
-        integer, intent(in) :: n_loads
-        logical :: ok
+    !> The names of the support sets of the scene that `config` describes: every &support,
+    !> then every &obstacle with a coordinate that no &support prescribes (the scene
+    !> builder holds those; the node ids must be checked).
+    function get_support_set_names(config) result(sets)
+        type(config_type), intent(in) :: config
+        character(len=name_length), allocatable :: sets(:)
+        logical, allocatable :: prescribed(:, :), held(:)
+        character(len=1), parameter :: axis(3) = ['x', 'y', 'z']
+        integer :: s, k
 
-        load_number = 0
-        if (index(text, 'load_') /= 1) return
-        call parse_integer(text(6:), load_number, ok)
-        if (.not. ok .or. load_number < 1 .or. load_number > n_loads) then
-            load_number = 0
-        else if (load_column_prefix(load_number) /= text) then
-            load_number = 0          ! 'load_01' or 'load_+1' is no column name
+        allocate(sets(0))
+        allocate(prescribed(3, size(config%node_positions, 2)), source=.false.)
+        if (allocated(config%supports)) then
+            sets = config%supports%name
+            do s = 1, size(config%supports)
+                do k = 1, 3
+                    if (index(config%supports(s)%fix, axis(k)) > 0) &
+                        prescribed(k, config%supports(s)%nodes) = .true.
+                end do
+            end do
         end if
-    end function load_number
+        if (.not. allocated(config%obstacles)) return
+        held = [(.not. all(prescribed(:, config%obstacles(s)%nodes)), &
+            s = 1, size(config%obstacles))]
+        sets = [character(len=name_length) :: sets, pack(config%obstacles%name, held)]
+    end function get_support_set_names
 
 end module yarnfort_input_channel_checks

@@ -6,6 +6,8 @@
     generate.py reference           the variable tables of inputs/REFERENCE.md, on stdout
     generate.py check REFERENCE.md  exit 1 (with a diff) if the tables there differ
     generate.py update REFERENCE.md rewrite the tables there
+    generate.py python OUT.json     the description as JSON for the Python scene classes
+                                    (installed in the package; meson runs this)
 
 The module holds, per group: its config type (defaults, one doc line per variable), a
 reader of one occurrence (each variable taken from the tokenizer's assignments by the
@@ -15,7 +17,9 @@ and the --help summary.
 """
 from __future__ import annotations
 
+import dataclasses
 import difflib
+import json
 import re
 import sys
 import textwrap
@@ -469,9 +473,28 @@ def with_tables(text: str) -> str:
     return SECTION.sub(lambda m: m[1] + reference_table(groups[m[2]]) + "\n", text)
 
 
+# ---------------------------------------------------------------- Python description
+def python_description() -> str:
+    """Every group and variable as JSON (the fields of descriptors.py, a character
+    variable's length resolved), which yarnfort.scene builds its group classes from."""
+    groups = []
+    for group in GROUPS:
+        variables = []
+        for var in group.variables:
+            entry = dataclasses.asdict(var)
+            if var.type == "character":
+                entry["length"] = var.char_length
+            variables.append(entry)
+        groups.append({"name": group.name, "kind": group.kind, "doc": group.doc,
+                       "variables": variables})
+    return json.dumps({"groups": groups}, indent=1) + "\n"
+
+
 def main(argv: list[str]) -> int:
     if len(argv) == 2 and argv[0] == "fortran":
         Path(argv[1]).write_text(fortran_module())
+    elif len(argv) == 2 and argv[0] == "python":
+        Path(argv[1]).write_text(python_description())
     elif argv == ["reference"]:
         print("\n\n".join(f"## `&{g.name}`\n\n{reference_table(g)}" for g in GROUPS))
     elif len(argv) == 2 and argv[0] in ("check", "update"):

@@ -6,16 +6,19 @@
 !>     yarn <material> <elements_per_segment> <id> <id> ... [&]
 !>     length0 <L0 of element 1> <L0 of element 2> ... [&]   (optional, after its yarn)
 !>     stretch <stretch of element 1> ... [&]                 (or this instead)
+!>     unit <length unit>                                      (optional, once: mm, ...)
 !>
 !> Words are separated by blanks; keywords are case-insensitive. Node ids are 1..n, each
 !> defined exactly once, in any order. A yarn line ending in '&' continues on the next
-!> line. Node and yarn lines may be mixed in any order.
+!> line. Node and yarn lines may be mixed in any order. With a unit (the `unit` line or
+!> `&geometry unit`, which must agree) coordinates and length0 values are converted to m.
 module yarnfort_input_geometry
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: yarn_config_type, name_length
     use yarnfort_text, only: string_type, to_lower, format_integer, split_words, &
-        parse_integer, parse_real, read_file_text, drop_byte_order_mark
+        parse_integer, parse_real, read_file_text, drop_byte_order_mark, quote_string
+    use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, length_kind
     implicit none
     private
 
@@ -23,12 +26,15 @@ module yarnfort_input_geometry
 
 contains
 
-    !> Read node positions (3, n) and yarns from the geometry file `path`.
-    subroutine read_geometry_file(path, node_positions, yarns, error)
+    !> Read node positions (3, n) and yarns from the geometry file `path`. `stated_unit`
+    !> ('&geometry unit', '' for none) and a `unit` line of the file give the length unit
+    !> of its coordinates and length0 values (they must agree), converted to m; none: m.
+    subroutine read_geometry_file(path, node_positions, yarns, error, stated_unit)
         character(len=*), intent(in) :: path
         real(wp), allocatable, intent(out) :: node_positions(:, :)
         type(yarn_config_type), allocatable, intent(out) :: yarns(:)
         type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in), optional :: stated_unit
         character(len=:), allocatable :: content, line, record, keyword
         type(string_type), allocatable :: words(:)
         integer :: position, line_number, first_line, n_nodes, n_yarns, id, k, i
@@ -36,8 +42,9 @@ contains
         real(wp), allocatable :: node_xyz(:, :), values(:)
         real(wp) :: xyz(3)
         logical :: ok
-        integer :: stat
+        integer :: stat, unit_line
         character(len=256) :: message
+        type(unit_type) :: unit, declared
 
         call read_file_text(path, "file '" // path // "'", content, error)
         if (allocated(error)) then
@@ -53,6 +60,7 @@ contains
         n_yarns = 0
         line_number = 0
         position = 1
+        unit_line = 0
         read_lines: do
             ! A logical line: lines joined while they end in '&'.
             record = ''
@@ -175,13 +183,66 @@ contains
                 else
                     call move_alloc(values, yarns(n_yarns)%stretch)
                 end if
+            case ('unit')
+                if (unit_line > 0) then
+                    call fail(first_line, 'a second unit line (the first is line ' &
+                        // format_integer(unit_line) // ')')
+                    return
+                end if
+                if (size(words) /= 2) then
+                    call fail(first_line, 'a unit line is: unit <length unit> (' &
+                        // unit_names(length_kind) // ')')
+                    return
+                end if
+                call take_length_unit(words(2)%text, unit, message, ok)
+                if (.not. ok) then
+                    call fail(first_line, trim(message))
+                    return
+                end if
+                unit_line = first_line
             case default
                 call fail(first_line, "unknown keyword '" // words(1)%text &
-                    // "' (a line is 'node ...', 'yarn ...', 'length0 ...' or 'stretch ...'; " &
-                    // 'comments start with #)')
+                    // "' (a line is 'node ...', 'yarn ...', 'length0 ...', 'stretch ...' " &
+                    // "or 'unit ...'; comments start with #)")
                 return
             end select
         end do read_lines
+
+        if (n_nodes == 0) then
+            if (len(content) == 0) then
+                call fatal_error(error, "&geometry: file '" // path // "' is empty (0 bytes " &
+                    // 'read; a device or a pipe reads as empty): it must hold the node and ' &
+                    // 'yarn lines')
+            else
+                call fatal_error(error, "&geometry: file '" // path // "' has no node lines " &
+                    // '(' // format_integer(line_number) // ' lines read; a node line is: ' &
+                    // 'node <id> <x> <y> <z>)')
+            end if
+            return
+        end if
+
+        ! The length unit: the file's and &geometry's must agree; none: m (factor 1).
+        if (present(stated_unit)) then
+            if (len_trim(stated_unit) > 0) then
+                call take_length_unit(trim(adjustl(stated_unit)), declared, message, ok)
+                if (.not. ok) then
+                    call fatal_error(error, '&geometry: unit ' // trim(message))
+                    return
+                end if
+                if (unit_line == 0) then
+                    unit = declared
+                else if (unit%name /= declared%name) then
+                    call fail(unit_line, 'unit ' // quote_string(trim(unit%name)) &
+                        // ' but &geometry unit = ' // quote_string(trim(adjustl(stated_unit))))
+                    return
+                end if
+            end if
+        end if
+        node_xyz(:, :n_nodes) = to_scene_unit(node_xyz(:, :n_nodes), unit)
+        do i = 1, n_yarns
+            if (allocated(yarns(i)%length0)) yarns(i)%length0 = to_scene_unit( &
+                yarns(i)%length0, unit)
+        end do
 
         ! Node ids must be exactly 1..n. An id above the number of node lines means that
         ! some id up to it is missing (found below): nothing is allocated by such an id,
@@ -277,6 +338,20 @@ contains
         end subroutine fail
 
     end subroutine read_geometry_file
+
+    !> The length unit spelled `text`; `ok` false and `message` set if it is not one.
+    pure subroutine take_length_unit(text, unit, message, ok)
+        character(len=*), intent(in) :: text
+        type(unit_type), intent(out) :: unit
+        character(len=*), intent(out) :: message
+        logical, intent(out) :: ok
+
+        message = ''
+        call find_unit(text, unit, ok)
+        if (ok) ok = unit%kind == length_kind
+        if (.not. ok) message = quote_string(text) // ' is not a known length unit (' &
+            // unit_names(length_kind) // ')'
+    end subroutine take_length_unit
 
     !> The line of `content` starting at `position` (without its end: LF, CR LF or a lone
     !> CR, as old Mac editors write); `position` moves to the start of the next line.

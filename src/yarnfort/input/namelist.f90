@@ -94,8 +94,12 @@ contains
                 end if
             end do
             call read_geometry_file(resolve_path(config%geometry%file, config%input_folder), &
-                config%node_positions, config%yarns, error)
+                config%node_positions, config%yarns, error, config%geometry%unit)
             if (allocated(error)) return
+        else if (len_trim(config%geometry%unit) > 0) then
+            call fatal_error(error, "&geometry: unit = '" // trim(config%geometry%unit) &
+                // "' is set but no file (it is the unit of the geometry file)")
+            return
         end if
         if (len_trim(config%fabric%kind) > 0) then
             do k = 1, size(generated_names)

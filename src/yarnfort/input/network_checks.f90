@@ -14,6 +14,7 @@ module yarnfort_input_network_checks
         check_load_variables
     use yarnfort_input_fields, only: quoted_list, suggestion, check_item_name, group_label
     use yarnfort_text, only: format_integer, format_real
+    use yarnfort_material_law, only: is_usable_stretch, max_stretch
     implicit none
     private
 
@@ -112,8 +113,6 @@ contains
                         // ' node id(s); a yarn needs at least 2')
                     return
                 end if
-                call check_element_lengths(config, yarn, label, error)
-                if (allocated(error)) return
                 n_elements = n_elements + (size(yarn%nodes) - 1) &
                     * int(yarn%elements_per_segment, int64)
                 n_new_nodes = n_new_nodes + (size(yarn%nodes) - 1) &
@@ -156,6 +155,9 @@ contains
                         end if
                     end associate
                 end do
+                ! After the node ids and segment lengths: the stretches use them.
+                call check_element_lengths(config, yarn, label, error)
+                if (allocated(error)) return
             end associate
         end do
         i = findloc(used, .false., dim=1)
@@ -174,7 +176,8 @@ contains
         character(len=*), intent(in) :: label
         type(error_type), allocatable, intent(out) :: error
         integer(int64) :: n_elements
-        integer :: n_values, n(2)
+        integer :: n_values, n(2), e, s
+        real(wp) :: length, stretch, value
         character(len=:), allocatable :: name
 
         n = 0
@@ -206,8 +209,32 @@ contains
                     // "material '" // trim(yarn%material) // "' has prestress = " &
                     // format_real(material%prestress) // ' (both set the ' &
                     // 'reference lengths: give one)')
+                return
             end if
         end associate
+        ! Their stretches l / L0 within the bound of a prestress (is_usable_stretch);
+        ! their values are > 0 and finite (checked with the group).
+        do e = 1, n_values
+            s = (e - 1) / yarn%elements_per_segment + 1
+            length = norm2(config%node_positions(:, yarn%nodes(s + 1)) &
+                - config%node_positions(:, yarn%nodes(s))) / yarn%elements_per_segment
+            if (n(1) > 0) then
+                value = yarn%length0(e)
+                stretch = length / value
+            else
+                value = yarn%stretch(e)
+                stretch = value
+            end if
+            if (is_usable_stretch(stretch)) cycle
+            call fatal_error(error, label // ': ' // name // '(' // format_integer(e) &
+                // ') = ' // format_real(value) // ' stretches element ' &
+                // format_integer(e) // ' (length ' // format_real(length) &
+                // ' m) by l / L0 = ' // format_real(stretch) &
+                // ', outside [' // format_real(1 / max_stretch) // ', ' &
+                // format_real(max_stretch) // '] (2**-60 to 2**60: the bound on the ' &
+                // 'stretch a prestress gives)')
+            return
+        end do
     end subroutine check_element_lengths
 
     !> No two segments, of one yarn or of two, join the same two nodes: their elements

@@ -20,7 +20,7 @@ module yarnfort_input_validate
     use yarnfort_input_contact_checks, only: check_contacts
     use yarnfort_input_contact_node_checks, only: check_contact_nodes, check_contact_node_laws
     use yarnfort_input_channel_checks, only: check_channels
-    use yarnfort_text, only: format_integer, format_real
+    use yarnfort_text, only: format_integer, format_real, format_short
     implicit none
     private
 
@@ -171,16 +171,14 @@ contains
         type(path_config_type), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
         real(wp) :: largest, interval
-        character(len=16) :: shortest
 
         largest = maxval(abs(path%time))
         interval = minval(path%time(2:) - path%time(:size(path%time) - 1))
         if (solver%min_step * interval < time_resolution * largest) then
-            write(shortest, '(es9.2)') time_resolution * largest
             call fatal_error(error, '&solver: min_step = ' // format_real(solver%min_step) &
                 // ' is below the resolution of &path time (up to ' // format_real(largest) &
                 // ' in magnitude, shortest knot interval ' // format_real(interval) &
-                // '): a step shorter than ' // trim(adjustl(shortest)) &
+                // '): a step shorter than ' // format_short(time_resolution * largest) &
                 // ' would not advance the pseudo-time; raise min_step (a fraction of the ' &
                 // 'knot interval) or move the path times closer to 0')
         end if

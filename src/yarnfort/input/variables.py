@@ -23,7 +23,8 @@ from descriptors import Group, Var
 #: Both columns of the gap-factor curve of &fabric.
 GAP_FACTOR = ('The gap factor as a piecewise-linear function of the displacement factor p_disp '
               "(constant beyond the end knots): the holders' length is gap * factor (paper "
-              'Fig. 13b). `gap_factor_p_disp` increasing; factors positive.')
+              'Fig. 13b). `gap_factor_p_disp` increasing; factors at least `100 * epsilon` '
+              '(about 2.2e-14): a smaller one collapses the holders to zero length.')
 #: A name that other groups or columns refer to.
 NAME_RULE = 'Required and unique. One word of letters, digits, `_`, `-`, `.`.'
 #: The nodes of a named node set.
@@ -232,16 +233,38 @@ GROUPS = [
         law_parameter('area', 'm^2', '> 0', ['neo_hookean'],
                       '`neo_hookean`: undeformed cross-section S(1).'),
         Var('table_file', 'character', '', length='path_length', adjust=False, laws=['table'],
-            doc='`table`: CSV file of (strain, force in N). The material code reads it. A '
+            doc='`table`: CSV file of (strain, force). The material code reads it. A '
                 "relative name is taken relative to the input file's folder (the working "
-                'directory when the input comes from standard input).'),
+                'directory when the input comes from standard input). Its units: the header '
+                '(`Elongation (%),Force (cN)`), `strain_unit` and `force_unit`, else 1 and N; '
+                'see *Table files* below.'),
+        Var('strain_unit', 'character', '', length=16, checked_by='table',
+            default_doc="`''` (the header's, else `'1'`)",
+            type_doc="character(16): `'1'`, `'-'`, `'%'`, `'permille'`, or a length: `'m'`, "
+                     "`'cm'`, `'mm'`, `'um'`",
+            doc='`table`: the unit of the strain column, as its header would state it; must '
+                'agree with a unit the header states. A length makes the column an '
+                'elongation, divided by `gauge_length`. Case-sensitive (`permille` in any '
+                'case).'),
+        Var('force_unit', 'character', '', length=16, checked_by='table',
+            default_doc="`''` (the header's, else `'N'`)",
+            type_doc="character(16): `'N'`, `'cN'`, `'mN'`, `'kN'`, `'gf'`, `'kgf'`, `'lbf'`",
+            doc='`table`: the unit of the force column, as its header would state it; must '
+                'agree with a unit the header states. Case-sensitive (`gf`, `kgf`, `lbf` in '
+                'any case).'),
+        Var('gauge_length', 'real', -1.0, unit='m', range='> 0', checked_by='table',
+            default_doc='`-1` (not set)',
+            doc='`table`: initial length of the tensile specimen; required when the strain '
+                'column is an elongation (a length unit), an error otherwise: strain = '
+                'elongation / gauge_length.'),
         Var('prestress', 'real', 0.0, unit='N', range='>= 0',
             doc='Pre-stress: every element of this yarn type starts with reference length L0 = l '
                 '/ lambda_p, where f(lambda_p) = prestress and l is its length in the initial '
                 "geometry, so it carries that tension there (the paper's knitting yarns carry 2 "
                 'cN: `prestress = 0.02`). The initial geometry is then not in equilibrium in '
-                'general; step 0 of the run finds the equilibrium. An error if the law never '
-                'reaches that force.'),
+                'general; step 0 of the run finds the equilibrium. An error if the law does '
+                'not reach that force at a stretch up to 2**60 (about 1.2e18; the same bound '
+                'holds for `&yarn length0` and `stretch`).'),
     ]),
     Group('contact', 'repeatable',
           'The friction law where yarns of two types cross (one group per unordered pair).', [
@@ -390,6 +413,12 @@ GROUPS = [
           'Node positions and yarns from a plain text file instead of &nodes and &yarn groups.', [
         Var('file', 'character', '', length='path_length', adjust=False, default_doc="`''` (none)",
             doc='Geometry file with the nodes and yarns (format below).'),
+        Var('unit', 'character', '', length=16, checked_by='geometry',
+            default_doc="`''` (the file's, else `'m'`)",
+            type_doc="character(16): `'m'`, `'cm'`, `'mm'`, `'um'`",
+            doc="The length unit of the file's coordinates and `length0` values, converted to "
+                "m (the scene's unit); must agree with the file's `unit` line if it has one. "
+                'Case-sensitive. Requires `file`.'),
     ]),
     Group('yarn', 'repeatable',
           'One yarn, a polyline through node ids, split into elements.', [
@@ -410,13 +439,16 @@ GROUPS = [
             default_doc='none (from the geometry)',
             doc='Reference length L0 of every element of the yarn, in order along it (one '
                 'value per element: (number of nodes - 1) * elements_per_segment), so that a '
-                'measured or computed pretensioned state is given exactly. Each > 0. Not with '
-                '`stretch`, nor on a yarn whose material has a `prestress`.'),
+                'measured or computed pretensioned state is given exactly. Each > 0, with '
+                'l / L0 (l: the element\'s initial length) in [2**-60, 2**60], the bound of a '
+                '`prestress`. Not with `stretch`, nor on a yarn whose material has a '
+                '`prestress`.'),
         Var('stretch', 'real', None, shape='list', unit='1', range='> 0',
             default_doc='none (1)',
             doc='Initial stretch lambda of every element of the yarn instead: L0 = l / lambda, '
                 'l the element\'s length in the initial geometry (the operation `prestress` '
-                'does with one lambda per material). One value per element, each > 0. Not with '
+                'does with one lambda per material). One value per element, each in [2**-60, '
+                '2**60] (about 8.7e-19 to 1.2e18), the bound of a `prestress`. Not with '
                 '`length0`, nor with a `prestress` of the material.'),
     ]),
     Group('support', 'repeatable',

@@ -6,7 +6,13 @@ module yarnfort_material_law
     implicit none
     private
 
-    public :: force_law_type
+    public :: force_law_type, max_stretch, is_usable_stretch
+
+    !> Largest stretch l / L0 of an element: a prestress is refused when its law needs
+    !> more (get_stretch_at_force searches up to it), and so are per-element reference
+    !> lengths that give more, or less than its inverse (is_usable_stretch; docs/
+    !> decisions.md, One bound on an element's stretch).
+    real(wp), parameter :: max_stretch = 2.0_wp**60
 
     !> Tension f(lambda) of a yarn, lambda = l/L0. f(lambda) = 0 and df/dlambda = 0 for
     !> lambda <= 1 (slack), here for every law. Contract for each law's taut branch: f
@@ -78,15 +84,23 @@ contains
         end if
     end function get_energy
 
+    !> The one bound on the stretch l / L0 of an element, however its reference length
+    !> is given (prestress, length0, stretch): between 1 / max_stretch and max_stretch.
+    elemental logical function is_usable_stretch(stretch)
+        real(wp), intent(in) :: stretch
+
+        is_usable_stretch = stretch >= 1.0_wp / max_stretch .and. stretch <= max_stretch
+    end function is_usable_stretch
+
     !> Stretch lambda > 1 with f(lambda) = force > 0, by Newton's method safeguarded by
-    !> bisection on a bracket grown from [1, 2]. `found` is false if no stretch up to
-    !> 2**max_doublings carries the force or the iteration does not converge.
+    !> bisection on a bracket grown from [1, 2]. `found` is false if no usable stretch
+    !> (up to max_stretch) carries the force or the iteration does not converge.
     pure subroutine get_stretch_at_force(self, force, stretch, found)
         class(force_law_type), intent(in) :: self
         real(wp), intent(in) :: force
         real(wp), intent(out) :: stretch
         logical, intent(out) :: found
-        integer, parameter :: max_doublings = 60, max_iterations = 200
+        integer, parameter :: max_iterations = 200
         real(wp), parameter :: tolerance = 8.0_wp * epsilon(1.0_wp)
         real(wp) :: low, high, f, df
         integer :: k
@@ -99,9 +113,9 @@ contains
         end if
         low = 1.0_wp
         high = 2.0_wp
-        do k = 1, max_doublings
+        do
             call self%get_force(high, f, df)
-            if (f >= force) exit
+            if (f >= force .or. .not. is_usable_stretch(2.0_wp * high)) exit
             low = high
             high = 2.0_wp * high
         end do

@@ -25,19 +25,29 @@ module yarnfort_material_table
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_material_law, only: force_law_type
-    use yarnfort_text, only: format_real, format_integer
+    use yarnfort_text, only: format_real, format_integer, quote_string, string_type
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
+    use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &
+        get_header_units, strain_kind, length_kind, force_kind
     implicit none
     private
 
     public :: table_law_type, new_table_law, read_table_law
-    public :: default_end_slope_ratio
+    public :: default_end_slope_ratio, max_table_strain
 
     !> Default floor of an end slope as a fraction of the adjacent secant slope.
     real(wp), parameter :: default_end_slope_ratio = 0.1_wp
 
     !> Largest end-slope floor accepted (the secant itself).
     real(wp), parameter :: max_end_slope_ratio = 1.0_wp
+
+    !> Largest strain a table file may hold, after unit conversion (1000 %): above the
+    !> elongation at break of any textile yarn, elastane included (docs/decisions.md,
+    !> "Largest strain of a table file"); a larger one is a column misread.
+    real(wp), parameter :: max_table_strain = 10.0_wp
+
+    !> Longest unit text taken from a `&material` variable.
+    integer, parameter :: max_unit_text = 64
 
     !> Fewest rows in a table: (0, 0) and one more.
     integer, parameter :: min_rows = 2
@@ -98,21 +108,167 @@ contains
     !> two numbers are headers; blank lines and lines starting with '#' are skipped
     !> anywhere. Same rules and `end_slope_ratio` as `new_table_law`; messages name the
     !> file, the line and the offending value.
-    subroutine read_table_law(self, path, error, end_slope_ratio)
+    !>
+    !> Units: the last header line, if it has two comma-separated fields, may state the
+    !> unit of each column ('Elongation (%),Force (cN)', see `get_header_unit`);
+    !> `strain_unit` and `force_unit` (the `&material` variables, '' for none) may state
+    !> them too, and must then agree with the header. A column without a stated unit is in
+    !> 1 (strain) or N (force). A strain column in a length unit is an elongation of a
+    !> specimen `gauge_length` m long. The converted strains may not exceed
+    !> `max_table_strain`.
+    subroutine read_table_law(self, path, error, end_slope_ratio, strain_unit, force_unit, &
+            gauge_length)
         type(table_law_type), intent(out) :: self
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
         real(wp), intent(in), optional :: end_slope_ratio
-        character(len=:), allocatable :: context
+        character(len=*), intent(in), optional :: strain_unit, force_unit
+        real(wp), intent(in), optional :: gauge_length
+        character(len=:), allocatable :: context, header
         real(wp), allocatable :: strain(:), force(:)
         integer, allocatable :: lines(:)
+        type(unit_type) :: units(2)
+        integer :: header_line
 
         context = "table '" // path // "'"
         call read_csv_pairs(path, context, [character(len=6) :: 'strain', 'force'], &
-            check_row, strain, force, lines, error)
+            check_row, strain, force, lines, error, header, header_line)
         if (allocated(error)) return
+        call get_column_units(header, header_line, strain_unit, force_unit, gauge_length, &
+            units, error)
+        if (allocated(error)) then
+            error%message = context // error%message
+            return
+        end if
+        strain = to_scene_unit(strain, units(1))
+        if (units(1)%kind == length_kind) strain = strain / gauge_length
+        force = to_scene_unit(force, units(2))
+        call check_strain_range(strain, lines, units(1), gauge_length, error)
+        if (allocated(error)) then
+            error%message = context // error%message
+            return
+        end if
         call finish_table(self, strain, force, context, 'line', lines, end_slope_ratio, error)
     end subroutine read_table_law
+
+    !> The unit of each column of a table file: from the header (`header` on line
+    !> `header_line`; 0: none) and the stated `strain_unit`, `force_unit` ('' or absent:
+    !> none), which must agree; 1 and N where neither states one. A strain column in a
+    !> length unit needs `gauge_length` > 0, and `gauge_length` needs one. Messages start
+    !> with ', line L, column C: ' or ': ' (for the table's context).
+    subroutine get_column_units(header, header_line, strain_unit, force_unit, gauge_length, &
+            units, error)
+        character(len=*), intent(in) :: header
+        integer, intent(in) :: header_line
+        character(len=*), intent(in), optional :: strain_unit, force_unit
+        real(wp), intent(in), optional :: gauge_length
+        type(unit_type), intent(out) :: units(2)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), parameter :: names(2) = [character(len=11) :: 'strain_unit', &
+            'force_unit']
+        character(len=max_unit_text) :: stated(2)
+        character(len=:), allocatable :: place
+        type(string_type) :: fields(2), texts(2)
+        type(unit_type) :: declared
+        logical :: in_header(2)
+        integer :: c
+
+        ! The header's units (if it has two fields); the units stated in &material.
+        call get_header_units(header, fields, texts, in_header)
+        if (header_line == 0) in_header(:) = .false.
+        stated(:) = ''
+        if (present(strain_unit)) stated(1) = strain_unit
+        if (present(force_unit)) stated(2) = force_unit
+
+        do c = 1, 2
+            place = ', line ' // format_integer(header_line) // ', column ' &
+                // format_integer(c) // ' (' // quote_string(fields(c)%text) // ')'
+            if (in_header(c)) then
+                call take_unit(texts(c)%text, c, units(c), error)
+                if (allocated(error)) then
+                    error%message = place // ': ' // error%message
+                    return
+                end if
+            end if
+            if (len_trim(stated(c)) == 0) cycle
+            call take_unit(trim(adjustl(stated(c))), c, declared, error)
+            if (allocated(error)) then
+                error%message = ': ' // trim(names(c)) // ' ' // error%message
+                return
+            end if
+            if (.not. in_header(c)) then
+                units(c) = declared
+            else if (declared%name /= units(c)%name) then
+                call fatal_error(error, place // ': the header states ' &
+                    // quote_string(trim(units(c)%name)) // ' but ' // trim(names(c)) &
+                    // ' = ' // quote_string(trim(adjustl(stated(c)))))
+                return
+            end if
+        end do
+        ! Neither states a unit: strain 1 (the default unit_type), force N.
+        if (.not. (in_header(2) .or. len_trim(stated(2)) > 0)) call take_unit('N', 2, &
+            units(2), error)
+
+        if (units(1)%kind == length_kind .and. .not. present(gauge_length)) then
+            call fatal_error(error, ': the strain column is an elongation in ' &
+                // quote_string(trim(units(1)%name)) // ', which needs &material ' &
+                // 'gauge_length (the initial length of the specimen, m)')
+        else if (units(1)%kind /= length_kind .and. present(gauge_length)) then
+            call fatal_error(error, ': gauge_length = ' // format_real(gauge_length) &
+                // ' is set but the strain column is in ' // quote_string(trim(units(1)%name)) &
+                // ', not a length (remove it, or state the length unit of the elongation)')
+        else if (present(gauge_length)) then
+            ! Nested tests: no ordered comparison with a NaN.
+            if (.not. (ieee_is_finite(gauge_length) .and. gauge_length > 0.0_wp)) &
+                call fatal_error(error, ': gauge_length = ' // format_real(gauge_length) &
+                    // ' must be positive and finite')
+        end if
+    end subroutine get_column_units
+
+    !> The unit spelled `text` for column `column` (1: a strain or a length, 2: a force).
+    pure subroutine take_unit(text, column, unit, error)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: column
+        type(unit_type), intent(out) :: unit
+        type(error_type), allocatable, intent(out) :: error
+        logical :: found
+
+        call find_unit(text, unit, found)
+        if (column == 1) then
+            if (found) found = unit%kind == strain_kind .or. unit%kind == length_kind
+            if (.not. found) call fatal_error(error, quote_string(text) // ' is not a known ' &
+                // 'strain unit (' // unit_names(strain_kind) // ') or length unit of an ' &
+                // 'elongation (' // unit_names(length_kind) // ')')
+        else
+            if (found) found = unit%kind == force_kind
+            if (.not. found) call fatal_error(error, quote_string(text) // ' is not a known ' &
+                // 'force unit (' // unit_names(force_kind) // ')')
+        end if
+    end subroutine take_unit
+
+    !> The strains, converted, must stay below `max_table_strain`: a larger one is a
+    !> column in another unit than the one it was read in (5 % read as a strain of 5).
+    subroutine check_strain_range(strain, lines, unit, gauge_length, error)
+        real(wp), intent(in) :: strain(:)
+        integer, intent(in) :: lines(:)
+        type(unit_type), intent(in) :: unit
+        real(wp), intent(in), optional :: gauge_length
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: read_as
+        integer :: k
+
+        ! Strains increase strictly: the first one above the limit is the row to name.
+        k = findloc(strain > max_table_strain, .true., dim=1)
+        if (k == 0) return
+        read_as = 'in ' // quote_string(trim(unit%name))
+        if (unit%kind == length_kind) read_as = read_as // ' over a gauge length of ' &
+            // format_real(gauge_length) // ' m'
+        call fatal_error(error, ', line ' // format_integer(lines(k)) // ', column 1: ' &
+            // 'strain ' // format_real(strain(k)) // ' (the column read ' // read_as &
+            // ') exceeds ' // format_real(max_table_strain) // ', more than any yarn ' &
+            // 'stretches: state the unit of the column, e.g. a header ''strain (%)'' or ' &
+            // '&material strain_unit = ''%'' (see inputs/REFERENCE.md, Table files)')
+    end subroutine check_strain_range
 
     !> The part of new_table_law and read_table_law after the rows are read and in order:
     !> enough rows, the end slope ratio, the interpolant. `places(i)` is the row or line

@@ -10,7 +10,7 @@ module yarnfort_output_curve
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_text, only: read_line
     use yarnfort_output_csv_rows, only: csv_rows_type, format_csv_real
-    use yarnfort_input_channel_checks, only: load_column_prefix
+    use yarnfort_input_channel_checks, only: get_curve_columns, curve_column_length
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, open_append, &
         flush_checked, truncate_file, open_new_file, close_new_file
     implicit none
@@ -234,34 +234,23 @@ contains
         end function count_commas
     end subroutine resume_table
 
-    !> The header line of the curve file for `scene` (columns: see open_curve).
+    !> The header line of the curve file for `scene` (columns: see open_curve; the
+    !> names of get_curve_columns, which the input check found unique).
     function get_header(scene) result(header)
         type(scene_type), intent(in) :: scene
         character(len=:), allocatable :: header
-        character(len=:), allocatable :: name
-        integer :: s
+        character(len=curve_column_length), allocatable :: names(:)
+        integer, allocatable :: kind(:), item(:)
+        integer :: n_loads, j
 
-        header = 'step,time'
-        do s = 1, size(scene%path%channel)
-            header = header // ',' // trim(scene%path%channel(s))
+        n_loads = 0
+        if (allocated(scene%loads)) n_loads = size(scene%loads)
+        call get_curve_columns(scene%path%channel, scene%supports%name, n_loads, &
+            scene%fabric_set > 0, names, kind, item)
+        header = trim(names(1))
+        do j = 2, size(names)
+            header = header // ',' // trim(names(j))
         end do
-        do s = 1, size(scene%supports)
-            name = trim(scene%supports(s)%name)
-            header = header // ',' // name // '_rx,' // name // '_ry,' // name // '_rz'
-        end do
-        do s = 1, size(scene%supports)
-            name = trim(scene%supports(s)%name)
-            header = header // ',' // name // '_ux,' // name // '_uy,' // name // '_uz'
-        end do
-        if (allocated(scene%loads)) then
-            do s = 1, size(scene%loads)
-                name = load_column_prefix(s)
-                header = header // ',' // name // '_ux,' // name // '_uy,' // name // '_uz'
-            end do
-        end if
-        if (scene%fabric_set > 0) header = header // ',strain,force_per_width'
-        header = header // ',direction,slipping,held,jumped,passages,newton_iterations,residual,' &
-            // 'step_cuts,wall_time'
     end function get_header
 
     subroutine write_step(self, scene, state, error)

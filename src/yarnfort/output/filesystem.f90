@@ -1,20 +1,29 @@
 ! SPDX-License-Identifier: MIT
 !> File-system calls Fortran has no portable statement for, through the C library and a
-!> small C shim (filesystem_shim.c): folder creation, atomic rename, removal, fsync, and
-!> the exclusive lock of an output folder.
+!> small C shim (filesystem_shim.c): folder creation, atomic rename, hard links, removal,
+!> fsync, and the exclusive lock of an output folder. No routine here writes, truncates or
+!> removes through a symbolic link: a link at a name the program writes is refused, so
+!> nothing outside the output folder is ever changed through one.
 module yarnfort_output_filesystem
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_long_long
     use yarnfort_error, only: error_type, fatal_error
     implicit none
     private
 
-    public :: make_folder, rename_file, remove_file, sync_file, folder_lock_type
+    public :: make_folder, rename_file, link_file, remove_file, sync_file, sync_folder
+    public :: folder_lock_type, get_links, refuse_link
     public :: close_checked, flush_checked, truncate_file, ignore_file_size_signal
     public :: open_append, open_new_file, close_new_file
-    public :: lock_file_name
+    public :: lock_file_name, probe_file_name
 
     !> The lock file of an output folder (kept; the lock is the kernel's, not the file).
     character(len=*), parameter :: lock_file_name = '.yarnfort-lock'
+    !> The file created and removed again to tell whether a folder can be written.
+    character(len=*), parameter :: probe_file_name = '.yarnfort-write-test'
+
+    !> What yarnfort_file_kind, yarnfort_create_file and yarnfort_lock_file tell of a
+    !> name: a symbolic link, or something else than a regular file of its own.
+    integer(c_int), parameter :: kind_link = 2, kind_other = 3
 
     !> An exclusive lock on an output folder, held from `acquire` to `release` (or the end
     !> of the process, however it ends: a killed run leaves no stale lock).
@@ -35,11 +44,32 @@ module yarnfort_output_filesystem
             integer(c_int) :: status
         end function c_mkdir
 
+        function c_rmdir(path) result(status) bind(C, name='rmdir')
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: status
+        end function c_rmdir
+
+        function c_list_links(folder, names, length) result(needed) &
+                bind(C, name='yarnfort_list_links')
+            import :: c_char, c_long_long
+            character(kind=c_char), intent(in) :: folder(*)
+            character(kind=c_char), intent(out) :: names(*)
+            integer(c_long_long), value :: length
+            integer(c_long_long) :: needed
+        end function c_list_links
+
         function c_rename(old, new) result(status) bind(C, name='rename')
             import :: c_int, c_char
             character(kind=c_char), intent(in) :: old(*), new(*)
             integer(c_int) :: status
         end function c_rename
+
+        function c_link(old, new) result(status) bind(C, name='yarnfort_link_file')
+            import :: c_int, c_char
+            character(kind=c_char), intent(in) :: old(*), new(*)
+            integer(c_int) :: status
+        end function c_link
 
         function c_lock_file(path, fd, holder, holder_length) result(status) &
                 bind(C, name='yarnfort_lock_file')
@@ -81,8 +111,9 @@ module yarnfort_output_filesystem
     end interface
 
     abstract interface
-        !> yarnfort_sync_file, yarnfort_remove_file: 0 on success, -1 on failure (the
-        !> reason: c_last_error).
+        !> yarnfort_sync_file, yarnfort_sync_folder, yarnfort_remove_file: 0 on success, -1
+        !> on failure (the reason: c_last_error); yarnfort_file_kind, yarnfort_create_file,
+        !> yarnfort_remove_regular_file: see filesystem_shim.c.
         function path_status_interface(path) result(status) bind(C)
             import :: c_int, c_char
             character(kind=c_char), intent(in) :: path(*)
@@ -99,7 +130,12 @@ module yarnfort_output_filesystem
     end interface
 
     procedure(path_status_interface), bind(C, name='yarnfort_sync_file') :: c_sync_file
+    procedure(path_status_interface), bind(C, name='yarnfort_sync_folder') :: c_sync_folder
     procedure(path_status_interface), bind(C, name='yarnfort_remove_file') :: c_remove_file
+    procedure(path_status_interface), bind(C, name='yarnfort_file_kind') :: c_file_kind
+    procedure(path_status_interface), bind(C, name='yarnfort_create_file') :: c_create_file
+    procedure(path_status_interface), bind(C, name='yarnfort_remove_regular_file') :: &
+        c_remove_regular_file
     procedure(path_bytes_interface), bind(C, name='yarnfort_file_size') :: c_file_size
     procedure(path_bytes_interface), bind(C, name='yarnfort_free_space') :: c_free_space
 
@@ -112,29 +148,104 @@ module yarnfort_output_filesystem
 contains
 
     !> Create `path` and its missing parents; an existing folder is fine. The error
-    !> names the folder that could not be created or written.
+    !> names the folder that could not be created or written; the folders this call
+    !> created are then removed again (a refused folder leaves nothing behind).
     subroutine make_folder(path, error)
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
-        integer :: i, status, unit
-        character(len=:), allocatable :: probe
-        character(len=text_length) :: message
+        character(len=:), allocatable :: folder, probe
+        integer, allocatable :: created(:)
+        integer(c_int) :: status
+        integer :: i
 
-        do i = 2, len_trim(path)
-            if (path(i:i) == '/') status = c_mkdir(path(1:i - 1) // c_null_char, folder_mode)
+        folder = trim(path)
+        ! The lengths of the prefixes of `folder` that mkdir created, shortest first.
+        allocate(created(0))
+        do i = 2, len(folder) + 1
+            if (i <= len(folder)) then
+                if (folder(i:i) /= '/') cycle
+            end if
+            if (c_mkdir(folder(:i - 1) // c_null_char, folder_mode) == 0) &
+                created = [created, i - 1]
         end do
-        status = c_mkdir(trim(path) // c_null_char, folder_mode)
         ! Whatever mkdir said, the folder is usable if a file can be created in it.
-        probe = trim(path) // '/.yarnfort-write-test'
-        open(newunit=unit, file=probe, status='replace', action='write', iostat=status, &
-            iomsg=message)
-        if (status /= 0) then
-            call fatal_error(error, "&output: folder '" // trim(path) &
-                // "' cannot be created or written: " // trim(message))
+        probe = folder // '/' // probe_file_name
+        status = c_create_file(probe // c_null_char)
+        if (status == 0) then
+            status = c_remove_file(probe // c_null_char)
             return
         end if
-        close(unit, status='delete')
+        if (status == -1) then
+            call fatal_error(error, "&output: folder '" // folder &
+                // "' cannot be created or written: " // get_reason())
+        else
+            call refuse_link(probe, status == kind_link, error)
+        end if
+        do i = size(created), 1, -1
+            status = c_rmdir(folder(:created(i)) // c_null_char)
+        end do
     end subroutine make_folder
+
+    !> The error for `path`, a name the program writes in its output folder, when a
+    !> symbolic link (`link`) or something else than a regular file is found there.
+    subroutine refuse_link(path, link, error)
+        character(len=*), intent(in) :: path
+        logical, intent(in) :: link
+        type(error_type), allocatable, intent(out) :: error
+
+        if (link) then
+            call fatal_error(error, "&output: '" // path // "' is a symbolic link; yarnfort " &
+                // 'writes no file through a link (remove it or choose another &output folder)')
+        else
+            call fatal_error(error, "&output: '" // path // "' is not a regular file of its " &
+                // 'own (a folder, a pipe or a file with other names); remove it or choose ' &
+                // 'another &output folder')
+        end if
+    end subroutine refuse_link
+
+    !> The names of the symbolic links in `folder`.
+    subroutine get_links(folder, names, error)
+        character(len=*), intent(in) :: folder
+        character(len=:), allocatable, intent(out) :: names(:)
+        type(error_type), allocatable, intent(out) :: error
+        character(kind=c_char, len=:), allocatable :: buffer
+        integer(c_long_long) :: needed
+        integer :: first, last, longest, n
+
+        allocate(character(len=1) :: names(0))
+        allocate(character(kind=c_char, len=256) :: buffer)
+        do
+            needed = c_list_links(folder // c_null_char, buffer, int(len(buffer), c_long_long))
+            if (needed < 0) then
+                call fatal_error(error, "&output: cannot read folder '" // folder // "': " &
+                    // get_reason())
+                return
+            end if
+            if (needed <= len(buffer)) exit
+            ! Links made while it was read may need more room still: read it again.
+            deallocate(buffer)
+            allocate(character(kind=c_char, len=needed + 256) :: buffer)
+        end do
+        ! NUL-ended names, one after the other.
+        n = 0
+        longest = 1
+        first = 1
+        do while (first <= needed)
+            last = first + index(buffer(first:needed), c_null_char) - 2
+            if (last < first - 1) exit
+            n = n + 1
+            longest = max(longest, last - first + 1)
+            first = last + 2
+        end do
+        deallocate(names)
+        allocate(character(len=longest) :: names(n))
+        first = 1
+        do n = 1, size(names)
+            last = first + index(buffer(first:needed), c_null_char) - 2
+            names(n) = buffer(first:last)
+            first = last + 2
+        end do
+    end subroutine get_links
 
     !> Rename `old` to `new`, replacing `new` if it exists. On POSIX systems this is
     !> atomic: `new` is always either the old file or the complete new one.
@@ -146,13 +257,30 @@ contains
             "cannot rename '" // old // "' to '" // new // "'", error)
     end subroutine rename_file
 
-    !> Remove the file `path`; a missing file is fine.
+    !> Give the file `old` the second name `new` (a hard link: one file, two names;
+    !> renaming another file over `old` later leaves `new` as it is). `new` must not exist.
+    !> `linked` is false, and no error, on a file system without hard links.
+    subroutine link_file(old, new, error, linked)
+        character(len=*), intent(in) :: old, new
+        type(error_type), allocatable, intent(out) :: error
+        logical, intent(out) :: linked
+        integer(c_int) :: status
+
+        status = c_link(old // c_null_char, new // c_null_char)
+        linked = status == 0
+        if (status /= 1) call check_call(status, "cannot link '" // old // "' to '" // new &
+            // "'", error)
+    end subroutine link_file
+
+    !> Remove `path` if it is a regular file; a symbolic link, a folder or anything else
+    !> of that name is left alone (no file the program writes is ever one), and a
+    !> missing file is fine.
     subroutine remove_file(path, error)
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
 
-        call check_call(c_remove_file(path // c_null_char), "cannot remove '" // path // "'", &
-            error)
+        if (c_remove_regular_file(path // c_null_char) == -1) &
+            call fatal_error(error, "cannot remove '" // path // "': " // get_reason())
     end subroutine remove_file
 
     !> Flush the closed file `path` to its device (fsync), so that a rename after it
@@ -164,6 +292,15 @@ contains
         call check_call(c_sync_file(path // c_null_char), &
             "cannot write '" // path // "' to disk", error)
     end subroutine sync_file
+
+    !> Flush the entries of the folder `path` (a rename in it) to its device.
+    subroutine sync_folder(path, error)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+
+        call check_call(c_sync_folder(path // c_null_char), &
+            "cannot write the entries of folder '" // path // "' to disk", error)
+    end subroutine sync_folder
 
     !> Cut the (closed) file `path` back to `bytes` bytes, e.g. to drop a line that could
     !> be written only in part.
@@ -186,22 +323,32 @@ contains
         if (status /= 0) call fatal_error(error, what // ': ' // get_reason())
     end subroutine check_call
 
-    !> Open the existing file `path` to append lines to it (`unit` = -1 on failure).
+    !> Open the existing file `path` to append lines to it (`unit` = -1 on failure; a
+    !> symbolic link is refused, not followed).
     subroutine open_append(unit, path, error)
         integer, intent(out) :: unit
         character(len=*), intent(in) :: path
         type(error_type), allocatable, intent(out) :: error
         character(len=text_length) :: message
+        integer(c_int) :: kind
         integer :: status
 
+        unit = -1
+        kind = c_file_kind(path // c_null_char)
+        if (kind == kind_link .or. kind == kind_other) then
+            call refuse_link(path, kind == kind_link, error)
+            return
+        end if
         message = ''
         open(newunit=unit, file=path, status='old', position='append', action='write', &
             iostat=status, iomsg=message)
         call check_open(unit, path, status, message, error)
     end subroutine open_append
 
-    !> Open `path` to write it anew (a file of that name is replaced): formatted lines, or
-    !> bytes with `stream` (`unit` = -1 on failure).
+    !> Open `path` to write it anew: formatted lines, or bytes with `stream` (`unit` = -1
+    !> on failure). A regular file of that name is replaced by a new one (so another name
+    !> of the old file, a hard link, keeps its content); a symbolic link or anything else
+    !> of that name is refused (yarnfort_create_file).
     subroutine open_new_file(unit, path, error, stream)
         integer, intent(out) :: unit
         character(len=*), intent(in) :: path
@@ -213,9 +360,18 @@ contains
 
         bytes = .false.
         if (present(stream)) bytes = stream
+        unit = -1
+        status = c_create_file(path // c_null_char)
+        if (status == kind_link .or. status == kind_other) then
+            call refuse_link(path, status == kind_link, error)
+            return
+        else if (status /= 0) then
+            call fatal_error(error, "cannot write '" // path // "': " // get_reason())
+            return
+        end if
         message = ''
         open(newunit=unit, file=path, access=merge('stream    ', 'sequential', bytes), &
-            form=merge('unformatted', 'formatted  ', bytes), status='replace', action='write', &
+            form=merge('unformatted', 'formatted  ', bytes), status='old', action='write', &
             iostat=status, iomsg=message)
         call check_open(unit, path, status, message, error)
     end subroutine open_new_file
@@ -324,7 +480,9 @@ contains
     end subroutine check_size
 
     !> Take the lock of `folder` (its file .yarnfort-lock). If another process holds it
-    !> the error says who (pid, host, since when); the lock then stays theirs.
+    !> the error says who (pid, host, since when); the lock then stays theirs. A lock
+    !> file that is a link or has other names is refused (the run's line is written
+    !> into it).
     subroutine acquire_lock(self, folder, error)
         class(folder_lock_type), intent(inout) :: self
         character(len=*), intent(in) :: folder
@@ -340,6 +498,8 @@ contains
         select case (status)
         case (0)
             self%fd = fd
+        case (kind_link, kind_other)
+            call refuse_link(folder // '/' // lock_file_name, status == kind_link, error)
         case (1)
             n = index(holder, c_null_char) - 1
             if (n < 0) n = len_trim(holder)

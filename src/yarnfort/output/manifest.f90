@@ -1,44 +1,60 @@
 ! SPDX-License-Identifier: MIT
 !> The manifest of an output folder, folder/.yarnfort-manifest: every file a run wrote
 !> there, so that a later run deletes only files of its own (never one named in a file
-!> another tool may have written, such as a foreign states.pvd). One entry a line:
+!> another tool may have written, such as a foreign states.pvd, nor a file of a name
+!> this program may write that no run of it wrote, such as one's own reactions.csv).
+!> One entry a line:
 !>
 !>     file <name>
 !>     state <name> <step> <time>
 !>
-!> A state is listed before its file is written (a kill in between leaves a listed file
-!> that is incomplete or missing, never an unlisted one). Only names this program writes
-!> are ever taken from the file (is_own_name), so a damaged or foreign manifest cannot
-!> make it delete anything else. The whole file is replaced atomically (tmp + rename);
-!> states are appended one line at a time.
+!> A name is listed when the run is about to create it (add_file, add_state), before the
+!> file exists: a kill in between leaves a listed file that is incomplete or missing,
+!> never an unlisted one. Only names this program writes are ever taken from the file
+!> (is_own_name), so a damaged or foreign manifest cannot make it delete anything else.
+!> The whole file is replaced atomically (tmp + rename); entries are appended one line
+!> at a time.
 module yarnfort_output_manifest
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, open_append, &
-        flush_checked, open_new_file, close_new_file
+        flush_checked, open_new_file, close_new_file, lock_file_name, probe_file_name
     implicit none
     private
 
     public :: manifest_type, manifest_file_name, is_own_name, is_state_name
+    public :: is_bookkeeping_name
 
     character(len=*), parameter :: manifest_file_name = '.yarnfort-manifest'
+
+    !> The files of the folder's bookkeeping (never listed, never deleted): the manifest
+    !> and its temporary, the lock and the write probe.
+    character(len=*), parameter :: bookkeeping_names(*) = [character(len=22) :: &
+        manifest_file_name, manifest_file_name // '.tmp', lock_file_name, probe_file_name]
 
     !> The fixed names a run may write (and their temporaries).
     character(len=*), parameter :: fixed_names(*) = [character(len=17) :: 'curve.csv', &
         'curve.csv.tmp', 'input.nml', 'input.nml.tmp', 'restart.dat', 'restart.dat.tmp', &
         'states.pvd', 'states.pvd.tmp', 'reactions.csv', 'reactions.csv.tmp', &
-        'contacts.csv', 'contacts.csv.tmp']
+        'contacts.csv', 'contacts.csv.tmp', 'restart.sync', 'restart.sync.tmp']
 
     !> Longest file name kept (state names are far shorter).
     integer, parameter :: entry_length = 64
 
     type :: manifest_type
         character(len=:), allocatable :: folder
-        !> Fixed files listed, and states with their step and pseudo-time.
+        !> Fixed files listed, and states with their step and pseudo-time (as loaded or
+        !> saved: add_state keeps the states it adds apart until save or settle).
         character(len=entry_length), allocatable :: files(:), states(:)
         integer, allocatable :: steps(:)
         real(wp), allocatable :: times(:)
         integer :: unit = -1
+        !> The states added since: the first n_added entries of arrays that grow by
+        !> doubling, so that adding one costs constant time on average.
+        character(len=entry_length), allocatable, private :: added_states(:)
+        integer, allocatable, private :: added_steps(:)
+        real(wp), allocatable, private :: added_times(:)
+        integer, private :: n_added = 0
     contains
         !> Read folder's manifest (none: empty); `found` tells whether there was one.
         procedure :: load
@@ -47,9 +63,13 @@ module yarnfort_output_manifest
         procedure :: save
         !> Append a state about to be written.
         procedure :: add_state
+        !> Append a fixed name about to be written (once; saved first if not open).
+        procedure :: add_file
+        !> Whether a fixed name is listed (written by a run of ours).
+        procedure :: has_file
+        !> Move the states added since the last save into states, steps and times.
+        procedure :: settle
         procedure :: close => close_manifest
-        !> Set the fixed files to every name a run may write.
-        procedure :: list_fixed_files
     end type manifest_type
 
 contains
@@ -69,6 +89,7 @@ contains
         allocate(character(len=entry_length) :: self%files(0), self%states(0))
         self%steps = [integer :: ]
         self%times = [real(wp) :: ]
+        self%n_added = 0
         open(newunit=unit, file=folder // '/' // manifest_file_name, status='old', &
             action='read', iostat=status)
         found = status == 0
@@ -91,19 +112,43 @@ contains
                     step = huge(step)
                     time = 0.0_wp
                 end if
-                self%states = [self%states, name]
-                self%steps = [self%steps, step]
-                self%times = [self%times, time]
+                call add_entry(self, name, step, time)
             end select
         end do
         close(unit)
+        call self%settle()
     end subroutine load
 
-    subroutine list_fixed_files(self)
+    pure logical function has_file(self, name)
+        class(manifest_type), intent(in) :: self
+        character(len=*), intent(in) :: name
+        has_file = .false.
+        if (allocated(self%files)) has_file = any(self%files == name)
+    end function has_file
+
+    subroutine add_file(self, name, error)
         class(manifest_type), intent(inout) :: self
-        integer :: i
-        self%files = [(fixed_names(i), i = 1, size(fixed_names))]
-    end subroutine list_fixed_files
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        character(len=256) :: message
+        integer :: status
+
+        if (self%has_file(name)) return
+        if (self%unit == -1) then
+            call self%save(error)
+            if (allocated(error)) return
+        end if
+        message = ''
+        write(self%unit, '(a)', iostat=status, iomsg=message) 'file ' // name
+        if (status /= 0) then
+            call fatal_error(error, "cannot write '" // self%folder // '/' &
+                // manifest_file_name // "': " // trim(message))
+            return
+        end if
+        call flush_checked(self%unit, self%folder // '/' // manifest_file_name, error)
+        if (allocated(error)) return
+        self%files = [self%files, [character(len=entry_length) :: name]]
+    end subroutine add_file
 
     subroutine save(self, error)
         class(manifest_type), intent(inout) :: self
@@ -114,6 +159,7 @@ contains
         integer :: unit, status, i
 
         call self%close()
+        call self%settle()
         path = self%folder // '/' // manifest_file_name
         temporary = path // '.tmp'
         call open_new_file(unit, temporary, error)
@@ -162,10 +208,47 @@ contains
         end if
         call flush_checked(self%unit, self%folder // '/' // manifest_file_name, error)
         if (allocated(error)) return
-        self%states = [self%states, [character(len=entry_length) :: name]]
-        self%steps = [self%steps, step]
-        self%times = [self%times, time]
+        call add_entry(self, name, step, time)
     end subroutine add_state
+
+    !> Keep a state apart (settle moves it into the lists), doubling the room when full.
+    subroutine add_entry(self, name, step, time)
+        class(manifest_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: step
+        real(wp), intent(in) :: time
+        character(len=entry_length), allocatable :: states(:)
+        integer, allocatable :: steps(:)
+        real(wp), allocatable :: times(:)
+        integer :: room
+
+        if (.not. allocated(self%added_states)) &
+            allocate(self%added_states(16), self%added_steps(16), self%added_times(16))
+        if (self%n_added == size(self%added_states)) then
+            room = 2 * size(self%added_states)
+            allocate(states(room), steps(room), times(room))
+            states(:self%n_added) = self%added_states(:self%n_added)
+            steps(:self%n_added) = self%added_steps(:self%n_added)
+            times(:self%n_added) = self%added_times(:self%n_added)
+            call move_alloc(states, self%added_states)
+            call move_alloc(steps, self%added_steps)
+            call move_alloc(times, self%added_times)
+        end if
+        self%n_added = self%n_added + 1
+        self%added_states(self%n_added) = name
+        self%added_steps(self%n_added) = step
+        self%added_times(self%n_added) = time
+    end subroutine add_entry
+
+    subroutine settle(self)
+        class(manifest_type), intent(inout) :: self
+
+        if (self%n_added == 0) return
+        self%states = [self%states, self%added_states(:self%n_added)]
+        self%steps = [self%steps, self%added_steps(:self%n_added)]
+        self%times = [self%times, self%added_times(:self%n_added)]
+        self%n_added = 0
+    end subroutine settle
 
     subroutine put_state(unit, name, step, time, status, message)
         integer, intent(in) :: unit
@@ -184,6 +267,12 @@ contains
         if (self%unit /= -1) close(self%unit, iostat=status)
         self%unit = -1
     end subroutine close_manifest
+
+    !> A file of the folder's bookkeeping: the manifest, its temporary, the lock, the probe.
+    pure logical function is_bookkeeping_name(name)
+        character(len=*), intent(in) :: name
+        is_bookkeeping_name = any(bookkeeping_names == name)
+    end function is_bookkeeping_name
 
     !> A name this program writes into an output folder: a fixed name, or a state file.
     pure logical function is_own_name(name)

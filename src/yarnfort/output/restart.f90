@@ -2,7 +2,14 @@
 !> The restart file, folder/restart.dat: the snapshot of the last converged step
 !> (yarnfort_solver_restart), rewritten after every step. It is written to
 !> restart.dat.tmp and renamed over restart.dat, so a run killed at any moment leaves
-!> either the previous complete file or the new one.
+!> either the previous complete file or the new one (a kill loses no written data: no
+!> fsync is needed for that). Flushing it to the device, which only a power cut or a
+!> crash of the system needs, is the caller's choice per write (`sync`; see
+!> docs/decisions.md, "restart.dat is flushed to disk by time, not by step"): the file
+!> is fsync'ed before its rename, gets the second name restart.sync (a hard link, so
+!> that the unflushed files renamed over restart.dat later leave it as it is), and the
+!> folder is fsync'ed after the renames. After a power cut restart.sync is the restart
+!> file of the last flush, whatever became of restart.dat.
 !>
 !> Binary (unformatted stream, native byte order, full precision), version 4:
 !>     'yarnfort-restart' (16 characters), version (integer),
@@ -28,15 +35,17 @@ module yarnfort_output_restart
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_text, only: resolve_path, format_integer, format_real, join_names
     use yarnfort_solver_restart, only: restart_type, stepper_elastic, stepper_friction
-    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, close_checked, &
-        open_new_file, close_new_file
+    use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, sync_folder, &
+        link_file, close_checked, open_new_file, close_new_file
     implicit none
     private
 
     public :: restart_file_name, write_restart, read_restart, check_restart
-    public :: remove_restart, get_input_hash
+    public :: remove_restart, get_input_hash, sync_restart, synced_file_name
 
     character(len=*), parameter :: restart_file_name = 'restart.dat'
+    !> The restart file of the last flush to disk (sync_restart, write_restart's `sync`).
+    character(len=*), parameter :: synced_file_name = 'restart.sync'
     character(len=16), parameter :: magic = 'yarnfort-restart'
     character(len=16), parameter :: end_marker = 'end-of-restart'
     integer, parameter :: format_version = 4
@@ -61,17 +70,21 @@ module yarnfort_output_restart
 
 contains
 
-    !> Write `snapshot` (stamped with `input_hash`) to folder/restart.dat atomically.
-    subroutine write_restart(folder, snapshot, input_hash, error)
+    !> Write `snapshot` (stamped with `input_hash`) to folder/restart.dat atomically;
+    !> with `sync` (default true) also flushed to the device before it replaces the
+    !> previous file, kept as restart.sync too, and the renames flushed after it.
+    subroutine write_restart(folder, snapshot, input_hash, error, sync)
         character(len=*), intent(in) :: folder
         type(restart_type), intent(in) :: snapshot
         character(len=*), intent(in) :: input_hash
         type(error_type), allocatable, intent(out) :: error
+        logical, intent(in), optional :: sync
         character(len=:), allocatable :: path, temporary
         character(len=16) :: stamp, stepper
         character(len=256) :: message
         type(error_type), allocatable :: ignored
         integer :: unit, status
+        logical :: flush_now
 
         path = folder // '/' // restart_file_name
         temporary = path // '.tmp'
@@ -112,11 +125,22 @@ contains
             error%message = error%message // kept()
             return
         end if
+        if (present(sync)) then
+            flush_now = sync
+        else
+            flush_now = .true.
+        end if
         ! On disk before it replaces the previous file: a crash of the machine cannot
         ! leave an empty restart file behind.
-        call sync_file(temporary, error)
+        if (flush_now) call sync_file(temporary, error)
+        if (flush_now .and. .not. allocated(error)) call keep_synced(folder, temporary, error)
         if (.not. allocated(error)) call rename_file(temporary, path, error)
-        if (allocated(error)) call remove_file(temporary, ignored)
+        if (allocated(error)) then
+            call remove_file(temporary, ignored)
+            return
+        end if
+        ! The folder holds the rename: on disk too, or a crash may bring back the old file.
+        if (flush_now) call sync_folder(folder, error)
     contains
         !> What the failure leaves: the previous restart file, if there is one.
         function kept() result(text)
@@ -141,14 +165,15 @@ contains
         end subroutine put_reals
     end subroutine write_restart
 
-    !> Read folder/restart.dat into `snapshot`. The error says whether the file is
-    !> missing, not a restart file, of another version, cut short or too long, or holds
-    !> sizes that do not fit its length (checked before anything is allocated, so a
-    !> damaged size field cannot ask for memory).
-    subroutine read_restart(folder, snapshot, error)
+    !> Read folder/restart.dat (or folder/`name`) into `snapshot`. The error says whether
+    !> the file is missing, not a restart file, of another version, cut short or too
+    !> long, or holds sizes that do not fit its length (checked before anything is
+    !> allocated, so a damaged size field cannot ask for memory).
+    subroutine read_restart(folder, snapshot, error, name)
         character(len=*), intent(in) :: folder
         type(restart_type), intent(out) :: snapshot
         type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in), optional :: name
         character(len=:), allocatable :: path
         character(len=16) :: header, marker, checksum
         character(len=32) :: text
@@ -158,6 +183,7 @@ contains
         logical :: exists
 
         path = folder // '/' // restart_file_name
+        if (present(name)) path = folder // '/' // name
         inquire(file=path, exist=exists)
         if (.not. exists) then
             call fatal_error(error, "&control restart: no restart file '" // path &
@@ -432,22 +458,60 @@ contains
         end function finite_state
     end subroutine check_restart
 
-    !> Delete folder/restart.dat if there is one and it is a yarnfort restart file (a
-    !> new run starts from the beginning); any other file of that name is left alone.
+    !> Flush folder/restart.dat, written without `sync`, to the device, keep it as
+    !> restart.sync too, and flush the folder (which holds the renames). No restart file
+    !> is fine (no step converged).
+    subroutine sync_restart(folder, error)
+        character(len=*), intent(in) :: folder
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: path
+        logical :: exists
+
+        path = folder // '/' // restart_file_name
+        inquire(file=path, exist=exists)
+        if (exists) call sync_file(path, error)
+        if (exists .and. .not. allocated(error)) call keep_synced(folder, path, error)
+        if (.not. allocated(error)) call sync_folder(folder, error)
+    end subroutine sync_restart
+
+    !> Give the flushed restart file `path` the name folder/restart.sync, atomically
+    !> (a link under restart.sync.tmp renamed over it). A file system without hard links
+    !> keeps the restart.sync of earlier flushes, if any (still one the tables hold).
+    subroutine keep_synced(folder, path, error)
+        character(len=*), intent(in) :: folder, path
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: synced
+        logical :: linked
+
+        synced = folder // '/' // synced_file_name
+        ! A link left by a kill would make link() fail.
+        call remove_file(synced // '.tmp', error)
+        if (.not. allocated(error)) call link_file(path, synced // '.tmp', error, linked)
+        if (.not. allocated(error) .and. linked) call rename_file(synced // '.tmp', synced, &
+            error)
+    end subroutine keep_synced
+
+    !> Delete folder/restart.dat and folder/restart.sync, each if it is a yarnfort
+    !> restart file (a new run starts from the beginning); any other file of those names
+    !> is left alone.
     subroutine remove_restart(folder)
         character(len=*), intent(in) :: folder
+        type(error_type), allocatable :: ignored
         character(len=16) :: header
-        integer :: unit, status
+        integer :: unit, status, i
+        character(len=*), parameter :: names(2) = [character(len=len(restart_file_name)) &
+            :: restart_file_name, synced_file_name]
 
-        open(newunit=unit, file=folder // '/' // restart_file_name, status='old', &
-            access='stream', form='unformatted', action='read', iostat=status)
-        if (status /= 0) return
-        read(unit, iostat=status) header
-        if (status == 0 .and. header == magic) then
-            close(unit, status='delete')
-        else
+        do i = 1, size(names)
+            open(newunit=unit, file=folder // '/' // trim(names(i)), status='old', &
+                access='stream', form='unformatted', action='read', iostat=status)
+            if (status /= 0) cycle
+            read(unit, iostat=status) header
             close(unit)
-        end if
+            ! (A regular file only: a link of that name is left alone.)
+            if (status == 0 .and. header == magic) &
+                call remove_file(folder // '/' // trim(names(i)), ignored)
+        end do
     end subroutine remove_restart
 
     !> Fingerprint (16 hex digits) of what determines a run's path: the effective input

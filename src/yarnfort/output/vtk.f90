@@ -37,18 +37,24 @@ module yarnfort_output_vtk
     public :: vtk_writer_type, get_state_name, collection_file_name
 
     character(len=*), parameter :: collection_file_name = 'states.pvd'
+    !> Longest state file name kept (get_state_name's are far shorter).
+    integer, parameter :: state_name_length = 64
 
     type :: vtk_writer_type
         character(len=:), allocatable :: folder
         !> Inline ASCII data instead of appended base64 binary.
         logical :: ascii = .false.
-        !> Files written so far and their times, for the collection file.
-        character(len=64), allocatable :: files(:)
+        !> Files written so far (the first n_files entries; the arrays grow by doubling,
+        !> so that adding one costs constant time on average) and their times.
+        character(len=state_name_length), allocatable :: files(:)
         real(wp), allocatable :: times(:)
+        integer :: n_files = 0
         !> Entries of states.pvd when it was last rewritten.
         integer :: listed = -1
     contains
         procedure :: write_state
+        !> Start the list of states anew with `files` and their `times`.
+        procedure :: set_files
         !> Rewrite states.pvd (atomically) with every state written so far.
         procedure :: write_collection
     end type vtk_writer_type
@@ -220,36 +226,87 @@ contains
         call write_text_file(path, vtu%xml, error)
         if (allocated(error)) return
 
-        if (.not. allocated(self%files)) allocate(self%files(0), self%times(0))
-        self%files = [self%files, [character(len=64) :: name]]
-        self%times = [self%times, state%time]
-        if (size(self%files) <= collection_always .or. &
-                real(size(self%files) - self%listed, wp) > collection_lag * size(self%files)) &
+        call add_file(self, name, state%time)
+        if (self%n_files <= collection_always .or. &
+                real(self%n_files - self%listed, wp) > collection_lag * self%n_files) &
             call self%write_collection(error)
     end subroutine write_state
 
-    !> Write states.pvd.tmp and rename it over states.pvd.
+    subroutine set_files(self, files, times)
+        class(vtk_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: files(:)
+        real(wp), intent(in) :: times(:)
+        integer :: i
+
+        if (allocated(self%files)) deallocate(self%files, self%times)
+        allocate(self%files(max(size(files), 16)), self%times(max(size(files), 16)))
+        self%n_files = 0
+        do i = 1, size(files)
+            call add_file(self, files(i), times(i))
+        end do
+    end subroutine set_files
+
+    !> Append a state file to the list, doubling the arrays when they are full.
+    subroutine add_file(self, name, time)
+        class(vtk_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        real(wp), intent(in) :: time
+        character(len=state_name_length), allocatable :: files(:)
+        real(wp), allocatable :: times(:)
+
+        if (.not. allocated(self%files)) allocate(self%files(16), self%times(16))
+        if (self%n_files == size(self%files)) then
+            allocate(files(2 * size(self%files)), times(2 * size(self%files)))
+            files(:self%n_files) = self%files(:self%n_files)
+            times(:self%n_files) = self%times(:self%n_files)
+            call move_alloc(files, self%files)
+            call move_alloc(times, self%times)
+        end if
+        self%n_files = self%n_files + 1
+        self%files(self%n_files) = name
+        self%times(self%n_files) = time
+    end subroutine add_file
+
+    !> Write states.pvd.tmp and rename it over states.pvd. The text is built in one
+    !> buffer sized for every entry, so a rewrite costs time linear in its entries.
     subroutine write_collection(self, error)
         class(vtk_writer_type), intent(inout) :: self
         type(error_type), allocatable, intent(out) :: error
+        character(len=*), parameter :: head = '<?xml version="1.0"?>' // achar(10) &
+            // '<VTKFile type="Collection" version="0.1">' // achar(10) // '<Collection>' &
+            // achar(10)
+        character(len=*), parameter :: tail = '</Collection></VTKFile>' // achar(10)
+        character(len=*), parameter :: before_time = '<DataSet timestep="', &
+            before_file = '" file="', after_file = '"/>' // achar(10)
+        !> The longest entry: its fixed text, a time (es24.16e3) and a file name.
+        integer, parameter :: entry_length = len(before_time) + 24 + len(before_file) &
+            + state_name_length + len(after_file)
         character(len=:), allocatable :: text
-        character(len=32) :: time
-        integer :: i
+        character(len=24) :: time
+        integer :: i, used
 
-        if (.not. allocated(self%files)) allocate(self%files(0), self%times(0))
-        text = '<?xml version="1.0"?>' // new_line('a') &
-            // '<VTKFile type="Collection" version="0.1">' // new_line('a') &
-            // '<Collection>' // new_line('a')
-        do i = 1, size(self%files)
+        allocate(character(len=len(head) + entry_length * self%n_files + len(tail)) :: text)
+        used = 0
+        call put(head)
+        do i = 1, self%n_files
             write(time, '(es24.16e3)') self%times(i)
-            text = text // '<DataSet timestep="' // trim(adjustl(time)) // '" file="' &
-                // trim(self%files(i)) // '"/>' // new_line('a')
+            call put(before_time)
+            call put(trim(adjustl(time)))
+            call put(before_file)
+            call put(trim(self%files(i)))
+            call put(after_file)
         end do
-        text = text // '</Collection></VTKFile>' // new_line('a')
-        call write_text_file(self%folder // '/' // collection_file_name, text, error, &
+        call put(tail)
+        call write_text_file(self%folder // '/' // collection_file_name, text(:used), error, &
             atomic=.true.)
         if (allocated(error)) return
-        self%listed = size(self%files)
+        self%listed = self%n_files
+    contains
+        subroutine put(piece)
+            character(len=*), intent(in) :: piece
+            text(used + 1:used + len(piece)) = piece
+            used = used + len(piece)
+        end subroutine put
     end subroutine write_collection
 
     !> Write `text` to `path` (a stream, so lines of any length), checking every write

@@ -1,29 +1,35 @@
 ! SPDX-License-Identifier: MIT
 !> The step observer that writes a run's files: curve.csv after every converged step, a
 !> VTK state every `vtk_every` steps (and always the last one, written by `finish`), and
-!> the restart file of every converged step. It holds the output folder's lock from
+!> the restart file of every converged step, flushed to disk with the tables at most
+!> every `sync_interval` seconds and by `finish`. It holds the output folder's lock from
 !> `open` (or `lock`) to `finish`, and lists every file it writes in the folder's
-!> manifest (yarnfort_output_manifest): a new run deletes only files listed there.
+!> manifest (yarnfort_output_manifest), as it first creates it: a new run deletes only
+!> files listed there. A symbolic link at any name it writes is refused when the folder
+!> is locked, before anything is deleted or written.
 !> Every write is checked; a failed one ends the run with an error (`failed` is then
 !> set), and what was written before it stays.
 module yarnfort_output_writer
+    use, intrinsic :: iso_fortran_env, only: int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type
     use yarnfort_input_echo, only: write_config
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_observer_type, step_state_type
-    use yarnfort_output_curve, only: curve_writer_type
+    use yarnfort_output_curve, only: curve_writer_type, curve_file_name
     use yarnfort_output_reactions, only: reactions_file_name, reactions_header, &
         get_reaction_rows
     use yarnfort_output_contacts, only: contacts_file_name, contacts_header, &
         get_contact_rows
-    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name
+    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, collection_file_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
-        remove_file, lock_file_name, open_new_file, close_new_file
-    use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name
+        remove_file, open_new_file, close_new_file, get_links, refuse_link, sync_file
+    use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name, &
+        is_bookkeeping_name
     use yarnfort_solver_restart, only: restart_type
-    use yarnfort_output_restart, only: write_restart, remove_restart
+    use yarnfort_output_restart, only: write_restart, remove_restart, restart_file_name, &
+        sync_restart, synced_file_name
     implicit none
     private
 
@@ -31,6 +37,10 @@ module yarnfort_output_writer
 
     !> The effective input, echoed for provenance.
     character(len=*), parameter :: input_file_name = 'input.nml'
+    !> Least seconds between two flushes of the tables and restart.dat to disk (fsync): a
+    !> power cut loses about this much of a run, and a flush costs a few ms (docs/
+    !> decisions.md, "restart.dat is flushed to disk by time, not by step").
+    real(wp), parameter :: sync_interval = 10.0_wp
 
     type, extends(step_observer_type) :: output_writer_type
         character(len=:), allocatable :: folder
@@ -58,6 +68,10 @@ module yarnfort_output_writer
         character(len=16) :: input_hash = ''
         !> A write to the folder failed (the error of on_step or on_checkpoint).
         logical :: failed = .false.
+        !> The clock count of the last flush to disk (or of open), and whether a restart
+        !> file was written since.
+        integer(int64) :: synced_at = 0
+        logical :: unsynced = .false.
     contains
         !> Create the folder if needed and take its lock (also done by open).
         procedure :: lock => lock_writer
@@ -74,7 +88,8 @@ module yarnfort_output_writer
 contains
 
     !> Take the lock of the scene's output folder (created when missing, unless
-    !> `create` is false: then a missing folder is left alone and not locked).
+    !> `create` is false: then a missing folder is left alone and not locked), and
+    !> refuse a folder with a symbolic link at a name the program writes.
     subroutine lock_writer(self, folder, error, create)
         class(output_writer_type), intent(inout) :: self
         character(len=*), intent(in) :: folder
@@ -93,7 +108,39 @@ contains
         call make_folder(self%folder, error)
         if (allocated(error)) return
         call self%folder_lock%acquire(self%folder, error)
+        if (allocated(error)) return
+        call check_links(self%folder, error)
+        if (allocated(error)) call self%folder_lock%release()
     end subroutine lock_writer
+
+    !> Refuse a symbolic link in `folder` at a name the program writes (its files, their
+    !> temporaries, the states, the manifest, the lock, the probe): a write there would
+    !> follow it out of the folder. (Writes refuse links too; this says so before the run.)
+    subroutine check_links(folder, error)
+        character(len=*), intent(in) :: folder
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: names(:)
+        integer :: i
+
+        call get_links(folder, names, error)
+        if (allocated(error)) return
+        do i = 1, size(names)
+            if (is_own_name(trim(names(i))) .or. is_bookkeeping_name(trim(names(i)))) then
+                call refuse_link(folder // '/' // trim(names(i)), .true., error)
+                return
+            end if
+        end do
+    end subroutine check_links
+
+    !> List a file written through `name`.tmp renamed to `name`: both names.
+    subroutine list_atomic_file(self, name, error)
+        class(output_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%manifest%add_file(name // '.tmp', error)
+        if (.not. allocated(error)) call self%manifest%add_file(name, error)
+    end subroutine list_atomic_file
 
     !> Lock the output folder, delete the files an earlier run listed in its manifest,
     !> and start the curve file; with `resume_step` (a restart), continue the folder's
@@ -112,6 +159,7 @@ contains
         self%node_reactions = scene%output%node_reactions
         self%contact_state = scene%output%contact_state .and. scene%passages%size() > 0
         self%vtk%ascii = trim(scene%output%vtk_format) == 'ascii'
+        call system_clock(self%synced_at)
         call self%lock(scene%output%folder, error)
         if (.not. allocated(error)) then
             self%vtk%folder = self%folder
@@ -120,18 +168,21 @@ contains
                 call resume_files(self, scene, resume_step, error, resume_time, &
                     resume_previous_time)
             else
-                call start_files(self, scene, error)
+                call start_files(self, scene, found, error)
                 if (.not. allocated(error)) call start_contacts(self, error)
             end if
         end if
         if (allocated(error)) call self%folder_lock%release()
     end subroutine open_writer
 
-    !> A new run: delete what the manifest lists (the files of an earlier run) and a
-    !> restart file of ours, then list the fixed names and start the curve file.
-    subroutine start_files(self, scene, error)
+    !> A new run: delete what the manifest lists (the files an earlier run wrote; regular
+    !> files only), or without a manifest a restart file of ours, then start the manifest
+    !> anew, empty, and the curve file.
+    subroutine start_files(self, scene, listed, error)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
+        !> The folder has a manifest.
+        logical, intent(in) :: listed
         type(error_type), allocatable, intent(out) :: error
         integer :: i
 
@@ -144,20 +195,21 @@ contains
             if (allocated(error)) return
         end do
         ! A restart file of an earlier version (no manifest) must not survive either:
-        ! removed when it is one of ours.
-        call remove_restart(self%folder)
+        ! removed when its header says it is one of ours.
+        if (.not. listed) call remove_restart(self%folder)
         self%manifest%states = self%manifest%states(:0)
         self%manifest%steps = self%manifest%steps(:0)
         self%manifest%times = self%manifest%times(:0)
-        call self%manifest%list_fixed_files()
+        self%manifest%files = self%manifest%files(:0)
         call self%manifest%save(error)
         if (allocated(error)) return
-        if (allocated(self%vtk%files)) deallocate(self%vtk%files, self%vtk%times)
-        allocate(self%vtk%files(0), self%vtk%times(0))
-        call self%curve%open(self%folder, scene, error)
+        call self%vtk%set_files([character(len=1) :: ], [real(wp) :: ])
+        call self%manifest%add_file(curve_file_name, error)
+        if (.not. allocated(error)) call self%curve%open(self%folder, scene, error)
         if (allocated(error) .or. .not. self%node_reactions) return
-        call self%reactions%open_table(self%folder, reactions_file_name, reactions_header, &
-            error)
+        call self%manifest%add_file(reactions_file_name, error)
+        if (.not. allocated(error)) call self%reactions%open_table(self%folder, &
+            reactions_file_name, reactions_header, error)
     end subroutine start_files
 
     !> Start contacts.csv when it is asked for.
@@ -165,13 +217,17 @@ contains
         class(output_writer_type), intent(inout) :: self
         type(error_type), allocatable, intent(out) :: error
 
-        if (self%contact_state) call self%contacts%open_table(self%folder, &
+        if (.not. self%contact_state) return
+        call self%manifest%add_file(contacts_file_name, error)
+        if (.not. allocated(error)) call self%contacts%open_table(self%folder, &
             contacts_file_name, contacts_header, error)
     end subroutine start_contacts
 
     !> A restart after `step`: keep curve rows and the listed states up to that step,
     !> delete the listed states after it (and any that is incomplete), and rewrite the
-    !> manifest and states.pvd with what is kept.
+    !> manifest and states.pvd with what is kept. A listed reactions.csv or contacts.csv
+    !> this run does not write is deleted (its rows would contradict this run's); one
+    !> that is not listed is not ours and stays.
     subroutine resume_files(self, scene, step, error, time, previous_time)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
@@ -181,21 +237,25 @@ contains
         logical, allocatable :: keep(:)
         integer :: i
 
+        call list_atomic_file(self, curve_file_name, error)
+        if (allocated(error)) return
         call self%curve%resume(self%folder, scene, step, error, time, previous_time)
         if (allocated(error)) return
         if (self%node_reactions) then
-            call self%reactions%resume_table(self%folder, reactions_file_name, &
-                reactions_header, step, error, row_required=has_constrained_nodes(scene))
+            call list_atomic_file(self, reactions_file_name, error)
+            if (.not. allocated(error)) call self%reactions%resume_table(self%folder, &
+                reactions_file_name, reactions_header, step, error, &
+                row_required=has_constrained_nodes(scene))
         else
-            ! Rows of the first run beyond this step would contradict this one's.
-            call remove_file(self%folder // '/' // reactions_file_name, error)
+            call drop_file(self, reactions_file_name, error)
         end if
         if (allocated(error)) return
         if (self%contact_state) then
-            call self%contacts%resume_table(self%folder, contacts_file_name, &
-                contacts_header, step, error)
+            call list_atomic_file(self, contacts_file_name, error)
+            if (.not. allocated(error)) call self%contacts%resume_table(self%folder, &
+                contacts_file_name, contacts_header, step, error)
         else
-            call remove_file(self%folder // '/' // contacts_file_name, error)
+            call drop_file(self, contacts_file_name, error)
         end if
         if (allocated(error)) return
         allocate(keep(size(self%manifest%states)))
@@ -213,13 +273,29 @@ contains
         self%manifest%states = pack(self%manifest%states, keep)
         self%manifest%steps = pack(self%manifest%steps, keep)
         self%manifest%times = pack(self%manifest%times, keep)
-        call self%manifest%list_fixed_files()
         call self%manifest%save(error)
         if (allocated(error)) return
-        self%vtk%files = self%manifest%states
-        self%vtk%times = self%manifest%times
-        call self%vtk%write_collection(error)
+        call self%vtk%set_files(self%manifest%states, self%manifest%times)
+        call list_atomic_file(self, collection_file_name, error)
+        if (.not. allocated(error)) call self%vtk%write_collection(error)
     end subroutine resume_files
+
+    !> A restart that does not write the table `name`: delete it if a run of ours wrote
+    !> it (listed), and list it no more; leave it alone otherwise.
+    subroutine drop_file(self, name, error)
+        class(output_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        logical, allocatable :: keep(:)
+
+        if (.not. self%manifest%has_file(name)) return
+        call remove_file(self%folder // '/' // name, error)
+        if (allocated(error)) return
+        keep = self%manifest%files /= name .and. self%manifest%files /= name // '.tmp'
+        call remove_file(self%folder // '/' // name // '.tmp', error)
+        if (allocated(error)) return
+        self%manifest%files = pack(self%manifest%files, keep)
+    end subroutine drop_file
 
     !> Whether a state file is whole: it ends with the closing tag.
     logical function is_complete(path)
@@ -252,6 +328,8 @@ contains
 
         path = self%folder // '/' // input_file_name
         temporary = path // '.tmp'
+        call list_atomic_file(self, input_file_name, error)
+        if (allocated(error)) return
         call open_new_file(unit, temporary, error)
         if (allocated(error)) then
             call remove_file(temporary, ignored)
@@ -299,6 +377,7 @@ contains
         type(scene_type), intent(in) :: scene
         type(restart_type), intent(in) :: snapshot
         type(error_type), allocatable, intent(out) :: error
+        logical :: due
 
         if (allocated(snapshot%mode)) then
             self%last_mode = snapshot%mode
@@ -327,9 +406,48 @@ contains
             call write_last_state(self, scene, error)
             if (allocated(error)) return
         end if
-        call write_restart(self%folder, snapshot, self%input_hash, error)
-        if (allocated(error)) self%failed = .true.
+        ! Flushed when due: the tables first, so that the rows of the restart's step
+        ! are on disk when it is.
+        due = seconds_since(self%synced_at) >= sync_interval
+        call list_atomic_file(self, restart_file_name, error)
+        if (.not. allocated(error)) call list_atomic_file(self, synced_file_name, error)
+        if (due .and. .not. allocated(error)) call sync_tables(self, error)
+        if (.not. allocated(error)) &
+            call write_restart(self%folder, snapshot, self%input_hash, error, sync=due)
+        if (allocated(error)) then
+            self%failed = .true.
+            return
+        end if
+        self%unsynced = .not. due
+        if (due) call system_clock(self%synced_at)
     end subroutine on_checkpoint
+
+    !> Seconds since the clock count `start`.
+    real(wp) function seconds_since(start)
+        integer(int64), intent(in) :: start
+        integer(int64) :: now, rate
+
+        call system_clock(now, rate)
+        seconds_since = real(now - start, wp) / real(max(rate, 1_int64), wp)
+    end function seconds_since
+
+    !> Flush the per-step tables (their rows are already written and flushed to the
+    !> system) and the manifest to disk.
+    subroutine sync_tables(self, error)
+        class(output_writer_type), intent(inout) :: self
+        type(error_type), allocatable, intent(out) :: error
+
+        call sync_table(self%curve)
+        if (.not. allocated(error)) call sync_table(self%reactions)
+        if (.not. allocated(error)) call sync_table(self%contacts)
+        if (.not. allocated(error)) call sync_file(self%folder // '/' // manifest_file_name, &
+            error)
+    contains
+        subroutine sync_table(table)
+            type(curve_writer_type), intent(in) :: table
+            if (allocated(table%path)) call sync_file(table%path, error)
+        end subroutine sync_table
+    end subroutine sync_tables
 
     !> The VTK state of the last step: listed in the manifest, then written.
     subroutine write_last_state(self, scene, error)
@@ -337,8 +455,10 @@ contains
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
 
-        call self%manifest%add_state(get_state_name(self%last%step), self%last%step, &
-            self%last%time, error)
+        ! The first state is followed by states.pvd at once (vtk%write_state).
+        call list_atomic_file(self, collection_file_name, error)
+        if (.not. allocated(error)) call self%manifest%add_state(get_state_name( &
+            self%last%step), self%last%step, self%last%time, error)
         if (.not. allocated(error)) then
             if (.not. allocated(self%last_mode)) self%last_mode = [integer :: ]
             if (.not. allocated(self%last_flow)) self%last_flow = [real(wp) :: ]
@@ -359,22 +479,33 @@ contains
     end subroutine note_written
 
     !> Write the last converged state if it was skipped and states.pvd complete, close
-    !> the files and release the folder's lock.
+    !> the files, flush the tables and restart.dat to disk if they were not since the
+    !> last restart file, and release the folder's lock.
     subroutine finish(self, scene, error)
         class(output_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
         type(error_type), allocatable, intent(out) :: error
+        type(error_type), allocatable :: sync_error
 
         if (.not. self%last_written .and. self%vtk_every > 0 .and. allocated(self%last%position)) &
             call write_last_state(self, scene, error)
         if (.not. allocated(error) .and. self%vtk_every > 0 .and. allocated(self%vtk%files)) then
-            if (self%vtk%listed /= size(self%vtk%files)) call self%vtk%write_collection(error)
+            if (self%vtk%listed /= self%vtk%n_files) call self%vtk%write_collection(error)
             if (allocated(error)) self%failed = .true.
         end if
         call close_table(self%curve)
         call close_table(self%contacts)
         call close_table(self%reactions)
         call self%manifest%close()
+        if (self%unsynced) then
+            call sync_tables(self, sync_error)
+            if (.not. allocated(sync_error)) call sync_restart(self%folder, sync_error)
+            if (allocated(sync_error) .and. .not. allocated(error)) then
+                self%failed = .true.
+                call move_alloc(sync_error, error)
+            end if
+            self%unsynced = .false.
+        end if
         call self%folder_lock%release()
     contains
         !> Close a CSV file; its error is the run's unless an earlier one is.

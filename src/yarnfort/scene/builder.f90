@@ -18,7 +18,7 @@ module yarnfort_scene_builder
         new_decaying_adhesion_law
     use yarnfort_friction_general, only: rate_table_law_type => table_law_type, &
         read_rate_table
-    use yarnfort_text, only: resolve_path
+    use yarnfort_text, only: resolve_path, quote_string
     use yarnfort_input_config, only: name_length
     use yarnfort_input_contact_node_checks, only: get_contact_node_sets, find_node_contact
     use yarnfort_input_channel_checks, only: get_channel_names, get_channel_factors, &
@@ -64,6 +64,14 @@ contains
         call build_loads(scene, config)
         call build_passages(scene, config, error)
         if (allocated(error)) return
+        ! Something to solve: a free coordinate or a passage that slides (an input error
+        ! here, before anything is written; yarnfort_input_validate finds the plain case).
+        if (scene%dofs%n_unknowns == 0 .and. scene%passages%size() == 0) then
+            call fatal_error(error, 'every coordinate of every node is prescribed (by ' &
+                // '&support, &obstacle or the links of a generated fabric) and no yarn ' &
+                // 'slides at a contact: the scene has no unknowns (nothing to solve)')
+            return
+        end if
         if (config%fabric_width > 0.0_wp) then
             scene%fabric_width = config%fabric_width
             scene%fabric_strain = config%fabric%strain
@@ -87,6 +95,10 @@ contains
         type(table_law_type) :: table
         character(len=:), allocatable :: path
 
+        if (trim(material%law) /= 'table') then
+            call check_table_units_unset(material, error)
+            if (allocated(error)) return
+        end if
         select case (trim(material%law))
         case ('linear')
             call new_linear_law(linear, material%stiffness, error)
@@ -97,13 +109,42 @@ contains
         case ('table')
             path = trim(material%table_file)
             if (present(folder)) path = resolve_path(path, folder)
-            call read_table_law(table, path, error)
+            ! gauge_length = -1: not set.
+            if (material%gauge_length == -1.0_wp) then
+                call read_table_law(table, path, error, strain_unit=trim(material%strain_unit), &
+                    force_unit=trim(material%force_unit))
+            else
+                call read_table_law(table, path, error, strain_unit=trim(material%strain_unit), &
+                    force_unit=trim(material%force_unit), gauge_length=material%gauge_length)
+            end if
             allocate(law, source=table)
         case default
             call fatal_error(error, "law '" // trim(material%law) &
                 // "' is unknown (use linear, neo_hookean or table)")
         end select
     end subroutine new_force_law
+
+    !> The units of a table file are not set for another law (they would be ignored).
+    subroutine check_table_units_unset(material, error)
+        type(material_config_type), intent(in) :: material
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: name, text
+
+        if (len_trim(material%strain_unit) > 0) then
+            name = 'strain_unit'
+            text = quote_string(trim(material%strain_unit))
+        else if (len_trim(material%force_unit) > 0) then
+            name = 'force_unit'
+            text = quote_string(trim(material%force_unit))
+        else if (.not. material%gauge_length == -1.0_wp) then
+            name = 'gauge_length'
+            text = format_real(material%gauge_length)
+        else
+            return
+        end if
+        call fatal_error(error, name // ' = ' // text // " is not used by law '" &
+            // trim(material%law) // "' (only by 'table'; remove it)")
+    end subroutine check_table_units_unset
 
     !> Nodes, and elements from the yarns: each segment between listed nodes is split
     !> into elements_per_segment elements through new, evenly spaced nodes. Elements
@@ -555,8 +596,7 @@ contains
         allocate(scene%passages%at_end(scene%network%n_elements()), source=0)
         allocate(scene%passages%share(scene%network%n_elements()), source=1.0_wp)
         ! At most every interior node of every yarn is a passage (filled below, trimmed
-        ! by store_passages; appending one at a time was quadratic: 20 s of the 29 s
-        ! set-up of the 100 x 100 knit, benchmarks/knit100.nml).
+        ! by store_passages; appending one at a time was quadratic in the passages).
         n_passages = sum([(max(size(config%yarns(y)%nodes) - 2, 0), y = 1, n_yarns)])
         allocate(yarn(n_passages), at_node(n_passages), before(n_passages), &
             after(n_passages), laws(n_passages))

@@ -11,7 +11,7 @@ module yarnfort_scene_scene
     private
 
     public :: scene_type, law_holder_type, support_set_type, load_set_type, load_path_type
-    public :: get_applied_force, get_node_force_scale, get_loaded_nodes, get_force_scale
+    public :: get_applied_force, get_loaded_nodes, get_force_scale
 
     !> One yarn type's force law.
     type :: law_holder_type
@@ -122,19 +122,9 @@ contains
         end do
     end subroutine get_applied_force
 
-    !> An upper bound of the applied force's magnitude at node n: the sum over channels of
-    !> |factor| * |force of the channel| (with one loaded channel, exactly its magnitude).
-    pure real(wp) function get_node_force_scale(scene, factors, n) result(scale)
-        type(scene_type), intent(in) :: scene
-        real(wp), intent(in) :: factors(:)
-        integer, intent(in) :: n
-        integer :: c
-
-        scale = get_force_scale(factors, [(norm2(scene%external_force(3 * n - 2:3 * n, c)), &
-            c = 1, size(scene%external_force, 2))])
-    end function get_node_force_scale
-
-    !> get_node_force_scale from the magnitudes of the channels' forces at the node.
+    !> An upper bound of the applied force's magnitude at a node: the sum over channels of
+    !> |factor| * magnitude (the magnitudes of the channels' forces at the node; with one
+    !> loaded channel, exactly its magnitude).
     pure real(wp) function get_force_scale(factors, magnitude) result(scale)
         real(wp), intent(in) :: factors(:), magnitude(:)
         integer :: c
@@ -146,7 +136,7 @@ contains
     end function get_force_scale
 
     !> The nodes where some channel applies a force, and each channel's magnitude there
-    !> (n_channels, n_loaded). Elsewhere get_node_force_scale is 0 at any factors, so a
+    !> (n_channels, n_loaded). Elsewhere get_force_scale is 0 at any factors, so a
     !> caller that asks at every iterate (the row levels) need only visit these.
     pure subroutine get_loaded_nodes(scene, nodes, magnitude)
         type(scene_type), intent(in) :: scene

@@ -9,6 +9,7 @@
 module yarnfort_solver_continuation
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
+    use yarnfort_text, only: format_short
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_newton, only: newton_stats_type
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
@@ -164,8 +165,9 @@ contains
                     call stepper%try_jump(factors, stats, iterations, jumped, jump_error)
                     if (.not. jumped .or. allocated(jump_error)) then
                         write(buffer, '("step from time ", g0.6, " failed after ", i0, &
-                            & " cuts (step ", es9.2, " of the knot interval, min_step ", es9.2, &
-                            & "); last error")') t, cuts, dt, scene%solver%min_step
+                            & " cuts (step ", a, " of the knot interval, min_step ", a, &
+                            & "); last error")') t, cuts, format_short(dt), &
+                            format_short(scene%solver%min_step)
                         call fatal_error(error, trim(buffer) // ': ' // step_error%message)
                         if (jumped) error%message = error%message // '; then ' &
                             // jump_error%message

@@ -28,10 +28,11 @@ module yarnfort_solver_newton
     use fsundials_linearsolver_mod
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_text, only: format_short
     use yarnfort_input_config, only: solver_config_type
     use yarnfort_solver_problem, only: nonlinear_problem_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_dense, only: dense_solver_type
+    use yarnfort_linalg_backend_dense, only: dense_solver_type
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc, &
         analyse_counted, factor_counted, solve_counted, solve_columns_counted
     use yarnfort_solver_timer, only: wall_time
@@ -391,7 +392,6 @@ contains
         type(error_type), allocatable, intent(out) :: error
         real(wp), allocatable :: guess(:), level(:), noise(:)
         real(wp) :: cap, stiffest
-        character(len=12) :: cap_text
         integer :: m
 
         associate(problem => self%problem%problem)
@@ -409,9 +409,8 @@ contains
                 call solve_once(self, guess, stats, error)
                 problem%stiffness_cap = no_stiffness_cap
                 if (allocated(error)) then
-                    write(cap_text, '(es10.3)') cap
                     error%message = '; with the yarns softened to a stiffness of ' &
-                        // trim(adjustl(cap_text)) // ' as predictor: ' // error%message
+                        // format_short(cap, 4) // ' as predictor: ' // error%message
                     return
                 end if
                 cap = cap * stiffening_factor
@@ -507,8 +506,9 @@ contains
 
         if (.not. converged) then
             write(buffer, '("Newton did not converge: KINSOL flag ", i0, ", ", i0, &
-                & " iterations, scaled residual ", es10.3, " > tolerance ", es10.3)') &
-                ierr, stats%iterations, stats%residual_norm, self%options%residual_tolerance
+                & " iterations, scaled residual ", a, " > tolerance ", a)') ierr, &
+                stats%iterations, format_short(stats%residual_norm, 4), &
+                format_short(self%options%residual_tolerance, 4)
             if (allocated(self%problem%kinsol_message)) then
                 call fatal_error(error, trim(buffer) // ' (' // self%problem%kinsol_message // ')')
             else

@@ -1,7 +1,7 @@
 ! SPDX-License-Identifier: MIT
 !> Truss element and global assembly checked against finite differences.
 module test_assembly
-    use yarnfort_kinds, only: wp, ik
+    use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     use yarnfort_testing, only: unittest_type, new_unittest, check, check_close
     use yarnfort_material_linear, only: linear_law_type, new_linear_law

@@ -1,5 +1,5 @@
 ! SPDX-License-Identifier: MIT
-!> Unit tests of the bordered solver (yarnfort_linalg_bordered): a symmetric positive
+!> Unit tests of the bordered solver (yarnfort_linalg_composite_bordered): a symmetric positive
 !> definite block K bordered by unsymmetric rows and columns, solved through the Schur
 !> complement, through the whole-matrix solver when the border is too wide, and through
 !> it too when K alone is singular; the analysis of K kept across patterns; the solve of
@@ -8,7 +8,7 @@ module test_bordered
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_testing, only: unittest_type, new_unittest, check
-    use yarnfort_linalg_bordered, only: bordered_solver_type
+    use yarnfort_linalg_composite_bordered, only: bordered_solver_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, chosen_lu_name
     implicit none

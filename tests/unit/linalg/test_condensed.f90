@@ -1,11 +1,11 @@
 ! SPDX-License-Identifier: MIT
-!> Unit tests of the condensed solver (yarnfort_linalg_condensed): unknowns whose rows
+!> Unit tests of the condensed solver (yarnfort_linalg_composite_condensed): unknowns whose rows
 !> hold only their diagonal are eliminated exactly, the rest goes to KLU.
 module test_condensed
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
     use yarnfort_testing, only: unittest_type, new_unittest, check
-    use yarnfort_linalg_condensed, only: condensed_solver_type
+    use yarnfort_linalg_composite_condensed, only: condensed_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
     implicit none
     private

@@ -10,10 +10,10 @@ module test_linalg
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
         klu_max_order, chosen_lu_name
-    use yarnfort_linalg_klu, only: klu_solver_type
-    use yarnfort_linalg_umfpack, only: umfpack_solver_type, umfpack_memory_type
-    use yarnfort_linalg_threads, only: apply_thread_policy, count_serial_regions
-    use yarnfort_linalg_heap, only: apply_heap_policy
+    use yarnfort_linalg_backend_klu, only: klu_solver_type
+    use yarnfort_linalg_backend_umfpack, only: umfpack_solver_type, umfpack_memory_type
+    use yarnfort_linalg_process_threads, only: apply_thread_policy, count_serial_regions
+    use yarnfort_linalg_process_heap, only: apply_heap_policy
     use yarnfort_text, only: format_real, format_integer
     implicit none
     private

@@ -1,5 +1,5 @@
 ! SPDX-License-Identifier: MIT
-!> Unit tests of the choice between KLU and UMFPACK (yarnfort_linalg_lu_choice): the rule
+!> Unit tests of the choice between KLU and UMFPACK (yarnfort_linalg_composite_lu_choice): the rule
 !> on KLU's predicted cost, the solver it picks for a chain and for a dense block, the
 !> same pick for the same pattern, METIS' order where it fills less, and right solutions
 !> either way.
@@ -9,10 +9,10 @@ module test_lu_choice
     use yarnfort_error, only: error_type
     use yarnfort_testing, only: unittest_type, new_unittest, check
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_lu_choice, only: lu_choice_solver_type, prefers_umfpack, &
+    use yarnfort_linalg_composite_lu_choice, only: lu_choice_solver_type, prefers_umfpack, &
         umfpack_min_flops_per_nonzero, metis_min_flops_per_nonzero
     use yarnfort_linalg_factory, only: new_linear_solver, chosen_lu_name
-    use yarnfort_linalg_klu, only: klu_solver_type
+    use yarnfort_linalg_backend_klu, only: klu_solver_type
     implicit none
     private
 

@@ -12,8 +12,8 @@ module test_solve_columns
     use yarnfort_error, only: error_type
     use yarnfort_testing, only: unittest_type, new_unittest, check
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_condensed, only: condensed_solver_type
-    use yarnfort_linalg_bordered, only: bordered_solver_type
+    use yarnfort_linalg_composite_condensed, only: condensed_solver_type
+    use yarnfort_linalg_composite_bordered, only: bordered_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, chosen_lu_name
     implicit none
     private

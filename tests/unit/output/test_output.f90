@@ -5,7 +5,7 @@ module test_output
     use yarnfort_testing, only: unittest_type, new_unittest, check
     use yarnfort_error, only: error_type
     use yarnfort_output_vtk, only: get_state_name
-    use yarnfort_output_manifest, only: is_own_name, is_state_name
+    use yarnfort_output_manifest, only: is_own_name, is_state_name, is_bookkeeping_name
     implicit none
     private
 
@@ -18,7 +18,8 @@ contains
 
         testsuite = [ &
             new_unittest('state_names', test_state_names), &
-            new_unittest('own_names', test_own_names)]
+            new_unittest('own_names', test_own_names), &
+            new_unittest('bookkeeping_names', test_bookkeeping_names)]
     end subroutine collect_output
 
     !> Five digits up to step 99 999, then as many as needed; every name distinct and
@@ -47,7 +48,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         character(len=*), parameter :: own(*) = [character(len=24) :: 'curve.csv', &
             'input.nml', 'restart.dat', 'restart.dat.tmp', 'states.pvd', 'states.pvd.tmp', &
-            'state_00012.vtu', 'state_123456.vtu']
+            'restart.sync', 'restart.sync.tmp', 'state_00012.vtu', 'state_123456.vtu']
         character(len=*), parameter :: foreign(*) = [character(len=24) :: 'notes.txt', &
             '../curve.csv', 'sub/state_00001.vtu', 'state_1.vtu', 'state_0000x.vtu', &
             'state_00001.vtu.bak', 'state_00001.vtk', '.yarnfort-lock', 'measured.csv', '']
@@ -63,5 +64,23 @@ contains
             if (allocated(error)) return
         end do
     end subroutine test_own_names
+
+    !> The manifest, its temporary, the lock and the probe: checked for links like the
+    !> files of a run, but never listed, so never deleted.
+    subroutine test_bookkeeping_names(error)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), parameter :: names(*) = [character(len=24) :: &
+            '.yarnfort-manifest', '.yarnfort-manifest.tmp', '.yarnfort-lock', &
+            '.yarnfort-write-test']
+        integer :: i
+
+        do i = 1, size(names)
+            call check(error, is_bookkeeping_name(trim(names(i))) .and. &
+                .not. is_own_name(trim(names(i))), trim(names(i)) // ' is not bookkeeping only')
+            if (allocated(error)) return
+        end do
+        call check(error, .not. is_bookkeeping_name('curve.csv') .and. &
+            .not. is_bookkeeping_name('.yarnfort-lock.tmp'), 'a run file taken as bookkeeping')
+    end subroutine test_bookkeeping_names
 
 end module test_output

@@ -1,0 +1,160 @@
+! SPDX-License-Identifier: MIT
+!> The units a measurement file may state (a table's column header, a geometry file's
+!> `unit` line, the `&material` and `&geometry` unit variables) and their exact factors
+!> to the units of the scene: strain 1, force N, length m.
+!>
+!> A value v in unit u is v * numerator / denominator in the scene's unit. The prefixes
+!> are exact integer denominators, so 5 % is 5 / 100, correctly rounded, the same
+!> double as a hand-written 0.05.
+module yarnfort_units
+    use yarnfort_kinds, only: wp
+    use yarnfort_text, only: to_lower, string_type
+    implicit none
+    private
+
+    public :: unit_type, find_unit, unit_names, to_scene_unit, get_header_unit
+    public :: get_header_units
+    public :: strain_kind, length_kind, force_kind
+
+    !> The kinds of quantity a unit measures.
+    character(len=*), parameter :: strain_kind = 'strain', length_kind = 'length', &
+        force_kind = 'force'
+
+    !> One unit: its spelling, what it measures and its exact factor to the scene's unit.
+    type :: unit_type
+        character(len=8) :: name = '1'
+        character(len=6) :: kind = strain_kind
+        real(wp) :: numerator = 1.0_wp
+        real(wp) :: denominator = 1.0_wp
+        !> Also matched in any letter case (no SI prefix it could be confused with).
+        logical :: any_case = .false.
+    end type unit_type
+
+    !> The standard acceleration of gravity (CGPM 1901), m/s^2: 1 gf = 9.80665e-3 N exactly.
+    real(wp), parameter :: standard_gravity = 9.80665_wp
+    !> The avoirdupois pound-force, N (1 lb = 0.45359237 kg exactly, times standard_gravity).
+    real(wp), parameter :: pound_force = 4.4482216152605_wp
+    !> 'per mille' sign and micro sign in UTF-8.
+    character(len=*), parameter :: per_mille = char(226) // char(128) // char(176)
+    character(len=*), parameter :: micro = char(194) // char(181)
+
+    !> Every unit a tensile tester or a CAD export writes for strain, elongation and force.
+    type(unit_type), parameter :: known_units(*) = [ &
+        unit_type('1', strain_kind, 1.0_wp, 1.0_wp, .false.), &
+        unit_type('-', strain_kind, 1.0_wp, 1.0_wp, .false.), &
+        unit_type('%', strain_kind, 1.0_wp, 100.0_wp, .false.), &
+        unit_type('permille', strain_kind, 1.0_wp, 1000.0_wp, .true.), &
+        unit_type(per_mille, strain_kind, 1.0_wp, 1000.0_wp, .false.), &
+        unit_type('m', length_kind, 1.0_wp, 1.0_wp, .false.), &
+        unit_type('cm', length_kind, 1.0_wp, 100.0_wp, .false.), &
+        unit_type('mm', length_kind, 1.0_wp, 1000.0_wp, .false.), &
+        unit_type('um', length_kind, 1.0_wp, 1.0e6_wp, .false.), &
+        unit_type(micro // 'm', length_kind, 1.0_wp, 1.0e6_wp, .false.), &
+        unit_type('N', force_kind, 1.0_wp, 1.0_wp, .false.), &
+        unit_type('cN', force_kind, 1.0_wp, 100.0_wp, .false.), &
+        unit_type('mN', force_kind, 1.0_wp, 1000.0_wp, .false.), &
+        unit_type('kN', force_kind, 1000.0_wp, 1.0_wp, .false.), &
+        unit_type('gf', force_kind, standard_gravity, 1000.0_wp, .true.), &
+        unit_type('kgf', force_kind, standard_gravity, 1.0_wp, .true.), &
+        unit_type('lbf', force_kind, pound_force, 1.0_wp, .true.)]
+
+contains
+
+    !> The unit spelled `text` (exactly, or in any case for gf, kgf, lbf, permille);
+    !> `found` is false for an unknown spelling.
+    pure subroutine find_unit(text, unit, found)
+        character(len=*), intent(in) :: text
+        type(unit_type), intent(out) :: unit
+        logical, intent(out) :: found
+        integer :: i
+
+        do i = 1, size(known_units)
+            found = trim(known_units(i)%name) == trim(text)
+            if (.not. found .and. known_units(i)%any_case) &
+                found = trim(known_units(i)%name) == to_lower(trim(text))
+            if (found) then
+                unit = known_units(i)
+                return
+            end if
+        end do
+    end subroutine find_unit
+
+    !> "'1', '-', '%', ..." : the spellings of the units of one kind, for messages.
+    pure function unit_names(kind) result(names)
+        character(len=*), intent(in) :: kind
+        character(len=:), allocatable :: names
+        integer :: i
+
+        names = ''
+        do i = 1, size(known_units)
+            if (known_units(i)%kind /= kind) cycle
+            if (len(names) > 0) names = names // ', '
+            names = names // "'" // trim(known_units(i)%name) // "'"
+        end do
+    end function unit_names
+
+    !> A value in `unit` converted to the scene's unit of its kind.
+    elemental function to_scene_unit(value, unit) result(converted)
+        real(wp), intent(in) :: value
+        type(unit_type), intent(in) :: unit
+        real(wp) :: converted
+
+        ! Left to right: a numerator of 1 is exact, so 5 % is 5 / 100, one rounding.
+        converted = (value * unit%numerator) / unit%denominator
+    end function to_scene_unit
+
+    !> The unit a column header `field` states, as text: the contents of its last (...)
+    !> or [...] ('Force (cN)', 'strain [%]'), else its last word after a blank or '/' when
+    !> that is a known unit ('Force in cN', 'Force/cN', 'mm'). `stated` is false when the
+    !> field states none ('strain', 'force'): such a header keeps the default units.
+    pure subroutine get_header_unit(field, text, stated)
+        character(len=*), intent(in) :: field
+        character(len=:), allocatable, intent(out) :: text
+        logical, intent(out) :: stated
+        character(len=:), allocatable :: name
+        type(unit_type) :: unit
+        integer :: last, first
+
+        name = trim(adjustl(field))
+        last = scan(name, ')]', back=.true.)
+        if (last > 0) then
+            if (name(last:last) == ')') then
+                first = index(name(:last), '(', back=.true.)
+            else
+                first = index(name(:last), '[', back=.true.)
+            end if
+            stated = first > 0
+            if (stated) then
+                text = trim(adjustl(name(first + 1:last - 1)))
+                return
+            end if
+        end if
+        text = name(scan(name, ' /', back=.true.) + 1:)
+        call find_unit(text, unit, stated)
+    end subroutine get_header_unit
+
+    !> The fields of a two-column header line and the unit text each states
+    !> (`get_header_unit`); a line without exactly two comma-separated fields states none.
+    pure subroutine get_header_units(header, fields, texts, stated)
+        character(len=*), intent(in) :: header
+        type(string_type), intent(out) :: fields(2), texts(2)
+        logical, intent(out) :: stated(2)
+        integer :: comma, c
+
+        stated(:) = .false.
+        fields(1)%text = ''
+        fields(2)%text = ''
+        texts(1)%text = ''
+        texts(2)%text = ''
+        comma = index(header, ',')
+        if (comma == 0) return
+        if (index(header(comma + 1:), ',') /= 0) return
+        fields(1)%text = trim(adjustl(header(:comma - 1)))
+        fields(2)%text = trim(adjustl(header(comma + 1:)))
+        do c = 1, 2
+            if (len(fields(c)%text) > 0) call get_header_unit(fields(c)%text, texts(c)%text, &
+                stated(c))
+        end do
+    end subroutine get_header_units
+
+end module yarnfort_units

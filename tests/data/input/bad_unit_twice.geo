@@ -1,0 +1,4 @@
+# two unit lines
+unit mm
+node 1 0 0 0
+unit m

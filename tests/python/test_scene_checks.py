@@ -1,0 +1,129 @@
+# SPDX-License-Identifier: MIT
+"""The Python API refuses what it should (issue 38 item 6): every group and variable is
+known to Python from the one input description, a typo is an error at construction that
+suggests the name meant, shapes, types and ranges are checked there, no 'not set' marker
+collides with a user value; read_run and run_scene return one type; a missing extra names
+the pip command; integer columns are integers."""
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import yarnfort
+from yarnfort import Fabric, LoadPath, Scene, SceneError, UnknownVariableError
+
+TOP = Path(__file__).resolve().parents[2]
+
+
+def scene() -> Scene:
+    built = Scene("checks")
+    built.add_material("yarn", "linear", stiffness=10.0)
+    built.nodes = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    return built
+
+
+def test_a_typo_is_found_at_construction_with_the_name_meant():
+    with pytest.raises(UnknownVariableError,
+                       match=r"&material 'yarn'.*no variable 'stifness'; did you mean"
+                       r" 'stiffness'\?") as info:
+        Scene().add_material("yarn", "linear", stifness=10.0)
+    # Both a SceneError and a TypeError (an unexpected keyword).
+    assert isinstance(info.value, SceneError) and isinstance(info.value, TypeError)
+    with pytest.raises(UnknownVariableError, match="did you mean 'elements_per_segment'"):
+        scene().add_yarn("yarn", [1, 2, 3], element_per_segment=2)
+    with pytest.raises(UnknownVariableError, match=r"&solver.*did you mean 'max_step'"):
+        Scene(solver={"max_stepp": 0.1})
+    with pytest.raises(UnknownVariableError, match="did you mean 'cells'"):
+        Fabric("knit", cels=[2, 2])
+    with pytest.raises(UnknownVariableError, match="did you mean 'p_disp'"):
+        LoadPath(time=[0, 1], extra={"p_dsp": [0, 1]})
+
+
+def test_a_setting_changed_later_is_checked_before_writing(tmp_path):
+    built = scene()
+    built.add_yarn("yarn", [1, 2, 3])
+    built.path = LoadPath(time=[0, 1], p_force=[0, 1])
+    built.output["vtk_evry"] = 2
+    with pytest.raises(UnknownVariableError, match="did you mean 'vtk_every'"):
+        built.write(tmp_path / "x.nml")
+
+
+def test_shapes_types_ranges_and_choices():
+    built = scene()
+    with pytest.raises(SceneError, match=r"expected shape \(n, 3\).*\(3, 2\)"):
+        built.nodes = np.zeros((3, 2))
+    # -1 is no 'not set' marker in Python: it is out of range.
+    with pytest.raises(SceneError, match=r"&material 'a' stiffness = -1.0 N: must be > 0"):
+        built.add_material("a", "linear", stiffness=-1.0)
+    with pytest.raises(SceneError, match="'linaer' is not one of 'linear', 'neo_hookean',"
+                       " 'table'"):
+        built.add_material("b", "linaer", stiffness=1.0)
+    with pytest.raises(SceneError, match="elements_per_segment: expected an integer"):
+        built.add_yarn("yarn", [1, 2, 3], elements_per_segment=1.5)
+    with pytest.raises(SceneError, match="progress: expected True or False"):
+        Scene(output={"progress": "yes"})
+    with pytest.raises(SceneError, match=r"friction_coefficient = -0.1: must be >= 0"):
+        built.add_contact(("yarn", "yarn"), "coulomb", friction_coefficient=-0.1)
+    with pytest.raises(SceneError, match="residual_tolerance = 0.0: must be > 0"):
+        Scene(solver={"residual_tolerance": 0.0})
+    with pytest.raises(SceneError, match="not a yarnfort group; did you mean &solver"):
+        Scene.from_namelist(yarnfort.make_namelist({"solvr": {"max_step": 0.1}}))
+
+
+def test_echoed_inputs_read_back_without_markers(tmp_path, monkeypatch):
+    """An echoed input writes unset law parameters as -1 (the file format's 'not set');
+    reading it gives None, and the scene writes and checks as before."""
+    shutil.copytree(TOP / "inputs", tmp_path / "inputs")
+    text = (TOP / "inputs" / "knit.nml").read_text().replace("out/knit", str(tmp_path / "o"))
+    (tmp_path / "knit.nml").write_text(text)
+    monkeypatch.chdir(tmp_path)
+    first = yarnfort.run_scene(tmp_path / "knit.nml")
+    echoed = (first.folder / "input.nml").read_text()
+    assert "stiffness = -1.0" in echoed
+    read = Scene.read(first.folder / "input.nml")
+    assert [m.stiffness for m in read.materials] == [None, None]
+    read.check()
+
+
+def test_read_run_and_run_scene_return_one_type(tmp_path, monkeypatch):
+    shutil.copytree(TOP / "inputs", tmp_path / "inputs")
+    monkeypatch.chdir(tmp_path)
+    ran = yarnfort.run_scene("inputs/vnet.nml")
+    read = yarnfort.read_run("out/vnet")
+    assert type(read) is type(ran) is yarnfort.RunResult
+    assert read.outcome == "read" and read.folder == ran.folder
+    assert read.n_steps == len(ran.curve)
+    np.testing.assert_array_equal(read.curve["p_force"], ran.curve["p_force"])
+    assert len(read.states) == len(ran.states)
+    with pytest.raises(yarnfort.ResultError, match="no output folder"):
+        yarnfort.read_run("out/missing")
+
+
+def test_integer_columns_are_integers(tmp_path):
+    path = tmp_path / "curve.csv"
+    path.write_text("step,time,p_force,direction,newton_iterations\n"
+                    "0,0.0000000000000000E+000,0.0E+000,0,0\n"
+                    "1,1.0000000000000001E-001,1.0E-001,1,7\n"
+                    "2,2.0E-001,-5.0E-001,-1,12\n")
+    curve = yarnfort.read_curve(path)
+    for name in ("step", "direction", "newton_iterations"):
+        assert curve[name].dtype.kind == "i", name
+    np.testing.assert_array_equal(curve["direction"], [0, 1, -1])
+    assert curve["time"].dtype.kind == "f" and curve["p_force"][2] == -0.5
+
+
+def test_a_missing_extra_names_the_pip_command(tmp_path, monkeypatch):
+    path = tmp_path / "curve.csv"
+    path.write_text("step,time\n0,0.0E+000\n")
+    monkeypatch.setitem(sys.modules, "pandas", None)  # import pandas now fails
+    with pytest.raises(ImportError, match=r"pip install 'yarnfort\[pandas\]'"):
+        yarnfort.read_curve(path).to_dataframe()
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    with pytest.raises(ImportError, match=r"pip install 'yarnfort\[dask\]'"):
+        yarnfort.run_sweep(TOP / "inputs" / "vnet.nml",
+                           {"material[0].stiffness": [10.0]}, support="ends",
+                           scheduler="tcp://127.0.0.1:1", progress=False)
