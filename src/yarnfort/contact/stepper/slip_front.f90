@@ -17,7 +17,7 @@
 !> the front in one round, while a front that falls short would cost a round per
 !> passage again. Only the active set is predicted: every answer is judged by the
 !> stick/slip test of the solved state as before.
-module yarnfort_contact_slip_front
+module yarnfort_contact_stepper_slip_front
     use yarnfort_kinds, only: wp
     use yarnfort_friction_law, only: friction_law_type
     use yarnfort_contact_friction_problem, only: friction_problem_type, mode_stick, &
@@ -179,4 +179,4 @@ contains
         end do
     end function get_inverse_critical
 
-end module yarnfort_contact_slip_front
+end module yarnfort_contact_stepper_slip_front
