@@ -734,7 +734,7 @@ def test_friction_ring_with_defaults(run_yarnfort, tmp_path, yarn):
             (key, value)
 
 
-#: The stick test's dead band (friction_stepper.f90, dead_band_factor) in units of the
+#: The stick test's dead band (contact/stepper/active_set.f90, dead_band_factor) in units of the
 #: rounding allowance of a passage's tensions, and that allowance per element in units
 #: of eps (|T| + r dT/dlambda) (truss.f90, rounding_factor).
 DEAD_BAND_FACTOR = 10.0

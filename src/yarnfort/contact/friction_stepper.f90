@@ -1,39 +1,20 @@
 ! SPDX-License-Identifier: MIT
-!> Load steps with sliding at contact nodes, by either scheme:
-!> - monolithic: positions and flows solved together (friction_problem_type) for a
-!>   stick/slip active set, which is updated like a return mapping until it settles;
-!> - staggered (the paper's two-step method, Fig. 4): an elastic solve with reference
-!>   lengths frozen, then a sliding solve with positions frozen, repeated until the
-!>   equilibrium residual is small and the active set no longer changes; a step that
-!>   the first round does not solve is finished by monolithic solves from the
-!>   alternation's state (try_staggered, finish_monolithic).
-!> Active-set rules, per passage, after each solve:
-!>   stick -> slip forward  if T_after  > T_crit(T_before, alpha) (beyond tolerance);
-!>   stick -> slip backward if T_before > T_crit(T_after, alpha);
-!>   slip -> stick if the flow increment of the step has the wrong sign (at a held node:
-!>   is not beyond the flows' accuracy in the right one);
-!>   and the stick passages that the new slips' fronts pass along their yarns, by the
-!>   capstan relation, start to slip in the same round (yarnfort_contact_slip_front;
-!>   docs/decisions.md, "Slip fronts: the capstan march").
-!> A step starts from the predicted state (secant, or the parabola through three states of
-!> one active set; reversed secant across a turn) with the stick passages that it takes
-!> across their limit slipping (predict_modes), or all-stick when it is the first load
-!> step from the initial state; a guessed start set whose first Newton step raises the
-!> residual gives way at once to the last step's set. Each round after the first is a fast
-!> Newton solve (full steps only), and one that fails is retried with fewer new slips.
-!> When the step's first set fails with no new slip, its passages whose flows the first
-!> Newton step sends back stick and the set is solved again (stop_flowing_back). Every
-!> solve starts with chord steps (newton_solver_type%chord_steps), in both schemes.
-!> A monolithic round's set may be judged and changed before it is solved, at the
-!> chord path's iterate (provisional rounds, max_provisional_rounds); in any round but
-!> the step's first, an iterate that does not contract is judged for its stops only.
-!> A passage whose element would become shorter than min_length_ratio times its initial
-!> reference length locks at that length (stick), and may not slip that way again while
-!> the element keeps that length, in this step and the next ones. A passage that flips
-!> more than max_flips times in one step is held in stick for the rest of the step
-!> (chatter damping); the step fails if a held passage ends beyond its limit
-!> (check_damped). A step whose rounds fail that way at every step size down to
-!> min_step is a slip instability: the continuation then asks for a jump (try_jump).
+!> Proxy module for load steps with sliding at contact nodes: it keeps the public
+!> friction_stepper_type and its set-up; the concerns live in contact/stepper/:
+!> - monolithic.f90: positions and flows solved together for a stick/slip active set,
+!>   updated like a return mapping until it settles (the default scheme);
+!> - staggered.f90: the paper's two-step method (Fig. 4), elastic and sliding solves
+!>   in turn, finished by monolithic solves;
+!> - active_set.f90: the stick/slip rules after each solve, locks at the minimum
+!>   length, chatter damping;
+!> - predictor.f90 and slip_front.f90: a step's predicted state and start set, and
+!>   the capstan march of new slips along their yarns;
+!> - jump.f90: a step whose rounds settle at no step size down to min_step (a slip
+!>   instability) is reached by viscous slip steps (try_jump);
+!> - base.f90: the stepper's state; trace.f90: where a step's work goes (for
+!>   benchmarks/steps_trace).
+!> Every solve starts with chord steps (newton_solver_type%chord_steps), in both
+!> schemes.
 module yarnfort_contact_friction_stepper
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
@@ -60,18 +41,9 @@ module yarnfort_contact_friction_stepper
 
     public :: friction_stepper_type, new_friction_stepper, step_trace_type
 
-
     !> Chord steps after the first Newton step of every friction solve
-    !> (newton_solver_type%chord_steps). Measured (benchmarks/steps_results.md, section
-    !> 8), Newton iterations (factorisations) per step, without -> in the first solve of
-    !> a step -> in every solve: inputs/knit_clamped.nml 4.42 -> 3.65 -> 3.27, woven
-    !> 2,200 aligned 1.68 -> 1.18 -> 1.13, 10,120 skewed 3.42 -> 2.48 -> 2.00, no step
-    !> cut in any of those runs. (Before stop_flowing_back, chord steps in every solve
-    !> made the planar 4 x 2 periodic knit at max_step 0.05 cut a step.) The staggered
-    !> scheme's elastic and sliding solves take them too: woven 840 / 2,200 / 10,120
-    !> aligned 3.30 / 4.43 / 6.72 -> 2.05 / 2.95 / 4.50 Newton iterations per step,
-    !> skewed 5.03 / 5.88 / 8.42 -> 3.32 / 4.10 / 5.88 (benchmarks/steps_trace), the
-    !> examples' curves with scheme = 'staggered' within 1.2e-10 of their largest force.
+    !> (newton_solver_type%chord_steps): they cost no factorisation and settle most
+    !> steps sooner (docs/decisions.md, "Friction steps: chord steps in every solve").
     integer, parameter :: chord_steps = 3
 
     !> Load steps with sliding at contact nodes (module notes).
@@ -93,7 +65,7 @@ contains
     !> solver, the flows-only one uses the measured default for unsymmetric systems and
     !> the monolithic one KLU or UMFPACK, chosen per reduced pattern (chosen_lu_name),
     !> else both use `linear_name`. The monolithic one first eliminates its stick flows
-    !> (yarnfort_linalg_condensed).
+    !> (yarnfort_linalg_composite_condensed).
     subroutine new_friction_stepper(self, scene, linear_name, error)
         type(friction_stepper_type), intent(out) :: self
         type(scene_type), target, intent(in) :: scene
@@ -139,9 +111,9 @@ contains
         block
             type(condensed_solver_type), allocatable :: condensed
             type(bordered_solver_type), allocatable :: bordered
-            ! Stick flows eliminated before factorising (yarnfort_linalg_condensed); with
+            ! Stick flows eliminated before factorising (linalg/composite/condensed); with
             ! the Cholesky default, the elastic block of the rest by `linear_name` and a
-            ! few slipping flows as its border (yarnfort_linalg_bordered).
+            ! few slipping flows as its border (linalg/composite/bordered).
             allocate(condensed)
             if (full_name == chosen_lu_name) then
                 allocate(bordered)
@@ -204,9 +176,9 @@ contains
         self%last_trace%mode_changes = count(self%mode_trial /= self%mode)
         self%trace = step_trace_type()
         ! The quadratic predictor only along a stretch of one active set: across a change
-        ! of the set the path has a kink, and extrapolating it cost iterations (measured
-        ! on inputs/knit_clamped.nml, end of the release: 5.12 Newton iterations per step
-        ! without this condition, 4.42 with it, 4.75 with the secant alone).
+        ! of the set the path has a kink, and extrapolating it costs iterations
+        ! (docs/decisions.md, "Predictor: secant, parabola along one active set, reversed
+        ! at a turn").
         self%have_older = self%have_old .and. self%held .and. all(self%mode_trial == self%mode)
         self%held = self%have_old .and. all(self%mode_trial == self%mode)
         if (self%have_older) then
@@ -298,8 +270,8 @@ contains
         self%u_older = snapshot%u_older
         self%flow_older = snapshot%flow_older
         ! Restarted from the initial state: its first load step starts all-stick, as in
-        ! the run that wrote the file (a 48 x 24 clamped knit's step 1 from the initial
-        ! state's slip set took 625 Newton iterations instead of 25).
+        ! the run that wrote the file (docs/decisions.md, "The first load step from rest
+        ! starts all-stick").
         self%from_initial = snapshot%step == 0
         ! Only a jump leaves a step after step 0 without a predictor state (accept).
         self%jumped = snapshot%step > 0 .and. .not. snapshot%have_old

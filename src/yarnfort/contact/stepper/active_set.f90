@@ -1,5 +1,18 @@
 ! SPDX-License-Identifier: MIT
-!> ACTIVE_HEADER
+!> The stick/slip active-set rules, per passage, after each solve:
+!>   stick -> slip forward  if T_after  > T_crit(T_before, alpha) (beyond tolerance);
+!>   stick -> slip backward if T_before > T_crit(T_after, alpha);
+!>   slip -> stick if the flow increment of the step has the wrong sign (at a held node:
+!>   is not beyond the flows' accuracy in the right one);
+!>   and the stick passages that the new slips' fronts pass along their yarns, by the
+!>   capstan relation, start to slip in the same round (yarnfort_contact_stepper_slip_front;
+!>   docs/decisions.md, "Slip fronts: the capstan march").
+!> A passage whose element would become shorter than min_length_ratio times its initial
+!> reference length locks at that length (stick), and may not slip that way again while
+!> the element keeps that length, in this step and the next ones. A passage that flips
+!> more than max_flips times in one step is held in stick for the rest of the step
+!> (chatter damping); the step fails if a held passage ends beyond its limit
+!> (check_damped).
 module yarnfort_contact_stepper_active_set
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
@@ -111,8 +124,9 @@ contains
                 ! of a flow (a stick row's tolerance), else it sticks: its flow is its only
                 ! motion, so one that stays at its limit without moving is stuck, as the
                 ! exact law has it (a march, or the last step's set, may slip a passage
-                ! that sits at its limit). At a free node a tiny flow can carry a large
-                ! change of tension (a stiff ring: measured, it then chattered).
+                ! that sits at its limit). Not at a free node, where a tiny flow can carry a
+                ! large change of tension (docs/decisions.md, "A slipping passage at a held
+                ! node that does not move sticks").
                 still = 0.0_wp
                 if (present(marched)) then
                     if (is_at_held_node(problem, p)) still = scene%solver%residual_tolerance &
@@ -168,7 +182,7 @@ contains
                 violation(p) = -huge(1.0_wp)
                 new_slips = new_slips + 1
             end do
-            ! Their fronts along the yarns (yarnfort_contact_slip_front), with no cap in
+            ! Their fronts along the yarns (yarnfort_contact_stepper_slip_front), no cap in
             ! force (after a failed round the rounds go one front step at a time).
             if (present(propagate) .and. max_new_slips >= huge(1) / 2) then
                 if (propagate .and. any(started)) then
@@ -292,10 +306,8 @@ contains
     !> A passage held in stick by chatter damping must meet the stick test at the
     !> solved state held in `problem`: a held passage beyond its limit is not a solution
     !> of the friction law but an end of the search, and the step fails (it is cut)
-    !> instead of being accepted. Measured on the planar 4 x 2 periodic knit
-    !> (benchmarks/steps_results.md, section 7): accepted, such states (7 passages up
-    !> to 3 % beyond their limit) took the runs onto another branch, 0.7 % of the
-    !> release force away from the small-step limit.
+    !> instead of being accepted: accepted, such states can take a run onto another
+    !> branch (docs/decisions.md, "Neutral slip sets: no state beyond the limit").
     subroutine check_damped(problem, flips, locked_forward, locked_backward, error)
         type(friction_problem_type), intent(in) :: problem
         integer, intent(in) :: flips(:)

@@ -1,5 +1,6 @@
 ! SPDX-License-Identifier: MIT
-!> JUMP_HEADER
+!> Slip jumps: a load step whose stick/slip rounds settle at no step size down to
+!> min_step is reached through viscous slip steps, then solved by the exact law.
 module yarnfort_contact_stepper_jump
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
@@ -14,13 +15,11 @@ module yarnfort_contact_stepper_jump
 
     public :: try_slip_jump
 
-    !> The slip-instability jump (try_jump): viscosity of its first viscous step (units
-    !> of friction_problem's stick_scale, the scene's largest force per length_scale),
-    !> the most it may grow to after failed ones, and the most viscous steps. Measured
-    !> from the restart before the failing release step of the 32 x 32 free-sided
-    !> clamped knit (benchmarks/steps_results.md, section 24), with the viscosity in
-    !> the rounds of every step (an experiment): at 1 that step settled at once (2
-    !> Newton iterations); at 1e-3 it did, and a later one failed; 1e-6 changed nothing.
+    !> The slip-instability jump (try_slip_jump): viscosity of its first viscous step
+    !> (units of friction_problem's stick_scale, the scene's largest force per
+    !> length_scale), the most it may grow to after failed ones, and the most viscous
+    !> steps. A viscosity of the order of the stiffness settles such a step at once
+    !> (docs/decisions.md, "Slip instabilities: a jump at `min_step`").
     real(wp), parameter :: jump_viscosity = 1.0_wp, max_jump_viscosity = 1.0e6_wp
     integer, parameter :: max_jump_steps = 100
 
@@ -29,11 +28,7 @@ contains
     !> Jump to the load `factors` after a slip instability: the last try failed in the
     !> stick/slip rounds (chatter, or no settling) at the smallest step (`attempted`
     !> is false otherwise, and nothing is done). There the rounds find no consistent
-    !> set: measured on the 32 x 32 free-sided clamped knit (benchmarks/
-    !> steps_results.md, sections 23 and 24), mirror pairs of passages flip for ever
-    !> (slipping, their flows go back; stuck, they exceed their limit, by an amount
-    !> proportional to the step), a semismooth Newton method's line search stalls, and
-    !> changing one passage per round (least index first) does not settle either.
+    !> set: mirror pairs of passages flip for ever (same entry).
     !> From the accepted state, viscous slip steps at the load `factors`
     !> (friction_problem's viscosity: implicit Euler steps of a viscoplastic law, whose
     !> stick/slip problem is well posed) relax the net: each starts from the last one's

@@ -1,5 +1,7 @@
 ! SPDX-License-Identifier: MIT
-!> PREDICTOR_HEADER
+!> The start of a load step: the predicted state (secant, or the parabola through three
+!> states of one active set; reversed secant across a turn) and the stick passages that
+!> it takes across their limit slipping, with their slip fronts (predict_modes).
 module yarnfort_contact_stepper_predictor
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
@@ -23,23 +25,17 @@ contains
     !> load increments (of the sum of the channels' factors), while the loading keeps its
     !> direction. Where the last three accepted states share one active set and lie in
     !> the same direction of the loading, the parabola through them (in the load) is
-    !> extrapolated instead. Measured (benchmarks/steps_results.md, section 6): steady
-    !> steps of the clamped knits started at scaled residuals of 6e-4 to 1e-2 and took 3
-    !> Newton iterations where 2 would do below about 5e-4; the parabola starts them at
-    !> 2e-5 to 1e-3.
-    !> When the loading turns, the positions go back along that increment (flows kept:
-    !> the step starts in stick). Measured (benchmarks/steps_results.md, section 6): the
-    !> turning step of inputs/knit_clamped.nml started at a scaled residual of 0.99 from
-    !> the accepted state and took 9 Newton iterations; from the reversed secant 1e-2 and
-    !> 4 iterations. The unloading response is stiffer (all stick), but the positions
-    !> follow the clamps nearly affinely either way.
+    !> extrapolated instead. When the loading turns, the positions go back along that
+    !> increment (flows kept: the step starts in stick). Why: a step started closer to
+    !> its solution takes fewer Newton iterations (docs/decisions.md, "Predictor:
+    !> secant, parabola along one active set, reversed at a turn").
     !> `outcome`: predicted_state, else reversed when the loading turned, else 0.
     subroutine predict(self, unknowns, outcome, quadratic)
         class(friction_stepper_base_type), intent(in) :: self
         real(wp), intent(inout) :: unknowns(:)
         integer, intent(out) :: outcome
-        !> The parabola may be used (not by the staggered scheme: its alternation took
-        !> 10.53 instead of 10.25 Newton iterations per step on inputs/knit_clamped.nml).
+        !> The parabola may be used (not by the staggered scheme: it measured no gain
+        !> there; same entry).
         logical, intent(in) :: quadratic
         real(wp) :: ratio, load, load_now, w_older, w_old, w_now
         integer :: n_x
@@ -87,10 +83,8 @@ contains
     !> equal at the node pair); its stick and slip are then both admissible, and slip
     !> can close a neutral mode (singular Jacobian). Such passages are left to the
     !> rounds, which slip them only when a solved state violates the stick test, as
-    !> they would without a prediction. Measured (benchmarks/steps_results.md, section
-    !> 5): without this exclusion the predicted start cut steps on the singular set,
-    !> and over the knit3d cycle it reached other branches, up to 36 % of the peak force
-    !> away from the small-step limit.
+    !> they would without a prediction (docs/decisions.md, "Start modes: passages at
+    !> their limit left to the rounds").
     !> `accepted_limits`: the stick passages' at_limit flags at the accepted state, kept
     !> from the last round of the step that reached it (update_active_set, the same test
     !> of the same state); without them the test is done here.

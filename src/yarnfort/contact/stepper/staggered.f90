@@ -1,5 +1,9 @@
 ! SPDX-License-Identifier: MIT
-!> STAG_HEADER
+!> The staggered scheme (the paper's two-step method, Fig. 4): an elastic solve with
+!> reference lengths frozen, then a sliding solve with positions frozen, repeated until
+!> the equilibrium residual is small and the active set no longer changes; a step that
+!> the first round does not solve is finished by monolithic solves from the
+!> alternation's state (try_staggered, finish_monolithic).
 module yarnfort_contact_stepper_staggered
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
@@ -28,12 +32,8 @@ contains
     !> should a finish fail to solve, after the next round whose active set held. The
     !> alternation alone contracts linearly (by a factor near 1 when contact nodes are
     !> free) and needed hundreds of rounds per step on inputs/belt.nml; the finish
-    !> converges quadratically to the same fixed point. Measured with
-    !> benchmarks/steps_trace (Newton iterations per step, before -> after): finishing
-    !> after round 1 instead of after 3 rounds with the set held, woven net of 840
-    !> unknowns 3.87 -> 3.47, of 1e4 9.30 -> 6.95, skewed 1e4 12.47 -> 8.65;
-    !> inputs/knit_clamped 12.72 -> 10.47 (there the first finish of a step often fails,
-    !> and a finish only once per step left up to 18 plain rounds).
+    !> converges quadratically to the same fixed point (docs/decisions.md, "Staggered
+    !> scheme: a monolithic finish after the first round").
     subroutine try_staggered(self, stats, iterations, error)
         class(friction_stepper_base_type), intent(inout) :: self
         type(newton_stats_type), intent(out) :: stats
@@ -53,9 +53,9 @@ contains
             sliding%flow_target = self%flow
             sliding%locked = 0
             ! Start from the secant-predicted state (positions, slipping flows), and in
-            ! stick when the loading turned, as the monolithic scheme does (measured on
-            ! the woven net of steps_trace, 840 unknowns: 6.4 -> 3.9 Newton iterations
-            ! per step; the all-stick start on reversal 3.47 -> 3.37, 1e4: 6.95 -> 6.83).
+            ! stick when the loading turned, as the monolithic scheme does: fewer
+            ! iterations (docs/decisions.md, "Staggered scheme: a monolithic finish after
+            ! the first round").
             block
                 real(wp), allocatable :: unknowns(:)
                 integer :: outcome
@@ -191,11 +191,9 @@ contains
     !> which is updated after each solve (as by try_monolithic) until it holds.
     !> `finished`: the last solve held the active set (the trial state is the solution).
     !> Otherwise the trial state is the last solution with the updated active set (or
-    !> left as it was if none solved), and the alternation goes on from it. Going back
-    !> to the alternation after every change measured far worse: the positions-frozen
-    !> sliding step undid the finish's stick/slip changes each round (inputs/knit_clamped
-    !> with the staggered scheme: up to 233 solves in a step, 4 step cuts, 427 steps
-    !> instead of 40).
+    !> left as it was if none solved), and the alternation goes on from it: the
+    !> positions-frozen sliding step would undo the finish's stick/slip changes (same
+    !> entry).
     subroutine finish_monolithic(self, flips, locked_forward, locked_backward, finished, &
             iterations, error)
         class(friction_stepper_base_type), intent(inout) :: self
