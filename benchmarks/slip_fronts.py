@@ -21,8 +21,6 @@ Every row is one run of build/benchmarks/steps_trace (summary and timings lines)
 """
 import argparse
 import pathlib
-import re
-import subprocess
 import sys
 import tempfile
 
@@ -32,7 +30,7 @@ TOP = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(TOP / 'tests' / 'verification'))
 sys.path.insert(0, str(TOP / 'benchmarks'))
 from scenes import group  # noqa: E402
-from steps_table import SUMMARY, TRACE, knit_scene, run  # noqa: E402
+from steps_table import TRACE, knit_scene, run  # noqa: E402
 
 import blas_env  # noqa: E402
 
@@ -52,33 +50,6 @@ def capstan_scene(k: int, folder: pathlib.Path) -> str:
             + group('contact', at='pins', law='coulomb', friction_coefficient=0.25)
             + group('path', time=[0.0, 1.0, 2.0], p_disp=[0.0, 1.0, 0.0])
             + group('output', folder=str(folder), vtk_every=0, progress=False))
-
-
-def factorisations(stdout: str) -> float:
-    """Factorisations per load step from steps_trace's `timings` line (NaN without)."""
-    lines = [line for line in stdout.splitlines() if line.startswith('timings')]
-    if not lines:
-        return float('nan')
-    return float(re.findall(r'\s(-?\d+\.\d+)', lines[-1])[1])
-
-
-def trace(binary, arguments, timeout):
-    """steps_trace's summary row (steps_table.run), with `factorisations` per step."""
-    try:
-        done = subprocess.run([str(binary)] + arguments, capture_output=True, text=True,
-                              cwd=TOP, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return {'failed': f'over {timeout} s'}
-    lines = [line for line in done.stdout.splitlines() if line.startswith('summary')]
-    if done.returncode != 0 or not lines:
-        tail = done.stderr.strip().splitlines()
-        return {'failed': tail[-1] if tail else f'exit {done.returncode}'}
-    values = [float(x) for x in lines[-1].split()[1:]]
-    if len(values) == len(SUMMARY) - 1:
-        values.insert(SUMMARY.index('chords'), 0.0)   # as steps_table.run
-    row = dict(zip(SUMMARY, values))
-    row['factorisations'] = factorisations(done.stdout)
-    return row
 
 
 def main():
@@ -107,7 +78,7 @@ def main():
             scene = work / f'capstan_{k}.nml'
             scene.write_text(capstan_scene(k, work / 'out'))
             print(f'slip_fronts: capstan K = {k} ({name})', file=sys.stderr, flush=True)
-            row = trace(binary, [str(scene)], args.timeout)
+            row = run(binary, [str(scene)], args.timeout)
             if 'failed' in row:
                 print(f'| {k} | failed: {row["failed"][:60]} |||||||', flush=True)
                 continue
