@@ -10,7 +10,8 @@ primary loading is time [0, 1] and the part of [2, 3] where the strain exceeds 0
 unloadings from the primary peaks are time [1, 2] (from 0.5) and [3, 4] (from 1.0); the
 release from 0.6 follows a reloading and is not from the primary curve. A second run of
 the same cell (strain 0.6 at p_disp = 1, loaded and released once) stands in as
-component 2, read through the uniaxial fallback columns."""
+component 2, read through the uniaxial columns (``uniaxial=True``: every periodic run
+now also has the membrane columns, in which this run's e22 does not grow)."""
 from __future__ import annotations
 
 import csv
@@ -163,7 +164,7 @@ def read_lsdyna(path: Path) -> list[tuple[int, str, np.ndarray]]:
 
 def test_abaqus_round_trip(runs, tmp_path):
     out = export_fabric({"1": runs["cycles"], "2": runs["other"]}, tmp_path / "knit.inp",
-                        thickness=f"{THICKNESS_MM}mm", units="N,mm")
+                        thickness=f"{THICKNESS_MM}mm", units="N,mm", uniaxial=True)
     written = read_abaqus(out)
     assert sorted(written) == ["1", "2"]
     for component, folder in (("1", runs["cycles"]), ("2", runs["other"])):
@@ -231,8 +232,12 @@ def test_inch_units(runs, tmp_path):
 
 
 def test_shear_and_missing_components(runs, tmp_path):
-    with pytest.raises(FabricExportError, match="no data for component 12"):
+    # A periodic run has the gamma12 column, 0 without a shear channel: no shear curve.
+    with pytest.raises(FabricExportError, match="component 12: gamma12 never grows"):
         export_fabric({"12": runs["cycles"]}, tmp_path / "a.inp", thickness="1mm")
+    with pytest.raises(FabricExportError, match="cannot give component 12"):
+        export_fabric({"12": runs["cycles"]}, tmp_path / "a.inp", thickness="1mm",
+                      uniaxial=True)
 
 
 def test_no_unloading_refused_or_left_out(runs, tmp_path):
@@ -282,7 +287,7 @@ def _cli(*args: str) -> subprocess.CompletedProcess:
 def test_cli_writes_and_refuses_overwrite(runs, tmp_path):
     out = tmp_path / "knit.inp"
     args = [str(runs["cycles"]), str(runs["other"]), "--component", "1", "2",
-            "--thickness", "0.6mm", "--units", "N,mm", "-o", str(out)]
+            "--thickness", "0.6mm", "--units", "N,mm", "--uniaxial", "-o", str(out)]
     done = _cli(*args)
     assert done.returncode == 0, done.stderr
     first = out.read_text()
@@ -294,7 +299,7 @@ def test_cli_writes_and_refuses_overwrite(runs, tmp_path):
     done = _cli(*args, "--force")
     assert done.returncode == 0 and out.read_text() == first
     done = _cli(str(runs["cycles"]), "--component", "1", "2", "-o", str(tmp_path / "b.csv"),
-                "--format", "csv")
+                "--format", "csv", "--uniaxial")
     assert done.returncode == 2 and "only the uniaxial columns" in done.stderr
     done = _cli(str(runs["cycles"]), str(runs["other"]), "--component", "1",
                 "-o", str(tmp_path / "c.csv"), "--format", "csv")
