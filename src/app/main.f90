@@ -10,6 +10,7 @@ program yarnfort_main
     use yarnfort_input_namelist, only: read_config_from_stdin, check_config
     use yarnfort_input_groups, only: input_help_lines => help_lines
     use yarnfort_scene_scene, only: scene_type
+    use yarnfort_generate_fabric, only: generate_fabric
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_driver, only: solve_with_outputs, get_linear_solver_name
     use yarnfort_app_progress, only: progress_writer_type
@@ -34,6 +35,8 @@ program yarnfort_main
 
     call system_clock(clock_start, clock_rate)
     call read_config_from_stdin(config, error)
+    if (allocated(error)) call fail('input', error, 2)
+    call generate_fabric(config, error)
     if (allocated(error)) call fail('input', error, 2)
     call check_config(config, error)
     if (allocated(error)) call fail('input', error, 2)

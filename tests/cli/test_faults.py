@@ -529,7 +529,7 @@ def test_killed_run_leaves_no_stale_lock(tmp_path):
 
 # ------------------------------------------------------------------ step numbers
 
-#: Byte offsets of the fields of restart.dat (format version 4, see output/restart.f90;
+#: Byte offsets of the fields of restart.dat (format version 4, see output/restart_file.f90;
 #: the factors of the scenes' two default channels p_force and p_disp follow have_old).
 OFFSET = {"n_nodes": 36, "n_elements": 40, "n_unknowns": 44, "n_passages": 48, "step": 52,
           "knot": 56, "time": 60, "next_step": 68, "previous_load": 76, "stepper": 84,

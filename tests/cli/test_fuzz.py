@@ -544,7 +544,7 @@ def test_fuzz_full_run(executable, tmp_path, batch):
 #: Restart cases per batch, and batches.
 RESTART_BATCHES, RESTART_CASES_PER_BATCH = 2, 40
 #: Byte offsets and types of the header fields of restart.dat (format version 4, see
-#: src/yarnfort/output/restart.f90): after the 16-byte magic, the version and the
+#: src/yarnfort/output/restart_file.f90): after the 16-byte magic, the version and the
 #: 16-byte fingerprint come n_nodes, n_elements, n_unknowns, n_passages, step, knot
 #: (int32), time, next_step, previous_load (float64), the stepper (16 bytes),
 #: n_channels (int32), load_old, time_old (float64), have_old (int32), then the factors of the

@@ -8,7 +8,7 @@ module yarnfort_output_contacts
     use yarnfort_output_csv_rows, only: csv_rows_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
-    use yarnfort_contact_geometry, only: get_wrap_angle
+    use yarnfort_contact_wrap_angle, only: get_wrap_angle
     use yarnfort_contact_friction_problem, only: mode_forward, mode_backward
     implicit none
     private

@@ -10,7 +10,7 @@ module yarnfort_output_curve
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_text, only: read_line
     use yarnfort_output_csv_rows, only: csv_rows_type, format_csv_real
-    use yarnfort_input_channel_checks, only: get_curve_columns, curve_column_length
+    use yarnfort_scene_channels, only: get_curve_columns, curve_column_length
     use yarnfort_output_filesystem, only: rename_file, remove_file, close_checked, open_append, &
         flush_checked, truncate_file, open_new_file, close_new_file
     implicit none

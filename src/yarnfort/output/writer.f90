@@ -28,7 +28,7 @@ module yarnfort_output_writer
     use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name, &
         is_bookkeeping_name
     use yarnfort_solver_restart, only: restart_type
-    use yarnfort_output_restart, only: write_restart, remove_restart, restart_file_name, &
+    use yarnfort_output_restart_file, only: write_restart, remove_restart, restart_file_name, &
         sync_restart, synced_file_name
     implicit none
     private
