@@ -29,7 +29,6 @@ against curve error (--png, default docs/images/presets_front.png). Progress on 
 from __future__ import annotations
 
 import argparse
-import csv
 import os
 import resource
 import subprocess
@@ -41,6 +40,7 @@ TOP = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(TOP / "tests" / "verification"))
 sys.path.insert(0, str(TOP / "benchmarks"))
 from fabric_scenes import ONE_CYCLE, patched_scene  # noqa: E402
+from steps_compare import read_curve as read_rows  # noqa: E402
 
 import blas_env  # noqa: E402
 
@@ -97,9 +97,8 @@ def settings() -> dict[str, dict]:
 
 
 def read_curve(folder: Path) -> list[tuple[float, float]]:
-    with open(folder / "curve.csv") as handle:
-        rows = list(csv.DictReader(line for line in handle if not line.startswith("#")))
-    return [(float(r["time"]), float(r["force_per_width"])) for r in rows]
+    """(time, force_per_width) of each row of curve.csv, by time."""
+    return sorted((t, float(row["force_per_width"])) for t, row in read_rows(folder).items())
 
 
 def run(base: str, values: dict, solver: dict, folder: Path) -> tuple[list, float] | str:
