@@ -124,7 +124,9 @@ contains
             'Writes to the &output folder: curve.csv (one row per converged step: channel', &
             'factors, reactions and displacements of the supports, load displacements),', &
             'state_NNNNN.vtu (5 or more digits; binary, or &output vtk_format = ''ascii'')', &
-            '+ states.pvd (ParaView) and input.nml (the effective input); it lists them in', &
+            'with its blocks holders_, links_, passages_NNNNN.vtu, state_NNNNN.vtm (the', &
+            'blocks by name) + states.pvd (ParaView: the series of .vtm)', &
+            'and input.nml (the effective input); it lists them in', &
             '.yarnfort-manifest and deletes only files listed there, and holds the lock', &
             '.yarnfort-lock while it runs (a second run into the folder stops at once).', &
             'Progress lines go to stderr. Exit code 0 on success, 1 if the solve or a write', &
