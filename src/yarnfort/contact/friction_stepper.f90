@@ -20,7 +20,7 @@ module yarnfort_contact_friction_stepper
     use yarnfort_error, only: error_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
-    use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name, &
+    use yarnfort_linalg_factory, only: new_linear_solver, get_friction_solver_names, &
         chosen_lu_name
     use yarnfort_linalg_composite_condensed, only: condensed_solver_type
     use yarnfort_linalg_composite_bordered, only: bordered_solver_type
@@ -75,12 +75,7 @@ contains
         n_p = scene%passages%size()
         ! The flows-only system of the staggered sliding step has order n_p, the
         ! monolithic one (also the staggered step's finish) n_unknowns + n_p.
-        general_name = linear_name
-        full_name = linear_name
-        if (linear_name == 'cholmod' .or. linear_name == 'cholmod+klu') then
-            general_name = default_linear_solver_name(int(n_p, 8), .false.)
-            full_name = chosen_lu_name
-        end if
+        call get_friction_solver_names(linear_name, int(n_p, 8), general_name, full_name)
         if (self%staggered) then
             allocate(self%elastic, self%sliding)
             call new_elastic_problem(self%elastic, scene)

@@ -15,7 +15,7 @@ module yarnfort_linalg_factory
     implicit none
     private
 
-    public :: new_linear_solver, default_linear_solver_name
+    public :: new_linear_solver, default_linear_solver_name, get_friction_solver_names
     public :: linear_solver_names, klu_max_order, chosen_lu_name
 
     !> Names accepted by `new_linear_solver` (with chosen_lu_name).
@@ -93,5 +93,24 @@ contains
             name = 'umfpack'
         end if
     end function default_linear_solver_name
+
+    !> The solvers of a friction stepper's unsymmetric systems for a run whose elastic
+    !> solves use `linear_name`: with a Cholesky one (which cannot factor them), the
+    !> flows-only system (order n_passages) gets the default for unsymmetric systems and
+    !> the reduced monolithic one chosen_lu_name (KLU or UMFPACK per pattern,
+    !> yarnfort_linalg_composite_lu_choice); otherwise both get `linear_name`.
+    pure subroutine get_friction_solver_names(linear_name, n_passages, flows_name, full_name)
+        character(len=*), intent(in) :: linear_name
+        integer(ik), intent(in) :: n_passages
+        character(len=:), allocatable, intent(out) :: flows_name, full_name
+
+        if (linear_name == 'cholmod' .or. linear_name == 'cholmod+klu') then
+            flows_name = default_linear_solver_name(n_passages, .false.)
+            full_name = chosen_lu_name
+        else
+            flows_name = linear_name
+            full_name = linear_name
+        end if
+    end subroutine get_friction_solver_names
 
 end module yarnfort_linalg_factory
