@@ -45,6 +45,7 @@ module yarnfort_contact_friction_stepper
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type, start_stepper, &
         accept_trial, save_common, restore_common
     use yarnfort_solver_state, only: fill_step_state
+    use yarnfort_solver_interrupt, only: interrupt_requested
     use yarnfort_solver_restart, only: restart_type, stepper_friction
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
         mode_stick, mode_forward, mode_backward, locked_both, node_level_floor
@@ -492,6 +493,7 @@ contains
             solved_before = .false.
             failed_before = self%trace%failed_solves
             do round = 1, scene%solver%max_friction_iterations
+                if (interrupt_requested()) exit     ! Ctrl-C: the step fails, unsettled
                 problem%mode = self%mode_trial
                 ! The last step's active set, when it has no solution nearby, is cheaper to
                 ! replace by all-stick (below) than to push through Newton's fallbacks:
@@ -836,6 +838,7 @@ contains
             relax = .false.
             may_finish = scene%dofs%n_unknowns > 0
             do round = 1, scene%solver%max_friction_iterations
+                if (interrupt_requested()) exit     ! Ctrl-C: the step fails, unsettled
                 ! (1) Elastic step: reference lengths frozen.
                 flow_in = self%flow_trial
                 call scene%passages%get_length0(scene%network%length0, self%flow_trial, &

@@ -36,6 +36,7 @@ module yarnfort_solver_newton
     use yarnfort_solver_sunlinsol_adapter, only: adapter_type, new_sunlinsol_adapter, get_csc, &
         analyse_counted, factor_counted, solve_counted, solve_columns_counted
     use yarnfort_solver_timer, only: wall_time
+    use yarnfort_solver_interrupt, only: check_interrupt
     use yarnfort_assembly_truss, only: no_stiffness_cap
     implicit none
     private
@@ -836,6 +837,9 @@ contains
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp) :: start
+        ! Every Newton path evaluates here: Ctrl-C fails the solve within an iteration.
+        call check_interrupt(error)
+        if (allocated(error)) return
         start = wall_time()
         if (jacobian) then
             call problem%problem%evaluate_jacobian(u, values, error)
