@@ -134,7 +134,8 @@ contains
             '.yarnfort-lock while it runs (a second run into the folder stops at once).', &
             'Progress lines go to stderr. Exit code 0 on success, 1 if the solve or a write', &
             'failed (e.g. a full disk; converged steps are kept), 2 for bad input, an', &
-            'unwritable or locked output folder, or a restart file that does not fit.', &
+            'unwritable or locked output folder, or a restart file that does not fit, 130', &
+            'after Ctrl-C (honoured within a Newton iteration; converged steps are kept).', &
             'After every converged step it also writes restart.dat; &control restart =', &
             '.true. continues a stopped or failed run from its last converged step.'
     end subroutine print_help
