@@ -2,8 +2,8 @@
 """yarnfort: textiles as networks of 1D hyperelastic strings with capstan friction.
 
 The Python side of yarnfort: build scenes (:class:`Scene`), run them in process
-(:func:`run_scene`) or over parameter grids (:func:`run_sweep`), fit friction and
-adhesion to a measured curve (:func:`calibrate`), and read and plot the results
+(:func:`run_scene`) or over parameter grids (:func:`run_sweep`), fit parameters to a
+measured curve in its lab units (:func:`calibrate`), and read and plot the results
 (:func:`read_run`, :mod:`yarnfort.plots`). The physics lives in the Fortran library.
 
 Names are loaded on first use, so that ``import yarnfort`` stays quick. Importing it sets
@@ -39,6 +39,7 @@ _EXPORTS: dict[str, str] = {
     "write_examples": "resources", "reference_text": "resources",
     "run_sweep": "sweep",
     "CalibrationResult": "calibrate", "calibrate": "calibrate", "plot_fit": "calibrate",
+    "IdentifiabilityWarning": "calibrate",
     "program_path": "_program",
 }
 

@@ -8,7 +8,10 @@ An address names one variable of one namelist group:
 - ``'contact[0].friction_coefficient'``: of the first ``&contact`` group in file
   order (indices from 0; negative ones count from the end, ``'yarn[-1].material'``);
 - ``'support[pull].displacement'``: of the group whose ``name`` is ``pull`` (quotes
-  around the name are optional: ``support['pull']``).
+  around the name are optional: ``support['pull']``);
+- ``'fabric.gap_factor[2]'``: one entry of a list variable (indices from 0, negative
+  ones from the end), e.g. one knot value of the gap-factor table. The list must be set
+  already and have that entry: its length is the scene's to choose.
 
 Group and variable names are case-insensitive; a group name is matched exactly. Setting a
 variable that the group does not have yet adds it, and setting a variable of a group the
@@ -29,7 +32,8 @@ import numpy as np
 
 __all__ = ["Address", "AddressError", "parse_address", "get_parameter", "set_parameter"]
 
-_ADDRESS = re.compile(r"^\s*(\w+)\s*(?:\[\s*([^\]]*?)\s*\])?\s*\.\s*(\w+)\s*$")
+_ADDRESS = re.compile(r"^\s*(\w+)\s*(?:\[\s*([^\]]*?)\s*\])?\s*\.\s*(\w+)\s*"
+                      r"(?:\[\s*([+-]?\d+)\s*\])?\s*$")
 _INTEGER = re.compile(r"^[+-]?\d+$")
 
 
@@ -51,16 +55,20 @@ class Address:
         Variable name, lower case.
     text : str
         The address as written.
+    element : int or None
+        Entry of a list variable (from 0), or None for the whole variable.
     """
 
     group: str
     index: int | str | None
     variable: str
     text: str
+    element: int | None = None
 
 
 def parse_address(address: str) -> Address:
-    """Parse ``'group.variable'``, ``'group[i].variable'`` or ``'group[name].variable'``.
+    """Parse ``'group.variable'``, ``'group[i].variable'`` or ``'group[name].variable'``,
+    each optionally with an entry of a list variable: ``'fabric.gap_factor[1]'``.
 
     Parameters
     ----------
@@ -79,15 +87,17 @@ def parse_address(address: str) -> Address:
     match = _ADDRESS.match(address) if isinstance(address, str) else None
     if not match:
         raise AddressError(f"bad parameter address {address!r}: expected 'group.variable',"
-                           " 'group[i].variable' or 'group[name].variable'")
-    group, index, variable = match.groups()
+                           " 'group[i].variable' or 'group[name].variable', optionally"
+                           " with a list entry 'variable[k]'")
+    group, index, variable, element = match.groups()
     if index is None or index == "":
         where: int | str | None = None
     elif _INTEGER.match(index):
         where = int(index)
     else:
         where = index.strip("'\"")
-    return Address(group.lower(), where, variable.lower(), address)
+    return Address(group.lower(), where, variable.lower(), address,
+                   None if element is None else int(element))
 
 
 def _instances(nml: f90nml.Namelist, group: str) -> list[f90nml.Namelist]:
@@ -131,6 +141,19 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _entry(instance: f90nml.Namelist, where: Address) -> tuple[list, int]:
+    """The list that an address with an entry names, and the entry's position in it."""
+    if where.variable not in instance:
+        raise AddressError(f"{where.text!r}: &{where.group} has no variable"
+                           f" {where.variable!r} set (an entry needs the list set)")
+    value = instance[where.variable]
+    items = list(value) if isinstance(value, list) else [value]
+    if not -len(items) <= where.element < len(items):
+        raise AddressError(f"{where.text!r}: &{where.group} {where.variable} has"
+                           f" {len(items)} value(s)")
+    return items, where.element % len(items)
+
+
 def get_parameter(nml: f90nml.Namelist, address: str) -> Any:
     """The value of the variable that ``address`` names (see the module notes).
 
@@ -153,6 +176,9 @@ def get_parameter(nml: f90nml.Namelist, address: str) -> Any:
     """
     where = parse_address(address)
     instance = _find_group(nml, where, create=False)
+    if where.element is not None:
+        items, position = _entry(instance, where)
+        return items[position]
     if where.variable not in instance:
         raise AddressError(f"{address!r}: &{where.group} has no variable"
                            f" {where.variable!r} set")
@@ -163,8 +189,9 @@ def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Name
     """Set the variable that ``address`` names, in place (see the module notes).
 
     A variable the group lacks is added; a group the scene lacks is added for an address
-    without an index (or index 0). An integer given for a variable that holds a real is
-    stored as a real; numpy values become Python values.
+    without an index (or index 0). An entry (``'fabric.gap_factor[1]'``) is set in a list
+    that the scene has; the other entries are kept. An integer given for a variable that
+    holds a real is stored as a real; numpy values become Python values.
 
     Parameters
     ----------
@@ -183,13 +210,24 @@ def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Name
     Raises
     ------
     AddressError
-        If the address is malformed or selects no group.
+        If the address is malformed or selects no group, or names an entry of a list
+        that is not set or is shorter.
     """
     where = parse_address(address)
-    instance = _find_group(nml, where, create=True)
     value = _plain(value)
-    old = instance.get(where.variable)
-    if isinstance(old, float) and isinstance(value, int) and not isinstance(value, bool):
-        value = float(value)
-    instance[where.variable] = value
+    if where.element is not None:
+        instance = _find_group(nml, where, create=False)
+        items, position = _entry(instance, where)
+        items[position] = _like(items[position], value)
+        instance[where.variable] = items
+        return nml
+    instance = _find_group(nml, where, create=True)
+    instance[where.variable] = _like(instance.get(where.variable), value)
     return nml
+
+
+def _like(old: Any, value: Any) -> Any:
+    """An integer stored where a real was is stored as a real."""
+    if isinstance(old, float) and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    return value

@@ -6,7 +6,9 @@ REFERENCE.md *Table files*): a column header states its unit in its last bracket
 (``Force (cN)``, ``strain [%]``) or as its last word after a blank or ``/`` when that is
 a unit (``Force in cN``); plain names (``strain``) state none. A value v in unit u is
 ``v * numerator / denominator`` in the scene's unit (strain 1, force N, length m).
-``tests/python/test_units.py`` checks that both sides convert alike.
+``tests/python/test_units.py`` checks that both sides convert alike. Measured curves
+(:mod:`yarnfort.calibrate`) may also give a force per width, any force unit over a length
+unit (``N/m``, ``cN/cm``, ``lbf/in``).
 """
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ import re
 
 import numpy as np
 
-__all__ = ["UNITS", "split_header", "to_scene_unit"]
+__all__ = ["UNITS", "split_header", "to_scene_unit", "strain_factor", "force_factor"]
 
 #: Standard gravity (m/s**2) and the avoirdupois pound-force (N), exact by definition.
 STANDARD_GRAVITY = 9.80665
@@ -30,6 +32,10 @@ UNITS: dict[str, tuple[str, float, float]] = {
     "kN": ("force", 1000.0, 1.0), "gf": ("force", STANDARD_GRAVITY, 1000.0),
     "kgf": ("force", STANDARD_GRAVITY, 1.0), "lbf": ("force", POUND_FORCE, 1.0),
 }
+#: Widths of a force per width: the length units, and the inch of strip tests (exact).
+WIDTH_UNITS: dict[str, float] = {**{name: numerator / denominator
+                                    for name, (kind, numerator, denominator) in UNITS.items()
+                                    if kind == "length"}, "in": 0.0254}
 #: Spellings also read in any case (no SI prefix to confuse them with).
 ANY_CASE = ("permille", "gf", "kgf", "lbf")
 #: A field ending in (unit) or [unit], perhaps followed by words without brackets.
@@ -45,7 +51,18 @@ def find_unit(text: str) -> str | None:
 
 
 def split_header(field: str) -> tuple[str, str | None]:
-    """A column header as (name, unit text), the unit None where it states none."""
+    """A column header as (name, unit text), the unit None where it states none.
+
+    Parameters
+    ----------
+    field : str
+        The header cell (``'Force (cN)'``, ``'strain [%]'``, ``'Force in cN'``).
+
+    Returns
+    -------
+    name : str
+    unit : str or None
+    """
     field = field.strip()
     match = _BRACKETS.match(field)
     if match:
@@ -62,6 +79,19 @@ def split_header(field: str) -> tuple[str, str | None]:
 def to_scene_unit(values: np.ndarray, unit: str, kind: str) -> np.ndarray:
     """``values`` in ``unit`` (a spelling of a unit of ``kind``) in the scene's unit.
 
+    Parameters
+    ----------
+    values : array_like
+        The values as given.
+    unit : str
+        Their unit.
+    kind : {'strain', 'force', 'length'}
+        What they are.
+
+    Returns
+    -------
+    numpy.ndarray
+
     Raises
     ------
     ValueError
@@ -73,3 +103,56 @@ def to_scene_unit(values: np.ndarray, unit: str, kind: str) -> np.ndarray:
         raise ValueError(f"{unit!r} is not a known {kind} unit ({known})")
     _, numerator, denominator = UNITS[name]
     return (np.asarray(values, dtype=float) * numerator) / denominator
+
+
+def strain_factor(unit: str | None) -> float:
+    """Factor from a strain in ``unit`` (``'%'``, ``'permille'``, ``'1'``; None is 1) to a
+    strain of 1.
+
+    Parameters
+    ----------
+    unit : str or None
+        The unit.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        For an unknown unit; the message lists the known ones.
+    """
+    return float(to_scene_unit(1.0, "1" if unit is None else unit.strip(), "strain"))
+
+
+def force_factor(unit: str | None) -> tuple[float, bool]:
+    """Factor from a force (``'N'``, ``'cN'``, ``'gf'``, ...) or a force per width (a force
+    unit over a width unit: ``'N/m'``, ``'cN/cm'``, ``'lbf/in'``) to N or N/m; None is N.
+
+    Parameters
+    ----------
+    unit : str or None
+        The unit.
+
+    Returns
+    -------
+    factor : float
+        To N (a force) or N/m (a force per width).
+    per_width : bool
+        True for a force per width.
+
+    Raises
+    ------
+    ValueError
+        For an unknown unit; the message lists the known ones.
+    """
+    force, _, width = (part.strip() for part in ("N" if unit is None else unit).partition("/"))
+    if width and width not in WIDTH_UNITS:
+        raise ValueError(f"force unit {unit!r}: a force per width is a force unit over one of "
+                         f"{', '.join(WIDTH_UNITS)}")
+    try:
+        factor = float(to_scene_unit(1.0, force, "force"))
+    except ValueError as error:
+        raise ValueError(f"force unit {unit!r}: {error}") from None
+    return (factor / WIDTH_UNITS[width], True) if width else (factor, False)

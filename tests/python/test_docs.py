@@ -14,7 +14,7 @@ import pytest
 #: Modules whose public names (``__all__``) are documented.
 MODULES = ["yarnfort", "yarnfort.address", "yarnfort.namelist", "yarnfort.results",
            "yarnfort.runner", "yarnfort.scene", "yarnfort.sweep", "yarnfort.calibrate",
-           "yarnfort.plots"]
+           "yarnfort.plots", "yarnfort.units"]
 
 
 def public_callables():

@@ -8,7 +8,7 @@ import pytest
 
 import yarnfort
 from yarnfort.calibrate import read_measured
-from yarnfort.units import UNITS, split_header, to_scene_unit
+from yarnfort.units import UNITS, force_factor, split_header, strain_factor, to_scene_unit
 
 #: Identities up to rounding (relative).
 IDENTITY = 100 * np.finfo(float).eps
@@ -70,11 +70,49 @@ def test_measured_curve_in_lab_units(tmp_path):
     lab = tmp_path / "lab.csv"
     lab.write_text("# tensile test\nStrain (%),Force [cN],branch\n0,0,loading\n5,12.3,loading\n"
                    "10,31,loading\n5,8,unloading\n")
-    strain, force, branch = read_measured(lab)
-    np.testing.assert_allclose(strain, [0.0, 0.05, 0.1, 0.05], rtol=IDENTITY)
-    np.testing.assert_allclose(force, [0.0, 0.123, 0.31, 0.08], rtol=IDENTITY)
-    assert list(branch) == [1, 1, 1, -1]
+    measured = read_measured(lab)
+    np.testing.assert_allclose(measured.strain, [0.0, 0.05, 0.1, 0.05], rtol=IDENTITY)
+    np.testing.assert_allclose(measured.force, [0.0, 0.123, 0.31, 0.08], rtol=IDENTITY)
+    assert list(measured.branch) == [1, 1, 1, -1]
     bad = tmp_path / "bad.csv"
     bad.write_text("strain,force (N/tex)\n0,0\n1,2\n")
-    with pytest.raises(ValueError, match="bad.csv: 'N/tex' is not a known force unit"):
+    with pytest.raises(ValueError, match="bad.csv: force unit 'N/tex'"):
         read_measured(bad)
+
+
+#: Round-off allowed in a product of two exact decimal factors.
+RTOL = 4 * 2.0**-52
+#: Standard gravity (m/s^2) and the avoirdupois pound (kg), both exact by definition.
+G0 = 9.80665
+POUND = 0.45359237
+
+
+def test_strain_units():
+    assert strain_factor("%") * 50 == pytest.approx(0.5, rel=RTOL)
+    assert strain_factor("permille") * 500 == pytest.approx(0.5, rel=RTOL)
+    assert strain_factor(None) == strain_factor("1") == 1.0
+    with pytest.raises(ValueError, match="'mm' is not a known strain unit \\('1'"):
+        strain_factor("mm")
+
+
+def test_force_units_by_their_definitions():
+    assert force_factor("N") == (1.0, False)
+    assert force_factor(None) == (1.0, False)
+    assert force_factor("cN")[0] * 250 == pytest.approx(2.5, rel=RTOL)
+    assert force_factor("mN")[0] * 250 == pytest.approx(0.25, rel=RTOL)
+    assert force_factor("gf")[0] == pytest.approx(G0 / 1000, rel=RTOL)
+    assert force_factor("kgf")[0] == pytest.approx(G0, rel=RTOL)
+    assert force_factor("lbf")[0] == pytest.approx(POUND * G0, rel=RTOL)
+
+
+def test_force_per_width_units():
+    factor, per_width = force_factor("N/m")
+    assert per_width and factor == 1.0
+    # 1 N/mm = 1000 N/m; 1 cN/cm = 0.01 N / 0.01 m = 1 N/m; 1 lbf/in = 175.1268... N/m.
+    assert force_factor("N/mm")[0] == pytest.approx(1000.0, rel=RTOL)
+    assert force_factor("cN/cm")[0] == pytest.approx(1.0, rel=RTOL)
+    assert force_factor("lbf/in")[0] == pytest.approx(POUND * G0 / 0.0254, rel=RTOL)
+    with pytest.raises(ValueError, match="force unit 'N/ft'"):
+        force_factor("N/ft")
+    with pytest.raises(ValueError, match="force unit 'MN'"):
+        force_factor("MN")
