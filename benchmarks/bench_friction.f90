@@ -100,6 +100,7 @@ program bench_friction
     use yarnfort_linalg_composite_lu_choice, only: lu_choice_solver_type
     use yarnfort_linalg_composite_bordered, only: bordered_solver_type
     use yarnfort_input_namelist, only: read_config_from_file, check_config
+    use yarnfort_generate_fabric, only: generate_fabric
     use yarnfort_linalg_process, only: apply_process_settings
     implicit none
 
@@ -173,6 +174,8 @@ program bench_friction
         if (n_positional /= 1) call fail_usage('bench_friction', &
             'need --input <file> <scheme>', usage)
         call read_config_from_file(input_file, config, error, from_working_directory=.true.)
+        if (allocated(error)) call fail('bench_friction', error)
+        call generate_fabric(config, error)
         if (allocated(error)) call fail('bench_friction', error)
         call check_config(config, error)
         if (allocated(error)) call fail('bench_friction', error)

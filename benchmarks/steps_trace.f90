@@ -100,6 +100,7 @@ program steps_trace
     use yarnfort_error, only: error_type
     use yarnfort_input_config, only: config_type
     use yarnfort_input_namelist, only: read_config_from_file, check_config
+    use yarnfort_generate_fabric, only: generate_fabric
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_driver, only: get_linear_solver_name
@@ -163,6 +164,8 @@ program steps_trace
         if (skewed) call skew_net(config, side)
     else
         call read_config_from_file(trim(source), config, error, from_working_directory=.true.)
+        if (allocated(error)) call fail('steps_trace', error)
+        call generate_fabric(config, error)
         if (allocated(error)) call fail('steps_trace', error)
         call check_config(config, error)
         if (allocated(error)) call fail('steps_trace', error)

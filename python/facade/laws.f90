@@ -5,7 +5,7 @@
 module yarnfort_facade_laws
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     use yarnfort_friction_law, only: friction_law_type
     use yarnfort_input_config, only: material_config_type, contact_config_type
     use yarnfort_scene_builder, only: new_force_law, new_friction_law

@@ -14,6 +14,7 @@ module yarnfort_facade_scene_runner
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_input_config, only: config_type
     use yarnfort_input_namelist, only: read_config_from_file, check_config
+    use yarnfort_generate_fabric, only: generate_fabric
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_output_writer, only: output_writer_type
     use yarnfort_driver, only: solve_with_outputs
@@ -101,6 +102,7 @@ contains
         outcome = outcome_done
         folder = ''
         call read_config_from_file(path, config, error, from_working_directory=.true.)
+        if (.not. allocated(error)) call generate_fabric(config, error)
         if (.not. allocated(error)) then
             folder = trim(config%output%folder)
             call check_config(config, error)

@@ -41,6 +41,8 @@ _EXPORTS: dict[str, str] = {
     "CalibrationResult": "calibrate", "calibrate": "calibrate", "plot_fit": "calibrate",
     "IdentifiabilityWarning": "calibrate",
     "program_path": "_program",
+    "export_fabric": "fabric_export", "fabric_curves": "fabric_export",
+    "FabricExportError": "fabric_export",
 }
 
 __all__ = ["__version__", *_EXPORTS]

@@ -11,6 +11,9 @@
 - ``python -m yarnfort examples DIR [--force]`` writes the example scenes with their
   tables and models into ``DIR/inputs/`` (run one there: ``cd DIR && yarnfort <
   inputs/vnet.nml``);
+- ``python -m yarnfort export-fabric RUN... --component C... --format abaqus|lsdyna|csv
+  --thickness 0.6mm --units N,mm -o FILE`` writes the effective loading and unloading
+  curves of periodic-cell runs for a macro model (:func:`yarnfort.export_fabric`);
 - ``python -m yarnfort reference`` prints the input reference (``inputs/REFERENCE.md``:
   every group and variable, checks, output files).
 
@@ -336,6 +339,42 @@ def _parser() -> argparse.ArgumentParser:
     examples.add_argument("folder", type=Path, help="folder to write into (made if missing)")
     examples.add_argument("--force", action="store_true",
                           help="overwrite example files that exist there")
+    export = commands.add_parser(
+        "export-fabric", help="write a fabric's effective curves for Abaqus, LS-DYNA or CSV",
+        description="Write the effective loading and unloading curves of periodic-cell"
+        " runs: an Abaqus/Explicit *FABRIC material block (*UNIAXIAL, *LOADING DATA,"
+        " *UNLOADING DATA), LS-DYNA *DEFINE_CURVE_TITLE blocks, or a CSV. Loading: the"
+        " primary loading of each run; unloading: one curve per peak the run releases"
+        " from. Stress = membrane force per width / thickness, in the units asked for."
+        " Layouts and sources: docs/fabric_export.md.")
+    export.add_argument("runs", type=Path, nargs="+", metavar="RUN",
+                        help="output folders of periodic-cell runs")
+    export.add_argument("--component", nargs="+", required=True, metavar="C",
+                        choices=["1", "2", "12"],
+                        help="the component each RUN gives, in order (1, 2 or 12 for shear);"
+                        " one RUN with several components reads its e11/n11, e22/n22,"
+                        " gamma12/n12 columns")
+    export.add_argument("--format", default="abaqus", choices=["abaqus", "lsdyna", "csv"],
+                        help="file format (default abaqus)")
+    export.add_argument("--thickness", metavar="LENGTH",
+                        help="fabric thickness with its unit, e.g. 0.6mm (required for"
+                        " abaqus and lsdyna: their curves are stress against strain)")
+    export.add_argument("--units", default="N,mm", metavar="FORCE,LENGTH",
+                        help="force and length units of the macro model (default N,mm:"
+                        " stress in MPa)")
+    export.add_argument("-o", "--out", type=Path, required=True, metavar="FILE",
+                        help="file to write (refused if it exists, unless --force)")
+    export.add_argument("--force", action="store_true", help="overwrite an existing FILE")
+    export.add_argument("--uniaxial", action="store_true",
+                        help="components 1 and 2 from strain and force_per_width (the"
+                        " cell's x direction) even where curve.csv has e11/n11, e22/n22:"
+                        " a cell turned by 90 degrees given as component 2")
+    export.add_argument("--no-unloading", action="store_true",
+                        help="write the loading curves only")
+    export.add_argument("--name", default="YARNFORT_FABRIC",
+                        help="Abaqus material name (default YARNFORT_FABRIC)")
+    export.add_argument("--first-curve-id", type=int, default=1, metavar="LCID",
+                        help="LS-DYNA id of the first curve (default 1)")
     commands.add_parser(
         "reference", help="print the input reference (inputs/REFERENCE.md)",
         description="Print the input reference: every namelist group and variable with"
@@ -352,6 +391,24 @@ def plot_states_command(args: argparse.Namespace) -> Path:
                          depth_scale=args.depth_scale, title=args.title)
     return save_figure(figure, args.out if args.out is not None
                        else args.folder / DEFAULT_STATES_PLOT)
+
+
+def export_fabric_command(args: argparse.Namespace) -> Path:
+    """Write the file that ``export-fabric`` asks for; the path written."""
+    from .fabric_export import export_fabric
+
+    runs, components = list(args.runs), list(args.component)
+    if len(runs) == 1 and len(components) > 1:
+        runs = runs * len(components)
+    elif len(runs) != len(components):
+        raise CommandError(f"{len(runs)} runs and {len(components)} components: give one"
+                           " --component per RUN, in order (or several for one RUN with"
+                           " membrane columns)")
+    return export_fabric(list(zip(components, runs)), args.out, format=args.format,
+                         thickness=args.thickness, units=args.units,
+                         unloading=not args.no_unloading, uniaxial=args.uniaxial,
+                         name=args.name,
+                         first_curve_id=args.first_curve_id, overwrite=args.force)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -381,6 +438,10 @@ def main(argv: list[str] | None = None) -> int:
             print(f"yarnfort: wrote {len(written)} example files into"
                   f" {args.folder / 'inputs'}; run one with: cd {args.folder} &&"
                   " yarnfort < inputs/vnet.nml")
+            return 0
+        if args.command == "export-fabric":
+            path = export_fabric_command(args)
+            print(f"yarnfort: wrote {path}")
             return 0
         if args.command == "plot":
             path = plot_folder(args.folder, args.support, args.out, channel=args.channel,

@@ -233,7 +233,7 @@ ROW_HEIGHT = 3.6
 LENGTH_UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "um": 1e-6}
 #: Length unit of every plot of positions and displacements (both plot commands).
 DEFAULT_UNIT = "mm"
-#: ``mode`` point data of a node whose passage slips (forward, backward).
+#: ``mode`` of a slipping passage (forward, backward; State.passages).
 SLIP_MODES = (2, 3)
 
 
@@ -355,9 +355,11 @@ def plot_network(state: State, ax: Axes | None = None, projection: str = "xy",
             ax.add_collection(each)
     if nodes:
         ax.plot(*points.T, "k.", markersize=3)
-    mode = state.point_data.get("mode")
+    mode = state.passages.get("mode")
     if slipping and mode is not None:
-        slip = np.flatnonzero(np.isin(np.ravel(mode), SLIP_MODES))
+        # The nodes with a slipping passage (each once).
+        slip = np.unique(np.ravel(state.passages["node"])[np.isin(np.ravel(mode),
+                                                                  SLIP_MODES)] - 1)
         where = np.concatenate([slip + k * len(state.position) for k in range(len(shifts))])
         ax.plot(*points[where].T, "o", markersize=7, markerfacecolor="none",
                 markeredgecolor="tab:red", label="slipping passage", gid="slipping")

@@ -1,16 +1,15 @@
 # SPDX-License-Identifier: MIT
 """Read a run's output folder: ``curve.csv``, ``reactions.csv`` and ``contacts.csv``, and
-the VTK states (``states.pvd`` and the ``state_*.vtu`` files it lists).
+the VTK states (``states.pvd`` and the files it lists).
 
 States are read with :mod:`meshio` when it is installed (any VTK XML encoding: ASCII,
 inline or appended binary); without it, a small reader of the ASCII encoding is used.
-What a state holds: node positions (the VTK points), the two-node elements (the
-``line`` cells of ``kind`` 0), the links (gap-holders and periodic images, the cells of
-another ``kind``), the field data (``step``, ``time``, load factors, a fabric's
-``strain``) and every point and cell data array of the file, by name. The element
-arrays ``tension``, ``stretch`` and ``L0`` are required; any others (displacement,
-yarn or material ids, contact state, ...) are kept in :attr:`State.point_data` and
-:attr:`State.cell_data`.
+A state is the yarns' file ``state_NNNNN.vtu`` (node positions, the two-node elements,
+the field data ``step``, ``time``, load factors, a fabric's ``strain``, and every point
+and cell data array by name: ``tension``, ``stretch`` and ``L0`` are required) and, next
+to it, the blocks ``holders_NNNNN.vtu`` (gap-holders), ``links_NNNNN.vtu`` (periodic
+links) and ``passages_NNNNN.vtu`` (one point per sliding passage) when the scene has them;
+``state_NNNNN.vtm`` lists them by name, and ``states.pvd`` lists the ``.vtm`` files.
 """
 from __future__ import annotations
 
@@ -27,9 +26,12 @@ import numpy as np
 __all__ = ["Curve", "State", "ResultError", "read_curve", "read_reactions", "read_contacts",
            "read_state", "read_states", "read_run"]
 
-#: ``kind`` of the link cells of a VTK state (0 is a yarn element).
+#: ``kind`` of a link of a :class:`State` (0 would be a yarn element).
 GAP_HOLDER = 1
 PERIODIC_LINK = 2
+#: The blocks of a state besides the yarns': file prefix (replacing ``state_``) -> kind
+#: of link (None: the passages).
+_PARTS = {"holders_": GAP_HOLDER, "links_": PERIODIC_LINK, "passages_": None}
 #: Periodic links along one period agree to this fraction of the longest link.
 PERIOD_TOLERANCE = 1e-9
 
@@ -174,16 +176,22 @@ class State:
     tension, stretch, length0 : numpy.ndarray
         Per element: tension (N), stretch l/L0 and reference length L0 (m).
     point_data, cell_data : dict of str to numpy.ndarray
-        Every array of the file, by name (the three above included in ``cell_data``,
-        which holds the elements' values only).
+        Every array of the yarns' file, by name (the three above included in
+        ``cell_data``).
     links : numpy.ndarray
-        Node indices (from 0) of each link: gap-holder or periodic image, shape
-        (n_links, 2); empty for a state without them.
+        Node indices (from 0) of each link, (leader, follower): the gap-holders, then
+        the periodic links, shape (n_links, 2); empty for a state without them.
     link_kind : numpy.ndarray
-        The ``kind`` of each link: :data:`GAP_HOLDER` or :data:`PERIODIC_LINK`.
+        The kind of each link: :data:`GAP_HOLDER` or :data:`PERIODIC_LINK`.
     link_data : dict of str to numpy.ndarray
-        The cell data of the links, by name (``period``: the lattice vector each
-        spans, m).
+        The cell data of the links, by name: ``period`` (the lattice vector each spans,
+        m), ``leader``, ``follower`` (1-based), and the gap-holders' ``contact_force``
+        (N), ``force`` (N), ``stretch`` and ``L0`` (NaN for a periodic link).
+    passages : dict of str to numpy.ndarray
+        One value per sliding passage: ``passage``, ``node``, ``yarn`` (1-based),
+        ``mode`` (1 stick, 2 forward, 3 backward, 4 locked), ``flow``, ``tension_min``,
+        ``tension_max``, ``critical_tension``, ``wrap_angle`` (as in ``contacts.csv``);
+        empty for a scene without passages.
     field_data : dict of str to numpy.ndarray
         The file's field data: ``step``, ``time``, the load factors and, for a fabric,
         ``strain`` and ``force_per_width`` (one value each).
@@ -200,6 +208,7 @@ class State:
     link_kind: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     link_data: dict[str, np.ndarray] = field(default_factory=dict)
     field_data: dict[str, np.ndarray] = field(default_factory=dict)
+    passages: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def step(self) -> int | None:
@@ -414,22 +423,34 @@ def _read_ascii(path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict, dict]:
                   for node in grid.iterfind("FieldData/DataArray")}
     points = _ascii_array(piece, "Points", None).reshape(-1, 3)
     connectivity = _ascii_array(piece, "Cells", "connectivity").astype(int)
+    per_cell = 2 if "line" in _ascii_types(piece) else 1
     point_data = {node.get("Name"): _ascii_array(piece, "PointData", node.get("Name"))
                   for node in piece.iterfind("PointData/DataArray")}
     cell_data = {node.get("Name"): _ascii_array(piece, "CellData", node.get("Name"))
                  for node in piece.iterfind("CellData/DataArray")}
-    for data, count in ((point_data, len(points)), (cell_data, len(connectivity) // 2)):
+    for data, count in ((point_data, len(points)), (cell_data, len(connectivity) // per_cell)):
         for name, values in data.items():
             if count and values.size != count and values.size % count == 0:
                 data[name] = values.reshape(count, -1)
-    return points, connectivity.reshape(-1, 2), point_data, cell_data, field_data
+    return points, connectivity.reshape(-1, per_cell), point_data, cell_data, field_data
 
 
-def _read_meshio(meshio: Any, path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict, dict]:
+def _ascii_types(piece: ET.Element) -> set[str]:
+    """The cell types of a piece: 'line' (VTK 3) or 'vertex' (VTK 1)."""
+    types = set(_ascii_array(piece, "Cells", "types").astype(int).tolist())
+    return {"line" if t == 3 else "vertex" for t in types}
+
+
+def _read_meshio(meshio: Any, path: Path, cell_type: str = "line"
+                 ) -> tuple[np.ndarray, np.ndarray, dict, dict, dict]:
     mesh = meshio.read(path)
-    blocks = [k for k, block in enumerate(mesh.cells) if block.type == "line"]
-    if not blocks:
+    blocks = [k for k, block in enumerate(mesh.cells) if block.type == cell_type]
+    if not blocks and cell_type == "line":
         raise ResultError(f"{path}: no line cells (two-node elements)")
+    if not blocks:
+        n = 2 if cell_type == "line" else 1
+        return (np.asarray(mesh.points, dtype=float).reshape(-1, 3),
+                np.zeros((0, n), dtype=int), {}, {}, {})
     elements = np.concatenate([mesh.cells[k].data for k in blocks]).astype(int)
     cell_data = {name: np.concatenate([np.asarray(arrays[k]) for k in blocks])
                  for name, arrays in mesh.cell_data.items()}
@@ -438,28 +459,9 @@ def _read_meshio(meshio: Any, path: Path) -> tuple[np.ndarray, np.ndarray, dict,
     return np.asarray(mesh.points, dtype=float), elements, point_data, cell_data, field_data
 
 
-def read_state(path: str | Path) -> State:
-    """Read one VTK state file (``state_*.vtu``) written by yarnfort: its yarn elements,
-    and apart from them its links (the cells of another ``kind``).
-
-    Parameters
-    ----------
-    path : str or Path
-        The ``.vtu`` file.
-
-    Returns
-    -------
-    State
-
-    Raises
-    ------
-    FileNotFoundError
-        If there is no such file (with either reader).
-    ResultError
-        If the file is not a state of line cells with ``tension``, ``stretch`` and
-        ``L0`` cell data.
-    """
-    path = Path(path)
+def _read_grid(path: Path, cell_type: str = "line"
+               ) -> tuple[np.ndarray, np.ndarray, dict, dict, dict]:
+    """Points, cells of `cell_type`, point, cell and field data of one .vtu file."""
     # Checked here, not left to meshio, whose ReadError is no OSError.
     if not path.exists():
         raise FileNotFoundError(errno.ENOENT, "no such VTK state file", str(path))
@@ -471,38 +473,102 @@ def read_state(path: str | Path) -> State:
     if meshio is not None:
         unreadable += (meshio.ReadError,)
     try:
-        points, elements, point_data, cell_data, field_data = (
-            _read_meshio(meshio, path) if meshio is not None else _read_ascii(path))
+        return (_read_meshio(meshio, path, cell_type) if meshio is not None
+                else _read_ascii(path))
     except unreadable as error:
         if isinstance(error, ResultError):
             raise
         raise ResultError(f"{path}: not a readable yarnfort VTK state ({error})") from None
+
+
+def _yarns_block(path: Path) -> Path:
+    """The yarns' file of a state's multiblock file (``state_NNNNN.vtm``): its block
+    named ``yarns`` (or its first block)."""
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as error:
+        raise ResultError(f"{path}: not a readable multiblock file ({error})") from None
+    blocks = [d for d in root.iter("DataSet") if d.get("file")]
+    if not blocks:
+        raise ResultError(f"{path}: lists no block")
+    yarns = next((d for d in blocks if d.get("name") == "yarns"), blocks[0])
+    return path.with_name(yarns.get("file"))
+
+
+def read_state(path: str | Path) -> State:
+    """Read one VTK state written by yarnfort: the yarns' file (``state_*.vtu``) and the
+    blocks next to it (gap-holders, periodic links, passages) that exist.
+
+    Parameters
+    ----------
+    path : str or Path
+        The yarns' ``state_NNNNN.vtu`` file, or the state's multiblock file
+        ``state_NNNNN.vtm``.
+
+    Returns
+    -------
+    State
+
+    Raises
+    ------
+    FileNotFoundError
+        If there is no such file (with either reader).
+    ResultError
+        If a file is not a state of line cells with ``tension``, ``stretch`` and
+        ``L0`` cell data, or a block lacks the arrays yarnfort writes there.
+    """
+    path = Path(path)
+    if path.suffix == ".vtm":
+        path = _yarns_block(path)
+    points, elements, point_data, cell_data, field_data = _read_grid(path)
     missing = [name for name in ("tension", "stretch", "L0") if name not in cell_data]
     if missing:
         raise ResultError(f"{path}: no cell data {', '.join(missing)}")
-    # Links (gap-holders, periodic images) are cells of another `kind`.
-    links, link_kind = np.zeros((0, 2), dtype=int), np.zeros(0, dtype=int)
+    pairs, kinds, tables = [], [], []
+    passages: dict[str, np.ndarray] = {}
+    for prefix, kind in _PARTS.items():
+        part = path.with_name(prefix + path.name[len("state_"):])
+        if not path.name.startswith("state_") or not part.exists():
+            continue
+        _, _, part_points, part_cells, _ = _read_grid(
+            part, "line" if kind == GAP_HOLDER else "vertex")
+        if kind is None:
+            passages = {name: np.asarray(values) for name, values in part_points.items()}
+            continue
+        if "leader" not in part_cells or "follower" not in part_cells:
+            raise ResultError(f"{part}: no cell data leader, follower")
+        leader = np.ravel(part_cells["leader"]).astype(int)
+        pairs.append(np.column_stack([leader, np.ravel(part_cells["follower"])]) - 1)
+        kinds.append(np.full(len(leader), kind))
+        tables.append({name: np.asarray(values) for name, values in part_cells.items()})
+    links = np.concatenate(pairs).astype(int) if pairs else np.zeros((0, 2), dtype=int)
+    link_kind = np.concatenate(kinds) if kinds else np.zeros(0, dtype=int)
     link_data: dict[str, np.ndarray] = {}
-    if "kind" in cell_data:
-        kind = np.ravel(cell_data["kind"]).astype(int)
-        element = kind == 0
-        links, link_kind = elements[~element], kind[~element]
-        elements = elements[element]
-        link_data = {name: np.asarray(values)[~element] for name, values in cell_data.items()}
-        cell_data = {name: np.asarray(values)[element] for name, values in cell_data.items()}
+    for name in {name for table in tables for name in table}:
+        columns = []
+        for table, kind in zip(tables, kinds):
+            if name in table:
+                columns.append(np.asarray(table[name], dtype=float))
+            else:
+                shape = (len(kind),) + np.shape(next(t[name] for t in tables if name in t))[1:]
+                columns.append(np.full(shape, np.nan))
+        link_data[name] = np.concatenate(columns)
     return State(position=points, elements=elements,
                  tension=np.ravel(cell_data["tension"]),
                  stretch=np.ravel(cell_data["stretch"]),
                  length0=np.ravel(cell_data["L0"]),
                  point_data=point_data, cell_data=cell_data, links=links,
-                 link_kind=link_kind, link_data=link_data, field_data=field_data)
+                 link_kind=link_kind, link_data=link_data, field_data=field_data,
+                 passages=passages)
 
 
 def read_states(folder: str | Path) -> list[State]:
     """The VTK states of an output folder, in step order.
 
     The states are those listed in the folder's ``states.pvd`` (the files of this run
-    only); without a ``states.pvd``, every ``state_*.vtu`` in name order.
+    only: each state's multiblock file, or in folders of earlier versions the yarns'
+    files, part 0, each read with its blocks); without a ``states.pvd``, every
+    ``state_*.vtu`` in name order.
 
     Parameters
     ----------
@@ -527,7 +593,8 @@ def read_states(folder: str | Path) -> list[State]:
             root = ET.parse(collection).getroot()
         except ET.ParseError as error:
             raise ResultError(f"{collection}: not a readable collection ({error})") from None
-        return [read_state(folder / d.get("file")) for d in root.iter("DataSet")]
+        return [read_state(folder / d.get("file")) for d in root.iter("DataSet")
+                if d.get("part", "0") == "0"]
     return [read_state(p) for p in sorted(folder.glob("state_*.vtu"),
                                           key=lambda p: int(p.stem[len("state_"):]))]
 

@@ -10,6 +10,7 @@ program yarnfort_main
     use yarnfort_input_namelist, only: read_config_from_stdin, check_config
     use yarnfort_input_groups, only: input_help_lines => help_lines
     use yarnfort_scene_scene, only: scene_type
+    use yarnfort_generate_fabric, only: generate_fabric
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_driver, only: solve_with_outputs, get_linear_solver_name
     use yarnfort_app_progress, only: progress_writer_type
@@ -35,6 +36,8 @@ program yarnfort_main
 
     call system_clock(clock_start, clock_rate)
     call read_config_from_stdin(config, error)
+    if (allocated(error)) call fail('input', error, 2)
+    call generate_fabric(config, error)
     if (allocated(error)) call fail('input', error, 2)
     call check_config(config, error)
     if (allocated(error)) call fail('input', error, 2)
@@ -129,7 +132,9 @@ contains
             'Writes to the &output folder: curve.csv (one row per converged step: channel', &
             'factors, reactions and displacements of the supports, load displacements),', &
             'state_NNNNN.vtu (5 or more digits; binary, or &output vtk_format = ''ascii'')', &
-            '+ states.pvd (ParaView) and input.nml (the effective input); it lists them in', &
+            'with its blocks holders_, links_, passages_NNNNN.vtu, state_NNNNN.vtm (the', &
+            'blocks by name) + states.pvd (ParaView: the series of .vtm)', &
+            'and input.nml (the effective input); it lists them in', &
             '.yarnfort-manifest and deletes only files listed there, and holds the lock', &
             '.yarnfort-lock while it runs (a second run into the folder stops at once).', &
             'Progress lines go to stderr. Exit code 0 on success, 1 if the solve or a write', &

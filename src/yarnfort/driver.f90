@@ -6,7 +6,7 @@ module yarnfort_driver
     use yarnfort_error, only: error_type, prefix_error
     use yarnfort_input_config, only: config_type
     use yarnfort_output_writer, only: output_writer_type
-    use yarnfort_output_restart, only: read_restart, check_restart, get_input_hash, &
+    use yarnfort_output_restart_file, only: read_restart, check_restart, get_input_hash, &
         restart_file_name, synced_file_name
     use yarnfort_text, only: format_integer
     use yarnfort_scene_scene, only: scene_type

@@ -74,8 +74,16 @@ def wait_for_step(process: subprocess.Popen, step: int) -> None:
 
 
 def collection(folder: Path) -> list[tuple[str, str]]:
+    """The states listed (the yarns' file of each multiblock file) and their times."""
     root = ET.parse(folder / "states.pvd").getroot()
-    return [(d.get("file"), d.get("timestep")) for d in root.iter("DataSet")]
+    return [(yarns_file(folder / d.get("file")), d.get("timestep"))
+            for d in root.iter("DataSet")]
+
+
+def yarns_file(multiblock: Path) -> str:
+    """The yarns' block of a state's multiblock file (state_NNNNN.vtm)."""
+    root = ET.parse(multiblock).getroot()
+    return next(d.get("file") for d in root.iter("DataSet") if d.get("name") == "yarns")
 
 
 def complete_rows(folder: Path) -> list[list[str]]:
@@ -290,7 +298,8 @@ def test_restart_keeps_tables_it_never_wrote(tmp_path):
 WRITTEN_NAMES = ("curve.csv", "curve.csv.tmp", "input.nml", "input.nml.tmp", "restart.dat",
                  "restart.dat.tmp", "states.pvd", "states.pvd.tmp", "reactions.csv",
                  "reactions.csv.tmp", "contacts.csv", "contacts.csv.tmp", "state_00000.vtu",
-                 "state_00003.vtu", ".yarnfort-manifest", ".yarnfort-manifest.tmp",
+                 "state_00003.vtu", "state_00000.vtm", "state_00003.vtm",
+                 ".yarnfort-manifest", ".yarnfort-manifest.tmp",
                  ".yarnfort-lock", ".yarnfort-write-test")
 
 
@@ -529,7 +538,7 @@ def test_killed_run_leaves_no_stale_lock(tmp_path):
 
 # ------------------------------------------------------------------ step numbers
 
-#: Byte offsets of the fields of restart.dat (format version 4, see output/restart.f90;
+#: Byte offsets of the fields of restart.dat (format version 4, see output/restart_file.f90;
 #: the factors of the scenes' two default channels p_force and p_disp follow have_old).
 OFFSET = {"n_nodes": 36, "n_elements": 40, "n_unknowns": 44, "n_passages": 48, "step": 52,
           "knot": 56, "time": 60, "next_step": 68, "previous_load": 76, "stepper": 84,

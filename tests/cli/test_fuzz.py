@@ -20,8 +20,9 @@ scene set-up, no solve, no output); a few hundred run in full, bounded by
 - stderr has exactly one ``yarnfort: error (...)`` line when the exit code is not 0 and
   none when it is 0, and never a Fortran runtime error or a backtrace;
 - a case that fails on its input writes nothing, nor does a check-only case;
-- no output file (curve.csv, states.pvd, *.vtu) holds NaN or Infinity (the VTK states
-  are read with yarnfort.read_state, whatever their encoding).
+- no output file (curve.csv, states.pvd, the VTK states) holds NaN or Infinity (the
+  states are read with yarnfort.read_state, their other blocks with meshio, whatever
+  their encoding).
 
 A third family damages restart files: a run of each seed stops after a few steps
 (``max_steps``), then bytes or whole fields of its ``restart.dat`` are overwritten at
@@ -55,6 +56,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import meshio
 import numpy as np
 import pytest
 
@@ -423,7 +425,8 @@ def non_finite_in_outputs(folder: Path) -> list[str]:
                     if not finite:
                         bad.append(f"{path.name}: {value}")
                         break
-        elif path.suffix == ".vtu" and not path.name.endswith(".tmp"):
+        elif path.name.startswith("state_") and path.suffix in (".vtu", ".vtm"):
+            # A state (the yarns' file, or the multiblock file that lists its blocks).
             try:
                 state = read_state(path)
             except Exception as error:          # noqa: BLE001 (any unreadable state)
@@ -431,6 +434,17 @@ def non_finite_in_outputs(folder: Path) -> list[str]:
                 continue
             arrays = [state.position, state.tension, state.stretch, state.length0,
                       *state.point_data.values(), *state.cell_data.values()]
+            if not all(np.all(np.isfinite(np.asarray(a, dtype=float))) for a in arrays):
+                bad.append(f"{path.name}: a non-finite value")
+        elif path.suffix == ".vtu":
+            # A state's other block (gap-holders, periodic links, passages).
+            try:
+                block = meshio.read(path)
+            except Exception as error:          # noqa: BLE001 (any unreadable block)
+                bad.append(f"{path.name}: unreadable ({error})")
+                continue
+            arrays = [block.points, *block.point_data.values(), *block.field_data.values(),
+                      *(a for per_type in block.cell_data.values() for a in per_type)]
             if not all(np.all(np.isfinite(np.asarray(a, dtype=float))) for a in arrays):
                 bad.append(f"{path.name}: a non-finite value")
         elif path.suffix == ".pvd":
@@ -544,7 +558,7 @@ def test_fuzz_full_run(executable, tmp_path, batch):
 #: Restart cases per batch, and batches.
 RESTART_BATCHES, RESTART_CASES_PER_BATCH = 2, 40
 #: Byte offsets and types of the header fields of restart.dat (format version 4, see
-#: src/yarnfort/output/restart.f90): after the 16-byte magic, the version and the
+#: src/yarnfort/output/restart_file.f90): after the 16-byte magic, the version and the
 #: 16-byte fingerprint come n_nodes, n_elements, n_unknowns, n_passages, step, knot
 #: (int32), time, next_step, previous_load (float64), the stepper (16 bytes),
 #: n_channels (int32), load_old, time_old (float64), have_old (int32), then the factors of the

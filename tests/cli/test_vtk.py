@@ -1,9 +1,14 @@
 # SPDX-License-Identifier: MIT
 """VTK states for ParaView, checked with two independent readers (meshio and VTK's own
-XML reader): point data (displacement, position, contact state), cell data (tension,
-stretch, L0, kind, yarn, material), the links of a fabric as cells of their own (the
-belt is one connected net), field data (time, step, load factors, a fabric's strain),
-appended base64 binary by default and inline ASCII on request, and states.pvd times."""
+XML reader): the yarns' file (point data displacement, position, contact state; cell
+data tension, stretch, L0, yarn, material; only yarn elements, so that colouring by
+tension shows yarn tensions), the gap-holders' block (drawn to the partner's image,
+contact_force from the equilibrium of the leader node) and the periodic links' block
+(a vertex at the leader's image), field data (time, step, load factors, a fabric's
+strain), appended base64 binary by default and inline ASCII on request, each state's
+multiblock file (read by VTK's XML multiblock reader, ParaView's own: its blocks by
+name, tension only in the yarns' block) and states.pvd (the multiblock files and their
+times)."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
@@ -23,8 +28,10 @@ TOP = Path(__file__).resolve().parents[2]
 INPUTS = TOP / "inputs"
 TIMEOUT = 300
 
-#: Kinds of cells in a state file.
-ELEMENT, GAP_HOLDER, PERIODIC = 0, 1, 2
+#: Kinds of links of a State.
+GAP_HOLDER, PERIODIC = 1, 2
+#: The solver's equilibrium: the force left at a node, relative to the forces there.
+EQUILIBRIUM = 1e-6
 #: Positions and lengths come from the same doubles: a length computed from positions
 #: agrees with stretch * L0 to round-off of the length itself.
 ROUND_OFF = 1e-12
@@ -69,9 +76,55 @@ def meshio_arrays(mesh) -> dict[str, np.ndarray]:
     return arrays
 
 
-def collection(folder: Path) -> list[tuple[str, float]]:
+#: The blocks of a state's multiblock file by name, and the prefix of their files.
+BLOCKS = {"yarns": "state_", "gap_holders": "holders_", "periodic_links": "links_",
+          "passages": "passages_"}
+
+
+def multiblock(folder: Path) -> list[tuple[str, float]]:
+    """The files states.pvd lists (each state's multiblock file) and their times."""
     root = ET.parse(folder / "states.pvd").getroot()
     return [(d.get("file"), float(d.get("timestep"))) for d in root.iter("DataSet")]
+
+
+def blocks(path: Path) -> dict[str, str]:
+    """The blocks of a multiblock file: name -> file."""
+    root = ET.parse(path).getroot()
+    return {d.get("name"): d.get("file") for d in root.iter("DataSet")}
+
+
+def collection(folder: Path) -> list[tuple[str, float]]:
+    """The yarns' files of the states states.pvd lists, and their times."""
+    return [(blocks(folder / name)["yarns"], time) for name, time in multiblock(folder)]
+
+
+def check_parts(folder: Path, names: list[str]) -> None:
+    """Every state states.pvd lists is a multiblock file of the yarns and the blocks
+    `names`, their files those of the same step; VTK's XML multiblock reader (ParaView's)
+    opens it with the blocks by name, each of the state's step and time, and only the
+    yarns' block has `tension`."""
+    for name, time in multiblock(folder):
+        assert name.startswith("state_") and name.endswith(".vtm")
+        step = name[len("state_"):-len(".vtm")]
+        listed = blocks(folder / name)
+        assert list(listed) == ["yarns"] + names
+        assert listed == {block: BLOCKS[block] + step + ".vtu" for block in listed}
+        reader = vtk.vtkXMLMultiBlockDataReader()
+        reader.SetFileName(str(folder / name))
+        reader.Update()
+        assert reader.GetErrorCode() == 0, name
+        data = reader.GetOutput()
+        assert data.GetNumberOfBlocks() == len(listed)
+        for i, block in enumerate(listed):
+            assert data.GetMetaData(i).Get(vtk.vtkCompositeDataSet.NAME()) == block
+            grid = data.GetBlock(i)
+            assert grid.GetNumberOfCells() > 0, (name, block)
+            assert grid.GetCellData().HasArray("tension") == (block == "yarns")
+            assert grid.GetPointData().HasArray("tension") == 0
+            # Every block is of the state's step and time (17 digits in states.pvd).
+            field = grid.GetFieldData()
+            assert field.GetArray("step").GetValue(0) == int(step)
+            assert field.GetArray("time").GetValue(0) == time
 
 
 def components(n_points: int, pairs: np.ndarray) -> int:
@@ -90,15 +143,22 @@ def components(n_points: int, pairs: np.ndarray) -> int:
     return len({root(i) for i in used})
 
 
-def check_state(path: Path, initial: np.ndarray | None = None) -> dict[str, np.ndarray]:
-    """Read a state with both readers, check they agree with each other and with the
-    geometry of the file (displacement from `initial`, lengths); return the arrays."""
+def read_both(path: Path):
+    """A file read with meshio and with VTK, which must give the same arrays: the meshio
+    mesh, the VTK grid and the arrays by name."""
     mesh = meshio.read(path)
     grid = vtk_read(path)
     a, b = meshio_arrays(mesh), vtk_arrays(grid)
     assert set(a) == set(b)
     for name in a:
         np.testing.assert_array_equal(a[name].ravel(), b[name].ravel(), err_msg=name)
+    return mesh, grid, b
+
+
+def check_state(path: Path, initial: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Read a state with both readers, check they agree with each other and with the
+    geometry of the file (displacement from `initial`, lengths); return the arrays."""
+    mesh, grid, b = read_both(path)
     points = vtk_to_numpy(grid.GetPoints().GetData())
     np.testing.assert_array_equal(points, mesh.points)
     assert grid.GetNumberOfCells() == sum(len(c.data) for c in mesh.cells)
@@ -132,7 +192,7 @@ def test_capstan_states_read_by_meshio_and_vtk(run_yarnfort, tmp_path):
         arrays = check_state(out / name, initial)
         assert arrays["time"][0] == time and arrays["step"][0] == k
         assert arrays["p_disp"][0] == curve["p_disp"][k]
-        assert np.all(arrays["kind"] == ELEMENT)
+        assert "kind" not in arrays
         # The capstan scene: yarn 1 (material 1, 'yarn', 4 elements) over three pegs,
         # each held by a yarn of material 2 ('peg', 1 element).
         np.testing.assert_array_equal(arrays["yarn"], [1, 1, 1, 1, 2, 3, 4])
@@ -166,7 +226,7 @@ def test_ascii_states_hold_the_same_values(run_yarnfort, tmp_path):
         for key in b:
             np.testing.assert_array_equal(a[key], b[key], err_msg=key)
         np.testing.assert_array_equal(read_state(tmp_path / "ascii" / name).tension,
-                                      b["tension"][b["kind"] == ELEMENT])
+                                      b["tension"])
 
 
 def test_unknown_vtk_format_is_refused(run_yarnfort, tmp_path):
@@ -176,51 +236,118 @@ def test_unknown_vtk_format_is_refused(run_yarnfort, tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def element_pulls(arrays: dict[str, np.ndarray]) -> np.ndarray:
+    """The force of the yarn elements on each node (n_nodes, 3), N, from the yarns'
+    file: tension along each element, towards its other end."""
+    points, pairs = arrays["points"], arrays["pairs"]
+    direction = points[pairs[:, 1]] - points[pairs[:, 0]]
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    pull = arrays["tension"][:, None] * direction
+    force = np.zeros_like(points)
+    np.add.at(force, pairs[:, 0], pull)
+    np.add.at(force, pairs[:, 1], -pull)
+    return force
+
+
+def check_holders(path: Path, arrays: dict[str, np.ndarray], free: np.ndarray) -> np.ndarray:
+    """The gap-holders' block of a state against the yarns' file `arrays`: each line
+    from its leader to its follower's image (follower minus period); its force is the
+    one the leader's yarn takes (equilibrium of a leader in `free`: no support, load
+    or other link), contact_force its component along the line. Returns the block's
+    arrays and the (leader, follower) pairs (from 0)."""
+    mesh, _, b = read_both(path)
+    assert {c.type for c in mesh.cells} == {"line"}
+    leader, follower = b["leader"] - 1, b["follower"] - 1
+    points = arrays["points"]
+    ends = mesh.points[np.concatenate([c.data for c in mesh.cells])]
+    np.testing.assert_array_equal(ends[:, 0], points[leader])
+    scale = np.abs(points).max()
+    np.testing.assert_allclose(ends[:, 1], points[follower] - b["period"], rtol=0,
+                               atol=ROUND_OFF * scale)
+    line = ends[:, 1] - ends[:, 0]
+    np.testing.assert_allclose(b["stretch"] * b["L0"], np.linalg.norm(line, axis=1),
+                               rtol=0, atol=ROUND_OFF * scale)
+    pulls = element_pulls(arrays)
+    check = np.isin(leader, free)
+    assert np.count_nonzero(check) > 0
+    # The leader is in equilibrium: its yarn pulls with what the holder pushes it with,
+    # which is minus the force on the follower.
+    force_scale = np.abs(arrays["tension"]).max()
+    np.testing.assert_allclose(b["force"][check], pulls[leader[check]], rtol=0,
+                               atol=EQUILIBRIUM * force_scale)
+    unit = line / np.linalg.norm(line, axis=1)[:, None]
+    np.testing.assert_allclose(b["contact_force"], np.sum(b["force"] * unit, axis=1),
+                               rtol=0, atol=ROUND_OFF * force_scale)
+    b["pairs"] = np.column_stack([leader, follower])
+    return b
+
+
 def test_belt_is_connected_by_its_gap_holders(run_yarnfort, tmp_path):
-    """The twill belt: gap-holders are cells of their own kind and join warp and weft
-    into one net; their stretch is the gap factor of the path (belt.nml's table)."""
+    """The twill belt: gap-holders are a block of their own and join warp and weft into
+    one net; their stretch is the gap factor of the path (belt.nml's table); their
+    contact force balances the leader's yarn and presses the yarns together."""
     run = run_yarnfort(scene("belt", "out"), timeout=TIMEOUT)
     assert run.returncode == 0, run.stderr
     out = tmp_path / "out"
     curve = read_curve(out)
     listed = collection(out)
+    check_parts(out, ["gap_holders", "passages"])
     first = check_state(out / listed[0][0])
     initial = first["points"] - first["displacement"]
     for name, _ in (listed[0], listed[len(listed) // 2], listed[-1]):
         # Every state's displacement is from the same initial (generated) geometry.
         arrays = check_state(out / name, initial)
-        kind, pairs = arrays["kind"], arrays["pairs"]
-        assert set(kind) == {ELEMENT, GAP_HOLDER}
         n_points = len(arrays["points"])
+        holders = check_holders(out / ("holders_" + name[len("state_"):]), arrays,
+                                free=np.arange(n_points))
         # 12 weft and 8 warp yarns: 20 parts without the gap-holders, one with them.
-        assert components(n_points, pairs[kind == ELEMENT]) == 20
-        assert components(n_points, pairs) == 1
-        assert set(arrays["yarn"][kind == ELEMENT]) == set(range(1, 21))
-        assert np.all(arrays["yarn"][kind != ELEMENT] == 0)
-        assert np.all(arrays["material"][kind != ELEMENT] == 0)
-        assert np.all(arrays["tension"][kind != ELEMENT] == 0)
+        assert components(n_points, arrays["pairs"]) == 20
+        assert components(n_points, np.concatenate([arrays["pairs"],
+                                                    holders["pairs"]])) == 1
+        assert set(arrays["yarn"]) == set(range(1, 21))
         p_disp = arrays["p_disp"][0]
         factor = np.interp(p_disp, [0.0, 0.5, 1.0], [1.0, 0.8, 0.7])
-        np.testing.assert_allclose(arrays["stretch"][kind == GAP_HOLDER], factor,
-                                   rtol=ROUND_OFF * 1e3)
+        np.testing.assert_allclose(holders["stretch"], factor, rtol=ROUND_OFF * 1e3)
+        # The crimped, tensioned yarns press on each other: no holder pulls.
+        assert np.all(holders["contact_force"] > 0)
         # The fabric's strain and force per width, as in curve.csv.
         step = int(arrays["step"][0])
         assert arrays["strain"][0] == curve["strain"][step]
         assert arrays["force_per_width"][0] == curve["force_per_width"][step]
+        # read_state gives the same links.
+        own = read_state(out / name)
+        np.testing.assert_array_equal(own.links, holders["pairs"])
+        np.testing.assert_array_equal(own.link_data["contact_force"],
+                                      holders["contact_force"])
 
 
 def test_knit_cell_has_periodic_links(run_yarnfort, tmp_path):
+    """The knit cell: its periodic links are vertices at the leader's image (the
+    follower, leader + period), never lines along the yarn they continue."""
     run = run_yarnfort(scene("knit", "out"), timeout=TIMEOUT)
     assert run.returncode == 0, run.stderr
     out = tmp_path / "out"
     listed = collection(out)
     curve = read_curve(out)
+    check_parts(out, ["gap_holders", "periodic_links", "passages"])
     first = check_state(out / listed[0][0])
     name = listed[len(listed) // 4][0]
     arrays = check_state(out / name, first["points"] - first["displacement"])
-    kind = arrays["kind"]
-    assert PERIODIC in set(kind) and GAP_HOLDER in set(kind)
-    assert components(len(arrays["points"]), arrays["pairs"]) == 1
+    suffix = name[len("state_"):]
+    points = arrays["points"]
+    links = meshio.read(out / ("links_" + suffix))
+    assert {c.type for c in links.cells} == {"vertex"}
+    data = meshio_arrays(links)
+    leader, follower = data["leader"] - 1, data["follower"] - 1
+    np.testing.assert_array_equal(links.points, points[follower])
+    np.testing.assert_allclose(points[follower] - points[leader], data["period"], rtol=0,
+                               atol=ROUND_OFF * np.abs(points).max())
+    holders = check_holders(out / ("holders_" + suffix), arrays,
+                            free=np.setdiff1d(np.arange(len(points)),
+                                              np.concatenate([leader, follower])))
+    pairs = np.concatenate([arrays["pairs"], holders["pairs"],
+                            np.column_stack([leader, follower])])
+    assert components(len(points), pairs) == 1
     step = int(arrays["step"][0])
     assert arrays["strain"][0] == curve["strain"][step]
     assert np.count_nonzero(arrays["contact_state"]) > 0
@@ -255,6 +382,8 @@ def test_states_pvd_of_a_long_path_lists_every_state(run_yarnfort, tmp_path):
         np.testing.assert_allclose([t for _, t in listed], np.array(expected_steps) / steps,
                                    rtol=0, atol=tolerance)
         assert sorted(p.name for p in out.glob("state_*.vtu")) == names
+        assert sorted(p.name for p in out.glob("state_*.vtm")) == [
+            name[:-len(".vtu")] + ".vtm" for name in names]
         for name in names:
             assert (out / name).read_bytes().endswith(b"</VTKFile>\n"), name
 

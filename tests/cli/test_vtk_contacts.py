@@ -1,10 +1,11 @@
 # SPDX-License-Identifier: MIT
-"""Contact state as VTK point data (ParaView colours stick/slip by `mode`): on every
-contact node the state files hold `passages`, `passage`, `mode`, `flow`,
-`tension_min`, `tension_max`, `critical_tension` and `wrap_angle`, read back with meshio
-(binary and ASCII files) and compared with the rows of contacts.csv of the same step;
-at a node with two passages the one shown is the slipping one (the rule: slip before
-locked before stick, then the larger tension_max)."""
+"""Contact state for ParaView: every sliding passage is a point of its own in the
+passages block (passages_NNNNN.vtu) at its node, with point data passage, node, yarn,
+mode (ParaView colours stick/slip by it), flow, tension_min, tension_max,
+critical_tension and wrap_angle, read back with meshio (binary and ASCII files) and
+compared with every row of contacts.csv of the same step; two passages at one node (one
+slipping, one sticking) both show. The yarns' file keeps per node `passages` (their
+number) and `contact_state` (2 when one of them slips)."""
 from __future__ import annotations
 
 import sys
@@ -21,7 +22,6 @@ from test_hysteresis import CASES, hysteresis_scene  # noqa: E402
 from yarnfort import read_contacts, read_curve  # noqa: E402
 
 MODE_CODES = {"stick": 1, "forward": 2, "backward": 3, "locked": 4}
-RANK = {1: 1, 4: 2, 2: 3, 3: 3}
 VALUE_COLUMNS = ["flow", "tension_min", "tension_max", "critical_tension", "wrap_angle"]
 
 
@@ -45,47 +45,43 @@ def cross_scene(vtk_format: str) -> str:
 
 
 def check_states_against_contacts(out: Path) -> dict[int, set[int]]:
-    """Every state's passage point data against contacts.csv; returns, per step, the
-    modes shown at the nodes with two or more passages."""
+    """Every state's passages block against contacts.csv; returns, per step, the modes
+    of the passages at nodes with two or more passages."""
     table = read_contacts(out)
     steps = np.asarray(table["step"], int)
-    shown_modes: dict[int, set[int]] = {}
+    shared_modes: dict[int, set[int]] = {}
     states = sorted(out.glob("state_*.vtu"))
     assert states
     for path in states:
-        mesh = meshio.read(path)
-        data = mesh.point_data
-        step = int(np.ravel(mesh.field_data["step"])[0])
+        yarns = meshio.read(path)
+        step = int(np.ravel(yarns.field_data["step"])[0])
         rows = np.flatnonzero(steps == step)
         assert len(rows) > 0
-        nodes = np.asarray(table["node"], int)[rows]
-        count = np.asarray(data["passages"]).ravel()
-        passage = np.asarray(data["passage"]).ravel()
-        mode = np.asarray(data["mode"]).ravel()
-        # Nodes without a passage: zeros everywhere, contact_state 0.
-        without = np.setdiff1d(np.arange(len(count)), nodes - 1)
-        assert np.all(count[without] == 0) and np.all(passage[without] == 0)
-        assert np.all(mode[without] == 0)
+        passages = meshio.read(out / ("passages_" + path.name[len("state_"):]))
+        assert {c.type for c in passages.cells} == {"vertex"}
+        assert int(np.ravel(passages.field_data["step"])[0]) == step
+        data = {name: np.ravel(values) for name, values in passages.point_data.items()}
+        # One point per row of the step, in passage order, at its node.
+        assert len(passages.points) == len(rows)
+        for column in ("passage", "node", "yarn"):
+            np.testing.assert_array_equal(data[column], table[column][rows], err_msg=column)
+        np.testing.assert_array_equal(passages.points, yarns.points[data["node"] - 1])
+        np.testing.assert_array_equal(
+            data["mode"], [MODE_CODES[m] for m in np.asarray(table["mode"])[rows]])
         for column in VALUE_COLUMNS:
-            assert np.all(np.asarray(data[column]).ravel()[without] == 0.0), column
-        for node in set(nodes):
-            at = rows[nodes == node]
-            assert count[node - 1] == len(at)
-            codes = np.array([MODE_CODES[m] for m in np.asarray(table["mode"])[at]])
-            t_max = np.asarray(table["tension_max"])[at]
-            # The rule: highest rank, then the largest tension_max, then the first.
-            best = max(range(len(at)), key=lambda i: (RANK[codes[i]], t_max[i], -i))
-            row = at[best]
-            assert passage[node - 1] == int(table["passage"][row])
-            assert mode[node - 1] == codes[best]
-            for column in VALUE_COLUMNS:
-                # Both files carry 17 significant digits (or the bits): the same double.
-                assert np.ravel(data[column])[node - 1] == table[column][row], column
-            state = np.asarray(data["contact_state"]).ravel()[node - 1]
-            assert state == (2 if any(c in (2, 3) for c in codes) else 1)
-            if len(at) > 1:
-                shown_modes.setdefault(step, set()).update(codes.tolist())
-    return shown_modes
+            # Both files carry 17 significant digits (or the bits): the same double.
+            np.testing.assert_array_equal(data[column], table[column][rows], err_msg=column)
+        # Per node in the yarns' file: the number of passages, and whether one slips.
+        count = np.bincount(data["node"] - 1, minlength=len(yarns.points))
+        np.testing.assert_array_equal(np.ravel(yarns.point_data["passages"]), count)
+        slips = np.bincount(data["node"] - 1, weights=np.isin(data["mode"], (2, 3)),
+                            minlength=len(yarns.points))
+        np.testing.assert_array_equal(np.ravel(yarns.point_data["contact_state"]),
+                                      np.where(count == 0, 0, np.where(slips > 0, 2, 1)))
+        for node in np.flatnonzero(count > 1) + 1:
+            shared_modes.setdefault(step, set()).update(
+                data["mode"][data["node"] == node].tolist())
+    return shared_modes
 
 
 @pytest.mark.parametrize("vtk_format", ["binary", "ascii"])
@@ -97,17 +93,17 @@ def test_one_pin_point_data_match_contacts_csv(run_yarnfort, tmp_path, vtk_forma
     check_states_against_contacts(tmp_path / "out")
     # The run slips both ways and sticks: ParaView sees every mode over the states.
     modes = set()
-    for path in (tmp_path / "out").glob("state_*.vtu"):
+    for path in (tmp_path / "out").glob("passages_*.vtu"):
         modes.update(np.asarray(meshio.read(path).point_data["mode"]).ravel().tolist())
     assert {1, 2, 3} <= modes
 
 
 @pytest.mark.parametrize("vtk_format", ["binary", "ascii"])
-def test_two_passages_at_a_node_show_the_slipping_one(run_yarnfort, tmp_path, vtk_format):
+def test_two_passages_at_a_node_both_show(run_yarnfort, tmp_path, vtk_format):
     done = run_yarnfort(cross_scene(vtk_format), cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     shown = check_states_against_contacts(tmp_path / "out")
-    # Some step has a slipping and a sticking passage at node 5 (the rule was used).
+    # Some step has a slipping and a sticking passage at node 5: both points show.
     assert any({1} <= modes and modes & {2, 3} for modes in shown.values()), shown
     curve = read_curve(tmp_path / "out")
     # The pulled end's displacement column is the prescribed one: p_disp * 0.4 along x.

@@ -14,7 +14,7 @@ import pytest
 #: Modules whose public names (``__all__``) are documented.
 MODULES = ["yarnfort", "yarnfort.address", "yarnfort.namelist", "yarnfort.results",
            "yarnfort.runner", "yarnfort.scene", "yarnfort.sweep", "yarnfort.calibrate",
-           "yarnfort.plots", "yarnfort.units"]
+           "yarnfort.plots", "yarnfort.units", "yarnfort.fabric_export"]
 
 
 def public_callables():

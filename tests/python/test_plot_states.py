@@ -60,11 +60,12 @@ def curve_column(folder: Path, name: str) -> dict[int, float]:
 
 
 def element_tensions(path: Path) -> np.ndarray:
-    """Tensions of the yarn elements (kind 0) of an ASCII VTK state."""
+    """Tensions of the yarn elements (every cell of the yarns' file) of an ASCII VTK
+    state."""
     piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
     arrays = {node.get("Name"): np.array(node.text.split(), dtype=float)
               for node in piece.iterfind("CellData/DataArray")}
-    return arrays["tension"][arrays["kind"] == 0]
+    return arrays["tension"]
 
 
 def saved_steps(folder: Path) -> list[int]:

@@ -2,8 +2,8 @@
 """Sliding at contact nodes (capstan friction) against closed forms and limits.
 
 The reference critical tensions are computed here, independently of the Fortran laws, in
-closed forms solved from each law's ODE (paper eqs. 20, 35 with alpha* = 1/mu - T0/beta as
-in the design notes, 40-44 with w = w_d), and those are checked against a numerical
+closed forms solved from each law's ODE (paper eqs. 20; 35, read with alpha* = 1/mu -
+T0/beta, not T1; 40-44, their "w" read as w_d), and those are checked against a numerical
 integration of the ODE.
 """
 from __future__ import annotations

@@ -5,15 +5,27 @@ Run with the Python of ``.venv-texgen`` (tools/bootstrap installs pytexgen there
 from ``.venv``)::
 
     .venv-texgen/bin/python tests/verification/texgen_models.py plain out.tg3 2 2 1.0 0.4 0.8
-    .venv-texgen/bin/python tests/verification/texgen_models.py twill out.tg3 4 4 1.0 0.4 0.8
+    .venv-texgen/bin/python tests/verification/texgen_models.py twill out.tg3 4 4 1.0 0.4
+    .venv-texgen/bin/python tests/verification/texgen_models.py satin out.tg3 5 5 1.0 0.4
+    .venv-texgen/bin/python tests/verification/texgen_models.py layered out.tg3 2 2 1.0 0.4
     .venv-texgen/bin/python tests/verification/texgen_models.py knit out.tg3 1.0 1.0 1.2 0.2
 
-Weaves: yarns along x and y, ``spacing`` apart, fabric ``thickness`` (TexGen places the
-yarn centres thickness / 2 apart at a crossing), yarn ``width``; the crossings where
-(i + j) mod 2 = 0 (plain) or (i + j) mod 4 < 2 (2/2 twill) are swapped from TexGen's default.
-The weft knit: TexGen's CTextileWeftKnit (wale height, loop height, course width, yarn
-thickness), whose cell is one loop. Lengths in mm (TexGen's GeometryScale).
-pytexgen's own messages go to stderr; the file is written with OUTPUT_STANDARD.
+Weaves (``plain``, ``twill``, ``satin``: nx ny spacing thickness [width]) are TexGen's
+``CTextileWeave2D(nx, ny, spacing, thickness)`` (its defaults: refined, in-plane
+tangents): yarns along x and y, ``spacing`` apart, fabric ``thickness`` (TexGen places
+the yarn centres thickness / 2 apart at a crossing). ``SetYarnWidths(width)`` only when a
+width is given; without it TexGen takes the width equal to the spacing. The crossings
+where (i + j) mod 2 = 0 (plain), (i + j) mod 4 < 2 (2/2 twill) or j = 2 i mod nx (satin,
+nx = ny >= 5, odd: the 5-harness satin for 5) are swapped with ``SwapPosition(i, j)``
+from TexGen's default (every crossing alike), then ``AssignDefaultDomain()``.
+``layered``: ``CTextileLayered()`` with two such plain weaves, ``AddLayer(weave,
+XYZ(0, 0, 0))`` and ``AddLayer(weave, XYZ(0, 0, thickness))`` (stacked, touching).
+The weft knit (``knit``: wale height, loop height, course width, yarn thickness) is
+``CTextileWeftKnit(2, 2, wale_height, loop_height, course_width, thickness)`` (two loops
+wide and high, as TexGen's knit wizard makes it), whose cell is one loop.
+Each textile is then ``AddTextile(name, textile)`` and ``SaveToXML(path, name,
+OUTPUT_STANDARD)``. Lengths in mm (TexGen's GeometryScale).
+pytexgen's own messages go to stderr.
 """
 from __future__ import annotations
 
@@ -21,26 +33,52 @@ import contextlib
 import os
 import sys
 
+WEAVES = ("plain", "twill", "satin")
 
-def make(kind: str, path: str, values: list[float]) -> None:
+
+def swapped(kind: str, nx: int, i: int, j: int) -> bool:
+    """Crossings swapped from TexGen's default to make the pattern."""
+    if kind == "plain":
+        return (i + j) % 2 == 0
+    if kind == "twill":
+        return (i + j) % 4 < 2
+    return j == (2 * i) % nx
+
+
+def weave(kind: str, values: list[float]):
     from pytexgen import Core as tg  # imported here: only this script needs pytexgen
 
-    if kind in ("plain", "twill"):
-        nx, ny, spacing, thickness, width = values
-        textile = tg.CTextileWeave2D(int(nx), int(ny), spacing, thickness, True)
-        textile.SetYarnWidths(width)
-        repeat = 2 if kind == "plain" else 4
-        for i in range(int(nx)):
-            for j in range(int(ny)):
-                if (i + j) % repeat < repeat // 2:
-                    textile.SwapPosition(i, j)
-        textile.AssignDefaultDomain()
+    nx, ny, spacing, thickness, *width = values
+    nx, ny = int(nx), int(ny)
+    if kind == "satin" and (nx != ny or nx < 5 or nx % 2 == 0):
+        raise SystemExit("satin: nx = ny, odd and >= 5")
+    textile = tg.CTextileWeave2D(nx, ny, spacing, thickness)
+    if width:
+        textile.SetYarnWidths(width[0])
+    for i in range(nx):
+        for j in range(ny):
+            if swapped(kind, nx, i, j):
+                textile.SwapPosition(i, j)
+    textile.AssignDefaultDomain()
+    return textile
+
+
+def make(kind: str, path: str, values: list[float]) -> None:
+    from pytexgen import Core as tg
+
+    if kind in WEAVES:
+        textile = weave(kind, values)
+    elif kind == "layered":
+        layer = weave("plain", values)
+        textile = tg.CTextileLayered()
+        textile.AddLayer(layer, tg.XYZ(0.0, 0.0, 0.0))
+        textile.AddLayer(layer, tg.XYZ(0.0, 0.0, values[3]))
     elif kind == "knit":
         wale_height, loop_height, course_width, thickness = values
         textile = tg.CTextileWeftKnit(2, 2, wale_height, loop_height, course_width,
                                       thickness)
     else:
-        raise SystemExit(f"unknown kind {kind!r} (plain, twill or knit)")
+        raise SystemExit(f"unknown kind {kind!r} (plain, twill, satin, layered or knit)")
     tg.AddTextile(kind, textile)
     tg.SaveToXML(path, kind, tg.OUTPUT_STANDARD)
 

@@ -8,7 +8,7 @@ module yarnfort_assembly_scales
     use yarnfort_kinds, only: wp
     use yarnfort_scene_scene, only: scene_type, get_loaded_nodes, get_force_scale
     use yarnfort_assembly_truss, only: get_truss_tension, get_tension_rounding
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     implicit none
     private
 

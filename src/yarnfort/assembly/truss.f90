@@ -2,7 +2,7 @@
 !> The two-node truss element (paper eqs. 6-13): internal force and tangent block.
 module yarnfort_assembly_truss
     use yarnfort_kinds, only: wp
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     implicit none
     private
 

@@ -6,55 +6,21 @@
 !>   stick passage: k (s - s_target), k = the scene's largest force / length_scale;
 !>   slip forward (T_after > T_before, s grows):    T_crit(T_before, alpha) - T_after;
 !>   slip backward (T_before > T_after, s shrinks): T_before - T_crit(T_after, alpha).
-!> (The signs make the residual continuous where the semismooth choice below switches
-!> a passage between stick and slip: there k ds = -g_f, resp. k ds = g_b.)
-!> Each slip row is divided by a weight w = max(1, dT_crit/dT_min), fixed for a Newton
-!> solve from its initial guess (`prepare_solve`), so that it measures the change of the
-!> low-side tension that would satisfy it. Unweighted, the row cannot reach the residual
-!> tolerance once exp(mu alpha) is large: T_min carries a rounding error of about
-!> EA*epsilon (from lambda - 1 near lambda = 1), which T_crit multiplies by
-!> dT_crit/dT_min (measured: mu alpha = 20 stalled at 5e-8 of the largest stiffness).
-!> Rows are judged (get_row_levels) against the forces at their node, the passage's
-!> larger tension / w for a slip row, the largest force for a stick row. With
-!> `semismooth` the weights stay 1 (the modes change within a solve).
 !> Tensions enter the friction conditions as max(T, 0) (a slack string pulls nothing).
-!> With `semismooth` (off by default) the mode of each passage is not fixed from outside
-!> but chosen at every evaluation from the current iterate, as in a primal-dual active
-!> set (semismooth Newton) method: with k ds the scaled flow increment and
-!> g_f = T_after - T_crit(T_before), g_b = T_before - T_crit(T_after),
-!>   forward slip if k ds + g_f > 0, else backward slip if -k ds + g_b > 0, else stick,
-!> which at a solution is exactly the stick/slip complementarity (ds >= 0, g_f <= 0,
-!> ds g_f = 0, and likewise backward). A whole slip front then moves in one Newton
-!> solve instead of one passage per active-set round. Measured on the woven benchmark
-!> net (benchmarks/bench_friction) it made KINSOL cycle on the first load step and cost
-!> 9.6 factorisations per step against 2.5 for the active-set rounds, so the stepper's
-!> rounds (semismooth off) are the default. `locked` forbids a direction (minimum
-!> reference length reached, or chatter damping).
-!> Viscous slip (`viscosity` > 0, off by default; only the slip-instability jump of
-!> friction_stepper sets it): each slip row gets eta (s - s_start) added, eta =
-!> viscosity * stick_scale and s_start = flow_target, so a slipping passage is held
-!> above its limit by an overstress eta ds >= 0 (forward; backward likewise): implicit
-!> Euler steps of a viscoplastic slip law. Where the stepper's rounds find no
-!> consistent stick/slip set for the rate-independent law (a slip instability), the
-!> viscous one is well posed, and the end state of such steps, where ds -> 0, is one
-!> of the exact law.
-!> Neutral modes: a set of slipping passages can let material run along a path without
-!> changing any tension (the yarn round a periodic cell, or a column of contact nodes
-!> sliding along a straight course whose heads and sinkers carry one tension); the
-!> Jacobian is then singular, the factorisation meets pivots of rounding size, and
-!> Newton's steps along the mode are set by rounding. Where it stops there is the same
-!> state of forces, but the flow increments, whose signs the stepper's active-set test
-!> reads, were arbitrary: passages were dropped at random, the rounds cycled, and on the
-!> planar 4 x 2 knit of inputs/knit3d.nml chatter damping ended steps beyond the limit
-!> (benchmarks/steps_results.md, section 7). So the tangent (never the residual) of
-!> each slip row gets neutral_shift times its largest flow derivative added to its own
-!> flow's entry, like the slack strings' spring: the converged answer is that of the
-!> exact law, and along a neutral mode the step now moves the flows as little as the
-!> shift allows instead of by rounding noise, so the solve keeps the flows of its start
-!> there (and the cell's symmetry). Relative 1e-12 is 1e4 times the rounding of a
-!> pivot and perturbs a regular step by 1e-12 of itself; 1e-8 (measured) was enough to
-!> let the stiff frictionless ring of test_defaults (EA = 1e6 times its load) stop at
-!> its residual tolerance 1e-7 away from the closed form instead of failing loudly.
+!> Each slip row is divided by w = max(1, dT_crit/dT_min), fixed per Newton solve
+!> (`prepare_solve`): unweighted, T_min's rounding times dT_crit/dT_min keeps the row
+!> above the tolerance once exp(mu alpha) is large (docs/decisions.md, 'Friction slip
+!> rows weighted per solve'). Rows are judged (get_row_levels) against the forces at
+!> their node, the passage's larger tension / w (slip) or the largest force (stick).
+!> `locked` forbids a direction (minimum reference length reached, or chatter damping).
+!> With `semismooth` (off) the modes are chosen at every evaluation instead
+!> (docs/decisions.md, 'Not kept: semismooth Newton for the slip modes').
+!> Viscous slip (`viscosity` > 0, set only by the stepper's slip-instability jump) adds
+!> eta (s - s_start) to each slip row: implicit Euler steps of a viscoplastic slip law,
+!> well posed where the rate-independent law has no consistent active set.
+!> The tangent (never the residual) of each slip row gets neutral_shift times its
+!> largest flow derivative on its own flow, so that Newton does not move along a
+!> neutral mode of a slipping set by rounding (docs/decisions.md, 'Neutral slip sets').
 module yarnfort_contact_friction_problem
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type, fatal_error
@@ -66,8 +32,8 @@ module yarnfort_contact_friction_problem
     use yarnfort_assembly_assemble, only: assemble_internal_force, add_element_tangents
     use yarnfort_assembly_scales, only: gather_node_force_levels, get_unknown_levels, &
         node_level_floor
-    use yarnfort_contact_geometry, only: get_wrap_angle
-    use yarnfort_solver_problem, only: nonlinear_problem_type
+    use yarnfort_contact_wrap_angle, only: get_wrap_angle
+    use yarnfort_solver_problem, only: nonlinear_problem_type, regularisation_type, chosen_law
     implicit none
     private
 
@@ -125,9 +91,9 @@ module yarnfort_contact_friction_problem
         !> per load step, the unknowns at every iterate.
         real(wp), allocatable :: x_prescribed(:, :), applied(:), load_factors(:)
         !> What the work arrays were last computed from (update_state): the unknowns, the
-        !> frozen positions, the load factors and the spring weight. A solve asks for the
-        !> same state several times (initial guess, row levels, the last iterate, the
-        !> solution check, the stepper's active-set test); it is computed once.
+        !> frozen positions, the load factors, the law's spring weight and cap. A solve asks
+        !> for the same state several times (initial guess, row levels, the last iterate,
+        !> the solution check, the stepper's active-set test); it is computed once.
         logical :: state_valid = .false.
         real(wp), allocatable :: state_u(:), state_u_frozen(:), state_factors(:)
         real(wp) :: state_spring = 0.0_wp, state_stiffness_cap = 0.0_wp
@@ -142,7 +108,8 @@ module yarnfort_contact_friction_problem
         procedure :: get_force_level
         !> Rounding error of an element's tension at the current state.
         procedure :: get_element_noise
-        !> Split unknowns into position unknowns and flows; set the work arrays.
+        !> Split unknowns into position unknowns and flows; set the work arrays (with
+        !> `law`, default the exact law).
         procedure :: update_state
         !> Tensions (clipped at 0) on both sides and the wrap angle of passage p.
         procedure :: get_passage_state
@@ -294,14 +261,17 @@ contains
     end function get_size
 
     !> Positions, reference lengths, internal forces and tensions for unknowns u.
-    subroutine update_state(self, u, error)
+    subroutine update_state(self, u, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
+        type(regularisation_type) :: used
 
+        used = chosen_law(law)
         if (self%state_valid) then
-            if (self%state_spring == self%spring .and. all(self%state_u == u) &
-                    .and. self%state_stiffness_cap == self%stiffness_cap &
+            if (self%state_spring == used%spring .and. all(self%state_u == u) &
+                    .and. self%state_stiffness_cap == used%stiffness_cap &
                     .and. all(self%state_factors == self%factors)) then
                 if (.not. self%positions_frozen) return
                 if (all(self%state_u_frozen == self%u_frozen)) return
@@ -321,15 +291,15 @@ contains
                     self%length0)
             end if
             call assemble_internal_force(scene, self%x, self%length0, self%internal, &
-                self%tension, self%stretch, error, self%spring, self%rounding, &
-                self%stiffness_cap)
+                self%tension, self%stretch, error, used%spring, self%rounding, &
+                used%stiffness_cap)
         end associate
         if (allocated(error)) return
         self%state_valid = size(u) == self%get_size()
         self%state_u = u
         self%state_factors = self%factors
-        self%state_spring = self%spring
-        self%state_stiffness_cap = self%stiffness_cap
+        self%state_spring = used%spring
+        self%state_stiffness_cap = used%stiffness_cap
         if (self%positions_frozen) self%state_u_frozen = self%u_frozen
     end subroutine update_state
 
@@ -399,14 +369,15 @@ contains
     !> overshot to L0 = -7 m "converged" with zero tension on both sides instead of the
     !> slip solution; the stepper then locked the passage at its minimum length). The
     !> failed solve makes the step be retried (fewer new slips, or a shorter step).
-    subroutine check_solution(self, u, error)
+    subroutine check_solution(self, u, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         integer :: e
         character(len=160) :: buffer
 
-        call self%update_state(u, error)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         if (all(self%length0 > 0.0_wp)) return
         e = findloc(self%length0 > 0.0_wp, .false., dim=1)
@@ -416,15 +387,16 @@ contains
     end subroutine check_solution
 
     !> Fix the slip rows' weights w = max(1, dT_crit/dT_min) at the initial guess u.
-    subroutine prepare_solve(self, u, error)
+    subroutine prepare_solve(self, u, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         integer :: p
         real(wp) :: t_before, t_after, angle, t_min, critical, dcrit_dt, dcrit_da
 
         self%slip_weight = 1.0_wp
-        call self%update_state(u, error)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         ! Stick rows in units of the scene's forces (it only scales the rows).
         self%stick_scale = self%get_force_level() / self%length_scale
@@ -456,17 +428,18 @@ contains
     !> the largest force (a flow to residual_tolerance * length_scale). Slip rows
     !> (T_crit - T_hi) / w: the passage's larger tension / w, floored like the nodes,
     !> and the rounding of T_crit - T_hi.
-    subroutine get_row_levels(self, u, level, noise, error)
+    subroutine get_row_levels(self, u, level, noise, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: level(:), noise(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         real(wp), allocatable :: node_level(:), node_noise(:)
         real(wp) :: max_force, t_before, t_after, angle, t_lo, critical, dcrit_dt, dcrit_da
         real(wp) :: noise_lo, noise_hi
         integer :: p, row, lo, hi
 
-        call self%update_state(u, error)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
         ! From the tensions and their rounding at this state (update_state), not evaluated
@@ -515,15 +488,16 @@ contains
         noise = self%rounding(e)
     end function get_element_noise
 
-    subroutine evaluate_residual(self, u, values, error)
+    subroutine evaluate_residual(self, u, values, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         integer :: p, row
         real(wp) :: t_before, t_after, angle, critical, dcrit_dt, dcrit_da, flow
 
-        call self%update_state(u, error)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         row = 0
         if (.not. self%positions_frozen) row = self%n_x
@@ -555,15 +529,18 @@ contains
         end do
     end subroutine evaluate_residual
 
-    subroutine evaluate_jacobian(self, u, values, error)
+    subroutine evaluate_jacobian(self, u, values, error, law)
         class(friction_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         integer :: e, p, a, b, slot
         real(wp) :: dforce_dl0(3)
+        type(regularisation_type) :: used
 
-        call self%update_state(u, error)
+        used = chosen_law(law)
+        call self%update_state(u, error, law)
         if (allocated(error)) return
         if (self%semismooth) then
             if (self%positions_frozen) then
@@ -578,8 +555,8 @@ contains
                 ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2,
                 ! from the tangents' own evaluation of each element.
                 call add_element_tangents(scene, self%element_slot, self%x, self%length0, &
-                    values, error, self%spring, self%tangent_spring, self%dforce_dl0, &
-                    self%stiffness_cap)
+                    values, error, used%spring, used%tangent_spring, self%dforce_dl0, &
+                    used%stiffness_cap)
                 if (allocated(error)) return
                 do e = 1, net%n_elements()
                     ! L0 changes by share(e) times the flows bounding its segment.
@@ -660,10 +637,10 @@ contains
                     if (abs(lambda - 1.0_wp) > kink_round_off) return
                     t = 0.0_wp
                     dt = capped_stiffness(self%scene%laws(net%element_material(e))%law, &
-                        self%stiffness_cap)
+                        used%stiffness_cap)
                 else
                     call get_truss_tension(self%scene%laws(net%element_material(e))%law, &
-                        self%spring, lambda, t, dt, self%stiffness_cap)
+                        used%spring, lambda, t, dt, used%stiffness_cap)
                 end if
                 gradient(first:first + 2) = -dt / self%length0(e) * c
                 gradient(first + 3:first + 5) = dt / self%length0(e) * c

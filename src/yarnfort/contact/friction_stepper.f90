@@ -19,7 +19,7 @@
 !> Newton solve (full steps only), and one that fails is retried with fewer new slips.
 !> When the step's first set fails with no new slip, its passages whose flows the first
 !> Newton step sends back stick and the set is solved again (stop_flowing_back). Every
-!> solve starts with chord steps (newton_solver_type%chord_steps), in both schemes.
+!> solve starts with chord steps (solve_options_type%chord_steps), in both schemes.
 !> A monolithic round's set may be judged and changed before it is solved, at the
 !> chord path's iterate (provisional rounds, max_provisional_rounds); in any round but
 !> the step's first, an iterate that does not contract is judged for its stops only.
@@ -40,7 +40,8 @@ module yarnfort_contact_friction_stepper
         chosen_lu_name
     use yarnfort_linalg_composite_condensed, only: condensed_solver_type
     use yarnfort_linalg_composite_bordered, only: bordered_solver_type
-    use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
+    use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type, &
+        solve_options_type
     use yarnfort_solver_elastic_problem, only: elastic_problem_type, new_elastic_problem
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type, start_stepper, &
         accept_trial, save_common, restore_common
@@ -80,7 +81,7 @@ module yarnfort_contact_friction_stepper
     real(wp), parameter :: dead_band_factor = 10.0_wp
 
     !> Chord steps after the first Newton step of every friction solve
-    !> (newton_solver_type%chord_steps). Measured (benchmarks/steps_results.md, section
+    !> (solve_options_type%chord_steps). Measured (benchmarks/steps_results.md, section
     !> 8), Newton iterations (factorisations) per step, without -> in the first solve of
     !> a step -> in every solve: inputs/knit_clamped.nml 4.42 -> 3.65 -> 3.27, woven
     !> 2,200 aligned 1.68 -> 1.18 -> 1.13, 10,120 skewed 3.42 -> 2.48 -> 2.00, no step
@@ -235,14 +236,12 @@ contains
                 call new_newton_solver(self%newton_elastic, self%elastic, linear, scene%solver, &
                     error)
                 if (allocated(error)) return
-                self%newton_elastic%chord_steps = chord_steps
             end if
             call new_friction_problem(self%sliding, scene, positions_frozen=.true.)
             call new_linear_solver(linear, general_name, error, unsymmetric=.true.)
             if (allocated(error)) return
             call new_newton_solver(self%newton_sliding, self%sliding, linear, scene%solver, error)
             if (allocated(error)) return
-            self%newton_sliding%chord_steps = chord_steps
         end if
         ! The monolithic problem: the whole solve, or the staggered scheme's finish of a
         ! step (finish_monolithic), which takes full Newton steps only.
@@ -272,9 +271,6 @@ contains
         end block
         call new_newton_solver(self%newton_full, self%full, linear, scene%solver, error)
         if (allocated(error)) return
-        self%newton_full%quick = self%staggered
-        ! The staggered scheme's finish takes full Newton steps only (above).
-        if (.not. self%staggered) self%newton_full%chord_steps = chord_steps
         allocate(self%flow(n_p), source=0.0_wp)
         allocate(self%mode(n_p), source=mode_stick)
         self%flow_trial = self%flow
@@ -445,6 +441,8 @@ contains
         logical :: solved_before
         type(error_type), allocatable :: step_error
         type(newton_stats_type) :: carried
+        !> The options of this round's solves (quick: rounds with slipping passages).
+        type(solve_options_type) :: full_options
 
         associate(problem => self%full, scene => self%scene)
             n_x = scene%dofs%n_unknowns
@@ -513,7 +511,8 @@ contains
                 ! (benchmarks/steps_results.md, section 5). A fast round that fails is
                 ! retried with half its new slips from the solved state; one with a single
                 ! new slip or none is solved again with the fallbacks.
-                self%newton_full%quick = any(self%mode_trial /= mode_stick) .and. .not. full_retry
+                full_options = solve_options_type(quick=any(self%mode_trial /= mode_stick) &
+                    .and. .not. full_retry, chord_steps=merge(0, chord_steps, self%staggered))
                 start = unknowns
                 solved = .false.
                 carried = newton_stats_type()
@@ -548,7 +547,8 @@ contains
                     ! Each pass is one Newton step: with the solve after them, within
                     ! max_iterations (a solve's limit).
                     do pass = 1, min(provisional_passes, scene%solver%max_iterations - 1)
-                        call self%newton_full%try_chord(unknowns, stats, solved, step_error)
+                        call self%newton_full%try_chord(unknowns, stats, solved, step_error, &
+                            full_options)
                         factored_mode = problem%mode
                         iterations = iterations + stats%iterations
                         call stats%add_earlier(carried)
@@ -607,14 +607,15 @@ contains
                     end if
                 end if
                 if (.not. solved) then
-                    call self%newton_full%solve(unknowns, stats, error, after_chord=chorded)
+                    call self%newton_full%solve(unknowns, stats, error, full_options, &
+                        after_chord=chorded)
                     iterations = iterations + stats%iterations
                     call stats%add_earlier(carried)
                 end if
                 call record_solve(self%trace, stats, allocated(error))
                 if (allocated(error)) then
                     solved_before = .false.
-                    if (self%newton_full%quick .and. .not. (have_good .or. guessed &
+                    if (full_options%quick .and. .not. (have_good .or. guessed &
                         .or. sign_tried)) then
                         ! The step's first set failed, with no new slip: where a set that
                         ! slips as a whole must end (a periodic knit cell's passages at the
@@ -652,7 +653,7 @@ contains
                     ! all-stick (the elastic problem, which has a solution).
                     if (have_good) then
                         if (new_slips <= 1) then
-                            if (.not. self%newton_full%quick) return
+                            if (.not. full_options%quick) return
                             full_retry = .true.
                             deallocate(error)
                             cycle
@@ -844,7 +845,8 @@ contains
                 call scene%passages%get_length0(scene%network%length0, self%flow_trial, &
                     elastic%length0)
                 if (scene%dofs%n_unknowns > 0) then
-                    call self%newton_elastic%solve(self%u_trial, stats, error)
+                    call self%newton_elastic%solve(self%u_trial, stats, error, &
+                        solve_options_type(chord_steps=chord_steps))
                     iterations = iterations + stats%iterations
                     call record_solve(self%trace, stats, allocated(error))
                     if (allocated(error)) return
@@ -854,7 +856,8 @@ contains
                 mode_before = self%mode_trial
                 do inner = 1, scene%solver%max_friction_iterations
                     sliding%mode = self%mode_trial
-                    call self%newton_sliding%solve(self%flow_trial, stats, error)
+                    call self%newton_sliding%solve(self%flow_trial, stats, error, &
+                        solve_options_type(chord_steps=chord_steps))
                     iterations = iterations + stats%iterations
                     call record_solve(self%trace, stats, allocated(error))
                     if (allocated(error)) return
@@ -936,14 +939,8 @@ contains
             ! as on a ring sliding along a yarn 1e5 times stiffer than its load (residual
             ! 7e-4 falling by 1e-10 per round), the softened-yarn predictor solves it.
             if (may_finish) then
-                block
-                    logical :: quick
-                    quick = self%newton_full%quick
-                    self%newton_full%quick = .false.
-                    call finish_monolithic(self, flips, locked_forward, locked_backward, &
-                        finished, iterations, error)
-                    self%newton_full%quick = quick
-                end block
+                call finish_monolithic(self, flips, locked_forward, locked_backward, &
+                    finished, iterations, error)
                 if (allocated(error)) return
                 if (finished) then
                     self%n_damped = count(flips > max_flips)

@@ -1,7 +1,9 @@
 ! SPDX-License-Identifier: MIT
 !> The &fabric group: check its parameters and generate the fabric's nodes, yarns,
 !> supports and links into the configuration (knitted: yarnfort_generate_knit; woven:
-!> yarnfort_generate_woven).
+!> yarnfort_generate_woven; TexGen: yarnfort_generate_texgen). Called by the program and
+!> the Python entry between reading the input and checking it; the input layer never
+!> calls it.
 module yarnfort_generate_fabric
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
@@ -32,6 +34,7 @@ contains
         real(wp) :: width
         integer :: pulled
 
+        if (len_trim(config%fabric%kind) == 0) return
         call check_fabric(config, error)
         if (allocated(error)) return
         select case (trim(config%fabric%kind))

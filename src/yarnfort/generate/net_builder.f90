@@ -112,6 +112,7 @@ contains
         if (.not. allocated(self%supports)) allocate(self%supports(0))
         call move_alloc(self%yarns, config%yarns)
         call move_alloc(self%supports, config%supports)
+        if (allocated(config%links)) deallocate(config%links)
         if (allocated(self%links)) then
             config%links = self%links(1:self%n_links)
         else

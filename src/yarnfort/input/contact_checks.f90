@@ -3,13 +3,13 @@
 !> the parameters of its friction law, and, when any &contact is given, one for every
 !> pair of yarn types that meet at a node.
 module yarnfort_input_contact_checks
-    use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, name_length
     use yarnfort_input_groups, only: check_contact_variables
     use yarnfort_input_fields, only: quoted_list
     use yarnfort_input_network_checks, only: yarn_label, check_defined, sort_by_key
-    use yarnfort_input_contact_node_checks, only: check_node_contact, get_contact_node_sets
+    use yarnfort_input_contact_node_checks, only: check_node_contact
+    use yarnfort_scene_contact_nodes, only: get_contact_node_sets
     use yarnfort_text, only: format_integer, format_real
     implicit none
     private

@@ -3,11 +3,10 @@
 !> lengths, squared lengths and force scales must be finite normal numbers. Values
 !> outside it are input errors here, not NaN residuals in the solve.
 module yarnfort_input_magnitudes
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type, name_length
-    use yarnfort_input_channel_checks, only: get_channel_names, get_channel_factors, &
+    use yarnfort_scene_channels, only: get_channel_names, get_channel_factors, &
         find_channel, default_displacement_channel
     use yarnfort_text, only: format_real, format_integer
     implicit none

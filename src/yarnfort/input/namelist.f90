@@ -19,10 +19,9 @@ module yarnfort_input_namelist
         read_obstacle_groups, read_ring_groups, fabric_kind_choices
     use yarnfort_input_fields, only: max_list, max_coordinates
     use yarnfort_input_scan, only: namelist_scan_type, scan_namelist
-    use yarnfort_input_geometry, only: read_geometry_file
+    use yarnfort_input_geometry_file, only: read_geometry_file
     use yarnfort_text, only: format_integer, folder_of, resolve_path, open_to_read, join_names
     use yarnfort_input_validate, only: check_config
-    use yarnfort_generate_fabric, only: generate_fabric
     implicit none
     private
 
@@ -110,8 +109,6 @@ contains
                     return
                 end if
             end do
-            call generate_fabric(config, error)
-            if (allocated(error)) return
         end if
         if (.not. allocated(config%links)) allocate(config%links(0))
     end subroutine read_config

@@ -14,7 +14,7 @@ module yarnfort_input_network_checks
         check_load_variables
     use yarnfort_input_fields, only: quoted_list, suggestion, check_item_name, group_label
     use yarnfort_text, only: format_integer, format_real
-    use yarnfort_material_law, only: is_usable_stretch, max_stretch
+    use yarnfort_material_force_law, only: is_usable_stretch, max_stretch
     implicit none
     private
 

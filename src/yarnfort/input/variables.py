@@ -130,8 +130,8 @@ GROUPS = [
                 "regularising spring's, see `slack_stiffness`), otherwise KLU up to 5e3 "
                 'unknowns and UMFPACK above; the unsymmetric friction systems never use '
                 'CHOLMOD: with stick flows eliminated, their reduced system goes to KLU, or to '
-                "UMFPACK where KLU's analysis predicts 100 or more flops per factor nonzero "
-                '(decided per pattern, `benchmarks/results-lu-choice.md`).'),
+                "UMFPACK where KLU's analysis predicts 80 or more flops per factor nonzero "
+                '(decided per pattern, `docs/decisions.md`).'),
         Var('residual_tolerance', 'real', 1e-10, unit='1', range='> 0',
             presets={'fast': 1e-6, 'balanced': 1e-9, 'accurate': 1e-11},
             doc='Relative. Newton stops when every row meets \\|F_i\\| <= residual_tolerance * '

@@ -4,7 +4,7 @@ module yarnfort_material_linear
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     use yarnfort_text, only: format_real
     implicit none
     private

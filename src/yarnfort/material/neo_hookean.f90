@@ -1,12 +1,13 @@
 ! SPDX-License-Identifier: MIT
-!> Incompressible neo-Hookean string (design notes, eq. 4 of the paper): Cauchy stress
-!> sigma = C*(lambda**2 - 1/lambda) on the deformed cross-section S1/lambda, so the
+!> Incompressible neo-Hookean string (the paper's eq. 4): Cauchy stress
+!> sigma = C*(lambda**2 - 1/lambda) on the deformed cross-section S1/lambda (that of an
+!> incompressible string, whatever the paper's eq. 4 prints), so the
 !> tension is f = S1*C*(lambda - lambda**(-2)) for lambda > 1, zero when slack.
 module yarnfort_material_neo_hookean
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     use yarnfort_text, only: format_real
     implicit none
     private

@@ -24,7 +24,7 @@ module yarnfort_material_table
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     use yarnfort_text, only: format_real, format_integer, quote_string, string_type
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
     use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &

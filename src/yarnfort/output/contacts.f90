@@ -1,19 +1,21 @@
 ! SPDX-License-Identifier: MIT
 !> The rows of contacts.csv (`&output contact_state`): per converged step, the state of
-!> every sliding passage (a yarn through a contact node) in long format. The file itself
-!> is written by a `curve_writer_type` (header, rows appended and flushed per step,
+!> every sliding passage (a yarn through a contact node) in long format, written by
+!> `contacts_writer_type` (a table_writer_type: rows appended and flushed per step,
 !> resumed on restart).
 module yarnfort_output_contacts
     use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type
+    use yarnfort_output_table, only: table_writer_type
     use yarnfort_output_csv_rows, only: csv_rows_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
-    use yarnfort_contact_geometry, only: get_wrap_angle
+    use yarnfort_contact_wrap_angle, only: get_wrap_angle
     use yarnfort_contact_friction_problem, only: mode_forward, mode_backward
     implicit none
     private
 
-    public :: contacts_file_name, contacts_header, get_contact_rows
+    public :: contacts_writer_type, contacts_file_name, contacts_header, get_contact_rows
     public :: passage_state_type, get_passage_states, mode_names
     public :: mode_none, mode_code_stick, mode_code_forward, mode_code_backward, mode_code_locked
 
@@ -49,7 +51,46 @@ module yarnfort_output_contacts
     !> (as the friction stepper judges it).
     real(wp), parameter :: length_round_off = 64 * epsilon(1.0_wp)
 
+    type, extends(table_writer_type) :: contacts_writer_type
+    contains
+        procedure :: open => open_contacts
+        !> Keep the rows up to a step of an existing contacts.csv and append after them.
+        procedure :: resume => resume_contacts
+        procedure :: write_step
+    end type contacts_writer_type
+
 contains
+
+    !> Create folder/contacts.csv and write its header.
+    subroutine open_contacts(self, folder, error)
+        class(contacts_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: folder
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%open_table(folder, contacts_file_name, contacts_header, error)
+    end subroutine open_contacts
+
+    !> Continue folder/contacts.csv after `step` (a restart).
+    subroutine resume_contacts(self, folder, step, error)
+        class(contacts_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: folder
+        integer, intent(in) :: step
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%resume_table(folder, contacts_file_name, contacts_header, step, error)
+    end subroutine resume_contacts
+
+    !> Append the rows of `state` with the snapshot's passage `mode` and `flow`.
+    subroutine write_step(self, scene, state, mode, flow, error)
+        class(contacts_writer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: mode(:)
+        real(wp), intent(in) :: flow(:)
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%put_line(get_contact_rows(scene, state, mode, flow), error)
+    end subroutine write_step
 
     !> The state of every passage at `state`; `mode` and `flow` are the snapshot's. Mode:
     !> 'forward' / 'backward' while the yarn slides towards the element after / before

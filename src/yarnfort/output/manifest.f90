@@ -8,6 +8,9 @@
 !>     file <name>
 !>     state <name> <step> <time>
 !>
+!> A state entry (state_NNNNN.vtu) stands for its multiblock file and its other blocks
+!> too (state_NNNNN.vtm, holders_NNNNN.vtu, links_..., passages_...: yarnfort_output_vtk),
+!> written before it.
 !> A name is listed when the run is about to create it (add_file, add_state), before the
 !> file exists: a kill in between leaves a listed file that is incomplete or missing,
 !> never an unlisted one. Only names this program writes are ever taken from the file
@@ -23,7 +26,7 @@ module yarnfort_output_manifest
     private
 
     public :: manifest_type, manifest_file_name, is_own_name, is_state_name
-    public :: is_bookkeeping_name
+    public :: is_bookkeeping_name, part_prefixes
 
     character(len=*), parameter :: manifest_file_name = '.yarnfort-manifest'
 
@@ -37,6 +40,12 @@ module yarnfort_output_manifest
         'curve.csv.tmp', 'input.nml', 'input.nml.tmp', 'restart.dat', 'restart.dat.tmp', &
         'states.pvd', 'states.pvd.tmp', 'reactions.csv', 'reactions.csv.tmp', &
         'contacts.csv', 'contacts.csv.tmp', 'restart.sync', 'restart.sync.tmp']
+
+    !> The blocks of a state besides the yarns' (state_NNNNN.vtu), by the prefix that
+    !> replaces 'state_' in their file names (yarnfort_output_vtk): gap-holders,
+    !> periodic links, sliding passages.
+    character(len=*), parameter :: part_prefixes(3) = [character(len=9) :: 'holders_', &
+        'links_', 'passages_']
 
     !> Longest file name kept (state names are far shorter).
     integer, parameter :: entry_length = 64
@@ -274,10 +283,24 @@ contains
         is_bookkeeping_name = any(bookkeeping_names == name)
     end function is_bookkeeping_name
 
-    !> A name this program writes into an output folder: a fixed name, or a state file.
+    !> A name this program writes into an output folder: a fixed name, a state file, its
+    !> multiblock file (state_NNNNN.vtm) or one of its other blocks (holders_, links_,
+    !> passages_ + the state's digits).
     pure logical function is_own_name(name)
         character(len=*), intent(in) :: name
+        integer :: part, n
         is_own_name = any(fixed_names == name) .or. is_state_name(name)
+        n = len(name)
+        if (n > len('.vtm')) then
+            if (name(n - 3:) == '.vtm') is_own_name = is_own_name &
+                .or. is_state_name(name(:n - 4) // '.vtu')
+        end if
+        do part = 1, size(part_prefixes)
+            n = len_trim(part_prefixes(part))
+            if (len(name) <= n) cycle
+            if (name(:n) == part_prefixes(part)(:n)) &
+                is_own_name = is_own_name .or. is_state_name('state_' // name(n + 1:))
+        end do
     end function is_own_name
 
     !> state_<at least 5 digits>.vtu

@@ -1,23 +1,78 @@
 ! SPDX-License-Identifier: MIT
 !> The rows of reactions.csv (`&output node_reactions`): per converged step, the reaction
-!> of every node of every support set, in long format. The file itself is written by a
-!> `curve_writer_type` (header, rows appended and flushed per step, resumed on restart).
+!> of every node of every support set, in long format, written by `reactions_writer_type`
+!> (a table_writer_type: rows appended and flushed per step, resumed on restart).
 module yarnfort_output_reactions
     use yarnfort_kinds, only: wp
+    use yarnfort_error, only: error_type
+    use yarnfort_output_table, only: table_writer_type
     use yarnfort_output_csv_rows, only: csv_rows_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     implicit none
     private
 
-    public :: reactions_file_name, reactions_header, get_reaction_rows
+    public :: reactions_writer_type, reactions_file_name, reactions_header, get_reaction_rows
+    public :: has_constrained_nodes
 
     character(len=*), parameter :: reactions_file_name = 'reactions.csv'
 
     !> Columns: step, support set name, node id, force (N) the support applies on the node.
     character(len=*), parameter :: reactions_header = 'step,support,node,rx,ry,rz'
 
+    type, extends(table_writer_type) :: reactions_writer_type
+    contains
+        procedure :: open => open_reactions
+        !> Keep the rows up to a step of an existing reactions.csv and append after them.
+        procedure :: resume => resume_reactions
+        procedure :: write_step
+    end type reactions_writer_type
+
 contains
+
+    !> Create folder/reactions.csv and write its header.
+    subroutine open_reactions(self, folder, error)
+        class(reactions_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: folder
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%open_table(folder, reactions_file_name, reactions_header, error)
+    end subroutine open_reactions
+
+    !> Continue folder/reactions.csv after `step` (a restart); the step must have rows
+    !> when `scene` has a constrained node.
+    subroutine resume_reactions(self, folder, scene, step, error)
+        class(reactions_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: folder
+        type(scene_type), intent(in) :: scene
+        integer, intent(in) :: step
+        type(error_type), allocatable, intent(out) :: error
+
+        call self%resume_table(folder, reactions_file_name, reactions_header, step, error, &
+            row_required=has_constrained_nodes(scene))
+    end subroutine resume_reactions
+
+    !> Append the rows of `state` (none when the scene has no constrained node).
+    subroutine write_step(self, scene, state, error)
+        class(reactions_writer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        type(error_type), allocatable, intent(out) :: error
+
+        if (has_constrained_nodes(scene)) call self%put_line(get_reaction_rows(scene, state), &
+            error)
+    end subroutine write_step
+
+    !> Whether any support set prescribes a coordinate (reactions.csv has rows).
+    pure logical function has_constrained_nodes(scene)
+        type(scene_type), intent(in) :: scene
+        integer :: s
+
+        has_constrained_nodes = .false.
+        do s = 1, size(scene%supports)
+            if (size(scene%supports(s)%coordinates) > 0) has_constrained_nodes = .true.
+        end do
+    end function has_constrained_nodes
 
     !> The rows of one step, joined by newlines (no newline after the last), or '' if the
     !> scene has no constrained node. One row per node of each set, in the order of the

@@ -1,40 +1,42 @@
 ! SPDX-License-Identifier: MIT
-!> Network states as VTK XML unstructured grids (.vtu, one per written step) for
-!> ParaView, and the states.pvd collection listing them with their pseudo-time.
+!> Network states as VTK XML unstructured grids for ParaView, and the states.pvd
+!> collection listing them with their pseudo-time.
 !>
-!> Each state holds the nodes (points: current positions) and, as cells, the yarn
-!> elements followed by the links (gap-holders and periodic images, so that a fabric
-!> shows connected). Arrays:
-!> - field data: time, step, the factor of each load channel (p_force, p_disp without
-!>   &path channels); for a fabric also strain and
-!>   force_per_width (as in curve.csv);
-!> - point data: displacement (from the initial position), position, and for scenes
-!>   with sliding passages contact_state (0 no passage, 1 all stick, 2 a passage slips),
-!>   passages (the number of sliding passages at the node), and the state of one of them
-!>   (see write_state): passage (its number, 0 none), mode (0 none, 1 stick, 2 forward,
-!>   3 backward, 4 locked), flow, tension_min, tension_max, critical_tension and
-!>   wrap_angle (as in contacts.csv; 0 at nodes without a passage);
-!> - cell data: kind (0 yarn element, 1 gap-holder, 2 periodic link), yarn and material
-!>   (1-based, in input order; 0 for links), tension (N; 0 for links), stretch
-!>   (current over reference length), L0 (reference length) and period (the current
-!>   lattice vector a link spans: a periodic link's, a gap-holder's to a periodic
-!>   image; zero for elements and links inside the cell).
-!> The data are appended base64-encoded binary (VTK XML 1.0, UInt64 headers) by
-!> default, or inline ASCII (&output vtk_format).
+!> A state is up to four blocks (files), so that colouring by any array shows only what
+!> has it (ParaView draws a block without the array in one plain colour):
+!> - state_NNNNN.vtu, the yarns: points the nodes (current positions), cells the yarn
+!>   elements; point data displacement (from the initial position), position, and for
+!>   scenes with sliding passages contact_state (0 no passage, 1 all stick, 2 a passage
+!>   slips) and passages (their number at the node); cell data tension (N), stretch
+!>   (current over reference length), L0 (reference length), yarn and material
+!>   (1-based, input order);
+!> - holders_NNNNN.vtu, links_NNNNN.vtu: the gap-holders and the periodic links
+!>   (write_links);
+!> - passages_NNNNN.vtu: one point per sliding passage (write_passages), so that two
+!>   passages at one node both show.
+!> Every block has the field data time, step, the factor of each load channel (p_force,
+!> p_disp without &path channels), and for a fabric strain and force_per_width (as in
+!> curve.csv). The multiblock file state_NNNNN.vtm lists the blocks of a state by name
+!> (ParaView and VTK's XML multiblock reader open it as one dataset), and states.pvd
+!> the multiblock files with their pseudo-time.
+!> The files are built by yarnfort_output_vtu: appended base64-encoded binary by default,
+!> or inline ASCII (&output vtk_format).
 module yarnfort_output_vtk
     use, intrinsic :: iso_fortran_env, only: int8, int32, int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
-    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_scene, only: scene_type, get_applied_force
     use yarnfort_solver_continuation, only: step_state_type
-    use yarnfort_output_filesystem, only: rename_file, remove_file, open_new_file, &
-        close_new_file
+    use yarnfort_output_vtu, only: vtu_builder_type, start_vtu, finish_vtu, write_text_file, &
+        add_text, add_reals, add_int32, vtk_vertex, vtk_line
     use yarnfort_text, only: format_integer
+    use yarnfort_output_manifest, only: part_prefixes
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
     implicit none
     private
 
-    public :: vtk_writer_type, get_state_name, collection_file_name
+    public :: vtk_writer_type, get_state_name, get_part_name, get_multiblock_name
+    public :: collection_file_name
 
     character(len=*), parameter :: collection_file_name = 'states.pvd'
     !> Longest state file name kept (get_state_name's are far shorter).
@@ -51,7 +53,11 @@ module yarnfort_output_vtk
         integer :: n_files = 0
         !> Entries of states.pvd when it was last rewritten.
         integer :: listed = -1
+        !> The blocks besides the yarns' that each state has (set_parts).
+        logical :: has_part(3) = .false.
     contains
+        !> Which blocks the states of a scene have.
+        procedure, private :: set_parts
         procedure :: write_state
         !> Start the list of states anew with `files` and their `times`.
         procedure :: set_files
@@ -59,8 +65,11 @@ module yarnfort_output_vtk
         procedure :: write_collection
     end type vtk_writer_type
 
-    integer(int8), parameter :: vtk_line = 3_int8
-    integer, parameter :: kind_element = 0, kind_gap = 1, kind_periodic = 2
+    !> The blocks of a state besides the yarns', by their place in part_prefixes.
+    integer, parameter :: part_holders = 1, part_links = 2, part_passages = 3
+    !> The names of the blocks in a state's .vtm (ParaView's block tree), yarns first.
+    character(len=*), parameter :: block_names(0:3) = [character(len=14) :: 'yarns', &
+        'gap_holders', 'periodic_links', 'passages']
     integer, parameter :: contact_none = 0, contact_stick = 1, contact_slip = 2
 
     !> states.pvd is rewritten after a state when it then misses more than this fraction
@@ -68,15 +77,6 @@ module yarnfort_output_vtk
     !> of the rewrites stays linear in the number of states.
     real(wp), parameter :: collection_lag = 0.05_wp
     integer, parameter :: collection_always = 100
-
-    character(len=64), parameter :: base64_alphabet = &
-        'ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/'
-
-    !> The XML text and appended data of one file being built.
-    type :: vtu_builder_type
-        logical :: ascii = .false.
-        character(len=:), allocatable :: xml, appended
-    end type vtu_builder_type
 
 contains
 
@@ -90,13 +90,44 @@ contains
         name = trim(buffer)
     end function get_state_name
 
-    !> Write the state file of `state` (`mode`, `flow`: stick/slip mode and flow of each
-    !> passage, may be empty), then states.pvd when due (collection_lag). A failed write
-    !> removes the incomplete state file and says why. A node with several passages shows
-    !> the one that matters most for stick/slip: a slipping one (forward or backward)
-    !> before a locked one before a stick one, and among those the one with the largest
-    !> tension_max (the first in passage order on a tie); `passages` tells how many there
-    !> are and contact_state whether any slips.
+    !> The file name of block `part` (part_holders, part_links, part_passages) of the
+    !> state file `name` (state_NNNNN.vtu): holders_NNNNN.vtu, links_..., passages_....
+    pure function get_part_name(name, part) result(part_name)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: part
+        character(len=:), allocatable :: part_name
+        part_name = trim(part_prefixes(part)) // name(len('state_') + 1:)
+    end function get_part_name
+
+    !> The multiblock file of the state file `name` (state_NNNNN.vtu): state_NNNNN.vtm.
+    pure function get_multiblock_name(name) result(multiblock_name)
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: multiblock_name
+        multiblock_name = name(:len(name) - len('.vtu')) // '.vtm'
+    end function get_multiblock_name
+
+    !> Which blocks the states of `scene` have: gap-holders, periodic links, sliding
+    !> passages.
+    subroutine set_parts(self, scene)
+        class(vtk_writer_type), intent(inout) :: self
+        type(scene_type), intent(in) :: scene
+        integer :: n_links
+
+        n_links = 0
+        if (allocated(scene%link_nodes)) n_links = size(scene%link_nodes, 2)
+        self%has_part = .false.
+        if (n_links > 0) then
+            self%has_part(part_holders) = any(scene%link_is_gap)
+            self%has_part(part_links) = .not. all(scene%link_is_gap)
+        end if
+        self%has_part(part_passages) = scene%passages%size() > 0
+    end subroutine set_parts
+
+    !> Write the files of `state` (`mode`, `flow`: stick/slip mode and flow of each
+    !> passage, may be empty): its blocks and the multiblock file that lists them first,
+    !> the yarns' state file last (a whole state file means a whole state), then
+    !> states.pvd when due (collection_lag). A failed write removes the incomplete file
+    !> and says why.
     subroutine write_state(self, scene, state, mode, flow, error)
         class(vtk_writer_type), intent(inout) :: self
         type(scene_type), intent(in) :: scene
@@ -104,66 +135,282 @@ contains
         integer, intent(in) :: mode(:)
         real(wp), intent(in) :: flow(:)
         type(error_type), allocatable, intent(out) :: error
-        type(vtu_builder_type) :: vtu
-        character(len=:), allocatable :: name, path
-        integer :: n_nodes, n_elements, n_links, n_cells, e, l, p, node, y
-        integer(int64), allocatable :: connectivity(:), offsets(:)
-        integer(int32), allocatable :: cell_kind(:), yarn(:), material(:), contact(:)
-        real(wp), allocatable :: tension(:), stretch(:), length0(:), period(:, :)
-        real(wp) :: now(3), before(3), p_disp
+        character(len=:), allocatable :: name
 
         name = get_state_name(state%step)
-        path = self%folder // '/' // name
+        call self%set_parts(scene)
+        if (self%has_part(part_holders) .or. self%has_part(part_links)) then
+            call write_links(self, scene, state, name, error)
+            if (allocated(error)) return
+        end if
+        if (self%has_part(part_passages)) then
+            call write_passages(self, scene, state, mode, flow, &
+                self%folder // '/' // get_part_name(name, part_passages), error)
+            if (allocated(error)) return
+        end if
+        call write_multiblock(self, name, error)
+        if (allocated(error)) return
+        call write_yarns(self, scene, state, mode, self%folder // '/' // name, error)
+        if (allocated(error)) return
+
+        call add_file(self, name, state%time)
+        if (self%n_files <= collection_always .or. &
+                real(self%n_files - self%listed, wp) > collection_lag * self%n_files) &
+            call self%write_collection(error)
+    end subroutine write_state
+
+    !> The multiblock file of the state file `name` (state_NNNNN.vtm): its blocks by
+    !> name (block_names), the yarns first, so that ParaView shows each in its tree.
+    subroutine write_multiblock(self, name, error)
+        class(vtk_writer_type), intent(in) :: self
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        integer :: part, index
+
+        text = '<?xml version="1.0"?>' // new_line('a') &
+            // '<VTKFile type="vtkMultiBlockDataSet" version="1.0">' // new_line('a') &
+            // '<vtkMultiBlockDataSet>' // new_line('a') &
+            // '<DataSet index="0" name="' // trim(block_names(0)) // '" file="' // name &
+            // '"/>' // new_line('a')
+        index = 0
+        do part = 1, size(self%has_part)
+            if (.not. self%has_part(part)) cycle
+            index = index + 1
+            text = text // '<DataSet index="' // format_integer(index) // '" name="' &
+                // trim(block_names(part)) // '" file="' // get_part_name(name, part) // '"/>' &
+                // new_line('a')
+        end do
+        text = text // '</vtkMultiBlockDataSet>' // new_line('a') // '</VTKFile>' &
+            // new_line('a')
+        call write_text_file(self%folder // '/' // get_multiblock_name(name), text, error)
+    end subroutine write_multiblock
+
+    !> The yarns' block (state_NNNNN.vtu): the nodes and the yarn elements.
+    subroutine write_yarns(self, scene, state, mode, path, error)
+        class(vtk_writer_type), intent(in) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: mode(:)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        type(vtu_builder_type) :: vtu
+        integer :: n_nodes, n_elements, e, p, node, y
+        integer(int64), allocatable :: connectivity(:)
+        integer(int32), allocatable :: yarn(:), contact(:), count(:)
+
         n_nodes = size(state%position, 2)
         n_elements = size(state%tension)
-        n_links = 0
-        if (allocated(scene%link_nodes)) n_links = size(scene%link_nodes, 2)
-        n_cells = n_elements + n_links
-
-        allocate(connectivity(2 * n_cells), offsets(n_cells))
-        allocate(cell_kind(n_cells), yarn(n_cells), material(n_cells))
-        allocate(tension(n_cells), stretch(n_cells), length0(n_cells))
-        allocate(period(3, n_cells), source=0.0_wp)
-        p_disp = 0.0_wp
-        if (scene%dofs%gap_channel >= 1 .and. scene%dofs%gap_channel <= size(state%factors)) &
-            p_disp = state%factors(scene%dofs%gap_channel)
+        allocate(connectivity(2 * n_elements), yarn(n_elements))
         do e = 1, n_elements
             connectivity(2 * e - 1:2 * e) = scene%network%element_nodes(:, e) - 1
         end do
-        cell_kind(:n_elements) = kind_element
         do y = 1, scene%network%n_yarns()
             yarn(scene%network%yarn_first_element(y):scene%network%yarn_first_element(y + 1) &
                 - 1) = y
         end do
-        material(:n_elements) = scene%network%element_material
-        tension(:n_elements) = state%tension
-        stretch(:n_elements) = state%stretch
-        length0(:n_elements) = state%length0
+        call start_file(vtu, self%ascii, scene, state, n_nodes, n_elements)
+        call add_text(vtu, '<PointData Vectors="displacement">')
+        call add_reals(vtu, 'displacement', &
+            reshape(state%position - scene%network%position, [3 * n_nodes]), 3)
+        call add_reals(vtu, 'position', reshape(state%position, [3 * n_nodes]), 3)
+        if (scene%passages%size() > 0) then
+            allocate(contact(n_nodes), source=int(contact_none, int32))
+            allocate(count(n_nodes), source=0_int32)
+            do p = 1, scene%passages%size()
+                node = scene%passages%node(p)
+                count(node) = count(node) + 1
+                if (contact(node) == contact_none) contact(node) = contact_stick
+                if (p <= size(mode)) then
+                    if (mode(p) /= 0) contact(node) = contact_slip
+                end if
+            end do
+            call add_int32(vtu, 'contact_state', contact)
+            call add_int32(vtu, 'passages', count)
+        end if
+        call add_text(vtu, '</PointData>')
+        call add_text(vtu, '<CellData Scalars="tension">')
+        call add_reals(vtu, 'tension', state%tension, 1)
+        call add_reals(vtu, 'stretch', state%stretch, 1)
+        call add_reals(vtu, 'L0', state%length0, 1)
+        call add_int32(vtu, 'yarn', yarn)
+        call add_int32(vtu, 'material', int(scene%network%element_material, int32))
+        call add_text(vtu, '</CellData>')
+        call finish_vtu(vtu, state%position, connectivity, vtk_line, 2, path, error)
+    end subroutine write_yarns
+
+    !> The links' blocks. holders_NNNNN.vtu: each gap-holder a line from its leader to
+    !> its follower, or to the follower's image next to the leader when it holds the gap
+    !> to a periodic image (follower minus period), with cell data contact_force (N: the
+    !> force it pushes the follower away from the leader with, along the line; negative
+    !> when it pulls), force (the vector on the follower, N), stretch, L0, period, leader
+    !> and follower. links_NNNNN.vtu: each periodic link a vertex at the follower (the
+    !> leader's image; a line would lie along the yarn it continues), cell data period,
+    !> leader and follower. Node numbers 1-based.
+    subroutine write_links(self, scene, state, name, error)
+        class(vtk_writer_type), intent(in) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        type(vtu_builder_type) :: vtu
+        integer :: n_links, n_nodes, l, k, n, e, r
+        integer, allocatable :: chosen(:), link_of(:)
+        integer(int64), allocatable :: connectivity(:)
+        real(wp), allocatable :: net(:, :), carried(:, :), period(:, :), points(:, :), &
+            applied(:), along(:), stretch(:), length0(:)
+        real(wp) :: p_disp, now(3), before(3), pull(3)
+        logical :: gap
+
+        n_links = size(scene%link_nodes, 2)
+        n_nodes = size(state%position, 2)
+        p_disp = 0.0_wp
+        if (scene%dofs%gap_channel >= 1 .and. scene%dofs%gap_channel <= size(state%factors)) &
+            p_disp = state%factors(scene%dofs%gap_channel)
+        allocate(period(3, n_links))
         do l = 1, n_links
-            associate(pair => scene%link_nodes(:, l))
-                e = n_elements + l
-                connectivity(2 * e - 1:2 * e) = pair - 1
-                cell_kind(e) = merge(kind_gap, kind_periodic, scene%link_is_gap(l))
-                yarn(e) = 0
-                material(e) = 0
-                tension(e) = 0.0_wp
-                now = state%position(:, pair(2)) - state%position(:, pair(1))
-                before = scene%network%position(:, pair(2)) - scene%network%position(:, pair(1))
-                length0(e) = norm2(before)
-                stretch(e) = 1.0_wp
-                if (length0(e) > 0.0_wp) stretch(e) = norm2(now) / length0(e)
-                period(:, e) = scene%link_period(:, l) &
-                    * (1.0_wp + p_disp * scene%link_strain(:, l))
+            period(:, l) = scene%link_period(:, l) * (1.0_wp + p_disp * scene%link_strain(:, l))
+        end do
+        ! The force a link carries: what acts on its follower's node (element tensions,
+        ! applied load) and on the nodes that follow that node, down the chain of links.
+        allocate(applied(3 * n_nodes))
+        call get_applied_force(scene, state%factors, applied)
+        net = reshape(applied, [3, n_nodes])
+        do e = 1, size(state%tension)
+            associate(ends => scene%network%element_nodes(:, e))
+                pull = state%position(:, ends(2)) - state%position(:, ends(1))
+                if (norm2(pull) > 0.0_wp) pull = state%tension(e) * pull / norm2(pull)
+                net(:, ends(1)) = net(:, ends(1)) + pull
+                net(:, ends(2)) = net(:, ends(2)) - pull
             end associate
         end do
-        offsets = [(2_int64 * e, e = 1, n_cells)]
+        allocate(link_of(n_nodes), source=0)
+        do l = 1, n_links
+            link_of(scene%link_nodes(2, l)) = l
+        end do
+        allocate(carried(3, n_links), source=0.0_wp)
+        do n = 1, n_nodes
+            r = n
+            k = 0
+            do while (link_of(r) /= 0 .and. k < n_links)
+                carried(:, link_of(r)) = carried(:, link_of(r)) + net(:, n)
+                r = scene%link_nodes(1, link_of(r))
+                k = k + 1
+            end do
+        end do
 
-        vtu%ascii = self%ascii
-        vtu%xml = '<?xml version="1.0"?>' // new_line('a') &
-            // '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="' &
-            // get_byte_order() // '" header_type="UInt64">' // new_line('a') &
-            // '<UnstructuredGrid>' // new_line('a') // '<FieldData>' // new_line('a')
-        vtu%appended = ''
+        do k = 1, 2
+            gap = k == 1
+            if (.not. self%has_part(merge(part_holders, part_links, gap))) cycle
+            chosen = pack([(l, l = 1, n_links)], scene%link_is_gap .eqv. gap)
+            if (gap) then
+                allocate(points(3, 2 * size(chosen)), connectivity(2 * size(chosen)))
+                allocate(along(size(chosen)), stretch(size(chosen)), length0(size(chosen)))
+                do l = 1, size(chosen)
+                    associate(pair => scene%link_nodes(:, chosen(l)))
+                        points(:, 2 * l - 1) = state%position(:, pair(1))
+                        points(:, 2 * l) = state%position(:, pair(2)) - period(:, chosen(l))
+                        now = points(:, 2 * l) - points(:, 2 * l - 1)
+                        before = scene%network%position(:, pair(2)) &
+                            - scene%link_period(:, chosen(l)) - scene%network%position(:, pair(1))
+                        length0(l) = norm2(before)
+                        stretch(l) = 1.0_wp
+                        if (length0(l) > 0.0_wp) stretch(l) = norm2(now) / length0(l)
+                        ! The link balances the follower: it pushes with -carried.
+                        along(l) = 0.0_wp
+                        if (norm2(now) > 0.0_wp) &
+                            along(l) = -dot_product(carried(:, chosen(l)), now) / norm2(now)
+                    end associate
+                end do
+                connectivity = [(int(l, int64), l = 0, 2 * size(chosen) - 1)]
+            else
+                allocate(points(3, size(chosen)), connectivity(size(chosen)))
+                do l = 1, size(chosen)
+                    points(:, l) = state%position(:, scene%link_nodes(2, chosen(l)))
+                end do
+                connectivity = [(int(l, int64), l = 0, size(chosen) - 1)]
+            end if
+            call start_file(vtu, self%ascii, scene, state, size(points, 2), size(chosen))
+            if (gap) then
+                call add_text(vtu, '<CellData Scalars="contact_force">')
+                call add_reals(vtu, 'contact_force', along, 1)
+                call add_reals(vtu, 'force', reshape(-carried(:, chosen), &
+                    [3 * size(chosen)]), 3)
+                call add_reals(vtu, 'stretch', stretch, 1)
+                call add_reals(vtu, 'L0', length0, 1)
+            else
+                call add_text(vtu, '<CellData>')
+            end if
+            call add_reals(vtu, 'period', reshape(period(:, chosen), [3 * size(chosen)]), 3)
+            call add_int32(vtu, 'leader', int(scene%link_nodes(1, chosen), int32))
+            call add_int32(vtu, 'follower', int(scene%link_nodes(2, chosen), int32))
+            call add_text(vtu, '</CellData>')
+            if (gap) then
+                call finish_vtu(vtu, points, connectivity, vtk_line, 2, self%folder // '/' &
+                    // get_part_name(name, part_holders), error)
+            else
+                call finish_vtu(vtu, points, connectivity, vtk_vertex, 1, self%folder // '/' &
+                    // get_part_name(name, part_links), error)
+            end if
+            if (allocated(error)) return
+            deallocate(points, connectivity)
+        end do
+    end subroutine write_links
+
+    !> The passages' block (passages_NNNNN.vtu): one vertex per sliding passage at its
+    !> node, with point data passage, node, yarn (1-based), mode (1 stick, 2 forward,
+    !> 3 backward, 4 locked; 0 when the step has no friction state), flow,
+    !> tension_min, tension_max, critical_tension and wrap_angle (as in contacts.csv).
+    subroutine write_passages(self, scene, state, mode, flow, path, error)
+        class(vtk_writer_type), intent(in) :: self
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: mode(:)
+        real(wp), intent(in) :: flow(:)
+        character(len=*), intent(in) :: path
+        type(error_type), allocatable, intent(out) :: error
+        type(vtu_builder_type) :: vtu
+        type(passage_state_type) :: ps
+        integer :: n, p
+        integer, allocatable :: nodes(:)
+
+        n = scene%passages%size()
+        nodes = [(scene%passages%node(p), p = 1, n)]
+        if (size(mode) == n .and. size(flow) == n) then
+            call get_passage_states(scene, state, mode, flow, ps)
+        else
+            allocate(ps%mode(n), source=0)
+            allocate(ps%flow(n), ps%tension_min(n), ps%tension_max(n), ps%critical(n), &
+                ps%angle(n), source=0.0_wp)
+        end if
+        call start_file(vtu, self%ascii, scene, state, n, n)
+        call add_text(vtu, '<PointData Scalars="mode">')
+        call add_int32(vtu, 'passage', [(int(p, int32), p = 1, n)])
+        call add_int32(vtu, 'node', int(nodes, int32))
+        call add_int32(vtu, 'yarn', [(int(scene%passages%yarn(p), int32), p = 1, n)])
+        call add_int32(vtu, 'mode', int(ps%mode, int32))
+        call add_reals(vtu, 'flow', ps%flow, 1)
+        call add_reals(vtu, 'tension_min', ps%tension_min, 1)
+        call add_reals(vtu, 'tension_max', ps%tension_max, 1)
+        call add_reals(vtu, 'critical_tension', ps%critical, 1)
+        call add_reals(vtu, 'wrap_angle', ps%angle, 1)
+        call add_text(vtu, '</PointData>')
+        call finish_vtu(vtu, state%position(:, nodes), [(int(p, int64), p = 0, n - 1)], &
+            vtk_vertex, 1, path, error)
+    end subroutine write_passages
+
+    !> Begin a file: the XML header, the field data (time, step, the load factors, a
+    !> fabric's strain and force per width) and the piece of `n_points` and `n_cells`.
+    subroutine start_file(vtu, ascii, scene, state, n_points, n_cells)
+        type(vtu_builder_type), intent(out) :: vtu
+        logical, intent(in) :: ascii
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        integer, intent(in) :: n_points, n_cells
+        integer :: l
+
+        call start_vtu(vtu, ascii)
+        call add_text(vtu, '<FieldData>')
         call add_reals(vtu, 'time', [state%time], 1, field=.true.)
         call add_int32(vtu, 'step', [int(state%step, int32)], field=.true.)
         do l = 1, size(state%factors)
@@ -178,59 +425,9 @@ contains
                 [state%reaction(1, scene%fabric_set) / scene%fabric_width], 1, field=.true.)
         end if
         call add_text(vtu, '</FieldData>')
-        call add_text(vtu, '<Piece NumberOfPoints="' // format_integer(n_nodes) &
+        call add_text(vtu, '<Piece NumberOfPoints="' // format_integer(n_points) &
             // '" NumberOfCells="' // format_integer(n_cells) // '">')
-        call add_text(vtu, '<PointData Vectors="displacement">')
-        call add_reals(vtu, 'displacement', &
-            reshape(state%position - scene%network%position, [3 * n_nodes]), 3)
-        call add_reals(vtu, 'position', reshape(state%position, [3 * n_nodes]), 3)
-        if (scene%passages%size() > 0) then
-            allocate(contact(n_nodes), source=int(contact_none, int32))
-            do p = 1, scene%passages%size()
-                node = scene%passages%node(p)
-                if (contact(node) == contact_none) contact(node) = contact_stick
-                if (p <= size(mode)) then
-                    if (mode(p) /= 0) contact(node) = contact_slip
-                end if
-            end do
-            call add_int32(vtu, 'contact_state', contact)
-            if (size(mode) == scene%passages%size() .and. size(flow) == size(mode)) &
-                call add_passage_data(vtu, scene, state, mode, flow, n_nodes)
-        end if
-        call add_text(vtu, '</PointData>')
-        call add_text(vtu, '<CellData Scalars="tension">')
-        call add_reals(vtu, 'tension', tension, 1)
-        call add_reals(vtu, 'stretch', stretch, 1)
-        call add_reals(vtu, 'L0', length0, 1)
-        call add_reals(vtu, 'period', reshape(period, [3 * n_cells]), 3)
-        call add_int32(vtu, 'kind', cell_kind)
-        call add_int32(vtu, 'yarn', yarn)
-        call add_int32(vtu, 'material', material)
-        call add_text(vtu, '</CellData>')
-        call add_text(vtu, '<Points>')
-        call add_reals(vtu, 'Points', reshape(state%position, [3 * n_nodes]), 3)
-        call add_text(vtu, '</Points>')
-        call add_text(vtu, '<Cells>')
-        call add_int64(vtu, 'connectivity', connectivity)
-        call add_int64(vtu, 'offsets', offsets)
-        call add_uint8(vtu, 'types', spread(vtk_line, 1, n_cells))
-        call add_text(vtu, '</Cells>')
-        call add_text(vtu, '</Piece>')
-        call add_text(vtu, '</UnstructuredGrid>')
-        if (.not. vtu%ascii) then
-            call add_text(vtu, '<AppendedData encoding="base64">')
-            vtu%xml = vtu%xml // '_' // vtu%appended // new_line('a')
-            call add_text(vtu, '</AppendedData>')
-        end if
-        call add_text(vtu, '</VTKFile>')
-        call write_text_file(path, vtu%xml, error)
-        if (allocated(error)) return
-
-        call add_file(self, name, state%time)
-        if (self%n_files <= collection_always .or. &
-                real(self%n_files - self%listed, wp) > collection_lag * self%n_files) &
-            call self%write_collection(error)
-    end subroutine write_state
+    end subroutine start_file
 
     subroutine set_files(self, files, times)
         class(vtk_writer_type), intent(inout) :: self
@@ -267,8 +464,9 @@ contains
         self%times(self%n_files) = time
     end subroutine add_file
 
-    !> Write states.pvd.tmp and rename it over states.pvd. The text is built in one
-    !> buffer sized for every entry, so a rewrite costs time linear in its entries.
+    !> Write states.pvd.tmp and rename it over states.pvd: each state's multiblock file
+    !> with its pseudo-time. The text is built in one buffer sized for every entry, so a
+    !> rewrite costs time linear in its entries.
     subroutine write_collection(self, error)
         class(vtk_writer_type), intent(inout) :: self
         type(error_type), allocatable, intent(out) :: error
@@ -293,7 +491,7 @@ contains
             call put(before_time)
             call put(trim(adjustl(time)))
             call put(before_file)
-            call put(trim(self%files(i)))
+            call put(get_multiblock_name(trim(self%files(i))))
             call put(after_file)
         end do
         call put(tail)
@@ -308,224 +506,5 @@ contains
             used = used + len(piece)
         end subroutine put
     end subroutine write_collection
-
-    !> Write `text` to `path` (a stream, so lines of any length), checking every write
-    !> and the close; with `atomic`, through path.tmp renamed over path. On failure the
-    !> incomplete file is removed.
-    subroutine write_text_file(path, text, error, atomic)
-        character(len=*), intent(in) :: path, text
-        type(error_type), allocatable, intent(out) :: error
-        logical, intent(in), optional :: atomic
-        type(error_type), allocatable :: ignored
-        character(len=:), allocatable :: target
-        character(len=256) :: message
-        integer :: unit, status
-        logical :: through_temporary
-
-        through_temporary = .false.
-        if (present(atomic)) through_temporary = atomic
-        target = path
-        if (through_temporary) target = path // '.tmp'
-        call open_new_file(unit, target, error, stream=.true.)
-        if (allocated(error)) then
-            call remove_file(target, ignored)
-            return
-        end if
-        message = ''
-        write(unit, iostat=status, iomsg=message) text
-        call close_new_file(unit, target, error, status, message)
-        if (allocated(error) .or. .not. through_temporary) return
-        call rename_file(target, path, error)
-        if (allocated(error)) call remove_file(target, ignored)
-    end subroutine write_text_file
-
-    subroutine add_text(vtu, text)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: text
-        vtu%xml = vtu%xml // text // new_line('a')
-    end subroutine add_text
-
-    !> The DataArray element of an array: `values` inline as ASCII, or an offset into the
-    !> appended data (where the byte count and `bytes`, their binary form, go, each
-    !> base64-encoded).
-    subroutine add_array(vtu, type_name, label, components, n_tuples, field, bytes, values)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: type_name, label
-        integer, intent(in) :: components, n_tuples
-        logical, intent(in) :: field
-        integer(int8), intent(in) :: bytes(:)
-        class(*), intent(in) :: values(:)
-        character(len=:), allocatable :: attributes
-
-        attributes = '<DataArray type="' // type_name // '" Name="' // label // '"'
-        if (components > 1) attributes = attributes // ' NumberOfComponents="' &
-            // format_integer(components) // '"'
-        if (field) attributes = attributes // ' NumberOfTuples="' &
-            // format_integer(n_tuples) // '"'
-        if (vtu%ascii) then
-            call add_text(vtu, attributes // ' format="ascii">' // format_values(values) &
-                // '</DataArray>')
-        else
-            call add_text(vtu, attributes // ' format="appended" offset="' &
-                // format_integer(len(vtu%appended)) // '"/>')
-            vtu%appended = vtu%appended &
-                // encode_base64(transfer(int(size(bytes), int64), [0_int8])) &
-                // encode_base64(bytes)
-        end if
-    end subroutine add_array
-
-    !> Point data of the passages: count, the shown passage (rule in write_state), its
-    !> mode code and values.
-    subroutine add_passage_data(vtu, scene, state, mode, flow, n_nodes)
-        type(vtu_builder_type), intent(inout) :: vtu
-        type(scene_type), intent(in) :: scene
-        type(step_state_type), intent(in) :: state
-        integer, intent(in) :: mode(:), n_nodes
-        real(wp), intent(in) :: flow(:)
-        !> Rank of each mode code for the choice of the shown passage (higher wins).
-        integer, parameter :: rank(0:4) = [0, 1, 3, 3, 2]
-        type(passage_state_type) :: ps
-        integer(int32), allocatable :: count(:), shown(:), code(:)
-        real(wp), allocatable :: values(:, :)
-        integer :: p, node, q
-
-        call get_passage_states(scene, state, mode, flow, ps)
-        allocate(count(n_nodes), shown(n_nodes), code(n_nodes), source=0_int32)
-        allocate(values(n_nodes, 5), source=0.0_wp)
-        do p = 1, scene%passages%size()
-            node = scene%passages%node(p)
-            count(node) = count(node) + 1
-            q = shown(node)
-            if (q > 0) then
-                if (rank(ps%mode(p)) < rank(ps%mode(q))) cycle
-                if (rank(ps%mode(p)) == rank(ps%mode(q)) .and. &
-                    .not. ps%tension_max(p) > ps%tension_max(q)) cycle
-            end if
-            shown(node) = int(p, int32)
-            code(node) = int(ps%mode(p), int32)
-            values(node, :) = [ps%flow(p), ps%tension_min(p), ps%tension_max(p), &
-                ps%critical(p), ps%angle(p)]
-        end do
-        call add_int32(vtu, 'passages', count)
-        call add_int32(vtu, 'passage', shown)
-        call add_int32(vtu, 'mode', code)
-        call add_reals(vtu, 'flow', values(:, 1), 1)
-        call add_reals(vtu, 'tension_min', values(:, 2), 1)
-        call add_reals(vtu, 'tension_max', values(:, 3), 1)
-        call add_reals(vtu, 'critical_tension', values(:, 4), 1)
-        call add_reals(vtu, 'wrap_angle', values(:, 5), 1)
-    end subroutine add_passage_data
-
-    subroutine add_reals(vtu, label, values, components, field)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: label
-        real(wp), intent(in) :: values(:)
-        integer, intent(in) :: components
-        logical, intent(in), optional :: field
-
-        call add_array(vtu, 'Float64', label, components, size(values) / components, &
-            is_field(field), transfer(values, [0_int8], 8 * size(values)), values)
-    end subroutine add_reals
-
-    subroutine add_int32(vtu, label, values, field)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: label
-        integer(int32), intent(in) :: values(:)
-        logical, intent(in), optional :: field
-
-        call add_integers(vtu, 'Int32', label, int(values, int64), &
-            transfer(values, [0_int8], 4 * size(values)), field)
-    end subroutine add_int32
-
-    subroutine add_int64(vtu, label, values)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: label
-        integer(int64), intent(in) :: values(:)
-
-        call add_integers(vtu, 'Int64', label, values, transfer(values, [0_int8], 8 * size(values)))
-    end subroutine add_int64
-
-    subroutine add_uint8(vtu, label, values)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: label
-        integer(int8), intent(in) :: values(:)
-
-        call add_integers(vtu, 'UInt8', label, int(values, int64), values)
-    end subroutine add_uint8
-
-    !> An integer array of VTK type `type_name`: `values` in ASCII, or `bytes`, their
-    !> binary form in that type, appended.
-    subroutine add_integers(vtu, type_name, label, values, bytes, field)
-        type(vtu_builder_type), intent(inout) :: vtu
-        character(len=*), intent(in) :: type_name, label
-        integer(int64), intent(in) :: values(:)
-        integer(int8), intent(in) :: bytes(:)
-        logical, intent(in), optional :: field
-
-        call add_array(vtu, type_name, label, 1, size(values), is_field(field), bytes, values)
-    end subroutine add_integers
-
-    !> The ASCII form of a DataArray: ' v1 v2 ...', reals as es24.16e3, integers as i0.
-    function format_values(values) result(text)
-        class(*), intent(in) :: values(:)
-        character(len=:), allocatable :: text
-        integer :: status
-
-        select type (values)
-        type is (real(wp))
-            allocate(character(len=25 * size(values) + 1) :: text)
-            write(text, '(*(1x, es24.16e3))', iostat=status) values
-        type is (integer(int64))
-            allocate(character(len=21 * size(values) + 1) :: text)
-            write(text, '(*(1x, i0))', iostat=status) values
-        end select
-        text = trim(text)
-    end function format_values
-
-    pure logical function is_field(field)
-        logical, intent(in), optional :: field
-        is_field = .false.
-        if (present(field)) is_field = field
-    end function is_field
-
-    !> Base64 (RFC 4648, with '=' padding) of `bytes`.
-    pure function encode_base64(bytes) result(text)
-        integer(int8), intent(in) :: bytes(:)
-        character(len=:), allocatable :: text
-        integer :: i, j, n, b1, b2, b3, group
-
-        n = size(bytes)
-        allocate(character(len=4 * ((n + 2) / 3)) :: text)
-        j = 0
-        do i = 1, n, 3
-            b1 = iand(int(bytes(i)), 255)
-            b2 = 0
-            b3 = 0
-            if (i + 1 <= n) b2 = iand(int(bytes(i + 1)), 255)
-            if (i + 2 <= n) b3 = iand(int(bytes(i + 2)), 255)
-            group = ior(ior(ishft(b1, 16), ishft(b2, 8)), b3)
-            text(j + 1:j + 1) = base64_alphabet(ishft(group, -18) + 1:ishft(group, -18) + 1)
-            text(j + 2:j + 2) = base64_alphabet(iand(ishft(group, -12), 63) + 1: &
-                iand(ishft(group, -12), 63) + 1)
-            text(j + 3:j + 3) = base64_alphabet(iand(ishft(group, -6), 63) + 1: &
-                iand(ishft(group, -6), 63) + 1)
-            text(j + 4:j + 4) = base64_alphabet(iand(group, 63) + 1:iand(group, 63) + 1)
-            if (i + 1 > n) text(j + 3:j + 3) = '='
-            if (i + 2 > n) text(j + 4:j + 4) = '='
-            j = j + 4
-        end do
-    end function encode_base64
-
-    !> 'LittleEndian' or 'BigEndian': the byte order of this machine.
-    pure function get_byte_order() result(order)
-        character(len=:), allocatable :: order
-        integer(int8) :: bytes(4)
-        bytes = transfer(1_int32, bytes)
-        if (bytes(1) == 1_int8) then
-            order = 'LittleEndian'
-        else
-            order = 'BigEndian'
-        end if
-    end function get_byte_order
 
 end module yarnfort_output_vtk

@@ -18,17 +18,17 @@ module yarnfort_output_writer
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_observer_type, step_state_type
     use yarnfort_output_curve, only: curve_writer_type, curve_file_name
-    use yarnfort_output_reactions, only: reactions_file_name, reactions_header, &
-        get_reaction_rows
-    use yarnfort_output_contacts, only: contacts_file_name, contacts_header, &
-        get_contact_rows
-    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, collection_file_name
+    use yarnfort_output_reactions, only: reactions_writer_type, reactions_file_name
+    use yarnfort_output_contacts, only: contacts_writer_type, contacts_file_name
+    use yarnfort_output_table, only: table_writer_type
+    use yarnfort_output_vtk, only: vtk_writer_type, get_state_name, get_part_name, &
+        get_multiblock_name, collection_file_name
     use yarnfort_output_filesystem, only: make_folder, folder_lock_type, rename_file, &
         remove_file, open_new_file, close_new_file, get_links, refuse_link, sync_file
     use yarnfort_output_manifest, only: manifest_type, manifest_file_name, is_own_name, &
-        is_bookkeeping_name
+        is_bookkeeping_name, part_prefixes
     use yarnfort_solver_restart, only: restart_type
-    use yarnfort_output_restart, only: write_restart, remove_restart, restart_file_name, &
+    use yarnfort_output_restart_file, only: write_restart, remove_restart, restart_file_name, &
         sync_restart, synced_file_name
     implicit none
     private
@@ -46,12 +46,12 @@ module yarnfort_output_writer
         character(len=:), allocatable :: folder
         integer :: vtk_every = 1
         type(curve_writer_type) :: curve
-        !> reactions.csv (`&output node_reactions`), written like the curve.
-        type(curve_writer_type) :: reactions
+        !> reactions.csv (`&output node_reactions`).
+        type(reactions_writer_type) :: reactions
         logical :: node_reactions = .false.
-        !> contacts.csv (`&output contact_state` and sliding passages), written like the
-        !> curve, from the snapshot of each step (on_checkpoint).
-        type(curve_writer_type) :: contacts
+        !> contacts.csv (`&output contact_state` and sliding passages), from the snapshot
+        !> of each step (on_checkpoint).
+        type(contacts_writer_type) :: contacts
         logical :: contact_state = .false.
         type(vtk_writer_type) :: vtk
         type(manifest_type) :: manifest
@@ -187,7 +187,7 @@ contains
         integer :: i
 
         do i = 1, size(self%manifest%states)
-            call remove_file(self%folder // '/' // trim(self%manifest%states(i)), error)
+            call remove_state(self, self%manifest%states(i), error)
             if (allocated(error)) return
         end do
         do i = 1, size(self%manifest%files)
@@ -208,8 +208,7 @@ contains
         if (.not. allocated(error)) call self%curve%open(self%folder, scene, error)
         if (allocated(error) .or. .not. self%node_reactions) return
         call self%manifest%add_file(reactions_file_name, error)
-        if (.not. allocated(error)) call self%reactions%open_table(self%folder, &
-            reactions_file_name, reactions_header, error)
+        if (.not. allocated(error)) call self%reactions%open(self%folder, error)
     end subroutine start_files
 
     !> Start contacts.csv when it is asked for.
@@ -219,8 +218,7 @@ contains
 
         if (.not. self%contact_state) return
         call self%manifest%add_file(contacts_file_name, error)
-        if (.not. allocated(error)) call self%contacts%open_table(self%folder, &
-            contacts_file_name, contacts_header, error)
+        if (.not. allocated(error)) call self%contacts%open(self%folder, error)
     end subroutine start_contacts
 
     !> A restart after `step`: keep curve rows and the listed states up to that step,
@@ -243,17 +241,15 @@ contains
         if (allocated(error)) return
         if (self%node_reactions) then
             call list_atomic_file(self, reactions_file_name, error)
-            if (.not. allocated(error)) call self%reactions%resume_table(self%folder, &
-                reactions_file_name, reactions_header, step, error, &
-                row_required=has_constrained_nodes(scene))
+            if (.not. allocated(error)) call self%reactions%resume(self%folder, scene, step, &
+                error)
         else
             call drop_file(self, reactions_file_name, error)
         end if
         if (allocated(error)) return
         if (self%contact_state) then
             call list_atomic_file(self, contacts_file_name, error)
-            if (.not. allocated(error)) call self%contacts%resume_table(self%folder, &
-                contacts_file_name, contacts_header, step, error)
+            if (.not. allocated(error)) call self%contacts%resume(self%folder, step, error)
         else
             call drop_file(self, contacts_file_name, error)
         end if
@@ -266,7 +262,7 @@ contains
             if (keep(i)) keep(i) = .not. any(self%manifest%states(i + 1:) &
                 == self%manifest%states(i))
             if (.not. keep(i)) then
-                call remove_file(self%folder // '/' // trim(self%manifest%states(i)), error)
+                call remove_state(self, self%manifest%states(i), error)
                 if (allocated(error)) return
             end if
         end do
@@ -279,6 +275,23 @@ contains
         call list_atomic_file(self, collection_file_name, error)
         if (.not. allocated(error)) call self%vtk%write_collection(error)
     end subroutine resume_files
+
+    !> Delete the state file `name`, its multiblock file and its other blocks (those of
+    !> any scene).
+    subroutine remove_state(self, name, error)
+        class(output_writer_type), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        type(error_type), allocatable, intent(out) :: error
+        integer :: part
+
+        call remove_file(self%folder // '/' // trim(name), error)
+        if (.not. allocated(error)) call remove_file(self%folder // '/' &
+            // get_multiblock_name(trim(name)), error)
+        do part = 1, size(part_prefixes)
+            if (.not. allocated(error)) call remove_file(self%folder // '/' &
+                // get_part_name(trim(name), part), error)
+        end do
+    end subroutine remove_state
 
     !> A restart that does not write the table `name`: delete it if a run of ours wrote
     !> it (listed), and list it no more; leave it alone otherwise.
@@ -349,10 +362,8 @@ contains
         type(error_type), allocatable, intent(out) :: error
 
         call self%curve%write_step(scene, state, error)
-        if (.not. allocated(error) .and. self%node_reactions) then
-            if (has_constrained_nodes(scene)) &
-                call self%reactions%put_line(get_reaction_rows(scene, state), error)
-        end if
+        if (.not. allocated(error) .and. self%node_reactions) &
+            call self%reactions%write_step(scene, state, error)
         call note_written(self, error)
         if (allocated(error)) return
         if (self%contact_state .and. self%vtk_every <= 0) self%last = state
@@ -394,8 +405,8 @@ contains
                 call fatal_error(error, "cannot write '" // self%contacts%path // "': the " &
                     // 'step has no friction state')
             else
-                call self%contacts%put_line(get_contact_rows(scene, self%last, &
-                    snapshot%mode, snapshot%flow), error)
+                call self%contacts%write_step(scene, self%last, snapshot%mode, snapshot%flow, &
+                    error)
             end if
             if (allocated(error)) then
                 self%failed = .true.
@@ -444,7 +455,7 @@ contains
             error)
     contains
         subroutine sync_table(table)
-            type(curve_writer_type), intent(in) :: table
+            class(table_writer_type), intent(in) :: table
             if (allocated(table%path)) call sync_file(table%path, error)
         end subroutine sync_table
     end subroutine sync_tables
@@ -510,7 +521,7 @@ contains
     contains
         !> Close a CSV file; its error is the run's unless an earlier one is.
         subroutine close_table(table)
-            type(curve_writer_type), intent(inout) :: table
+            class(table_writer_type), intent(inout) :: table
             type(error_type), allocatable :: close_error
 
             call table%close(close_error)
@@ -520,16 +531,5 @@ contains
             end if
         end subroutine close_table
     end subroutine finish
-
-    !> Whether any support set prescribes a coordinate (reactions.csv has rows).
-    pure logical function has_constrained_nodes(scene)
-        type(scene_type), intent(in) :: scene
-        integer :: s
-
-        has_constrained_nodes = .false.
-        do s = 1, size(scene%supports)
-            if (size(scene%supports(s)%coordinates) > 0) has_constrained_nodes = .true.
-        end do
-    end function has_constrained_nodes
 
 end module yarnfort_output_writer

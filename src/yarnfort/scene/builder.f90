@@ -6,7 +6,7 @@ module yarnfort_scene_builder
     use yarnfort_input_config, only: config_type, material_config_type
     use yarnfort_scene_scene, only: scene_type, support_set_type
     use yarnfort_text, only: format_real
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     use yarnfort_material_linear, only: linear_law_type, new_linear_law
     use yarnfort_material_neo_hookean, only: neo_hookean_law_type, new_neo_hookean_law
     use yarnfort_material_table, only: table_law_type, read_table_law
@@ -20,8 +20,8 @@ module yarnfort_scene_builder
         read_rate_table
     use yarnfort_text, only: resolve_path, quote_string
     use yarnfort_input_config, only: name_length
-    use yarnfort_input_contact_node_checks, only: get_contact_node_sets, find_node_contact
-    use yarnfort_input_channel_checks, only: get_channel_names, get_channel_factors, &
+    use yarnfort_scene_contact_nodes, only: get_contact_node_sets, find_node_contact
+    use yarnfort_scene_channels, only: get_channel_names, get_channel_factors, &
         find_channel, default_force_channel, default_displacement_channel
     implicit none
     private

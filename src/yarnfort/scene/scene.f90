@@ -2,7 +2,7 @@
 !> A scene: everything a run needs, built from the input (see yarnfort_scene_builder).
 module yarnfort_scene_scene
     use yarnfort_kinds, only: wp
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     use yarnfort_network_network, only: network_type
     use yarnfort_network_dof_map, only: dof_map_type
     use yarnfort_contact_passages, only: passage_set_type, friction_holder_type

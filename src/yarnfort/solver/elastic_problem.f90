@@ -8,7 +8,7 @@ module yarnfort_solver_elastic_problem
     use yarnfort_assembly_pattern, only: pattern_type, new_pattern
     use yarnfort_assembly_assemble, only: assemble_residual, assemble_jacobian
     use yarnfort_assembly_scales, only: get_node_force_levels, get_unknown_levels
-    use yarnfort_solver_problem, only: nonlinear_problem_type
+    use yarnfort_solver_problem, only: nonlinear_problem_type, regularisation_type, chosen_law
     implicit none
     private
 
@@ -40,39 +40,48 @@ contains
         self%length_scale = scene%length_scale
     end subroutine new_elastic_problem
 
-    subroutine evaluate_residual(self, u, values, error)
+    subroutine evaluate_residual(self, u, values, error, law)
         class(elastic_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
+        type(regularisation_type) :: used
+        used = chosen_law(law)
         call self%scene%dofs%expand(u, self%factors, self%x)
         call assemble_residual(self%scene, self%x, self%length0, self%factors, values, error, &
-            self%spring, self%stiffness_cap)
+            used%spring, used%stiffness_cap)
     end subroutine evaluate_residual
 
-    subroutine evaluate_jacobian(self, u, values, error)
+    subroutine evaluate_jacobian(self, u, values, error, law)
         class(elastic_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
+        type(regularisation_type) :: used
+        used = chosen_law(law)
         call self%scene%dofs%expand(u, self%factors, self%x)
         call assemble_jacobian(self%scene, self%pattern, self%x, self%length0, values, error, &
-            self%spring, self%tangent_spring, self%stiffness_cap)
+            used%spring, used%tangent_spring, used%stiffness_cap)
     end subroutine evaluate_jacobian
 
     !> Each coordinate row is judged against the forces meeting at its node.
-    subroutine get_row_levels(self, u, level, noise, error)
+    subroutine get_row_levels(self, u, level, noise, error, law)
         class(elastic_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         real(wp), intent(out) :: level(:), noise(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
         real(wp), allocatable :: node_level(:), node_noise(:)
         real(wp) :: max_force
+        type(regularisation_type) :: used
+        used = chosen_law(law)
 
         allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
         call self%scene%dofs%expand(u, self%factors, self%x)
-        call get_node_force_levels(self%scene, self%x, self%length0, self%factors, self%spring, &
-            node_level, node_noise, max_force, self%stiffness_cap)
+        call get_node_force_levels(self%scene, self%x, self%length0, self%factors, used%spring, &
+            node_level, node_noise, max_force, used%stiffness_cap)
         call get_unknown_levels(self%scene, node_level, node_noise, level, noise)
     end subroutine get_row_levels
 

@@ -9,21 +9,24 @@ module yarnfort_solver_problem
     implicit none
     private
 
-    public :: nonlinear_problem_type
+    public :: nonlinear_problem_type, regularisation_type, chosen_law
+
+    !> The law a problem is evaluated with: the exact law (the default), or a regularised
+    !> one that only the Newton solver's predictors pass (see yarnfort_assembly_truss).
+    type :: regularisation_type
+        !> Weight of the regularising spring in the model (0: the exact law).
+        real(wp) :: spring = 0.0_wp
+        !> Weight of the regularising spring in the tangent of slack strings only.
+        real(wp) :: tangent_spring = 0.0_wp
+        !> Laws stiffer than this are scaled down to it (get_truss_tension;
+        !> no_stiffness_cap: the laws as they are).
+        real(wp) :: stiffness_cap = no_stiffness_cap
+    end type regularisation_type
 
     type, abstract :: nonlinear_problem_type
         !> Scale of the unknowns (KINSOL's scaling vector of u); residual rows are
         !> scaled by get_row_levels.
         real(wp) :: length_scale = 1.0_wp
-        !> Set by the Newton solver before each solve: the weight of the regularising
-        !> spring in the model (a predictor solve; 0 for the exact law) and in the
-        !> tangent of slack strings only (see yarnfort_assembly_truss).
-        real(wp) :: spring = 0.0_wp
-        real(wp) :: tangent_spring = 0.0_wp
-        !> Set by the Newton solver before each solve: laws stiffer than this are scaled
-        !> down to it (a predictor solve, get_truss_tension; no_stiffness_cap for the
-        !> exact laws).
-        real(wp) :: stiffness_cap = no_stiffness_cap
         !> The scene (which must outlive the problem), the load channels' factors, the
         !> elements' reference lengths and a work array of node positions (3, n_nodes).
         type(scene_type), pointer :: scene => null()
@@ -38,6 +41,7 @@ module yarnfort_solver_problem
         !> Write the Jacobian's CSC pattern into arrays of its size: the Newton solver
         !> restores it in KINSOL's matrix before each Jacobian, without a copy of its own.
         procedure :: copy_pattern
+        !> The residual at u (every evaluation: with `law`, default the exact law).
         procedure(evaluate_interface), deferred :: evaluate_residual
         !> Jacobian values in the order of the pattern.
         procedure(evaluate_interface), deferred :: evaluate_jacobian
@@ -50,23 +54,27 @@ module yarnfort_solver_problem
         !> Called by the Newton solver on a converged solution: a problem may reject it
         !> with an error (a spurious root outside its domain). Default: accept.
         procedure :: check_solution
+        !> The largest reference stiffness of the scene's material laws.
+        procedure :: get_max_reference_stiffness
     end type nonlinear_problem_type
 
     abstract interface
-        subroutine evaluate_interface(self, u, values, error)
-            import :: nonlinear_problem_type, wp, error_type
+        subroutine evaluate_interface(self, u, values, error, law)
+            import :: nonlinear_problem_type, regularisation_type, wp, error_type
             class(nonlinear_problem_type), intent(inout) :: self
             real(wp), intent(in) :: u(:)
             real(wp), intent(out) :: values(:)
             type(error_type), allocatable, intent(out) :: error
+            type(regularisation_type), intent(in), optional :: law
         end subroutine evaluate_interface
 
-        subroutine get_row_levels_interface(self, u, level, noise, error)
-            import :: nonlinear_problem_type, wp, error_type
+        subroutine get_row_levels_interface(self, u, level, noise, error, law)
+            import :: nonlinear_problem_type, regularisation_type, wp, error_type
             class(nonlinear_problem_type), intent(inout) :: self
             real(wp), intent(in) :: u(:)
             real(wp), intent(out) :: level(:), noise(:)
             type(error_type), allocatable, intent(out) :: error
+            type(regularisation_type), intent(in), optional :: law
         end subroutine get_row_levels_interface
     end interface
 
@@ -90,17 +98,34 @@ contains
     end subroutine copy_pattern
 
     !> Nothing to prepare.
-    subroutine prepare_solve(self, u, error)
+    subroutine prepare_solve(self, u, error, law)
         class(nonlinear_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
     end subroutine prepare_solve
 
     !> Every solution is acceptable.
-    subroutine check_solution(self, u, error)
+    subroutine check_solution(self, u, error, law)
         class(nonlinear_problem_type), intent(inout) :: self
         real(wp), intent(in) :: u(:)
         type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
     end subroutine check_solution
+
+    !> `law` if present, else the exact law.
+    pure type(regularisation_type) function chosen_law(law) result(used)
+        type(regularisation_type), intent(in), optional :: law
+        if (present(law)) used = law
+    end function chosen_law
+
+    !> The largest reference stiffness of the scene's material laws (the Newton
+    !> solver's softened-yarn predictor starts below it).
+    real(wp) function get_max_reference_stiffness(self) result(stiffest)
+        class(nonlinear_problem_type), intent(in) :: self
+        integer :: m
+        stiffest = maxval([(self%scene%laws(m)%law%get_reference_stiffness(), &
+            m = 1, size(self%scene%laws))])
+    end function get_max_reference_stiffness
 
 end module yarnfort_solver_problem

@@ -2,7 +2,7 @@
 !> A restart snapshot: everything the continuation and the load stepper need to go on
 !> from a converged step exactly as an uninterrupted run would. Filled after every
 !> converged step (yarnfort_solver_continuation), written to and read from the output
-!> folder by yarnfort_output_restart.
+!> folder by yarnfort_output_restart_file.
 module yarnfort_solver_restart
     use yarnfort_kinds, only: wp
     implicit none

@@ -10,7 +10,7 @@ module test_contact
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
         mode_stick, mode_forward, mode_backward
-    use yarnfort_contact_geometry, only: get_wrap_angle
+    use yarnfort_contact_wrap_angle, only: get_wrap_angle
     use yarnfort_generate_fabric, only: generate_fabric
     use two_pegs_scene, only: make_scene
     implicit none

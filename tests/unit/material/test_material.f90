@@ -6,7 +6,7 @@ module test_material
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
     use yarnfort_testing, only: unittest_type, new_unittest, check, check_close
-    use yarnfort_material_law, only: force_law_type
+    use yarnfort_material_force_law, only: force_law_type
     use yarnfort_material_linear, only: linear_law_type, new_linear_law
     use yarnfort_material_neo_hookean, only: neo_hookean_law_type, new_neo_hookean_law
     use yarnfort_material_table, only: table_law_type, new_table_law, read_table_law, &

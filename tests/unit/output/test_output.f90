@@ -43,14 +43,18 @@ contains
         end do
     end subroutine test_state_names
 
-    !> Only the fixed names of a run and state names; nothing with a folder in it.
+    !> Only the fixed names of a run, state names and those of their blocks; nothing with a
+    !> folder in it.
     subroutine test_own_names(error)
         type(error_type), allocatable, intent(out) :: error
         character(len=*), parameter :: own(*) = [character(len=24) :: 'curve.csv', &
             'input.nml', 'restart.dat', 'restart.dat.tmp', 'states.pvd', 'states.pvd.tmp', &
-            'restart.sync', 'restart.sync.tmp', 'state_00012.vtu', 'state_123456.vtu']
+            'restart.sync', 'restart.sync.tmp', 'state_00012.vtu', 'state_123456.vtu', &
+            'holders_00012.vtu', 'links_123456.vtu', 'passages_00000.vtu', 'state_00012.vtm']
         character(len=*), parameter :: foreign(*) = [character(len=24) :: 'notes.txt', &
             '../curve.csv', 'sub/state_00001.vtu', 'state_1.vtu', 'state_0000x.vtu', &
+            'holders_1.vtu', 'links_0000x.vtu', 'passages_.vtu', 'passages.vtu', &
+            'state_1.vtm', 'holders_00012.vtm', '.vtm', &
             'state_00001.vtu.bak', 'state_00001.vtk', '.yarnfort-lock', 'measured.csv', '']
         integer :: i
 

@@ -11,13 +11,17 @@ module test_row_update
     use two_pegs_scene, only: make_scene
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver
-    use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type
+    use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type, &
+        solve_options_type
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
         mode_stick, mode_forward, mode_backward
     implicit none
     private
 
     public :: collect_row_update
+
+    !> The friction stepper's solves: three chord steps after the first Newton step.
+    type(solve_options_type), parameter :: chorded = solve_options_type(chord_steps=3)
 
 contains
 
@@ -58,10 +62,9 @@ contains
         if (allocated(error)) return
         call new_newton_solver(newton, problem, linear, scene%solver, error)
         if (allocated(error)) return
-        newton%chord_steps = 3
         allocate(u(scene%dofs%n_unknowns + problem%n_p), source=0.0_wp)
         call scene%dofs%restrict(scene%network%position, u(1:scene%dofs%n_unknowns))
-        call newton%solve(u, stats, error)
+        call newton%solve(u, stats, error, chorded)
     end subroutine set_up
 
     !> The changed problem from `start`: by try_row_update (which must converge without
@@ -89,7 +92,7 @@ contains
             'try_row_update: the changed problem moved the unknowns')
         if (allocated(error)) return
         fresh = start
-        call newton%solve(fresh, stats, error)
+        call newton%solve(fresh, stats, error, chorded)
         if (allocated(error)) return
         ! Both to the residual tolerance (1e-8 of the forces): positions and flows agree to
         ! far less than the 1e-6 they moved.
@@ -111,7 +114,7 @@ contains
         if (allocated(error)) return
         call problem%get_passage_state(p, t_before, t_after, angle)
         problem%mode(p) = merge(mode_forward, mode_backward, t_after > t_before)
-        call newton%solve(u, stats, error)
+        call newton%solve(u, stats, error, chorded)
     end subroutine solve_slipping
 
     !> Factors of a Newton step at `u` (a solution: the step stays there).
@@ -166,7 +169,7 @@ contains
         problem%mode(2) = mode_stick
         problem%flow_target(2) = u(n_x + 2) - merge(1.0e-4_wp, -1.0e-4_wp, &
             direction == mode_forward)
-        call newton%solve(u, stats, error)
+        call newton%solve(u, stats, error, chorded)
         if (allocated(error)) return
         call factor_at(newton, u, error)
         if (allocated(error)) return
@@ -192,7 +195,6 @@ contains
         call factor_at(newton, u, error)
         if (allocated(error)) return
         ! A solve from a moved start without the chord path: KINSOL factors again.
-        newton%chord_steps = 0
         start = u
         start(1:n_x) = start(1:n_x) + 1.0e-3_wp
         call newton%solve(start, stats, error)

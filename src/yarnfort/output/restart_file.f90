@@ -25,7 +25,7 @@
 !>     'end-of-restart' (16 characters), then the checksum of every byte before it
 !>     (16 hex digits), so a file damaged after it was written is refused.
 !> Integers are default integers (4 bytes), reals 8 bytes.
-module yarnfort_output_restart
+module yarnfort_output_restart_file
     use, intrinsic :: iso_fortran_env, only: int8, int64
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
@@ -656,4 +656,4 @@ contains
         write(digest, '(z8.8, z8.8)') state(1), state(2)
     end function get_checksum
 
-end module yarnfort_output_restart
+end module yarnfort_output_restart_file

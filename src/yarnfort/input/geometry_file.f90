@@ -12,7 +12,7 @@
 !> defined exactly once, in any order. A yarn line ending in '&' continues on the next
 !> line. Node and yarn lines may be mixed in any order. With a unit (the `unit` line or
 !> `&geometry unit`, which must agree) coordinates and length0 values are converted to m.
-module yarnfort_input_geometry
+module yarnfort_input_geometry_file
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: yarn_config_type, name_length
@@ -375,4 +375,4 @@ contains
         end if
     end subroutine next_line
 
-end module yarnfort_input_geometry
+end module yarnfort_input_geometry_file

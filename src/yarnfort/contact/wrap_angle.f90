@@ -2,7 +2,7 @@
 !> Tensions and wrap angle at a passage and their derivatives, for the friction
 !> conditions. The wrap angle is alpha = pi - gamma, gamma the angle between the yarn's
 !> two elements pointing away from the contact node (alpha = 0 for a straight yarn).
-module yarnfort_contact_geometry
+module yarnfort_contact_wrap_angle
     use yarnfort_kinds, only: wp
     implicit none
     private
@@ -43,4 +43,4 @@ contains
         dangle(:, 2) = -(dcos_a + dcos_b) / sine
     end subroutine get_wrap_angle
 
-end module yarnfort_contact_geometry
+end module yarnfort_contact_wrap_angle

@@ -1,7 +1,7 @@
 ! SPDX-License-Identifier: MIT
 !> The force law of a yarn type: tension as a function of stretch (a string carries no
 !> compression). Concrete laws extend `force_law_type`.
-module yarnfort_material_law
+module yarnfort_material_force_law
     use yarnfort_kinds, only: wp
     implicit none
     private
@@ -138,4 +138,4 @@ contains
         end do
     end subroutine get_stretch_at_force
 
-end module yarnfort_material_law
+end module yarnfort_material_force_law
