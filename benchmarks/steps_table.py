@@ -76,7 +76,16 @@ def run(binary, arguments, timeout):
         values.insert(SUMMARY.index('chords'), 0.0)   # a build without chord steps
     row = dict(zip(SUMMARY, values))
     row['floor'] = floor(done.stdout, row)
+    row['factorisations'] = factorisations(done.stdout)
     return row
+
+
+def factorisations(stdout):
+    """Factorisations per load step from the `timings` line (NaN without)."""
+    lines = [line for line in stdout.splitlines() if line.startswith('timings')]
+    if not lines:
+        return float('nan')
+    return float(re.findall(r'\s(-?\d+\.\d+)', lines[-1])[1])
 
 
 def floor(stdout, row):

@@ -16,6 +16,7 @@ module yarnfort_driver
     use yarnfort_solver_continuation, only: step_observer_type, run_continuation
     use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
     use yarnfort_solver_restart, only: restart_type
+    use yarnfort_solver_lateral_control, only: lateral_stepper_type, new_lateral_stepper
     implicit none
     private
 
@@ -52,14 +53,22 @@ contains
         integer, intent(in), optional :: max_steps
         logical, intent(out), optional :: stopped
         class(linear_solver_type), allocatable :: linear
-        type(elastic_stepper_type) :: stepper
-        type(friction_stepper_type) :: friction_stepper
+        type(elastic_stepper_type), target :: stepper
+        type(friction_stepper_type), target :: friction_stepper
+        type(lateral_stepper_type) :: lateral
 
         if (present(stopped)) stopped = .false.
         ! Only a scene with sliding passages pays for the sliding machinery.
         if (scene%passages%size() > 0) then
             call new_friction_stepper(friction_stepper, scene, get_linear_solver_name(scene), error)
             if (allocated(error)) return
+            if (scene%lateral_channel > 0) then
+                ! A force-controlled y period: an outer iteration around every step.
+                call new_lateral_stepper(lateral, friction_stepper)
+                call run_continuation(scene, lateral, observer, error, restart, max_steps, &
+                    stopped)
+                return
+            end if
             call run_continuation(scene, friction_stepper, observer, error, restart, max_steps, &
                 stopped)
             return
@@ -71,6 +80,11 @@ contains
         end if
         call new_elastic_stepper(stepper, scene, linear, error)
         if (allocated(error)) return
+        if (scene%lateral_channel > 0) then
+            call new_lateral_stepper(lateral, stepper)
+            call run_continuation(scene, lateral, observer, error, restart, max_steps, stopped)
+            return
+        end if
         call run_continuation(scene, stepper, observer, error, restart, max_steps, stopped)
     end subroutine run_scene
 

@@ -317,6 +317,19 @@ def test_capstan_full_curve_with_defaults(run_yarnfort, tmp_path, k, law_name):
     check_capstan(net, k, law_name, curve, states)
 
 
+def test_capstan_over_many_pins_with_defaults(run_yarnfort, tmp_path):
+    """The capstan of test_capstan_full_curve_with_defaults over 128 pins, Coulomb: the
+    release's slip fronts cross tens of passages in one load step, which the rounds
+    settle by marching the fronts along the yarn (one round per passage before). Every
+    step against CapstanReference as there (tensions, L0, reaction, slip flags, gross
+    slip over the summed angle), and the whole run within 3 Newton iterations per pin
+    of the 4-pin run's count, so that no front goes a passage per round."""
+    net, curve, states = run_capstan(run_yarnfort, tmp_path, "many", 128, "coulomb")
+    check_capstan(net, 128, "coulomb", curve, states)
+    _, few, _ = run_capstan(run_yarnfort, tmp_path, "few", 4, "coulomb")
+    assert curve["newton_iterations"].sum() <= few["newton_iterations"].sum() + 3 * 128
+
+
 #: Exact violation of the stick test T_max / T_crit(T_min) - 1 at the knots placed just
 #: before (stick) and just after (slip) each slip onset: far above the solver's
 #: friction_tolerance (1e-9) and CLOSE_CALL, far below a step of the path.
@@ -721,7 +734,7 @@ def test_friction_ring_with_defaults(run_yarnfort, tmp_path, yarn):
             (key, value)
 
 
-#: The stick test's dead band (friction_stepper.f90, dead_band_factor) in units of the
+#: The stick test's dead band (contact/stepper/active_set.f90, dead_band_factor) in units of the
 #: rounding allowance of a passage's tensions, and that allowance per element in units
 #: of eps (|T| + r dT/dlambda) (truss.f90, rounding_factor).
 DEAD_BAND_FACTOR = 10.0

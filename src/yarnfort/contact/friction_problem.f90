@@ -13,8 +13,9 @@
 !> rows weighted per solve'). Rows are judged (get_row_levels) against the forces at
 !> their node, the passage's larger tension / w (slip) or the largest force (stick).
 !> `locked` forbids a direction (minimum reference length reached, or chatter damping).
-!> With `semismooth` (off) the modes are chosen at every evaluation instead
-!> (docs/decisions.md, 'Not kept: semismooth Newton for the slip modes').
+!> The active set is the stepper's (yarnfort_contact_friction_stepper); modes chosen at
+!> every evaluation were not kept (docs/decisions.md, 'Not kept: semismooth Newton for
+!> the slip modes').
 !> Viscous slip (`viscosity` > 0, set only by the stepper's slip-instability jump) adds
 !> eta (s - s_start) to each slip row: implicit Euler steps of a viscoplastic slip law,
 !> well posed where the rate-independent law has no consistent active set.
@@ -62,8 +63,6 @@ module yarnfort_contact_friction_problem
         real(wp), allocatable :: flow_target(:)
         !> Divisor of each slip row, fixed per Newton solve (module notes).
         real(wp), allocatable :: slip_weight(:)
-        !> Choose modes from the iterate (semismooth Newton) instead of keeping `mode`.
-        logical :: semismooth = .false.
         !> Viscous slip, in units of stick_scale (module notes; 0: the exact law).
         real(wp) :: viscosity = 0.0_wp
         !> Direction a passage may not slip in (mode_forward or mode_backward), both
@@ -113,8 +112,6 @@ module yarnfort_contact_friction_problem
         procedure :: update_state
         !> Tensions (clipped at 0) on both sides and the wrap angle of passage p.
         procedure :: get_passage_state
-        !> Modes from the current state and flows (semismooth Newton).
-        procedure :: choose_modes
     end type friction_problem_type
 
 contains
@@ -335,33 +332,6 @@ contains
         end associate
     end subroutine get_passage_state
 
-    subroutine choose_modes(self, flow)
-        class(friction_problem_type), intent(inout) :: self
-        real(wp), intent(in) :: flow(:)
-        integer :: p
-        real(wp) :: t_before, t_after, angle, forward, backward, increment, d1, d2
-
-        do p = 1, self%n_p
-            call self%get_passage_state(p, t_before, t_after, angle)
-            associate(law => self%scene%friction(self%scene%passages%law(p))%law)
-                call law%get_critical_tension(t_before, angle, forward, d1, d2)
-                call law%get_critical_tension(t_after, angle, backward, d1, d2)
-            end associate
-            forward = t_after - forward
-            backward = t_before - backward
-            increment = self%stick_scale * (flow(p) - self%flow_target(p))
-            if (increment + forward > 0.0_wp .and. self%locked(p) /= mode_forward &
-                    .and. self%locked(p) /= locked_both) then
-                self%mode(p) = mode_forward
-            else if (-increment + backward > 0.0_wp .and. self%locked(p) /= mode_backward &
-                    .and. self%locked(p) /= locked_both) then
-                self%mode(p) = mode_backward
-            else
-                self%mode(p) = mode_stick
-            end if
-        end do
-    end subroutine choose_modes
-
     !> Reject a solution whose flows leave an element a reference length <= 0. Newton's
     !> iterates may pass there (forbidding it made KINSOL's five step halvings too few on
     !> test_friction's bollard), but a string with L0 <= 0 counts as slack, so such a
@@ -401,7 +371,7 @@ contains
         ! Stick rows in units of the scene's forces (it only scales the rows).
         self%stick_scale = self%get_force_level() / self%length_scale
         if (.not. (self%stick_scale > 0.0_wp)) self%stick_scale = 1.0_wp / self%length_scale
-        if (self%semismooth .or. all(self%mode == mode_stick)) return
+        if (all(self%mode == mode_stick)) return
         do p = 1, self%n_p
             if (self%mode(p) == mode_stick) cycle
             call self%get_passage_state(p, t_before, t_after, angle)
@@ -500,9 +470,6 @@ contains
         call self%update_state(u, error, law)
         if (allocated(error)) return
         row = 0
-        if (.not. self%positions_frozen) row = self%n_x
-        if (self%semismooth) call self%choose_modes(u(row + 1:))
-        row = 0
         if (.not. self%positions_frozen) then
             ! The applied forces at these factors: update_state (set_load).
             call self%scene%dofs%gather(self%internal - self%applied, values(1:self%n_x))
@@ -542,13 +509,6 @@ contains
         used = chosen_law(law)
         call self%update_state(u, error, law)
         if (allocated(error)) return
-        if (self%semismooth) then
-            if (self%positions_frozen) then
-                call self%choose_modes(u)
-            else
-                call self%choose_modes(u(self%n_x + 1:))
-            end if
-        end if
         values = 0.0_wp
         associate(scene => self%scene, net => self%scene%network)
             if (.not. self%positions_frozen) then

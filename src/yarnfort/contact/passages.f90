@@ -16,7 +16,7 @@ module yarnfort_contact_passages
     implicit none
     private
 
-    public :: passage_set_type, friction_holder_type
+    public :: passage_set_type, friction_holder_type, is_at_minimum_length
 
     !> One pair-of-yarn-types friction law.
     type :: friction_holder_type
@@ -39,6 +39,21 @@ module yarnfort_contact_passages
     end type passage_set_type
 
 contains
+
+    !> A reference length `length0` (initial length `initial`, share `share` of its
+    !> segment) is at its minimum, `min_ratio` times `initial`: within rounding, and
+    !> within the solve's accuracy of the flows that set it (`flow_accuracy`, a stick
+    !> row's tolerance: residual_tolerance * length_scale). A lock's flow is solved to
+    !> that; an element left that much above its minimum must not slide on towards it.
+    pure logical function is_at_minimum_length(length0, initial, share, min_ratio, &
+            flow_accuracy)
+        real(wp), intent(in) :: length0, initial, share, min_ratio, flow_accuracy
+        !> Round-off of a reference length locked at its minimum, relative to its initial
+        !> length (the lock sets L0 = initial length - flow to the minimum).
+        real(wp), parameter :: length_round_off = 64 * epsilon(1.0_wp)
+        is_at_minimum_length = length0 <= min_ratio * initial &
+            + max(length_round_off * initial, flow_accuracy * share)
+    end function is_at_minimum_length
 
     pure integer function get_size(self)
         class(passage_set_type), intent(in) :: self

@@ -70,6 +70,8 @@ contains
             if (allocated(error)) return
             call require_choice(error, 'sides', fabric%sides, fabric_sides_choices)
             if (allocated(error)) return
+            call check_lateral_control(error)
+            if (allocated(error)) return
             if (fabric%kind == 'texgen') then
                 call require_range(error, 'strain', fabric%strain, -0.9_wp, 100.0_wp)
                 if (allocated(error)) return
@@ -182,6 +184,30 @@ contains
             end if
         end associate
     contains
+
+        !> A held lateral force or force ratio replaces the lateral strain of a periodic cell.
+        subroutine check_lateral_control(error)
+            type(error_type), allocatable, intent(out) :: error
+
+            associate(fabric => config%fabric)
+                call require_range(error, 'lateral_force', fabric%lateral_force, 0.0_wp, &
+                    huge(1.0_wp))
+                if (allocated(error)) return
+                call require_range(error, 'force_ratio', fabric%force_ratio, 0.0_wp, 100.0_wp)
+                if (allocated(error)) return
+                if (fabric%lateral_control == 'strain') return
+                if (fabric%boundary /= 'periodic') then
+                    call fatal_error(error, label // "lateral_control = '" &
+                        // trim(fabric%lateral_control) // "' needs boundary = 'periodic' " &
+                        // '(it holds the y period of a periodic cell)')
+                else if (fabric%lateral_strain /= 0.0_wp) then
+                    call fatal_error(error, label // 'lateral_strain = ' &
+                        // format_real(fabric%lateral_strain) // " is given with " &
+                        // "lateral_control = '" // trim(fabric%lateral_control) &
+                        // "' (the y period then follows the force: leave lateral_strain out)")
+                end if
+            end associate
+        end subroutine check_lateral_control
         !> A finite real in [low, high] (the message by the input's generic range check).
         subroutine require_range(error, variable, value, low, high)
             type(error_type), allocatable, intent(out) :: error

@@ -143,6 +143,7 @@ contains
         if (allocated(config%loads)) n_loads = size(config%loads)
         sets = get_support_set_names(config)
         call get_curve_columns(names, sets, n_loads, config%fabric_support > 0, &
+            config%fabric_width > 0.0_wp .and. config%fabric%boundary == 'periodic', &
             columns, kind, item)
         order = sort_text_index(columns)
         ! Of all clashes, the one whose later column comes first in the file.

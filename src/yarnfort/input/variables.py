@@ -337,7 +337,22 @@ GROUPS = [
                 'period one more unknown, with zero net y force across the cell. The '
                 'pre-stressed plain-weave cell then collapsed to a lateral strain of -0.99999 at '
                 "step 0, and the knit cell's initial state did not converge. For free lateral "
-                "contraction, use a clamped sample with `sides = 'free'`."),
+                "contraction, use a clamped sample with `sides = 'free'`, or hold a lateral force "
+                '(`lateral_control`).'),
+        Var('lateral_control', 'character', 'strain', length=16, lower=True,
+            choices=['strain', 'force', 'ratio'],
+            doc="Periodic: what holds the y period. `'strain'`: `lateral_strain` (prescribed). "
+                "`'force'`: the membrane force n22 (N/m) is held at `lateral_force` at every step, "
+                "the strain e22 an unknown. `'ratio'`: n22 = `force_ratio` * n11 at every step. "
+                'A force-controlled y period is found by an outer iteration on e22 around each '
+                'step (to 100 * residual_tolerance of the forces); where no e22 gives the '
+                'force (the cell collapses laterally, see `lateral_strain`), the run stops '
+                'with that message. `lateral_strain` must then be 0.'),
+        Var('lateral_force', 'real', 0.0, unit='N/m', range='>= 0',
+            doc="Periodic, `lateral_control = 'force'`: the membrane force n22 held (force "
+                'across an x-parallel cell edge per unit current edge length, as in curve.csv).'),
+        Var('force_ratio', 'real', 1.0, unit='1', range='[0, 100]',
+            doc="Periodic, `lateral_control = 'ratio'`: n22 / n11 held at every step."),
         Var('sides', 'character', 'free', length=16, lower=True, choices=['free', 'rollers'],
             doc="Clamped: `'free'` side edges or `'rollers'`. Woven: rollers hold the weft ends "
                 'in y and z (a selvedge); free weft ends of pre-stressed weft yarns cannot carry '

@@ -12,6 +12,7 @@ module yarnfort_output_contacts
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_contact_wrap_angle, only: get_wrap_angle
     use yarnfort_contact_friction_problem, only: mode_forward, mode_backward
+    use yarnfort_contact_passages, only: is_at_minimum_length
     implicit none
     private
 
@@ -46,10 +47,6 @@ module yarnfort_output_contacts
 
     !> Only the wrap angle's derivative uses its floor of sin(gamma): any value will do.
     real(wp), parameter :: unused_min_sine = 1.0e-8_wp
-
-    !> Round-off of a reference length at its minimum, relative to its initial length
-    !> (as the friction stepper judges it).
-    real(wp), parameter :: length_round_off = 64 * epsilon(1.0_wp)
 
     type, extends(table_writer_type) :: contacts_writer_type
     contains
@@ -142,11 +139,13 @@ contains
             end do
         end associate
     contains
-        !> Whether element e's reference length is at its minimum.
+        !> Whether element e's reference length is at its minimum (as the friction
+        !> stepper judges it).
         logical function at_minimum(e)
             integer, intent(in) :: e
-            at_minimum = state%length0(e) <= (scene%solver%min_length_ratio &
-                + length_round_off) * scene%network%length0(e)
+            at_minimum = is_at_minimum_length(state%length0(e), scene%network%length0(e), &
+                scene%passages%share(e), scene%solver%min_length_ratio, &
+                scene%solver%residual_tolerance * scene%length_scale)
         end function at_minimum
     end subroutine get_passage_states
 

@@ -9,6 +9,7 @@ module yarnfort_output_curve
     use yarnfort_output_csv_rows, only: csv_rows_type
     use yarnfort_scene_channels, only: get_curve_columns, curve_column_length
     use yarnfort_output_table, only: table_writer_type
+    use yarnfort_output_membrane, only: get_membrane
     implicit none
     private
 
@@ -33,7 +34,8 @@ contains
     !> the mean displacement of the set's prescribed coordinates, per component; 0 for a
     !> component it does not prescribe) for each support set, then load_<k>_ux, _uy, _uz
     !> (m, the mean displacement of the nodes of &load #k) for each &load, then for a
-    !> fabric strain and force_per_width, then direction (1 loading, -1 unloading, 0
+    !> fabric strain and force_per_width, for a periodic cell e11, e22, gamma12, n11, n22,
+    !> n12 (yarnfort_output_membrane), then direction (1 loading, -1 unloading, 0
     !> neither: sign of the change of the sum of the channels' factors), passages
     !> slipping, passages held in stick by chatter damping, 1 if the step ended in a jump
     !> after a slip instability (else 0), and sliding passages in all,
@@ -75,7 +77,7 @@ contains
         n_loads = 0
         if (allocated(scene%loads)) n_loads = size(scene%loads)
         call get_curve_columns(scene%path%channel, scene%supports%name, n_loads, &
-            scene%fabric_set > 0, names, kind, item)
+            scene%fabric_set > 0, scene%periodic_cell, names, kind, item)
         header = trim(names(1))
         do j = 2, size(names)
             header = header // ',' // trim(names(j))
@@ -109,6 +111,7 @@ contains
             call row%add(state%factors(2) * scene%fabric_strain)
             call row%add(state%reaction(1, scene%fabric_set) / scene%fabric_width)
         end if
+        if (scene%periodic_cell) call row%add(get_membrane(scene, state))
         call row%add(state%direction)
         call row%add(state%n_slipping)
         call row%add(state%n_held)

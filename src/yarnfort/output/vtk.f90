@@ -15,10 +15,10 @@
 !> - passages_NNNNN.vtu: one point per sliding passage (write_passages), so that two
 !>   passages at one node both show.
 !> Every block has the field data time, step, the factor of each load channel (p_force,
-!> p_disp without &path channels), and for a fabric strain and force_per_width (as in
-!> curve.csv). The multiblock file state_NNNNN.vtm lists the blocks of a state by name
-!> (ParaView and VTK's XML multiblock reader open it as one dataset), and states.pvd
-!> the multiblock files with their pseudo-time.
+!> p_disp without &path channels), for a fabric strain and force_per_width, and for a
+!> periodic cell e11 ... n12 (as in curve.csv). The multiblock file state_NNNNN.vtm lists
+!> the blocks of a state by name (ParaView and VTK's XML multiblock reader open it as one
+!> dataset), and states.pvd the multiblock files with their pseudo-time.
 !> The files are built by yarnfort_output_vtu: appended base64-encoded binary by default,
 !> or inline ASCII (&output vtk_format).
 module yarnfort_output_vtk
@@ -32,6 +32,7 @@ module yarnfort_output_vtk
     use yarnfort_text, only: format_integer
     use yarnfort_output_manifest, only: part_prefixes
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
+    use yarnfort_output_membrane, only: membrane_names, get_membrane
     implicit none
     private
 
@@ -400,7 +401,7 @@ contains
     end subroutine write_passages
 
     !> Begin a file: the XML header, the field data (time, step, the load factors, a
-    !> fabric's strain and force per width) and the piece of `n_points` and `n_cells`.
+    !> fabric's strain and force per width, a periodic cell's membrane strains and forces) and the piece of `n_points` and `n_cells`.
     subroutine start_file(vtu, ascii, scene, state, n_points, n_cells)
         type(vtu_builder_type), intent(out) :: vtu
         logical, intent(in) :: ascii
@@ -408,6 +409,7 @@ contains
         type(step_state_type), intent(in) :: state
         integer, intent(in) :: n_points, n_cells
         integer :: l
+        real(wp) :: membrane(6)
 
         call start_vtu(vtu, ascii)
         call add_text(vtu, '<FieldData>')
@@ -424,6 +426,10 @@ contains
             call add_reals(vtu, 'force_per_width', &
                 [state%reaction(1, scene%fabric_set) / scene%fabric_width], 1, field=.true.)
         end if
+        if (scene%periodic_cell) membrane = get_membrane(scene, state)
+        do l = 1, merge(size(membrane_names), 0, scene%periodic_cell)
+            call add_reals(vtu, trim(membrane_names(l)), [membrane(l)], 1, field=.true.)
+        end do
         call add_text(vtu, '</FieldData>')
         call add_text(vtu, '<Piece NumberOfPoints="' // format_integer(n_points) &
             // '" NumberOfCells="' // format_integer(n_cells) // '">')

@@ -4,7 +4,7 @@ module yarnfort_scene_builder
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
     use yarnfort_input_config, only: config_type, material_config_type
-    use yarnfort_scene_scene, only: scene_type, support_set_type
+    use yarnfort_scene_scene, only: scene_type, support_set_type, lateral_channel_name
     use yarnfort_text, only: format_real
     use yarnfort_material_force_law, only: force_law_type
     use yarnfort_material_linear, only: linear_law_type, new_linear_law
@@ -52,6 +52,17 @@ contains
             end if
         end do
         scene%path%channel = get_channel_names(config%path)
+        ! A force-controlled y period of a periodic cell: e22 is the factor of a channel
+        ! of its own (the path leaves it at 0; the outer iteration sets it).
+        if (len_trim(config%fabric%kind) > 0 .and. config%fabric%boundary == 'periodic' &
+                .and. config%fabric%lateral_control /= 'strain') then
+            scene%path%channel = [character(len=name_length) :: scene%path%channel, &
+                lateral_channel_name]
+            scene%lateral_channel = size(scene%path%channel)
+            scene%lateral_control = config%fabric%lateral_control
+            scene%lateral_force = config%fabric%lateral_force
+            scene%force_ratio = config%fabric%force_ratio
+        end if
         call build_network(scene, config, error)
         if (allocated(error)) return
         call apply_prestress(scene, config, error)
@@ -76,10 +87,27 @@ contains
             scene%fabric_width = config%fabric_width
             scene%fabric_strain = config%fabric%strain
             if (config%fabric_support > 0) scene%fabric_set = config%fabric_support
+            ! A periodic cell's periods are its longest lattice vectors along x and y
+            ! (images lie one period away; a corner image both).
+            scene%periodic_cell = config%fabric%boundary == 'periodic'
+            if (scene%periodic_cell) then
+                scene%cell_period = maxval(abs(scene%cell_lattice(1:2, :)), dim=2)
+                scene%cell_strain = [config%fabric%strain, config%fabric%lateral_strain]
+            end if
         end if
         scene%path%time = config%path%time
         scene%path%channel = get_channel_names(config%path)
         scene%path%factor = get_channel_factors(config%path)
+        if (scene%lateral_channel > 0) then
+            scene%path%channel = [character(len=name_length) :: scene%path%channel, &
+                lateral_channel_name]
+            block
+                real(wp), allocatable :: factor(:, :)
+                allocate(factor(size(scene%path%time), scene%lateral_channel), source=0.0_wp)
+                factor(:, :scene%lateral_channel - 1) = scene%path%factor
+                call move_alloc(factor, scene%path%factor)
+            end block
+        end if
         scene%length_scale = sum(scene%network%length0) / size(scene%network%length0)
     end subroutine new_scene
 
@@ -384,7 +412,7 @@ contains
         integer :: n_nodes, l, n, r, k, c, cr, hops, displacement_channel, s, i
         integer, allocatable :: leader(:), link_of(:), stretch_coordinates(:)
         integer, allocatable :: set_of(:), place_of(:)
-        real(wp) :: offset(3), macro(3), gap(3), step(3)
+        real(wp) :: offset(3), macro(3), gap(3), step(3), lattice(3)
         character(len=200) :: buffer
 
         n_nodes = scene%network%n_nodes()
@@ -398,6 +426,7 @@ contains
         end if
         allocate(scene%link_nodes(2, 0), scene%link_is_gap(0))
         allocate(scene%link_period(3, 0), scene%link_strain(3, 0))
+        allocate(scene%cell_lattice(3, n_nodes), source=0.0_wp)
         if (.not. allocated(config%links)) return
         if (size(config%links) == 0) return
         scene%link_nodes = reshape([(config%links(l)%leader, config%links(l)%follower, &
@@ -448,6 +477,7 @@ contains
             offset = 0.0_wp
             macro = 0.0_wp
             gap = 0.0_wp
+            lattice = 0.0_wp
             r = n
             hops = 0
             do while (leader(r) /= 0)
@@ -463,12 +493,15 @@ contains
                     if (link%gap) then
                         gap = gap + step - link%period
                         macro = macro + link%strain * link%period
+                        lattice = lattice + link%period
                     else
                         macro = macro + link%strain * step
+                        lattice = lattice + step
                     end if
                 end associate
                 r = leader(r)
             end do
+            scene%cell_lattice(:, n) = lattice
             do k = 1, 3
                 c = 3 * (n - 1) + k
                 cr = 3 * (r - 1) + k
@@ -486,6 +519,10 @@ contains
                     scene%dofs%delta(c, displacement_channel) = macro(k)
                 end if
                 scene%dofs%gap(c) = gap(k)
+                ! A force-controlled y period: y = root + lattice_y * (1 + e22).
+                if (k == 2 .and. scene%lateral_channel > 0) &
+                    scene%dofs%delta(c, scene%lateral_channel) = &
+                    scene%dofs%delta(c, scene%lateral_channel) + lattice(2)
                 if (scene%dofs%unknown(cr) == 0 .and. set_of(cr) > 0) then
                     associate(set => scene%supports(set_of(cr)))
                         set%followers = [set%followers, c]

@@ -20,8 +20,9 @@ module yarnfort_scene_channels
     character(len=*), parameter :: default_displacement_channel = 'p_disp'
 
     !> The columns of curve.csv that are not named after a channel, support or load.
-    character(len=*), parameter :: fixed_curve_columns(13) = [character(len=17) :: &
-        'step', 'time', 'strain', 'force_per_width', 'direction', 'slipping', 'held', &
+    character(len=*), parameter :: fixed_curve_columns(19) = [character(len=17) :: &
+        'step', 'time', 'strain', 'force_per_width', &
+        'e11', 'e22', 'gamma12', 'n11', 'n22', 'n12', 'direction', 'slipping', 'held', &
         'jumped', 'passages', &
         'newton_iterations', 'residual', 'step_cuts', 'wall_time']
 
@@ -96,14 +97,14 @@ contains
     !> The columns of curve.csv, in order: step, time, the factor of each channel, rx, ry,
     !> rz of each support set (the &support groups, then the &obstacle groups that hold
     !> a coordinate), ux, uy, uz of each set, load_<k>_ux, _uy, _uz of each of n_loads
-    !> &load groups, strain and force_per_width for a fabric, then the step's counters.
+    !> &load groups, strain and force_per_width for a fabric, e11 ... n12 for a periodic cell, then the step's counters.
     !> What makes column j: `kind(j)` = column_fixed, column_channel (channel item(j)),
     !> column_set (set item(j)) or column_load (&load #item(j)). The one list of names:
     !> the header of the curve file is these names, and the input check finds clashes in it.
-    subroutine get_curve_columns(channels, sets, n_loads, fabric, names, kind, item)
+    subroutine get_curve_columns(channels, sets, n_loads, fabric, periodic, names, kind, item)
         character(len=*), intent(in) :: channels(:), sets(:)
         integer, intent(in) :: n_loads
-        logical, intent(in) :: fabric
+        logical, intent(in) :: fabric, periodic
         character(len=curve_column_length), allocatable, intent(out) :: names(:)
         integer, allocatable, intent(out) :: kind(:), item(:)
         character(len=3), parameter :: suffixes(6) = ['_rx', '_ry', '_rz', '_ux', '_uy', '_uz']
@@ -128,9 +129,10 @@ contains
                 call add(load_column_prefix(k) // suffixes(j), column_load, k)
             end do
         end do
-        ! fixed_curve_columns(3:4) are the fabric's.
+        ! fixed_curve_columns(3:4) are the fabric's, (5:10) a periodic cell's membrane.
         if (fabric) call add_fixed(3, 4)
-        call add_fixed(5, size(fixed_curve_columns))
+        if (periodic) call add_fixed(5, 10)
+        call add_fixed(11, size(fixed_curve_columns))
         names = names(:n)
         kind = kind(:n)
         item = item(:n)

@@ -11,7 +11,10 @@ module yarnfort_scene_scene
     private
 
     public :: scene_type, law_holder_type, support_set_type, load_set_type, load_path_type
-    public :: get_applied_force, get_loaded_nodes, get_force_scale
+    public :: get_applied_force, get_loaded_nodes, get_force_scale, lateral_channel_name
+
+    !> The channel of a force-controlled y period (its factor, and column, is e22).
+    character(len=*), parameter :: lateral_channel_name = 'lateral'
 
     !> One yarn type's force law.
     type :: law_holder_type
@@ -81,6 +84,21 @@ module yarnfort_scene_scene
         !> initial offset, a gap-holder's period (zero inside the cell); at factor p of
         !> dofs%gap_channel it is link_period * (1 + p * link_strain), componentwise.
         real(wp), allocatable :: link_period(:, :), link_strain(:, :)
+        !> A periodic cell (&fabric boundary = 'periodic'): each node's lattice vector at
+        !> p_disp = 0 (3, n_nodes; zero for a node that follows no periodic image), the
+        !> reference periods along x and y (m) and their engineering strains at p_disp = 1.
+        !> A node's position is its root's plus lattice * (1 + p_disp * cell_strain),
+        !> componentwise (yarnfort_output_membrane).
+        logical :: periodic_cell = .false.
+        real(wp), allocatable :: cell_lattice(:, :)
+        real(wp) :: cell_period(2) = 0.0_wp, cell_strain(2) = 0.0_wp
+        !> A periodic cell whose y period follows a force (&fabric lateral_control 'force'
+        !> or 'ratio'): the load channel (appended to the path's, factor 0 at every knot)
+        !> whose factor is e22, set by yarnfort_solver_lateral_control; 0 otherwise. The
+        !> n22 held, or the ratio n22 / n11 held.
+        integer :: lateral_channel = 0
+        character(len=16) :: lateral_control = 'strain'
+        real(wp) :: lateral_force = 0.0_wp, force_ratio = 0.0_wp
     end type scene_type
 
 contains

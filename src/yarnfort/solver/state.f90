@@ -26,6 +26,9 @@ module yarnfort_solver_state
         !> The same per prescribed coordinate: the force on coordinate
         !> scene%supports(s)%coordinates(i), for s = 1, 2, ... and i in order, concatenated.
         real(wp), allocatable :: coordinate_reaction(:)
+        !> Periodic cell: sum over nodes of (force on the node) (x) (its lattice vector),
+        !> (3, 3), N m; the forces conjugate to the period vectors (yarnfort_output_membrane).
+        real(wp) :: virial(3, 3) = 0.0_wp
         !> Figures of the step's (last) Newton solve; total Newton iterations of the step.
         type(newton_stats_type) :: newton
         integer :: newton_iterations = 0
@@ -110,6 +113,16 @@ contains
                 return
             end if
         end do
+        state%virial = 0.0_wp
+        if (scene%periodic_cell) then
+            do i = 1, size(scene%cell_lattice, 2)
+                if (all(scene%cell_lattice(:, i) == 0.0_wp)) cycle
+                do k = 1, 3
+                    state%virial(:, k) = state%virial(:, k) &
+                        + internal(3 * i - 2:3 * i) * scene%cell_lattice(k, i)
+                end do
+            end do
+        end if
         if (scene%fabric_set > 0) then
             if (.not. ieee_is_finite(state%reaction(1, scene%fabric_set) &
                     / scene%fabric_width)) then

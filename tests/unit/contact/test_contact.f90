@@ -215,8 +215,6 @@ contains
         ! deliberate Jacobian approximation (see yarnfort_assembly_truss).
         scene%solver%slack_stiffness = 0.0_wp
         call new_friction_problem(problem, scene, frozen)
-        ! Every mode combination in turn (not chosen from the iterate).
-        problem%semismooth = .false.
         problem%factors = [0.0_wp, 0.6_wp]
         problem%flow_target = [(0.01_wp * cos(real(j, wp)), j = 1, problem%n_p)]
         allocate(x0(scene%dofs%n_unknowns))

@@ -53,7 +53,6 @@ contains
         call make_scene(scene, error, prestress=[2.0_wp, 0.3_wp])
         if (allocated(error)) return
         call new_friction_problem(problem, scene, positions_frozen=.false.)
-        problem%semismooth = .false.
         problem%factors = [0.0_wp, 0.5_wp]
         problem%flow_target = 0.0_wp
         problem%locked = 0
