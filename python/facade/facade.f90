@@ -137,21 +137,26 @@ end module yarnfort_facade
 !> lines. `notify(step, time, time_start, time_end, p_force, p_disp, iterations, residual,
 !> n_slipping, n_passages, wall_time)` is called after every converged step once its files are
 !> written; a non-zero answer stops the run there (as `max_steps` would). It is called a
-!> last time with step = -1 when the run ends, whatever the outcome.
+!> last time with step = -1 when the run ends, whatever the outcome. With
+!> `catch_interrupts` /= 0, SIGINT (Ctrl-C) during the solve stops it within a Newton
+!> iteration (the handler it replaces is put back after the run).
 !> `n_steps`: converged steps written by this run (rows added to curve.csv; also set after
 !> a failed solve, whose steps are kept). `outcome`: 0 the path's end was reached, 1
-!> stopped by `max_steps`, 2 stopped by the call-back. Status: 2 for bad input, a bad
-!> restart file or an unusable output folder, 1 for a failed solve.
-subroutine run_scene_file(path, notify, status, message, n_steps, folder, outcome)
+!> stopped by `max_steps`, 2 stopped by the call-back, 3 interrupted (status 0, and
+!> `message` says which steps were kept). Status: 2 for bad input, a bad restart file
+!> or an unusable output folder, 1 for a failed solve.
+subroutine run_scene_file(path, notify, catch_interrupts, status, message, n_steps, folder, &
+        outcome)
     use, intrinsic :: iso_c_binding, only: c_double, c_int
     use yarnfort_error, only: error_type
     use yarnfort_facade, only: set_status, cut_text
-    use yarnfort_facade_scene_runner, only: run_scene_from_file
+    use yarnfort_facade_scene_runner, only: run_scene_from_file, outcome_interrupted
     implicit none
     !> Length of `message` and `folder` (above the input's path length, 512).
     integer, parameter :: text_length = 1024
     character(len=*), intent(in) :: path
     integer(c_int), external :: notify
+    integer(c_int), intent(in) :: catch_interrupts
     integer(c_int), intent(out) :: status
     character(len=text_length), intent(out) :: message
     integer(c_int), intent(out) :: n_steps
@@ -163,11 +168,13 @@ subroutine run_scene_file(path, notify, status, message, n_steps, folder, outcom
     real(c_double) :: time, time_start, time_end, p_force, p_disp, residual, wall_time
     integer :: steps, how
 
-    call run_scene_from_file(trim(path), notify, steps, folder_text, how, error)
+    call run_scene_from_file(trim(path), notify, catch_interrupts /= 0_c_int, steps, &
+        folder_text, how, error)
     n_steps = int(steps, c_int)
     outcome = int(how, c_int)
     call cut_text(folder_text, folder)
     call set_status(error, status, message)
+    if (how == outcome_interrupted) status = 0_c_int
     ! The closing call (step -1): the same signature, so that f2py sees it here.
     step = -1_c_int
     iterations = 0_c_int

@@ -18,11 +18,13 @@ module yarnfort_facade_scene_runner
     use yarnfort_scene_builder, only: new_scene
     use yarnfort_output_writer, only: output_writer_type
     use yarnfort_driver, only: solve_with_outputs
+    use yarnfort_solver_interrupt, only: catch_interrupts, release_interrupts, interrupt_stat
     implicit none
     private
 
     public :: run_scene_from_file, step_callback_interface
-    public :: status_input, status_solve, outcome_done, outcome_max_steps, outcome_stopped
+    public :: status_input, status_solve, outcome_done, outcome_max_steps, outcome_stopped, &
+        outcome_interrupted
 
     !> Error status for bad input or an unusable output folder (the program's exit code).
     integer, parameter :: status_input = 2
@@ -31,8 +33,11 @@ module yarnfort_facade_scene_runner
     integer, parameter :: status_solve = 1
 
     !> How a run without error ended: the path's end reached, `&control max_steps`
-    !> reached, or stopped on the call-back's request (at a step boundary).
-    integer, parameter :: outcome_done = 0, outcome_max_steps = 1, outcome_stopped = 2
+    !> reached, stopped on the call-back's request (at a step boundary), or by Ctrl-C
+    !> (the step being solved abandoned; the error, of stat interrupt_stat, says what
+    !> was kept).
+    integer, parameter :: outcome_done = 0, outcome_max_steps = 1, outcome_stopped = 2, &
+        outcome_interrupted = 3
 
     !> Marker status of the error that unwinds the continuation after a stop request.
     integer, parameter :: status_stop_request = -1
@@ -76,10 +81,13 @@ contains
     !> curve.csv). `outcome`: outcome_done, outcome_max_steps or outcome_stopped. With
     !> &control check_only nothing is solved or written. On failure `error%stat` is
     !> `status_input` or `status_solve` and the message starts with the stage (input,
-    !> restart, output, solve).
-    subroutine run_scene_from_file(path, notify, n_steps, folder, outcome, error)
+    !> restart, output, solve). With `catch`, SIGINT (Ctrl-C) during the solve stops it
+    !> within a Newton iteration: outcome_interrupted, and `error` (stat interrupt_stat)
+    !> says what was kept.
+    subroutine run_scene_from_file(path, notify, catch, n_steps, folder, outcome, error)
         character(len=*), intent(in) :: path
         procedure(step_callback_interface) :: notify
+        logical, intent(in) :: catch
         integer, intent(out) :: n_steps, outcome
         character(len=:), allocatable, intent(out) :: folder
         type(error_type), allocatable, intent(out) :: error
@@ -109,9 +117,17 @@ contains
         writer%notify => notify
         writer%time_start = scene%path%time(1)
         writer%time_end = scene%path%time(size(scene%path%time))
+        if (catch) call catch_interrupts(kill_on_second=.false.)
         call solve_with_outputs(config, scene, writer, error, stage, status, stopped, &
             unwind_stat=status_stop_request)
+        if (catch) call release_interrupts()
         n_steps = writer%n_steps
+        if (allocated(error)) then
+            if (error%stat == interrupt_stat) then
+                outcome = outcome_interrupted
+                return
+            end if
+        end if
         if (stopped) outcome = outcome_max_steps
         if (writer%stop_requested .and. .not. allocated(error)) outcome = outcome_stopped
         if (allocated(error)) call set_stage(error, stage, status)

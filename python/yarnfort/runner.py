@@ -10,25 +10,24 @@ current working directory: the same output files, relative file names in the sce
 
 Progress: after every converged step, once its files are written, a call-back gets a
 :class:`Step`; ``progress=True`` shows a :mod:`tqdm` bar (``tqdm.auto``: a widget in
-Jupyter) over the load path's pseudo-time. Ctrl-C (SIGINT) during the run stops it at
-the end of the step being solved: that step and every earlier one are complete on disk
-(curve rows, VTK states, ``restart.dat``), and :class:`RunInterrupted` (a
-:class:`KeyboardInterrupt`) is raised with the :class:`RunResult`; the run can go on with
-``&control restart = .true.``. A step in progress is not abandoned: a very long Newton
-solve delays the stop until it ends.
+Jupyter) over the load path's pseudo-time. Ctrl-C (SIGINT) during the run stops it
+within a Newton iteration (the solver polls for it): the step being solved is abandoned,
+every converged step before it is complete on disk (curve rows, VTK states,
+``restart.dat``), and :class:`RunInterrupted` (a :class:`KeyboardInterrupt`) is raised
+with the :class:`RunResult` and a message naming the last converged step and its load;
+the run can go on with ``&control restart = .true.``. (Run from a thread other than the
+main one, Ctrl-C is not caught: Python delivers it to the main thread.)
 """
 from __future__ import annotations
 
 import os
-import signal
 import tempfile
 import threading
 import warnings
 from collections.abc import Callable
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 from ._native import check_status, extension
 from .results import Curve, State, read_curve, read_states
@@ -36,7 +35,7 @@ from .results import Curve, State, read_curve, read_states
 __all__ = ["run_scene", "RunResult", "RunInterrupted", "Step", "OUTCOMES"]
 
 #: The facade's outcome codes of a run that did not fail.
-OUTCOMES: dict[int, str] = {0: "done", 1: "max_steps", 2: "stopped"}
+OUTCOMES: dict[int, str] = {0: "done", 1: "max_steps", 2: "stopped", 3: "interrupted"}
 
 
 @dataclass(frozen=True)
@@ -121,13 +120,21 @@ class RunResult:
 
 
 class RunInterrupted(KeyboardInterrupt):
-    """Ctrl-C stopped a run at a step boundary; ``result`` describes what was kept."""
+    """Ctrl-C stopped a run at a step boundary (the step being solved is abandoned);
+    ``result`` describes what was kept, ``detail`` the library's account of it (the step
+    abandoned, the last converged step and its load)."""
 
-    def __init__(self, result: RunResult) -> None:
-        super().__init__(f"run interrupted after {result.n_steps} converged steps; results"
-                         f" so far in {result.folder} (continue with &control restart ="
-                         " .true.)")
+    def __init__(self, result: RunResult, detail: str = "") -> None:
+        where = f"{detail}; " if detail else ""
+        if detail and "nothing is kept" in detail:
+            advice = "run the scene again to start over"
+        else:
+            advice = (f"results so far in {result.folder}; to go on from the last converged"
+                      " step, run the same scene with &control restart = .true.")
+        super().__init__(f"run interrupted after {result.n_steps} converged steps of this"
+                         f" run: {where}{advice}")
         self.result = result
+        self.detail = detail
 
 
 class _TqdmProgress:
@@ -148,20 +155,6 @@ class _TqdmProgress:
 
     def close(self) -> None:
         self.bar.close()
-
-
-@contextmanager
-def _catch_sigint(flag: threading.Event) -> Iterator[None]:
-    """While running, SIGINT sets ``flag`` instead of raising (main thread only)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.getsignal(signal.SIGINT)
-    signal.signal(signal.SIGINT, lambda number, frame: flag.set())
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 def run_scene(scene: str | os.PathLike | Any, *,
@@ -188,7 +181,7 @@ def run_scene(scene: str | os.PathLike | Any, *,
         For bad input or a bad restart file (``status`` 2, nothing written) or a failed
         solve (``status`` 1; the converged steps are kept and ``result`` describes them).
     RunInterrupted
-        After Ctrl-C, once the step being solved is complete on disk.
+        After Ctrl-C, within a Newton iteration; the converged steps are on disk.
     TypeError
         If ``progress`` is neither a bool nor a callable (before anything runs).
     """
@@ -205,7 +198,6 @@ def run_scene(scene: str | os.PathLike | Any, *,
 
 
 def _run_file(path: Path, progress: bool | Callable[[Step], Any]) -> RunResult:
-    interrupted = threading.Event()
     failure: list[BaseException] = []
     bar = _TqdmProgress() if progress is True else None
     report = bar if bar is not None else progress if callable(progress) else None
@@ -227,18 +219,18 @@ def _run_file(path: Path, progress: bool | Callable[[Step], Any]) -> RunResult:
                     stopped_by_callback = True
         except BaseException as error:  # noqa: BLE001 - re-raised after the run
             failure.append(error)
-        return 1 if interrupted.is_set() or failure or stopped_by_callback else 0
+        return 1 if failure or stopped_by_callback else 0
 
+    # The library's SIGINT handler (a flag its solver polls) replaces Python's for the
+    # run, on the main thread only: signals are delivered to it.
+    catch = threading.current_thread() is threading.main_thread()
     try:
-        with _catch_sigint(interrupted):
-            status, message, n_steps, folder, outcome = extension().run_scene_file(
-                os.fsencode(path), notify)
+        status, message, n_steps, folder, outcome = extension().run_scene_file(
+            os.fsencode(path), notify, int(catch))
     finally:
         if bar is not None:
             bar.close()
     name = OUTCOMES.get(int(outcome), "done")
-    if name == "stopped" and interrupted.is_set():
-        name = "interrupted"
     folder_text = os.fsdecode(folder.strip()) if isinstance(folder, bytes) else folder.strip()
     result = RunResult(Path.cwd() / folder_text, int(n_steps),
                        "failed" if status != 0 else name)
@@ -248,7 +240,9 @@ def _run_file(path: Path, progress: bool | Callable[[Step], Any]) -> RunResult:
             raise RunInterrupted(result) from failure[0]
         raise failure[0]
     if name == "interrupted":
-        raise RunInterrupted(result)
+        detail = message.decode("utf-8", errors="replace") if isinstance(message, bytes) \
+            else message
+        raise RunInterrupted(result, detail.strip())
     _warn_of_jumps(result)
     return result
 

@@ -246,15 +246,6 @@ def _split(group: f90nml.Namelist, names: tuple[str, ...]) -> tuple[dict, dict]:
     return known, extra
 
 
-def _without_unset_markers(group: str, variables: dict[str, Any]) -> dict[str, Any]:
-    """Variables as read from a namelist, without the law parameters that hold the file
-    format's 'not set' value (their default, e.g. ``stiffness = -1.0`` in an echoed
-    input): in Python an unset parameter is None, and every given value is checked."""
-    known = _known_variables(group)
-    return {key: value for key, value in variables.items()
-            if not (key in known and known[key]["laws"] and value == known[key]["default"])}
-
-
 #: Array variables whose unset entries take the default 0 (``displacement(2) = -0.3``
 #: leaves the first and third at 0), with the length they have.
 _ZERO_FILLED: dict[tuple[str, str], int | None] = {
@@ -1068,7 +1059,6 @@ class Scene:
                 objects = []
                 for group in groups:
                     known, extra = _split(group, names)
-                    known = _without_unset_markers(key, known)
                     if key == "contact" and "at" in known:
                         known.setdefault("materials", ())
                     objects.append(kind(**_defaults_filled(key, known), extra=extra))

@@ -16,6 +16,7 @@ program yarnfort_main
     use yarnfort_app_progress, only: progress_writer_type
     use yarnfort_output_filesystem, only: ignore_file_size_signal
     use yarnfort_linalg_process, only: apply_process_settings
+    use yarnfort_solver_interrupt, only: catch_interrupts, release_interrupts, interrupt_stat
     implicit none
     type(config_type) :: config
     type(scene_type), target :: scene
@@ -63,8 +64,15 @@ program yarnfort_main
 
     writer%progress = config%output%progress
     writer%residual_history = config%output%residual_history
+    ! Ctrl-C stops the solve at its next poll (within a Newton iteration); a second one
+    ! ends the process at once.
+    call catch_interrupts(kill_on_second=.true.)
     call solve_with_outputs(config, scene, writer, error, stage, status, stopped)
-    if (allocated(error)) call fail(stage, error, status)
+    call release_interrupts()
+    if (allocated(error)) then
+        if (error%stat == interrupt_stat) call stop_interrupted(error)
+        call fail(stage, error, status)
+    end if
     if (stopped) then
         write(error_unit, '(a, i0, a)') 'yarnfort: stopped after max_steps = ', &
             config%control%max_steps, ' load steps; results so far in ' &
@@ -131,10 +139,29 @@ contains
             '.yarnfort-lock while it runs (a second run into the folder stops at once).', &
             'Progress lines go to stderr. Exit code 0 on success, 1 if the solve or a write', &
             'failed (e.g. a full disk; converged steps are kept), 2 for bad input, an', &
-            'unwritable or locked output folder, or a restart file that does not fit.', &
+            'unwritable or locked output folder, or a restart file that does not fit, 130', &
+            'after Ctrl-C (honoured within a Newton iteration; converged steps are kept).', &
             'After every converged step it also writes restart.dat; &control restart =', &
             '.true. continues a stopped or failed run from its last converged step.'
     end subroutine print_help
+
+    !> After Ctrl-C: what was kept, how to go on, exit code 130 (as after SIGINT).
+    subroutine stop_interrupted(error)
+        type(error_type), intent(in) :: error
+        character(len=:), allocatable :: folder
+
+        folder = trim(config%output%folder)
+        write(error_unit, '(a)') 'yarnfort: ' // error%message
+        if (index(error%message, 'nothing is kept') > 0) then
+            write(error_unit, '(a)') 'yarnfort: run the same input again to start over'
+        else
+            write(error_unit, '(a)') 'yarnfort: results so far in ' // folder &
+                // ' (curve.csv, states, restart.dat); to go on from the last converged ' &
+                // 'step, set restart = .true. in the &control group of the same input ' &
+                // 'and run it again'
+        end if
+        stop 130, quiet=.true.
+    end subroutine stop_interrupted
 
     subroutine fail(stage, error, code)
         character(len=*), intent(in) :: stage

@@ -75,15 +75,16 @@ def test_shapes_types_ranges_and_choices():
 
 
 def test_echoed_inputs_read_back_without_markers(tmp_path, monkeypatch):
-    """An echoed input writes unset law parameters as -1 (the file format's 'not set');
-    reading it gives None, and the scene writes and checks as before."""
+    """An echoed input leaves unset law parameters out (no value means 'not set', issue
+    38); reading it gives None, and the scene writes and checks as before."""
     shutil.copytree(TOP / "inputs", tmp_path / "inputs")
     text = (TOP / "inputs" / "knit.nml").read_text().replace("out/knit", str(tmp_path / "o"))
     (tmp_path / "knit.nml").write_text(text)
     monkeypatch.chdir(tmp_path)
     first = yarnfort.run_scene(tmp_path / "knit.nml")
     echoed = (first.folder / "input.nml").read_text()
-    assert "stiffness = -1.0" in echoed
+    assert "\n    stiffness =" not in echoed and "= -1.0" not in echoed
+    assert "modulus" not in echoed and "friction_coefficient = 0.3999" in echoed
     read = Scene.read(first.folder / "input.nml")
     assert [m.stiffness for m in read.materials] == [None, None]
     read.check()
@@ -127,3 +128,14 @@ def test_a_missing_extra_names_the_pip_command(tmp_path, monkeypatch):
         yarnfort.run_sweep(TOP / "inputs" / "vnet.nml",
                            {"material[0].stiffness": [10.0]}, support="ends",
                            scheduler="tcp://127.0.0.1:1", progress=False)
+
+
+def test_minus_one_read_from_a_namelist_is_a_value(tmp_path):
+    """No value means 'not set' (issue 38): stiffness = -1.0 read from a file is refused as
+    out of range, in Python as by the program (tests/data/input/bad_stiffness_minus_one.nml)."""
+    text = (TOP / "inputs" / "vnet.nml").read_text()
+    assert "stiffness = 10.0" in text
+    path = tmp_path / "minus_one.nml"
+    path.write_text(text.replace("stiffness = 10.0", "stiffness = -1.0"))
+    with pytest.raises(SceneError, match=r"stiffness = -1.0 N: must be > 0"):
+        Scene.read(path)

@@ -43,6 +43,12 @@ class Var:
             raise ValueError(f"{self.name}: no doc")
 
     @property
+    def optional(self) -> bool:
+        """A real scalar without a default: not set until the input gives it (an
+        allocatable in Fortran, None in Python), so that no value means 'not set'."""
+        return self.type == "real" and self.shape is None and self.default is None
+
+    @property
     def is_list(self) -> bool:
         return self.shape == "list"
 

@@ -26,7 +26,7 @@ contains
 
         call put(unit, '! yarnfort effective input: every namelist variable with its ' &
             // 'value, defaults included')
-        call put(unit, '! (-1 marks a material or contact parameter that is not set).')
+        call put(unit, '! (a material or contact parameter that is not set is left out).')
         if (len_trim(config%input_folder) > 0) then
             call put(unit, '! Relative file names were resolved against the folder ' &
                 // quote_string(config%input_folder) // '.')

@@ -14,7 +14,8 @@ module yarnfort_input_fields
     private
 
     public :: max_list, max_coordinates, indent
-    public :: group_label, take_scalar, take_array, list_length, is_assigned
+    public :: group_label, take_scalar, take_optional, take_array, list_length, is_assigned
+    public :: optional_text
     public :: check_range, check_choice, check_law_parameter
     public :: suggestion, quoted_list, check_name, check_item_name, put, put_list
 
@@ -65,6 +66,43 @@ contains
         if (len(words(1)%text) == 0) return
         call convert(words(1)%text, sets(first)%line, label, name, field, error, lower, adjust)
     end subroutine take_scalar
+
+    !> Optional real variable `name` (one without a default, such as a law parameter):
+    !> allocated with its value where an assignment among `sets` gives one; unallocated
+    !> (not set) otherwise. Any value a user writes is a value, checked as such.
+    subroutine take_optional(sets, label, name, field, error)
+        type(assignment_type), intent(in) :: sets(:)
+        character(len=*), intent(in) :: label, name
+        real(wp), allocatable, intent(inout) :: field
+        type(error_type), allocatable, intent(out) :: error
+        type(string_type), allocatable :: words(:)
+        real(wp) :: value
+        integer :: k
+
+        value = 0.0_wp
+        call take_scalar(sets, label, name, value, error, .false., .false.)
+        if (allocated(error)) return
+        ! take_scalar found at most one assignment; a null value (`name = ,`) sets nothing.
+        do k = 1, size(sets)
+            if (sets(k)%name /= name) cycle
+            call expand(sets(k), label, 1, words, error)
+            if (allocated(error)) return
+            if (size(words) == 0) return
+            if (len(words(1)%text) > 0) field = value
+        end do
+    end subroutine take_optional
+
+    !> An optional real as text for a message: its value, or 'not set'.
+    function optional_text(value) result(text)
+        real(wp), allocatable, intent(in) :: value
+        character(len=:), allocatable :: text
+
+        if (allocated(value)) then
+            text = format_real(value)
+        else
+            text = 'not set'
+        end if
+    end function optional_text
 
     !> Array variable `name` of group `label` from its assignments among `sets`: `name =`
     !> sets the entries from 1 on, `name(i) =` from i on; the others stay as they are. A

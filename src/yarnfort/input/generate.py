@@ -62,6 +62,8 @@ def declaration(var: Var) -> str:
             "character": f"character(len={var.length})"}[var.type]
     if var.is_list:
         return f"{kind}, allocatable :: {var.name}(:)"
+    if var.optional:
+        return f"{kind}, allocatable :: {var.name}"
     shape = f"({var.size})" if var.size else ""
     return f"{kind} :: {var.name}{shape}"
 
@@ -169,8 +171,7 @@ def law_block(var: Var, law_bound: list[Var]) -> list[tuple[int, str]]:
             if v.type == "character":
                 is_set, text = f"len_trim(value%{v.name}) > 0", f"quote_string(value%{v.name})"
             else:
-                is_set = f".not. (value%{v.name} == {fortran_default(v)})"
-                text = f"format_real(value%{v.name})"
+                is_set, text = f"allocated(value%{v.name})", f"optional_text(value%{v.name})"
             body.append((1, f"call check_law_parameter(error, label, '{v.name}', {is_set}, "
                             f"{text}, '{law}', {'.true.' if needed else '.false.'})"))
             for call in range_check(v, f"value%{v.name}", f"'{v.name}'") if needed else []:
@@ -226,7 +227,10 @@ def read_routine(group: Group) -> list[str]:
         args = (f"sets, label, '{var.name}', value%{var.name}, error, "
                 f"{'.true.' if var.lower else '.false.'}, "
                 f"{'.true.' if var.adjust and var.type == 'character' else '.false.'}")
-        if var.is_list:
+        if var.optional:
+            takes.append(f"call take_optional(sets, label, '{var.name}', value%{var.name}, "
+                         "error)")
+        elif var.is_list:
             takes += [f"call list_length(sets, label, '{var.name}', {var.max}, n, error)",
                       "if (allocated(error)) return", f"allocate(value%{var.name}(n))",
                       f"call take_array({args}, most={var.max})"]
@@ -312,6 +316,10 @@ def write_routine(group: Group) -> list[str]:
         if var.is_list:
             puts.append(f"if (allocated({field})) call put_list(unit, '{var.name}', {field})")
             continue
+        if var.optional:
+            puts.append(f"if (allocated({field})) call put(unit, indent // '{var.name} = ' "
+                        f"// format_real({field}))")
+            continue
         text = {"character": "quote_string({})", "real": "format_real({})",
                 "integer": "format_integer({})",
                 "logical": "trim(merge('.true. ', '.false.', {}))"}[var.type]
@@ -350,7 +358,7 @@ def type_definition(group: Group) -> list[str]:
     out = doc_comment(f"&{group.name}: {group.doc}", INDENT)
     out.append(f"{INDENT}type, public :: {group.type_name}")
     for var in group.variables:
-        default = "" if var.is_list else f" = {fortran_default(var)}"
+        default = "" if var.is_list or var.optional else f" = {fortran_default(var)}"
         out += doc_comment(var.doc, INDENT * 2) + [INDENT * 2 + declaration(var) + default]
     return out + [f"{INDENT}end type {group.type_name}", ""]
 
@@ -406,7 +414,8 @@ def fortran_module() -> str:
 
         """, at="", publics=", ".join(publics), choices=", ".join(choices),
         fields="max_list, max_coordinates, group_label, take_scalar, take_array, list_length, "
-        "is_assigned, check_range, check_choice, check_law_parameter, put, put_list, indent",
+        "is_assigned, check_range, check_choice, check_law_parameter, put, put_list, indent, "
+        "take_optional, optional_text",
         lengths=[f"integer, parameter :: {k} = {v}" for k, v in LENGTHS.items()],
         group_names=[string_array("group_names", [g.name for g in GROUPS])],
         singleton_names=[string_array("singleton_names",

@@ -53,6 +53,8 @@ contains
         do m = 1, size(config%materials)
             associate(material => config%materials(m))
                 if (material%law /= 'neo_hookean') cycle
+                ! Not set: the law's checks name the missing parameter.
+                if (.not. (allocated(material%modulus) .and. allocated(material%area))) cycle
                 ! The law's force scale is modulus * area, its stiffness 3 times that.
                 if (.not. (3 * material%modulus * material%area <= huge(1.0_wp) &
                         .and. material%modulus * material%area >= tiny(1.0_wp))) then

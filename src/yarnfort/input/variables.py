@@ -37,10 +37,11 @@ LIKE_CURVE = ('Written, flushed and resumed on restart like `curve.csv` (a resta
 
 def law_parameter(name: str, unit: str, range: str, laws: list[str], doc: str,
                   **extra: object) -> Var:
-    """A real parameter of the laws `laws` of the group's selecting variable; -1 means
-    not set (required for those laws, an error for the others)."""
-    return Var(name, 'real', -1.0, unit=unit, range=range, laws=laws,
-               default_doc='`-1` (not set)', doc=doc, **extra)  # type: ignore[arg-type]
+    """A real parameter of the laws `laws` of the group's selecting variable, without a
+    default: not set until the input gives it (required for those laws, an error for the
+    others); every value given is checked as a value."""
+    return Var(name, 'real', None, unit=unit, range=range, laws=laws,
+               default_doc='not set', doc=doc, **extra)  # type: ignore[arg-type]
 
 
 def node_set(doc: str) -> Var:
@@ -252,8 +253,8 @@ GROUPS = [
             doc='`table`: the unit of the force column, as its header would state it; must '
                 'agree with a unit the header states. Case-sensitive (`gf`, `kgf`, `lbf` in '
                 'any case).'),
-        Var('gauge_length', 'real', -1.0, unit='m', range='> 0', checked_by='table',
-            default_doc='`-1` (not set)',
+        Var('gauge_length', 'real', None, unit='m', range='> 0', checked_by='table',
+            default_doc='not set',
             doc='`table`: initial length of the tensile specimen; required when the strain '
                 'column is an elongation (a length unit), an error otherwise: strain = '
                 'elongation / gauge_length.'),

@@ -137,8 +137,7 @@ contains
         case ('table')
             path = trim(material%table_file)
             if (present(folder)) path = resolve_path(path, folder)
-            ! gauge_length = -1: not set.
-            if (material%gauge_length == -1.0_wp) then
+            if (.not. allocated(material%gauge_length)) then
                 call read_table_law(table, path, error, strain_unit=trim(material%strain_unit), &
                     force_unit=trim(material%force_unit))
             else
@@ -164,7 +163,7 @@ contains
         else if (len_trim(material%force_unit) > 0) then
             name = 'force_unit'
             text = quote_string(trim(material%force_unit))
-        else if (.not. material%gauge_length == -1.0_wp) then
+        else if (allocated(material%gauge_length)) then
             name = 'gauge_length'
             text = format_real(material%gauge_length)
         else

@@ -9,12 +9,13 @@
 module yarnfort_solver_continuation
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
-    use yarnfort_text, only: format_short
+    use yarnfort_text, only: format_short, format_integer, format_real
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_newton, only: newton_stats_type
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_solver_timer, only: wall_time
+    use yarnfort_solver_interrupt, only: interrupt_requested, interrupt_stat
     implicit none
     private
 
@@ -116,7 +117,12 @@ contains
                 call path%get_factors(t, factors)
                 call stepper%try_step(factors, stats, iterations, error)
                 if (allocated(error)) then
+                    if (interrupt_requested()) then
+                        call stop_interrupted(-1)
+                        return
+                    end if
                     call prefix_error(error, 'initial state (time 0)')
+                    error%message = error%message // initial_state_hint(error%message)
                     return
                 end if
                 call stepper%accept()
@@ -134,6 +140,10 @@ contains
             cuts = 0
             start = wall_time()
             do while (t < t_end - knot_tolerance * span)
+                if (interrupt_requested()) then
+                    call stop_interrupted(step)
+                    return
+                end if
                 if (present(max_steps)) then
                     if (max_steps > 0 .and. step - first_step >= max_steps) then
                         if (present(stopped)) stopped = .true.
@@ -153,6 +163,10 @@ contains
                 call path%get_factors(t_next, factors)
                 call stepper%try_step(factors, stats, iterations, step_error)
                 if (allocated(step_error)) then
+                    if (interrupt_requested()) then
+                        call stop_interrupted(step)
+                        return
+                    end if
                     cuts = cuts + 1
                     call observer%on_cut(t, t_next - t, step_error%message)
                     dt = (t_next - t) / interval * scene%solver%step_cut
@@ -195,6 +209,61 @@ contains
             end do
         end associate
     contains
+        !> The error of a run stopped by Ctrl-C while solving the step after `last` (-1:
+        !> step 0): what the output keeps, the last converged step and its load.
+        subroutine stop_interrupted(last)
+            integer, intent(in) :: last
+            real(wp), allocatable :: kept(:)
+            character(len=:), allocatable :: loads
+            integer :: c
+
+            if (last < 0) then
+                call fatal_error(error, 'interrupted (SIGINT, Ctrl-C) while solving the ' &
+                    // 'initial state (step 0); no step converged, so nothing is kept to ' &
+                    // 'restart from', stat=interrupt_stat)
+                return
+            end if
+            allocate(kept(size(factors)))
+            call scene%path%get_factors(t, kept)
+            loads = ''
+            do c = 1, size(kept)
+                loads = loads // merge(', ', '  ', c > 1) // trim(scene%path%channel(c)) &
+                    // ' = ' // format_real(kept(c))
+            end do
+            call fatal_error(error, 'interrupted (SIGINT, Ctrl-C) while solving step ' &
+                // format_integer(last + 1) // '; kept: steps up to the last converged ' &
+                // 'step ' // format_integer(last) // ' (time ' // format_real(t) // ';' &
+                // loads(2:) // ')', stat=interrupt_stat)
+        end subroutine stop_interrupted
+
+        !> What in a scene usually makes its initial state fail, for the failure `message`
+        !> (the cases of tests/cli/test_interrupt.py): a user reads the scene, not KINSOL.
+        function initial_state_hint(message) result(hint)
+            character(len=*), intent(in) :: message
+            character(len=:), allocatable :: hint
+            integer :: c
+
+            if (index(message, 'singular') > 0) then
+                hint = '. Hint: a singular matrix usually means that a node or a part of ' &
+                    // 'the network is held in no way in some direction (a rigid-body ' &
+                    // 'motion: a &support is missing, e.g. fix = ''z'' for a planar scene), ' &
+                    // 'or that a loaded node sits on straight strings at zero tension, ' &
+                    // 'which have no stiffness across them (&solver slack_stiffness = 0)'
+            else
+                hint = '. Hint: the initial state is solved in one step from the drawn ' &
+                    // 'geometry; that usually fails when the load at the first knot of ' &
+                    // '&path is large (start the path at 0 and let the steps ramp it), ' &
+                    // 'when prestress or reference lengths (length0, stretch) are far from ' &
+                    // 'the drawn lengths, or in a clamped knit with sides = ''free'' whose ' &
+                    // 'cast-on and bind-off threads are not taut (&fabric edge_material: a ' &
+                    // 'yarn type with a prestress well above the loops'')'
+            end if
+            do c = 1, size(factors)
+                if (factors(c) /= 0.0_wp) hint = hint // '; this path starts at ' &
+                    // trim(scene%path%channel(c)) // ' = ' // format_real(factors(c))
+            end do
+        end function initial_state_hint
+
         subroutine report(step_cuts)
             integer, intent(in) :: step_cuts
             call stepper%get_state(state, error)

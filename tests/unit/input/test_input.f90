@@ -256,8 +256,8 @@ contains
         if (allocated(error)) return
         call check(error, config%geometry%file == '', 'no geometry file')
         if (allocated(error)) return
-        call check_close(error, [config%materials(1)%modulus, config%materials(1)%area], &
-            [-1.0_wp, -1.0_wp], exact, 'unset material parameters')
+        call check(error, .not. (allocated(config%materials(1)%modulus) &
+            .or. allocated(config%materials(1)%area)), 'unset material parameters not set')
     end subroutine test_defaults
 
     subroutine test_any_order(error)
@@ -346,9 +346,12 @@ contains
             if (allocated(error)) return
             call check(error, contact%law == 'coulomb', 'contact 1 law (lower case)')
             if (allocated(error)) return
-            call check_close(error, [contact%friction_coefficient, contact%adhesion, &
-                contact%decay_start, contact%decay_end], [0.3_wp, -1.0_wp, -1.0_wp, -1.0_wp], &
-                exact, 'contact 1 parameters (unset ones -1)')
+            call check_close(error, contact%friction_coefficient, 0.3_wp, exact, &
+                'contact 1 friction_coefficient')
+            if (allocated(error)) return
+            call check(error, .not. (allocated(contact%adhesion) .or. &
+                allocated(contact%decay_start) .or. allocated(contact%decay_end)), &
+                'contact 1: the parameters it does not give are not set')
             if (allocated(error)) return
         end associate
         associate(contact => config%contacts(2))
@@ -574,8 +577,14 @@ contains
                     call fatal_error(error, what // ' differs (text)')
                     return
                 end if
-                call check_reals(error, [a%stiffness, a%modulus, a%area], &
-                    [e%stiffness, e%modulus, e%area], what)
+                call check_optional(error, a%stiffness, e%stiffness, what // ' stiffness')
+                if (allocated(error)) return
+                call check_optional(error, a%modulus, e%modulus, what // ' modulus')
+                if (allocated(error)) return
+                call check_optional(error, a%area, e%area, what // ' area')
+                if (allocated(error)) return
+                call check_optional(error, a%gauge_length, e%gauge_length, &
+                    what // ' gauge_length')
                 if (allocated(error)) return
             end associate
         end do
@@ -590,9 +599,14 @@ contains
                     call fatal_error(error, what // ' differs (text)')
                     return
                 end if
-                call check_reals(error, [a%friction_coefficient, a%adhesion, a%decay_start, &
-                    a%decay_end], [e%friction_coefficient, e%adhesion, e%decay_start, &
-                    e%decay_end], what)
+                call check_optional(error, a%friction_coefficient, e%friction_coefficient, &
+                    what // ' friction_coefficient')
+                if (allocated(error)) return
+                call check_optional(error, a%adhesion, e%adhesion, what // ' adhesion')
+                if (allocated(error)) return
+                call check_optional(error, a%decay_start, e%decay_start, what // ' decay_start')
+                if (allocated(error)) return
+                call check_optional(error, a%decay_end, e%decay_end, what // ' decay_end')
                 if (allocated(error)) return
             end associate
         end do
@@ -674,6 +688,19 @@ contains
             end if
         end associate
     end subroutine check_configs_equal
+
+    !> Optional reals both not set, or both set to the same value (check_reals).
+    subroutine check_optional(error, actual, expected, what)
+        type(error_type), allocatable, intent(out) :: error
+        real(wp), allocatable, intent(in) :: actual, expected
+        character(len=*), intent(in) :: what
+
+        if (allocated(actual) .neqv. allocated(expected)) then
+            call fatal_error(error, what // ': set in one, not set in the other')
+        else if (allocated(actual)) then
+            call check_reals(error, [actual], [expected], what)
+        end if
+    end subroutine check_optional
 
     !> Equal reals, bit for bit apart from NaN payloads.
     subroutine check_reals(error, actual, expected, what)

@@ -14,6 +14,7 @@ module yarnfort_contact_stepper_monolithic
         stop_flowing_back, check_damped, not_settled
     use yarnfort_contact_stepper_predictor, only: predicted_state, reversed, predict, &
         predict_modes
+    use yarnfort_solver_interrupt, only: interrupt_requested
     implicit none
     private
 
@@ -100,6 +101,7 @@ contains
             solved_before = .false.
             failed_before = self%trace%failed_solves
             do round = 1, scene%solver%max_friction_iterations
+                if (interrupt_requested()) exit     ! Ctrl-C: the step fails, unsettled
                 problem%mode = self%mode_trial
                 ! Rounds with slipping passages are fast Newton solves (full steps only):
                 ! a set with no solution nearby is cheaper to give up than to push through

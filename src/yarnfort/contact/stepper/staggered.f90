@@ -14,6 +14,7 @@ module yarnfort_contact_stepper_staggered
     use yarnfort_contact_stepper_active_set, only: max_flips, update_active_set, &
         check_damped, not_settled
     use yarnfort_contact_stepper_predictor, only: reversed, predict
+    use yarnfort_solver_interrupt, only: interrupt_requested
     implicit none
     private
 
@@ -74,6 +75,7 @@ contains
             relax = .false.
             may_finish = scene%dofs%n_unknowns > 0
             do round = 1, scene%solver%max_friction_iterations
+                if (interrupt_requested()) exit     ! Ctrl-C: the step fails, unsettled
                 ! (1) Elastic step: reference lengths frozen.
                 flow_in = self%flow_trial
                 call scene%passages%get_length0(scene%network%length0, self%flow_trial, &

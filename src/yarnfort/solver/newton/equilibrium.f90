@@ -9,6 +9,7 @@ module yarnfort_solver_newton_equilibrium
     use yarnfort_error, only: error_type
     use yarnfort_solver_problem, only: nonlinear_problem_type, regularisation_type
     use yarnfort_solver_timer, only: wall_time
+    use yarnfort_solver_interrupt, only: check_interrupt
     implicit none
     private
 
@@ -51,6 +52,9 @@ contains
         real(wp), intent(out) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp) :: start
+        ! Every Newton path evaluates here: Ctrl-C fails the solve within an iteration.
+        call check_interrupt(error)
+        if (allocated(error)) return
         start = wall_time()
         if (jacobian) then
             call problem%problem%evaluate_jacobian(u, values, error, problem%law)
