@@ -413,10 +413,8 @@ contains
         if (allocated(error)) return
         allocate(node_level(self%scene%network%n_nodes()), node_noise(self%scene%network%n_nodes()))
         ! From the tensions and their rounding at this state (update_state), not evaluated
-        ! again (that second loop over the elements took 6-8 % of a woven cycle's CPU at
-        ! 96,600 unknowns, benchmarks/results-issue16-run7.md section 1). Measured, CPU
-        ! per cycle step, same run: woven 10,120 unknowns 9.94 -> 8.99 ms, 96,600 180.4 ->
-        ! 167.9 ms; the same counts, forces bitwise equal on 47 scenes.
+        ! again: a second loop over the elements cost 6-8 % of a woven cycle (docs/
+        ! decisions.md, 'Row levels from the state's tensions').
         call gather_node_force_levels(self%scene, self%tension, self%rounding, self%factors, &
             self%loaded, self%load_magnitude, node_level, node_noise, max_force)
         row = 0
