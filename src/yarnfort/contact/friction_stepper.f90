@@ -164,8 +164,9 @@ contains
         ! of the set the path has a kink, and extrapolating it costs iterations
         ! (docs/decisions.md, "Predictor: secant, parabola along one active set, reversed
         ! at a turn").
-        self%have_older = self%have_old .and. self%held .and. all(self%mode_trial == self%mode)
-        self%held = self%have_old .and. all(self%mode_trial == self%mode)
+        self%have_older = self%have_old .and. self%set_repeated &
+            .and. all(self%mode_trial == self%mode)
+        self%set_repeated = self%have_old .and. all(self%mode_trial == self%mode)
         if (self%have_older) then
             self%u_older = self%u_old
             self%flow_older = self%flow_old
@@ -187,7 +188,7 @@ contains
         if (self%jumped) then
             self%have_old = .false.
             self%have_older = .false.
-            self%held = .false.
+            self%set_repeated = .false.
         end if
     end subroutine accept
 
@@ -227,7 +228,7 @@ contains
             snapshot%flow_old = self%flow
         end if
         snapshot%have_older = self%have_older
-        snapshot%held = self%held
+        snapshot%set_repeated = self%set_repeated
         snapshot%load_older = self%load_older
         snapshot%u_older = self%u_older
         snapshot%flow_older = self%flow_older
@@ -250,7 +251,7 @@ contains
         self%u_old = snapshot%u_old
         self%flow_old = snapshot%flow_old
         self%have_older = snapshot%have_older
-        self%held = snapshot%held
+        self%set_repeated = snapshot%set_repeated
         self%load_older = snapshot%load_older
         self%u_older = snapshot%u_older
         self%flow_older = snapshot%flow_older

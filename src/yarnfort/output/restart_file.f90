@@ -20,7 +20,7 @@
 !>     factors(n_channels) (the load channels' factors), u(n_unknowns), u_old(n_unknowns),
 !>     length0(n_elements),
 !>     flow(n_passages), flow_old(n_passages) (reals), mode(n_passages) (integers),
-!>     load_older (real), have_older, held (integers 0 or 1), u_older(n_unknowns),
+!>     load_older (real), have_older, set_repeated (integers 0 or 1), u_older(n_unknowns),
 !>     flow_older(n_passages) (reals),
 !>     'end-of-restart' (16 characters), then the checksum of every byte before it
 !>     (16 hex digits), so a file damaged after it was written is refused.
@@ -118,7 +118,7 @@ contains
                 end if
             end if
             if (status == 0) write(unit, iostat=status, iomsg=message) s%load_older, &
-                merge(1, 0, s%have_older), merge(1, 0, s%held)
+                merge(1, 0, s%have_older), merge(1, 0, s%set_repeated)
             if (status == 0) call put_reals(s%u_older, s%n_unknowns)
             if (status == 0) call put_reals(s%flow_older, s%n_passages)
             if (status == 0) write(unit, iostat=status, iomsg=message) end_marker
@@ -183,7 +183,7 @@ contains
         character(len=16) :: header, marker, checksum
         character(len=32) :: text
         character(len=256) :: message
-        integer :: unit, status, version, have_old, n_channels, have_older, held
+        integer :: unit, status, version, have_old, n_channels, have_older, set_repeated
         integer(int64) :: file_size, position, expected
         logical :: exists
 
@@ -264,13 +264,13 @@ contains
                 return
             end if
             read(unit, iostat=status) s%factors, s%u, s%u_old, s%length0, s%flow, &
-                s%flow_old, s%mode, s%load_older, have_older, held, s%u_older, &
+                s%flow_old, s%mode, s%load_older, have_older, set_repeated, s%u_older, &
                 s%flow_older, marker, checksum
             if (status == 0 .and. marker /= end_marker) status = -1
             s%have_older = have_older == 1
-            s%held = held == 1
+            s%set_repeated = set_repeated == 1
             if (status == 0 .and. (have_older /= 0 .and. have_older /= 1 &
-                    .or. held /= 0 .and. held /= 1)) then
+                    .or. set_repeated /= 0 .and. set_repeated /= 1)) then
                 close(unit)
                 call fatal_error(error, "&control restart: '" // path // "' is damaged: " &
                     // 'a size or flag field holds an impossible value')

@@ -42,9 +42,9 @@ module yarnfort_solver_restart
         real(wp) :: time_old = 0.0_wp
         real(wp), allocatable :: u_old(:), flow_old(:)
         !> Friction: the accepted state before that (position unknowns, flows, sum of the
-        !> factors) for the quadratic predictor, valid when `have_older`; `held`: the
+        !> factors) for the quadratic predictor, valid when `have_older`; `set_repeated`: the
         !> active set held over the last step.
-        logical :: have_older = .false., held = .false.
+        logical :: have_older = .false., set_repeated = .false.
         real(wp) :: load_older = 0.0_wp
         real(wp), allocatable :: u_older(:), flow_older(:)
     end type restart_type

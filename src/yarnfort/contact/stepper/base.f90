@@ -35,11 +35,11 @@ module yarnfort_contact_stepper_base
         real(wp) :: load_old = 0.0_wp
         logical :: have_old = .false.
         !> The accepted state before u_old, for a quadratic predictor: valid when the
-        !> active set held over the last two steps (`have_older`); `held`: it held over
-        !> the last one.
+        !> active set held over the last two steps (`have_older`); `set_repeated`: it held
+        !> over the last one.
         real(wp), allocatable :: u_older(:), flow_older(:)
         real(wp) :: load_older = 0.0_wp
-        logical :: have_older = .false., held = .false.
+        logical :: have_older = .false., set_repeated = .false.
         !> The accepted state is the initial one (no load step accepted since).
         logical :: from_initial = .false.
         !> Passages held in stick by chatter damping in the last step.
