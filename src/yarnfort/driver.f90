@@ -3,12 +3,13 @@
 !> with its outputs, as the program and the Python facade run it.
 module yarnfort_driver
     use yarnfort_kinds, only: wp
-    use yarnfort_error, only: error_type, prefix_error
-    use yarnfort_input_config, only: config_type
+    use yarnfort_error, only: error_type, prefix_error, fatal_error
+    use yarnfort_input_config, only: config_type, control_config_type, output_config_type
+    use yarnfort_input_echo, only: write_config
     use yarnfort_output_writer, only: output_writer_type
     use yarnfort_output_restart_file, only: read_restart, check_restart, get_input_hash, &
         restart_file_name, synced_file_name
-    use yarnfort_text, only: format_integer
+    use yarnfort_text, only: format_integer, string_type, read_line, resolve_path
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_linalg_linear_solver, only: linear_solver_type
     use yarnfort_linalg_factory, only: new_linear_solver, default_linear_solver_name
@@ -88,7 +89,8 @@ contains
         call run_continuation(scene, stepper, observer, error, restart, max_steps, stopped)
     end subroutine run_scene
 
-    !> Solve the built `scene` of `config` with its outputs: open the &output folder with
+    !> Solve the built `scene` of `config` with its outputs: render the input's echo and
+    !> fingerprint (output/ does not read the input), open the &output folder with
     !> `writer` (with &control restart: lock it, read and check its restart.dat before
     !> touching anything else, tell `writer` (on_resume) and resume after that step),
     !> write the effective input, follow the load path (`stopped`: &control max_steps
@@ -108,10 +110,15 @@ contains
         integer, intent(in), optional :: unwind_stat
         type(restart_type) :: restart
         type(error_type), allocatable :: finish_error
+        type(string_type), allocatable :: echo(:), hashed_echo(:)
 
         stopped = .false.
         status = 2
-        writer%input_hash = get_input_hash(config, scene)
+        stage = 'output'
+        call get_echo(config, echo, error)
+        if (.not. allocated(error)) call get_echo(get_hashed_config(config), hashed_echo, error)
+        if (allocated(error)) return
+        writer%input_hash = get_input_hash(hashed_echo, get_named_files(config), scene)
         if (config%control%restart) then
             stage = 'output'
             call writer%lock(config%output%folder, error, create=.false.)
@@ -136,7 +143,7 @@ contains
             call writer%open(scene, error)
         end if
         if (allocated(error)) return
-        call writer%write_input(config, error)
+        call writer%write_input(echo, error)
         if (allocated(error)) then
             call writer%finish(scene, finish_error)     ! releases the folder's lock
             return
@@ -160,6 +167,89 @@ contains
             call move_alloc(finish_error, error)
         end if
     end subroutine solve_with_outputs
+
+    !> The lines of `config`'s echo (write_config), rendered through a scratch file.
+    subroutine get_echo(config, lines, error)
+        type(config_type), intent(in) :: config
+        type(string_type), allocatable, intent(out) :: lines(:)
+        type(error_type), allocatable, intent(out) :: error
+        type(string_type), allocatable :: grown(:)
+        character(len=:), allocatable :: line
+        character(len=256) :: message
+        integer :: unit, status, n
+
+        message = ''
+        open(newunit=unit, status='scratch', form='formatted', action='readwrite', &
+            iostat=status, iomsg=message)
+        if (status /= 0) then
+            call fatal_error(error, 'cannot open a scratch file to echo the input: ' &
+                // trim(message))
+            return
+        end if
+        call write_config(unit, config)
+        rewind(unit)
+        allocate(lines(64))
+        n = 0
+        do
+            call read_line(unit, line, status, message)
+            if (is_iostat_end(status)) exit
+            if (status /= 0) then
+                close(unit)
+                call fatal_error(error, 'cannot read back the echo of the input: ' &
+                    // trim(message))
+                return
+            end if
+            if (n == size(lines)) then
+                ! Doubling keeps the copies linear in the echo's length.
+                allocate(grown(2 * n))
+                grown(:n) = lines
+                call move_alloc(grown, lines)
+            end if
+            n = n + 1
+            call move_alloc(line, lines(n)%text)
+        end do
+        close(unit)
+        lines = lines(:n)
+    end subroutine get_echo
+
+    !> `config` as the restart fingerprint echoes it: without &control and &output (they
+    !> may change between a run and its restart) and without the input folder.
+    function get_hashed_config(config) result(copy)
+        type(config_type), intent(in) :: config
+        type(config_type) :: copy
+
+        copy = config
+        copy%control = control_config_type()
+        copy%output = output_config_type()
+        copy%input_folder = ''
+    end function get_hashed_config
+
+    !> The resolved paths of the files `config` names, in the fingerprint's order: the
+    !> material tables, the contact rate tables, the geometry file (blank names left out).
+    function get_named_files(config) result(files)
+        type(config_type), intent(in) :: config
+        type(string_type), allocatable :: files(:)
+        integer :: m
+
+        allocate(files(0))
+        if (allocated(config%materials)) then
+            do m = 1, size(config%materials)
+                call add(config%materials(m)%table_file)
+            end do
+        end if
+        if (allocated(config%contacts)) then
+            do m = 1, size(config%contacts)
+                call add(config%contacts(m)%rate_table)
+            end do
+        end if
+        call add(config%geometry%file)
+    contains
+        subroutine add(name)
+            character(len=*), intent(in) :: name
+            if (len_trim(name) > 0) &
+                files = [files, string_type(resolve_path(name, config%input_folder))]
+        end subroutine add
+    end function get_named_files
 
     !> After a power cut, restart.dat may be damaged, or on disk further than curve.csv;
     !> restart.sync, the restart file of the last flush to disk, is then one the tables

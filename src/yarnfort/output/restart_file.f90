@@ -30,10 +30,8 @@ module yarnfort_output_restart_file
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: config_type, control_config_type, output_config_type
-    use yarnfort_input_echo, only: write_config
     use yarnfort_scene_scene, only: scene_type
-    use yarnfort_text, only: resolve_path, format_integer, format_real, join_names
+    use yarnfort_text, only: string_type, format_integer, format_real, join_names
     use yarnfort_solver_restart, only: restart_type, stepper_elastic, stepper_friction
     use yarnfort_output_filesystem, only: rename_file, remove_file, sync_file, sync_folder, &
         link_file, close_checked, open_new_file, close_new_file
@@ -527,50 +525,28 @@ contains
         end do
     end subroutine remove_restart
 
-    !> Fingerprint (16 hex digits) of what determines a run's path: the effective input
-    !> without &control and &output (as written by write_config), the content of every
-    !> file it names (material tables, the geometry file), and the built scene's node
+    !> Fingerprint (16 hex digits) of what determines a run's path: `echo`, the lines of
+    !> the effective input's echo without &control and &output and without the input
+    !> folder (the caller renders it: output/ does not read the input), the content of
+    !> the files it names (`files`, resolved paths in the input's order: material
+    !> tables, contact rate tables, the geometry file), and the built scene's node
     !> positions, elements, reference lengths, external forces and load path.
-    function get_input_hash(config, scene) result(hash)
-        type(config_type), intent(in) :: config
+    function get_input_hash(echo, files, scene) result(hash)
+        type(string_type), intent(in) :: echo(:), files(:)
         type(scene_type), intent(in) :: scene
         character(len=16) :: hash
-        type(config_type) :: copy
         integer(int64) :: state(2)
-        character(len=1024) :: chunk
-        integer :: unit, status, n, m
+        integer :: i
 
         state = hash_basis
-        copy = config
-        copy%control = control_config_type()
-        copy%output = output_config_type()
-        copy%input_folder = ''
-        open(newunit=unit, status='scratch', form='formatted', action='readwrite', &
-            iostat=status)
-        if (status == 0) then
-            call write_config(unit, copy)
-            rewind(unit)
-            do
-                read(unit, '(a)', advance='no', size=n, iostat=status) chunk
-                if (is_iostat_end(status)) exit
-                if (status /= 0 .and. .not. is_iostat_eor(status)) exit
-                if (is_iostat_eor(status) .and. any(chunk(:n) == unhashed_defaults)) cycle
-                call add_bytes(transfer(chunk(:n), [0_int8], n))
-                if (is_iostat_eor(status)) call add_bytes([10_int8])
-            end do
-            close(unit)
-        end if
-        if (allocated(config%materials)) then
-            do m = 1, size(config%materials)
-                call add_named_file(config%materials(m)%table_file)
-            end do
-        end if
-        if (allocated(config%contacts)) then
-            do m = 1, size(config%contacts)
-                call add_named_file(config%contacts(m)%rate_table)
-            end do
-        end if
-        call add_named_file(config%geometry%file)
+        do i = 1, size(echo)
+            if (any(echo(i)%text == unhashed_defaults)) cycle
+            call add_bytes(transfer(echo(i)%text, [0_int8], len(echo(i)%text)))
+            call add_bytes([10_int8])
+        end do
+        do i = 1, size(files)
+            call add_file_bytes(state, files(i)%text)
+        end do
         call add_bytes(transfer(scene%network%position, [0_int8]))
         call add_bytes(transfer(scene%network%element_nodes, [0_int8]))
         call add_bytes(transfer(scene%network%length0, [0_int8]))
@@ -585,13 +561,6 @@ contains
             integer(int8), intent(in) :: bytes(:)
             call add_hash_bytes(state, bytes)
         end subroutine add_bytes
-
-        !> The content of a file the input names (nothing for a blank name).
-        subroutine add_named_file(name)
-            character(len=*), intent(in) :: name
-            if (len_trim(name) > 0) &
-                call add_file_bytes(state, resolve_path(name, config%input_folder))
-        end subroutine add_named_file
     end function get_input_hash
 
     !> Add `bytes` to the two 32-bit FNV-1a-like hashes of `state`.

@@ -13,8 +13,7 @@ module yarnfort_output_writer
     use, intrinsic :: iso_fortran_env, only: int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_input_config, only: config_type
-    use yarnfort_input_echo, only: write_config
+    use yarnfort_text, only: string_type
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_observer_type, step_state_type
     use yarnfort_output_curve, only: curve_writer_type, curve_file_name
@@ -76,7 +75,7 @@ module yarnfort_output_writer
         !> Create the folder if needed and take its lock (also done by open).
         procedure :: lock => lock_writer
         procedure :: open => open_writer
-        !> Echo the effective input to folder/input.nml.
+        !> Write the effective input's echo (rendered by the caller) to folder/input.nml.
         procedure :: write_input
         procedure :: on_step
         procedure :: on_checkpoint
@@ -330,14 +329,15 @@ contains
         close(unit)
     end function is_complete
 
-    !> Write folder/input.nml (through input.nml.tmp, renamed when complete).
-    subroutine write_input(self, config, error)
+    !> Write the lines of `echo` to folder/input.nml (through input.nml.tmp, renamed when
+    !> complete). The caller renders the echo, so that output/ does not read the input.
+    subroutine write_input(self, echo, error)
         class(output_writer_type), intent(inout) :: self
-        type(config_type), intent(in) :: config
+        type(string_type), intent(in) :: echo(:)
         type(error_type), allocatable, intent(out) :: error
         type(error_type), allocatable :: ignored
         character(len=:), allocatable :: path, temporary
-        integer :: unit
+        integer :: unit, i, status
 
         path = self%folder // '/' // input_file_name
         temporary = path // '.tmp'
@@ -349,7 +349,9 @@ contains
             return
         end if
         ! A failed write shows when closing: the file is shorter than what was written.
-        call write_config(unit, config)
+        do i = 1, size(echo)
+            write(unit, '(a)', iostat=status) echo(i)%text
+        end do
         call close_new_file(unit, temporary, error)
         if (allocated(error)) return
         call rename_file(temporary, path, error)
