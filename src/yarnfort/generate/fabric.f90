@@ -148,7 +148,7 @@ contains
                 if (len_trim(fabric%inlay_material) > 0) then
                     call check_gap(error)
                     if (allocated(error)) return
-                else if (fabric%gap /= -1.0_wp) then
+                else if (allocated(fabric%gap)) then
                     call fatal_error(error, label // 'gap applies to woven fabrics and to ' &
                         // 'the inlay of a knit; this knit has no inlay_material')
                     return
@@ -292,7 +292,7 @@ contains
                 if (allocated(error)) return
                 call forbid_woven_materials(error)
                 if (allocated(error)) return
-                if (fabric%gap /= -1.0_wp) then
+                if (allocated(fabric%gap)) then
                     call fatal_error(error, label // "gap does not apply to kind = 'texgen' " &
                         // '(the holders take the distances of the model; gap_factor scales ' &
                         // 'them)')
@@ -359,6 +359,11 @@ contains
 
         subroutine check_gap(error)
             type(error_type), allocatable, intent(out) :: error
+            if (.not. allocated(config%fabric%gap)) then
+                call fatal_error(error, label // 'gap is required (the distance between the ' &
+                    // 'axes of two crossing yarns, m)')
+                return
+            end if
             if (.not. (config%fabric%gap > 0.0_wp .and. &
                     config%fabric%gap < minval(config%fabric%spacing))) then
                 write(buffer, '(a, "gap = ", g0, " must be positive and smaller than the ", &

@@ -81,7 +81,8 @@ contains
         allocate(leg_left(0:nw - 1, 0:nc - 1), leg_right(0:nw - 1, 0:nc - 1), source=0)
         allocate(inlay_left(0:nw - 1, 0:nc - 1), inlay_right(0:nw - 1, 0:nc - 1), source=0)
         allocate(inlay_end(2, 0:nc - 1), source=0)
-        half_gap = 0.5_wp * max(fabric%gap, 0.0_wp)
+        half_gap = 0.0_wp
+        if (allocated(fabric%gap)) half_gap = 0.5_wp * max(fabric%gap, 0.0_wp)
         do j = -1, nc - 1
             do i = 0, nw - 1
                 left(i, j) = net%add_node([i * w + a, (j + 1) * c, 0.0_wp])
@@ -286,7 +287,8 @@ contains
         d = fabric%knit_depth
         periodic = fabric%boundary == 'periodic'
         strain = [fabric%strain, fabric%lateral_strain, 0.0_wp]
-        half_gap = 0.5_wp * max(fabric%gap, 0.0_wp)
+        half_gap = 0.0_wp
+        if (allocated(fabric%gap)) half_gap = 0.5_wp * max(fabric%gap, 0.0_wp)
         call get_inlaid_courses(fabric, inlaid)
         allocate(foot_left(0:nw - 1, 0:nc - 1), foot_right(0:nw - 1, 0:nc - 1))
         allocate(head_left(0:nw - 1, 0:nc - 1), head_right(0:nw - 1, 0:nc - 1))

@@ -382,7 +382,7 @@ GROUPS = [
         *[fabric_material(name, 'required (woven)', 'Woven: yarn types along x (warp, the '
                           'loaded direction) and along y (weft).')
           for name in ('warp_material', 'weft_material')],
-        Var('gap', 'real', -1.0, unit='m',
+        Var('gap', 'real', None, unit='m',
             default_doc='required (woven, knit with inlay)',
             type_doc='real, 0 < gap < min(spacing)',
             doc='Gap-holder length: distance between the axes of the two yarns at a crossing.'),
