@@ -33,7 +33,7 @@ CASES = {
                    "&fabric: spacing = -1.0"),
     "negative_spacing": ("spacing = 1.0e-3, 1.0e-3", "spacing = 1.0e-3, -1.0e-3",
                          "must be two positive lengths"),
-    "no_gap": ("gap = 0.2e-3", "", "&fabric: gap = -1.0"),
+    "no_gap": ("gap = 0.2e-3", "", "&fabric: gap is required"),
     "gap_too_wide": ("gap = 0.2e-3", "gap = 2.0e-3",
                      "must be positive and smaller than the yarn spacing"),
     "gap_table_lengths": ("gap = 0.2e-3", "gap = 0.2e-3\n gap_factor_p_disp = 0, 1\n"
@@ -145,7 +145,7 @@ def test_knit_inlay_needs_gap(run_yarnfort, tmp_path):
 """
     run = run_yarnfort(text, cwd=tmp_path)
     assert run.returncode == 2
-    assert "&fabric: gap = -1.0" in run.stderr
+    assert "&fabric: gap is required" in run.stderr
     assert list(tmp_path.iterdir()) == []
 
 
