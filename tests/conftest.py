@@ -16,6 +16,23 @@ TOP = Path(__file__).resolve().parents[1]
 #: build folder is build/), or $YARNFORT_EXE.
 EXECUTABLE = Path(os.environ.get("YARNFORT_EXE") or yarnfort.program_path())
 
+#: A Python process that runs the scene file argv[1] through run_scene, printing
+#: "STEP n" per converged step; on Ctrl-C it prints "INTERRUPTED <steps> <outcome>" and
+#: the exception's text, and exits 130 (tests/cli/test_interrupt.py,
+#: tests/python/test_package.py).
+INTERRUPTED_RUN = r"""
+import sys, yarnfort
+def report(step):
+    print("STEP", step.step, flush=True)
+try:
+    yarnfort.run_scene(sys.argv[1], progress=report)
+except yarnfort.RunInterrupted as stop:
+    print("INTERRUPTED", stop.result.n_steps, stop.result.outcome, flush=True)
+    print(stop, flush=True)
+    sys.exit(130)
+print("FINISHED", flush=True)
+"""
+
 
 @dataclass
 class Run:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from conftest import EXECUTABLE
+from conftest import EXECUTABLE, INTERRUPTED_RUN
 from test_restart import compare_curves, read_rows, with_output
 
 TOP = Path(__file__).resolve().parents[2]
@@ -140,20 +140,6 @@ def test_ctrl_c_in_the_initial_state_keeps_nothing(reference, tmp_path):
             "converged, so nothing is kept to restart from") in run.stderr
     assert "run the same input again to start over" in run.stderr
     assert read_rows(folder) == [] and not (folder / "restart.dat").exists()
-
-
-INTERRUPTED_RUN = r"""
-import sys, yarnfort
-def report(step):
-    print("STEP", step.step, flush=True)
-try:
-    yarnfort.run_scene(sys.argv[1], progress=report)
-except yarnfort.RunInterrupted as stop:
-    print("INTERRUPTED", stop.result.n_steps, stop.result.outcome, flush=True)
-    print(stop, flush=True)
-    sys.exit(130)
-print("FINISHED", flush=True)
-"""
 
 
 def test_ctrl_c_in_run_scene_raises_run_interrupted_within_an_iteration(reference, tmp_path):

@@ -18,6 +18,7 @@ import pytest
 
 import yarnfort
 from yarnfort import Scene, YarnfortError
+from conftest import INTERRUPTED_RUN
 
 TOP = Path(__file__).resolve().parents[2]
 EXAMPLES = sorted((TOP / "inputs").glob("*.nml"))
@@ -372,19 +373,6 @@ def test_pip_install_in_a_fresh_venv(tmp_path):
     out = subprocess.run([str(python), "-c", code], cwd=tmp_path, capture_output=True,
                          text=True, check=True).stdout
     assert "pip install 'yarnfort[pandas]'" in out
-
-
-INTERRUPTED_RUN = r"""
-import sys, yarnfort
-def report(step):
-    print("STEP", step.step, flush=True)
-try:
-    yarnfort.run_scene(sys.argv[1], progress=report)
-except yarnfort.RunInterrupted as stop:
-    print("INTERRUPTED", stop.result.n_steps, stop.result.outcome, flush=True)
-    sys.exit(130)
-print("FINISHED", flush=True)
-"""
 
 
 def test_ctrl_c_from_outside_keeps_the_converged_steps(workdir):
