@@ -46,7 +46,10 @@ module yarnfort_output_restart_file
     character(len=*), parameter :: synced_file_name = 'restart.sync'
     character(len=16), parameter :: magic = 'yarnfort-restart'
     character(len=16), parameter :: end_marker = 'end-of-restart'
-    integer, parameter :: format_version = 4
+    !> Version 5 added the force-control slopes (held_slope) before the end marker; a
+    !> version 4 file, without them, is read with slopes 0 (its restart agrees with the
+    !> uninterrupted run to the outer iteration's tolerance, not bit for bit).
+    integer, parameter :: format_version = 5, oldest_version = 4
     !> Most load channels a restart file may hold (&path channels has at most 8).
     integer, parameter :: max_restart_channels = 64
 
@@ -120,6 +123,7 @@ contains
                 merge(1, 0, s%have_older), merge(1, 0, s%set_repeated)
             if (status == 0) call put_reals(s%u_older, s%n_unknowns)
             if (status == 0) call put_reals(s%flow_older, s%n_passages)
+            if (status == 0) write(unit, iostat=status, iomsg=message) s%held_slope
             if (status == 0) write(unit, iostat=status, iomsg=message) end_marker
         end associate
         call close_new_file(unit, temporary, error, status, message)
@@ -211,12 +215,12 @@ contains
             return
         end if
         read(unit, iostat=status) version
-        if (status /= 0 .or. version /= format_version) then
+        if (status /= 0 .or. version < oldest_version .or. version > format_version) then
             close(unit)
             write(text, '(i0)') version
             call fatal_error(error, "&control restart: '" // path // "' has format version " &
-                // trim(text) // ', this yarnfort reads version ' &
-                // format_integer(format_version))
+                // trim(text) // ', this yarnfort reads versions ' &
+                // format_integer(oldest_version) // ' to ' // format_integer(format_version))
             return
         end if
         associate(s => snapshot)
@@ -240,8 +244,8 @@ contains
             ! What follows must be exactly the arrays of these sizes and the end marker.
             inquire(unit=unit, size=file_size, pos=position)
             expected = 8_int64 * (n_channels + 3_int64 * s%n_unknowns + s%n_elements &
-                + 3_int64 * s%n_passages + 1) + 4_int64 * (s%n_passages + 2) &
-                + len(end_marker) + len(checksum)
+                + 3_int64 * s%n_passages + 1 + merge(2, 0, version >= 5)) &
+                + 4_int64 * (s%n_passages + 2) + len(end_marker) + len(checksum)
             if (file_size - (position - 1) /= expected) then
                 close(unit)
                 write(text, '(i0)') file_size
@@ -264,7 +268,9 @@ contains
             end if
             read(unit, iostat=status) s%factors, s%u, s%u_old, s%length0, s%flow, &
                 s%flow_old, s%mode, s%load_older, have_older, set_repeated, s%u_older, &
-                s%flow_older, marker, checksum
+                s%flow_older
+            if (status == 0 .and. version >= 5) read(unit, iostat=status) s%held_slope
+            if (status == 0) read(unit, iostat=status) marker, checksum
             if (status == 0 .and. marker /= end_marker) status = -1
             s%have_older = have_older == 1
             s%set_repeated = set_repeated == 1
