@@ -361,6 +361,7 @@ GROUPS = [
                 '(with both, around it); p_disp must stay > 0 (n11 = 0 lets the cell collapse '
                 'along x: the run stops with that message). `strain` must then be left out.'),
         Var('axial_force', 'real', 0.0, unit='N/m', range='> 0',
+            default_doc="required (`'force'`)",
             doc="Periodic, `axial_control = 'force'`: the membrane force n11 held at p_disp = 1 "
                 '(force across a y-parallel cell edge per unit current edge length, as in '
                 'curve.csv).'),
