@@ -57,12 +57,16 @@ def test_axial_force_is_held_at_every_step(run_yarnfort, tmp_path):
 
 def test_force_control_reproduces_the_strain_controlled_curve(run_yarnfort, tmp_path):
     """A bonded plain weave (one state per strain): the strain-controlled run's n11 at
-    e11 = 0.09, 0.18, 0.3, held by force control, gives back those strains. The force is
-    held to 1e-8 of itself; the strain follows to that over the relative stiffness."""
+    e11 = 0.09, 0.18, 0.3, held by force control, gives back those strains, to the error
+    of the force held over the stiffness (bound about 1e-9, measured 7e-13)."""
     strained, _, _ = run_cell(run_yarnfort, tmp_path / "strain", "plain", "bonded", 0.1,
                               strain=0.3, lateral=0.0)
     steps = [3, 6, 10]
-    e11, n11 = (np.asarray(strained[c])[steps] for c in ("e11", "n11"))
+    e11, n11, n22 = (np.asarray(strained[c])[steps] for c in ("e11", "n11", "n22"))
+    # dn11/de11 by the secant to the step before: the force held to HOLD of the forces
+    # present moves e11 by at most that over this stiffness.
+    slope = (n11 - np.asarray(strained["n11"])[np.subtract(steps, 1)]) / 0.03
+    bound = HOLD * np.maximum(n11, np.abs(n22)) / slope
     assert np.allclose(e11, [0.09, 0.18, 0.3], rtol=1e-12)
     assert np.all(np.diff(n11) > 0) and n11[0] > 0
     forced, _, _ = run_cell(run_yarnfort, tmp_path / "force", "plain", "bonded", 0.5,
@@ -74,7 +78,7 @@ def test_force_control_reproduces_the_strain_controlled_curve(run_yarnfort, tmp_
     assert knots.sum() == 3
     assert np.allclose(np.asarray(forced["n11"])[knots], n11, rtol=HOLD, atol=0)
     found = np.asarray(forced["e11"])[knots]
-    assert np.abs(found - e11).max() <= 1e-6 * e11.max(), found - e11
+    assert np.all(np.abs(found - e11) <= bound), (found - e11, bound)
 
 
 @pytest.mark.parametrize("kind", ["bonded", "frictionless"])
