@@ -81,6 +81,31 @@ def test_force_control_reproduces_the_strain_controlled_curve(run_yarnfort, tmp_
     assert np.all(np.abs(found - e11) <= bound), (found - e11, bound)
 
 
+def test_held_x_force_turned_by_90_degrees_is_a_held_y_force(run_yarnfort, tmp_path):
+    """The square bonded plain weave (its own image under a turn by 90 degrees, see
+    test_membrane) with n11 held at 5 kN/m and e22 = 0.05, and with e11 = 0.05 and n22
+    held at 5 kN/m: the two axes of the stepper give mirrored states (to the force held,
+    2 * HOLD of it, over the secant stiffness F / e; measured 5e-12 in e, 6e-12 of F)."""
+    force, strain = 5000.0, 0.05
+    common = {"fabric.spacing": [1.0e-3, 1.0e-3], "path.p_disp": [0.2, 1.0]}
+    x_held, _, _ = run_cell(run_yarnfort, tmp_path / "x", "plain", "bonded", 0.25,
+                            lateral=strain, extra={
+                                **common, "fabric.strain": None,
+                                "fabric.axial_control": "force", "fabric.axial_force": force})
+    y_held, _, _ = run_cell(run_yarnfort, tmp_path / "y", "plain", "bonded", 0.25,
+                            strain=strain, extra={
+                                **common, "fabric.lateral_strain": None,
+                                "fabric.lateral_control": "force",
+                                "fabric.lateral_force": force})
+    a = {k: np.asarray(x_held[k])[-1] for k in ("e11", "e22", "n11", "n22")}
+    b = {k: np.asarray(y_held[k])[-1] for k in ("e11", "e22", "n11", "n22")}
+    assert a["e22"] == b["e11"] == pytest.approx(strain, rel=1e-15)
+    assert a["e11"] > 2 * strain   # found, not trivially the prescribed strain
+    assert abs(a["e11"] - b["e22"]) <= 2 * HOLD * a["e11"]
+    assert abs(a["n22"] - b["n11"]) <= 2 * HOLD * force
+    assert abs(a["n11"] - force) <= HOLD * force and abs(b["n22"] - force) <= HOLD * force
+
+
 @pytest.mark.parametrize("kind", ["bonded", "frictionless"])
 def test_work_balance_under_axial_force_control(run_yarnfort, tmp_path, kind):
     """The knit cell of linear yarns with n11 ramped from 1 to 10 kN/m (e22 = 0): the work of the membrane
