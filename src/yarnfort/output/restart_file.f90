@@ -66,8 +66,9 @@ module yarnfort_output_restart_file
     !> Echo lines of variables added after restart files were first written, at their
     !> defaults: left out of the fingerprint, so that a restart file of an input without
     !> them stays valid (one that sets them is another input).
-    character(len=*), parameter :: unhashed_defaults(3) = [character(len=32) :: &
-        "    lateral_control = 'strain'", '    lateral_force = 0.0', '    force_ratio = 1.0']
+    character(len=*), parameter :: unhashed_defaults(4) = [character(len=32) :: &
+        "    lateral_control = 'strain'", '    lateral_force = 0.0', '    force_ratio = 1.0', &
+        '    shear = 0.0']
     !> Bytes read at a time when an input file's content is hashed.
     integer, parameter :: hash_chunk = 65536
 

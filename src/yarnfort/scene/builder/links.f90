@@ -29,7 +29,7 @@ contains
         integer :: n_nodes, l, n, r, k, c, cr, hops, displacement_channel, s, i
         integer, allocatable :: leader(:), link_of(:), stretch_coordinates(:)
         integer, allocatable :: set_of(:), place_of(:)
-        real(wp) :: offset(3), macro(3), gap(3), step(3), lattice(3)
+        real(wp) :: offset(3), macro(3), gap(3), step(3), lattice(3), sheared
         character(len=200) :: buffer
 
         n_nodes = scene%network%n_nodes()
@@ -119,6 +119,9 @@ contains
                 r = leader(r)
             end do
             scene%cell_lattice(:, n) = lattice
+            ! Simple shear: an image one y period up moves along x with p_disp (the y
+            ! strain's term above is componentwise; this one crosses from y to x).
+            sheared = macro(1) + config%fabric%shear * lattice(2)
             do k = 1, 3
                 c = 3 * (n - 1) + k
                 cr = 3 * (r - 1) + k
@@ -129,11 +132,12 @@ contains
                     scene%dofs%base(c) = scene%dofs%base(cr) + offset(k)
                     scene%dofs%delta(c, :) = scene%dofs%delta(cr, :)
                     scene%dofs%delta(c, displacement_channel) = &
-                        scene%dofs%delta(cr, displacement_channel) + macro(k)
+                        scene%dofs%delta(cr, displacement_channel) &
+                        + merge(sheared, macro(k), k == 1)
                 else
                     scene%dofs%base(c) = offset(k)
                     scene%dofs%delta(c, :) = 0.0_wp
-                    scene%dofs%delta(c, displacement_channel) = macro(k)
+                    scene%dofs%delta(c, displacement_channel) = merge(sheared, macro(k), k == 1)
                 end if
                 scene%dofs%gap(c) = gap(k)
                 ! A force-controlled y period: y = root + lattice_y * (1 + e22).
@@ -147,6 +151,7 @@ contains
                     end associate
                 end if
             end do
+            ! 'stretch': the images the x strain moves (not those only the shear moves).
             if (macro(1) /= 0.0_wp) stretch_coordinates = [stretch_coordinates, 3 * n - 2]
         end do
         call renumber_unknowns(scene%dofs%unknown, scene%dofs%n_unknowns)
