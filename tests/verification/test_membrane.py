@@ -402,3 +402,46 @@ def test_n12_is_the_derivative_of_the_stored_energy(run_yarnfort, tmp_path, cell
     # Central differences: error O(h^2) of the derivative's scale, plus the solver's
     # tolerance over h.
     assert abs(derivative - predicted) <= 1e-6 * abs(predicted), (derivative, predicted)
+
+
+@pytest.mark.parametrize("cell", ["knit", "plain", "texgen_plain"])
+def test_a_string_net_has_no_shear_stiffness(run_yarnfort, tmp_path, cell):
+    """Pin-jointed crossings: the cell carries its yarns' tension along its periods only,
+    so n12 is n22 turned by the shear, n12 = n22 tan(gamma12), and the shear in the yarns'
+    frame, n12 cos - n22 sin, is zero (the rounding of the solver), with friction too
+    (mu = 0.3, the knit slides). The run's note says so."""
+    base, values, n_contacts, _ = CELLS[cell]
+    values = {**values, **contacts(n_contacts, "frictionless"),
+              **{f"contact[{c}].friction_coefficient": 0.3 for c in range(n_contacts)},
+              "fabric.strain": 0.3, "fabric.lateral_strain": 0.1, "fabric.shear": SHEAR,
+              "path.time": [0.0, 1.0, 2.0], "path.p_disp": [0.0, 1.0, 0.0],
+              "solver.max_step": 0.1, "output.vtk_every": 0}
+    result = run_yarnfort(patched_scene(base, values, tmp_path), cwd=TOP)
+    assert result.returncode == 0, result.stderr
+    curve = read_curve(tmp_path)
+    gamma, n11, n22, n12 = (np.asarray(curve[c]) for c in ("gamma12", "n11", "n22", "n12"))
+    scale = max(np.abs(n11).max(), np.abs(n22).max())
+    assert np.abs(n12 * np.cos(gamma) - n22 * np.sin(gamma)).max() <= 1e-9 * scale
+    assert np.abs(n12).max() > 0.01 * scale      # n12 itself is not zero
+    assert "note: no shear stiffness" in result.stderr
+
+
+def test_shear_without_tension_starts_without_stiffness(run_yarnfort, tmp_path):
+    """Without prestress the frictionless plain weave is slack at gamma12 = 0 and the
+    shear stretches the y yarns only to second order (less, as crimp is exchanged):
+    n12 = n22 tan(gamma12) with n22 of order gamma^2 or smaller grows at least as gamma^3,
+    so halving gamma divides n12 by 8 or more (measured 9.9 and 11.5), never by the 2 of
+    a shear stiffness."""
+    base, values, n_contacts, _ = CELLS["plain"]
+    values = {**values, **contacts(n_contacts, "frictionless"),
+              "material[0].prestress": 0.0, "material[1].prestress": 0.0,
+              "fabric.strain": 0.0, "fabric.lateral_strain": 0.0, "fabric.shear": 0.1,
+              "path.time": [0.0, 1.0], "path.p_disp": [0.0, 1.0],
+              "solver.max_step": 0.125, "output.vtk_every": 0}
+    result = run_yarnfort(patched_scene(base, values, tmp_path), cwd=TOP)
+    assert result.returncode == 0, result.stderr
+    curve = read_curve(tmp_path)
+    n12 = np.asarray(curve["n12"])
+    assert n12[0] == 0.0
+    ratios = n12[8] / n12[4], n12[4] / n12[2]
+    assert all(r > 7.0 for r in ratios), ratios

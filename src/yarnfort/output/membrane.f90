@@ -16,6 +16,10 @@
 !> the virial V = sum over nodes of force (x) reference lattice vector (F_j = V e_j / L_j0),
 !> A N = V Fc^T, and the work of N is dW = A N : dFc Fc^-1 = V : dFc, i.e.
 !>     dW = A0 [(1 + e22) n11 de11 + (1 + e11) n22 de22 + n12 ((1 + e11) dk - k de11)].
+!> The shear in the yarns' frame, tau = F1y / |a2| = n12 cos(gamma12) - n22 sin(gamma12)
+!> (moment balance), is the force across the cut along a2 normal to a1: zero when the
+!> cell carries tension along its periods only (F_j parallel to a_j), as a pin-jointed
+!> net does.
 module yarnfort_output_membrane
     use yarnfort_kinds, only: wp
     use yarnfort_scene_scene, only: scene_type
@@ -23,7 +27,7 @@ module yarnfort_output_membrane
     implicit none
     private
 
-    public :: membrane_names, get_membrane
+    public :: membrane_names, get_membrane, get_frame_shear
 
     !> The columns, in order: strains (1) and rad, then forces per width (N/m).
     character(len=*), parameter :: membrane_names(6) = [character(len=7) :: &
@@ -53,5 +57,11 @@ contains
         values(5) = force(2, 2) / area
         values(6) = 0.5_wp * (force(1, 2) + force(2, 1)) / area
     end function get_membrane
+
+    !> The shear force in the yarns' frame (N/m) of get_membrane's values (see the module).
+    pure real(wp) function get_frame_shear(values) result(tau)
+        real(wp), intent(in) :: values(6)
+        tau = values(6) * cos(values(3)) - values(5) * sin(values(3))
+    end function get_frame_shear
 
 end module yarnfort_output_membrane
