@@ -346,6 +346,9 @@ def test_sheared_images_and_gamma12(run_yarnfort, tmp_path):
     a2 = np.array([SHEAR * p * periods[1], (1 + 0.1 * p) * periods[1]])
     angle = np.arccos(a1 @ a2 / np.linalg.norm(a1) / np.linalg.norm(a2))
     assert abs(curve["gamma12"][-1] - (np.pi / 2 - angle)) <= 1e-14
+    # The VTK files' link periods (gap-holders into image cells too) are these vectors.
+    found = states[-1].periods()
+    assert np.allclose(found[:, :2], [a1, a2], rtol=0, atol=1e-12 * periods[0])
 
 
 def test_work_balance_with_shear_and_friction(run_yarnfort, tmp_path):
