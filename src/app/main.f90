@@ -6,6 +6,7 @@ program yarnfort_main
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64, real64
     use yarnfort_error, only: error_type
     use yarnfort_version, only: yarnfort_version_string
+    use yarnfort_text, only: format_short
     use yarnfort_input_config, only: config_type
     use yarnfort_input_namelist, only: read_config_from_stdin, check_config
     use yarnfort_input_groups, only: input_help_lines => help_lines
@@ -93,9 +94,9 @@ contains
         ! Below this fraction of the membrane forces the frame shear is the solver's
         ! rounding (the built-in cells: 1e-11 at most; the sliding twill 9e-6).
         real(real64), parameter :: zero_shear = 1.0e-8_real64
-        character(len=16) :: ratio
+        character(len=:), allocatable :: ratio
 
-        write(ratio, '(es9.2)') writer%frame_shear / max(writer%membrane_force, tiny(1.0_real64))
+        ratio = format_short(writer%frame_shear / max(writer%membrane_force, tiny(1.0_real64)))
         if (writer%frame_shear <= zero_shear * writer%membrane_force) then
             write(error_unit, '(a)') 'yarnfort: note: no shear stiffness: the shear in the ' &
                 // "yarns' frame, n12 cos(gamma12) - n22 sin(gamma12), is zero at every step (" &
