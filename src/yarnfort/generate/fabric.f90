@@ -75,6 +75,23 @@ contains
             if (allocated(error)) return
             call check_axial_control(error)
             if (allocated(error)) return
+            call require_range(error, 'shear', fabric%shear, -10.0_wp, 10.0_wp)
+            if (allocated(error)) return
+            ! Only a periodic cell has a y period to tilt; a clamped sample's shear would
+            ! need its edges moved, which no support set here does.
+            if (fabric%shear /= 0.0_wp .and. fabric%boundary /= 'periodic') then
+                call fatal_error(error, label // 'shear = ' // format_real(fabric%shear) &
+                    // " needs boundary = 'periodic' (it tilts the y period of a periodic " &
+                    // 'cell; a clamped sample cannot be sheared)')
+                return
+            end if
+            ! The shear follows p_disp, which under a held x force scales that force.
+            if (fabric%shear /= 0.0_wp .and. fabric%axial_control == 'force') then
+                call fatal_error(error, label // 'shear = ' // format_real(fabric%shear) &
+                    // " needs axial_control = 'strain' (under 'force' p_disp scales the " &
+                    // 'force n11 held, not a deformation)')
+                return
+            end if
             if (fabric%kind == 'texgen') then
                 call require_range(error, 'strain', fabric%strain, -0.9_wp, 100.0_wp)
                 if (allocated(error)) return

@@ -365,6 +365,11 @@ GROUPS = [
             doc="Periodic, `axial_control = 'force'`: the membrane force n11 held at p_disp = 1 "
                 '(force across a y-parallel cell edge per unit current edge length, as in '
                 'curve.csv).'),
+        Var('shear', 'real', 0.0, unit='1', range='[-10, 10]',
+            doc='Periodic: simple shear of the cell at p_disp = 1, prescribed: the y period '
+                'a2 = L20 (p_disp * shear e_x + (1 + e22) e_y), so an image one y period up '
+                'moves by p_disp * shear * L20 along x; curve.csv reports gamma12 = '
+                'atan(p_disp * shear / (1 + e22)) (rad). See *Shear* below.'),
         Var('sides', 'character', 'free', length=16, lower=True, choices=['free', 'rollers'],
             doc="Clamped: `'free'` side edges or `'rollers'`. Woven: rollers hold the weft ends "
                 'in y and z (a selvedge); free weft ends of pre-stressed weft yarns cannot carry '

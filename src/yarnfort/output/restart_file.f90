@@ -69,9 +69,9 @@ module yarnfort_output_restart_file
     !> Echo lines of variables added after restart files were first written, at their
     !> defaults: left out of the fingerprint, so that a restart file of an input without
     !> them stays valid (one that sets them is another input).
-    character(len=*), parameter :: unhashed_defaults(5) = [character(len=32) :: &
+    character(len=*), parameter :: unhashed_defaults(6) = [character(len=32) :: &
         "    lateral_control = 'strain'", '    lateral_force = 0.0', '    force_ratio = 1.0', &
-        "    axial_control = 'strain'", '    axial_force = 0.0']
+        "    axial_control = 'strain'", '    axial_force = 0.0', '    shear = 0.0']
     !> Bytes read at a time when an input file's content is hashed.
     integer, parameter :: hash_chunk = 65536
 

@@ -271,6 +271,7 @@ contains
         allocate(period(3, n_links))
         do l = 1, n_links
             period(:, l) = scene%link_period(:, l) * (1.0_wp + p_disp * scene%link_strain(:, l))
+            period(1, l) = period(1, l) + p_disp * scene%cell_shear * scene%link_period(2, l)
         end do
         ! The force a link carries: what acts on its follower's node (element tensions,
         ! applied load) and on the nodes that follow that node, down the chain of links.

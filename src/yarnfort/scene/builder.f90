@@ -91,6 +91,7 @@ contains
             if (scene%periodic_cell) then
                 scene%cell_period = maxval(abs(scene%cell_lattice(1:2, :)), dim=2)
                 scene%cell_strain = [config%fabric%strain, config%fabric%lateral_strain]
+                scene%cell_shear = config%fabric%shear
             end if
         end if
         scene%path%time = config%path%time

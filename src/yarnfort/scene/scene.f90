@@ -89,12 +89,13 @@ module yarnfort_scene_scene
         real(wp), allocatable :: link_period(:, :), link_strain(:, :)
         !> A periodic cell (&fabric boundary = 'periodic'): each node's lattice vector at
         !> p_disp = 0 (3, n_nodes; zero for a node that follows no periodic image), the
-        !> reference periods along x and y (m) and their engineering strains at p_disp = 1.
-        !> A node's position is its root's plus lattice * (1 + p_disp * cell_strain),
-        !> componentwise (yarnfort_output_membrane).
+        !> reference periods along x and y (m), their engineering strains and the simple
+        !> shear at p_disp = 1. A node's position is its root's plus lattice * (1 + p_disp *
+        !> cell_strain), componentwise, plus p_disp * cell_shear * lattice_y along x
+        !> (yarnfort_output_membrane).
         logical :: periodic_cell = .false.
         real(wp), allocatable :: cell_lattice(:, :)
-        real(wp) :: cell_period(2) = 0.0_wp, cell_strain(2) = 0.0_wp
+        real(wp) :: cell_period(2) = 0.0_wp, cell_strain(2) = 0.0_wp, cell_shear = 0.0_wp
         !> A periodic cell whose y period follows a force (&fabric lateral_control 'force'
         !> or 'ratio'): the load channel (appended to the path's, factor 0 at every knot)
         !> whose factor is e22, set by yarnfort_solver_force_control; 0 otherwise. The

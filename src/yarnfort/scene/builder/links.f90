@@ -29,7 +29,7 @@ contains
         integer :: n_nodes, l, n, r, k, c, cr, hops, displacement_channel, s, i
         integer, allocatable :: leader(:), link_of(:), stretch_coordinates(:)
         integer, allocatable :: set_of(:), place_of(:)
-        real(wp) :: offset(3), macro(3), gap(3), step(3), lattice(3)
+        real(wp) :: offset(3), macro(3), gap(3), step(3), lattice(3), sheared
         character(len=200) :: buffer
 
         n_nodes = scene%network%n_nodes()
@@ -122,6 +122,9 @@ contains
             ! A force-controlled x period: x = root + lattice_x * (1 + e11), whatever
             ! `strain` (p_disp then scales the force held).
             if (scene%axial_channel > 0) macro(1) = 0.0_wp
+            ! Simple shear: an image one y period up moves along x with p_disp (the y
+            ! strain's term above is componentwise; this one crosses from y to x).
+            sheared = macro(1) + config%fabric%shear * lattice(2)
             do k = 1, 3
                 c = 3 * (n - 1) + k
                 cr = 3 * (r - 1) + k
@@ -132,11 +135,12 @@ contains
                     scene%dofs%base(c) = scene%dofs%base(cr) + offset(k)
                     scene%dofs%delta(c, :) = scene%dofs%delta(cr, :)
                     scene%dofs%delta(c, displacement_channel) = &
-                        scene%dofs%delta(cr, displacement_channel) + macro(k)
+                        scene%dofs%delta(cr, displacement_channel) &
+                        + merge(sheared, macro(k), k == 1)
                 else
                     scene%dofs%base(c) = offset(k)
                     scene%dofs%delta(c, :) = 0.0_wp
-                    scene%dofs%delta(c, displacement_channel) = macro(k)
+                    scene%dofs%delta(c, displacement_channel) = merge(sheared, macro(k), k == 1)
                 end if
                 scene%dofs%gap(c) = gap(k)
                 ! A force-controlled y period: y = root + lattice_y * (1 + e22).
