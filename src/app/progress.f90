@@ -8,7 +8,7 @@ module yarnfort_app_progress
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_writer, only: output_writer_type
-    use yarnfort_output_membrane, only: get_membrane, get_frame_shear
+    use yarnfort_solver_membrane, only: get_membrane, get_frame_shear
     implicit none
     private
 

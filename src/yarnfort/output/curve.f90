@@ -9,7 +9,7 @@ module yarnfort_output_curve
     use yarnfort_output_csv_rows, only: csv_rows_type
     use yarnfort_scene_channels, only: get_curve_columns, curve_column_length
     use yarnfort_output_table, only: table_writer_type
-    use yarnfort_output_membrane, only: get_membrane
+    use yarnfort_solver_membrane, only: get_membrane
     implicit none
     private
 
@@ -35,7 +35,7 @@ contains
     !> component it does not prescribe) for each support set, then load_<k>_ux, _uy, _uz
     !> (m, the mean displacement of the nodes of &load #k) for each &load, then for a
     !> fabric strain and force_per_width, for a periodic cell e11, e22, gamma12, n11, n22,
-    !> n12 (yarnfort_output_membrane), then direction (1 loading, -1 unloading, 0
+    !> n12 (yarnfort_solver_membrane), then direction (1 loading, -1 unloading, 0
     !> neither: sign of the change of the sum of the channels' factors), passages
     !> slipping, passages held in stick by chatter damping, 1 if the step ended in a jump
     !> after a slip instability (else 0), and sliding passages in all,

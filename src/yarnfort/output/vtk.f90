@@ -32,7 +32,7 @@ module yarnfort_output_vtk
     use yarnfort_text, only: format_integer
     use yarnfort_output_manifest, only: part_prefixes
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
-    use yarnfort_output_membrane, only: membrane_names, get_membrane
+    use yarnfort_solver_membrane, only: membrane_names, get_membrane
     implicit none
     private
 

@@ -92,7 +92,7 @@ module yarnfort_scene_scene
         !> reference periods along x and y (m), their engineering strains and the simple
         !> shear at p_disp = 1. A node's position is its root's plus lattice * (1 + p_disp *
         !> cell_strain), componentwise, plus p_disp * cell_shear * lattice_y along x
-        !> (yarnfort_output_membrane).
+        !> (yarnfort_solver_membrane).
         logical :: periodic_cell = .false.
         real(wp), allocatable :: cell_lattice(:, :)
         real(wp) :: cell_period(2) = 0.0_wp, cell_strain(2) = 0.0_wp, cell_shear = 0.0_wp

@@ -23,7 +23,7 @@ module yarnfort_solver_force_control
     use yarnfort_solver_newton, only: newton_stats_type
     use yarnfort_solver_restart, only: restart_type
     use yarnfort_solver_stepper, only: load_stepper_type, step_state_type
-    use yarnfort_output_membrane, only: get_membrane
+    use yarnfort_solver_membrane, only: get_membrane
     implicit none
     private
 

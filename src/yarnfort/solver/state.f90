@@ -27,7 +27,7 @@ module yarnfort_solver_state
         !> scene%supports(s)%coordinates(i), for s = 1, 2, ... and i in order, concatenated.
         real(wp), allocatable :: coordinate_reaction(:)
         !> Periodic cell: sum over nodes of (force on the node) (x) (its lattice vector),
-        !> (3, 3), N m; the forces conjugate to the period vectors (yarnfort_output_membrane).
+        !> (3, 3), N m; the forces conjugate to the period vectors (yarnfort_solver_membrane).
         real(wp) :: virial(3, 3) = 0.0_wp
         !> Figures of the step's (last) Newton solve; total Newton iterations of the step.
         type(newton_stats_type) :: newton

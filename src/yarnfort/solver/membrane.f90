@@ -20,7 +20,7 @@
 !> (moment balance), is the force across the cut along a2 normal to a1: zero when the
 !> cell carries tension along its periods only (F_j parallel to a_j), as a pin-jointed
 !> net does.
-module yarnfort_output_membrane
+module yarnfort_solver_membrane
     use yarnfort_kinds, only: wp
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_state, only: step_state_type
@@ -65,4 +65,4 @@ contains
         tau = values(6) * cos(values(3)) - values(5) * sin(values(3))
     end function get_frame_shear
 
-end module yarnfort_output_membrane
+end module yarnfort_solver_membrane
