@@ -448,3 +448,29 @@ def test_shear_without_tension_starts_without_stiffness(run_yarnfort, tmp_path):
     assert n12[0] == 0.0
     ratios = n12[8] / n12[4], n12[4] / n12[2]
     assert all(r > 7.0 for r in ratios), ratios
+
+
+@pytest.mark.parametrize("example", ["inputs/weave_biaxial.nml", "inputs/weave_force.nml",
+                                     "inputs/weave_shear.nml"])
+def test_drawn_periods_are_the_cells(run_yarnfort, tmp_path, example):
+    """Under force control (e22, or e11 and e22, unknowns) and shear, every periodic link's
+    `period` in the VTK files is its image minus its node there (from the node
+    positions), and the cell's periods are Fc times the first state's (e11, e22 and
+    gamma12 of curve.csv)."""
+    result = run_yarnfort(patched_scene(example, {"output.vtk_every": 1}, tmp_path), cwd=TOP)
+    assert result.returncode == 0, result.stderr
+    curve, states = read_curve(tmp_path), read_states(tmp_path)
+    reference = states[0].periods()[:, :2]
+    assert len(states) == len(curve["step"])
+    for k in (len(states) // 2, len(states) - 1):
+        state = states[k]
+        periodic = state.link_kind == PERIODIC_LINK
+        drawn = np.asarray(state.link_data["period"]).reshape(-1, 3)[periodic]
+        scale = np.abs(drawn).max()
+        assert np.abs(drawn - image_offsets(state)).max() <= 1e-12 * scale
+        e11, e22, gamma12 = (curve[c][k] for c in ("e11", "e22", "gamma12"))
+        shear = (1 + e22) * np.tan(gamma12)
+        deformation = np.array([[1 + e11, shear], [0.0, 1 + e22]])
+        expected = (deformation @ (reference / (1 + np.array([curve["e11"][0], curve["e22"][0]]))
+                                   ).T).T
+        assert np.abs(state.periods()[:, :2] - expected).max() <= 1e-9 * scale

@@ -32,7 +32,7 @@ module yarnfort_output_vtk
     use yarnfort_text, only: format_integer
     use yarnfort_output_manifest, only: part_prefixes
     use yarnfort_output_contacts, only: passage_state_type, get_passage_states
-    use yarnfort_solver_membrane, only: membrane_names, get_membrane
+    use yarnfort_solver_membrane, only: membrane_names, get_membrane, get_cell_deformation
     implicit none
     private
 
@@ -260,7 +260,7 @@ contains
         integer(int64), allocatable :: connectivity(:)
         real(wp), allocatable :: net(:, :), carried(:, :), period(:, :), points(:, :), &
             applied(:), along(:), stretch(:), length0(:)
-        real(wp) :: p_disp, now(3), before(3), pull(3)
+        real(wp) :: p_disp, now(3), before(3), pull(3), deformation(2, 2)
         logical :: gap
 
         n_links = size(scene%link_nodes, 2)
@@ -271,8 +271,16 @@ contains
         allocate(period(3, n_links))
         do l = 1, n_links
             period(:, l) = scene%link_period(:, l) * (1.0_wp + p_disp * scene%link_strain(:, l))
-            period(1, l) = period(1, l) + p_disp * scene%cell_shear * scene%link_period(2, l)
         end do
+        ! A cell's periods follow its deformation, which force control and shear set too.
+        if (scene%periodic_cell) then
+            deformation = get_cell_deformation(scene, state)
+            do l = 1, n_links
+                period(1, l) = scene%link_period(1, l) * deformation(1, 1) &
+                    + deformation(1, 2) * scene%link_period(2, l)
+                period(2, l) = scene%link_period(2, l) * deformation(2, 2)
+            end do
+        end if
         ! The force a link carries: what acts on its follower's node (element tensions,
         ! applied load) and on the nodes that follow that node, down the chain of links.
         allocate(applied(3 * n_nodes))

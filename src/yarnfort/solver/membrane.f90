@@ -27,7 +27,7 @@ module yarnfort_solver_membrane
     implicit none
     private
 
-    public :: membrane_names, get_membrane, get_frame_shear
+    public :: membrane_names, get_membrane, get_frame_shear, get_cell_deformation
 
     !> The columns, in order: strains (1) and rad, then forces per width (N/m).
     character(len=*), parameter :: membrane_names(6) = [character(len=7) :: &
@@ -42,13 +42,8 @@ contains
         real(wp) :: values(6)
         real(wp) :: strain(2), shear, deformation(2, 2), force(2, 2), area
 
-        ! The periods follow the displacement channel, like every periodic link.
-        strain = state%factors(scene%dofs%gap_channel) * scene%cell_strain
-        shear = state%factors(scene%dofs%gap_channel) * scene%cell_shear
-        ! A force-controlled period has its strain (e11, e22) as its own channel's factor.
-        if (scene%lateral_channel > 0) strain(2) = state%factors(scene%lateral_channel)
-        if (scene%axial_channel > 0) strain(1) = state%factors(scene%axial_channel)
-        deformation = reshape([1.0_wp + strain(1), 0.0_wp, shear, 1.0_wp + strain(2)], [2, 2])
+        call get_cell_strain(scene, state, strain, shear)
+        deformation = get_cell_deformation(scene, state)
         area = product(scene%cell_period * [deformation(1, 1), deformation(2, 2)])
         ! A N = V Fc^T: the virial sums force (x) reference lattice vector.
         force = matmul(state%virial(1:2, 1:2), transpose(deformation))
@@ -58,6 +53,31 @@ contains
         values(5) = force(2, 2) / area
         values(6) = 0.5_wp * (force(1, 2) + force(2, 1)) / area
     end function get_membrane
+
+    !> Fc = [[1 + e11, k], [0, 1 + e22]] of a periodic cell's state: a_j = Fc A_j.
+    pure function get_cell_deformation(scene, state) result(deformation)
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        real(wp) :: deformation(2, 2)
+        real(wp) :: strain(2), shear
+
+        call get_cell_strain(scene, state, strain, shear)
+        deformation = reshape([1.0_wp + strain(1), 0.0_wp, shear, 1.0_wp + strain(2)], [2, 2])
+    end function get_cell_deformation
+
+    !> e11, e22 and the simple shear k of a periodic cell's state.
+    pure subroutine get_cell_strain(scene, state, strain, shear)
+        type(scene_type), intent(in) :: scene
+        type(step_state_type), intent(in) :: state
+        real(wp), intent(out) :: strain(2), shear
+
+        ! The periods follow the displacement channel, like every periodic link.
+        strain = state%factors(scene%dofs%gap_channel) * scene%cell_strain
+        shear = state%factors(scene%dofs%gap_channel) * scene%cell_shear
+        ! A force-controlled period has its strain (e11, e22) as its own channel's factor.
+        if (scene%lateral_channel > 0) strain(2) = state%factors(scene%lateral_channel)
+        if (scene%axial_channel > 0) strain(1) = state%factors(scene%axial_channel)
+    end subroutine get_cell_strain
 
     !> The shear force in the yarns' frame (N/m) of get_membrane's values (see the module).
     pure real(wp) function get_frame_shear(values) result(tau)
