@@ -65,7 +65,8 @@ contains
                 history = [history, f]
                 ! The Newton step and the chord steps together within max_iterations.
                 call take_chord_steps(self, min(chord_steps, self%options%max_iterations - 1), &
-                    residual, f, history, stats)
+                    residual, f, history, stats, max_finish=min(chord_steps, &
+                    self%options%max_iterations - 1 - chord_steps))
             end if
             call finish_chord(self, u, f, history, stats, converged)
         end associate
