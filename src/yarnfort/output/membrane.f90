@@ -37,8 +37,9 @@ contains
 
         ! The periods follow the displacement channel, like every periodic link.
         strain = state%factors(scene%dofs%gap_channel) * scene%cell_strain
-        ! A force-controlled y period has e22 as the factor of its own channel.
+        ! A force-controlled period has its strain (e11, e22) as its own channel's factor.
         if (scene%lateral_channel > 0) strain(2) = state%factors(scene%lateral_channel)
+        if (scene%axial_channel > 0) strain(1) = state%factors(scene%axial_channel)
         stretch = 1.0_wp + strain
         area = product(scene%cell_period * stretch)
         ! N_kl = virial_kl (1 + e_l) / A: the virial sums force (x) reference lattice vector.

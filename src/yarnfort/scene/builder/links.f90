@@ -119,6 +119,9 @@ contains
                 r = leader(r)
             end do
             scene%cell_lattice(:, n) = lattice
+            ! A force-controlled x period: x = root + lattice_x * (1 + e11), whatever
+            ! `strain` (p_disp then scales the force held).
+            if (scene%axial_channel > 0) macro(1) = 0.0_wp
             do k = 1, 3
                 c = 3 * (n - 1) + k
                 cr = 3 * (r - 1) + k
@@ -140,6 +143,9 @@ contains
                 if (k == 2 .and. scene%lateral_channel > 0) &
                     scene%dofs%delta(c, scene%lateral_channel) = &
                     scene%dofs%delta(c, scene%lateral_channel) + lattice(2)
+                if (k == 1 .and. scene%axial_channel > 0) &
+                    scene%dofs%delta(c, scene%axial_channel) = &
+                    scene%dofs%delta(c, scene%axial_channel) + lattice(1)
                 if (scene%dofs%unknown(cr) == 0 .and. set_of(cr) > 0) then
                     associate(set => scene%supports(set_of(cr)))
                         set%followers = [set%followers, c]
@@ -147,7 +153,9 @@ contains
                     end associate
                 end if
             end do
-            if (macro(1) /= 0.0_wp) stretch_coordinates = [stretch_coordinates, 3 * n - 2]
+            ! The x coordinates the macroscopic stretch moves ('stretch', force_per_width).
+            if (macro(1) /= 0.0_wp .or. (scene%axial_channel > 0 .and. lattice(1) /= 0.0_wp)) &
+                stretch_coordinates = [stretch_coordinates, 3 * n - 2]
         end do
         call renumber_unknowns(scene%dofs%unknown, scene%dofs%n_unknowns)
         if (size(stretch_coordinates) > 0) then
