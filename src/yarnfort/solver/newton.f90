@@ -116,7 +116,8 @@ contains
         type(solve_options_type), intent(in) :: options
 
         call set_exact_law(self)
-        call solve_chord(self, u, options%chord_steps, stats, converged, error)
+        call solve_chord(self, u, options%chord_steps, options%finish_steps, stats, converged, &
+            error)
     end subroutine try_chord
 
     !> Chord steps from u for a problem that differs from the one of the last Newton

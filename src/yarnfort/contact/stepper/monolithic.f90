@@ -109,9 +109,12 @@ contains
                 ! path (docs/decisions.md, "Rounds with slipping passages: fast Newton
                 ! solves, full steps only"). A fast round that fails is retried with half
                 ! its new slips from the solved state; one with a single new slip or none
-                ! is solved again with the fallbacks.
+                ! is solved again with the fallbacks. A chord path just short of the
+                ! tolerance finishes with chord steps (docs/decisions.md, "Chord paths
+                ! finish at the tolerance").
                 full_options = solve_options_type(quick=any(self%mode_trial /= mode_stick) &
-                    .and. .not. full_retry, chord_steps=merge(0, chord_steps, self%staggered))
+                    .and. .not. full_retry, chord_steps=merge(0, chord_steps, self%staggered), &
+                    finish_steps=merge(0, chord_steps, self%staggered))
                 start = unknowns
                 solved = .false.
                 carried = newton_stats_type()

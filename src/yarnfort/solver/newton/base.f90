@@ -167,22 +167,34 @@ contains
     !> Up to max_steps chord steps from self%u (its residual and scaled residual f) with the
     !> factors the linear solver holds, or with `update` (those factors and replaced
     !> rows), while each cuts f tenfold, until f meets the tolerance; residual, f and
-    !> history follow the accepted steps.
-    subroutine take_chord_steps(self, max_steps, residual, f, history, stats, update)
+    !> history follow the accepted steps. Then up to max_finish more (default none) while
+    !> the last chord step's contraction, kept, meets the tolerance within them: a path
+    !> that ends just short of the tolerance costs solves, not another factorisation
+    !> (docs/decisions.md, 'Chord paths finish at the tolerance').
+    subroutine take_chord_steps(self, max_steps, residual, f, history, stats, update, &
+            max_finish)
         class(newton_base_type), intent(inout) :: self
         integer, intent(in) :: max_steps
         real(wp), intent(inout) :: residual(:), f
         real(wp), allocatable, intent(inout) :: history(:)
         type(newton_stats_type), intent(inout) :: stats
         type(row_update_type), intent(inout), optional :: update
+        integer, intent(in), optional :: max_finish
         type(error_type), allocatable :: trial_error
         real(wp), allocatable :: step(:)
-        integer :: k
+        integer :: k, n_finish, accepted_steps
         logical :: accepted
 
+        n_finish = 0
+        if (present(max_finish)) n_finish = max(max_finish, 0)
+        accepted_steps = 0
         allocate(step(size(residual)))
-        do k = 1, max_steps
+        do k = 1, max_steps + n_finish
             if (f <= self%options%residual_tolerance) exit
+            if (k > max_steps) then
+                if (accepted_steps == 0) exit
+                if (.not. finishes(max_steps + n_finish - k + 1)) exit
+            end if
             step = -residual
             if (present(update)) then
                 call update%solve(self%adapter, step, trial_error)
@@ -192,7 +204,20 @@ contains
             if (allocated(trial_error)) exit
             call take_chord_step(self, step, residual, f, history, stats, accepted)
             if (.not. accepted) exit
+            accepted_steps = accepted_steps + 1
         end do
+    contains
+        !> The last chord step's contraction r, kept, takes f to the tolerance within
+        !> `steps` more steps: f r^steps <= tolerance.
+        logical function finishes(steps)
+            integer, intent(in) :: steps
+            real(wp) :: r
+
+            associate(n => size(history), tol => self%options%residual_tolerance)
+                r = history(n) / history(n - 1)
+                finishes = f * r**steps <= tol
+            end associate
+        end function finishes
     end subroutine take_chord_steps
 
     !> self%u + step replaces self%u if it cuts the scaled residual tenfold (`accepted`;

@@ -29,15 +29,17 @@ contains
 
     !> Chord fast path: one Newton step from u, then up to chord_steps steps with its
     !> factors while each cuts the scaled residual (rows at their own levels) tenfold,
-    !> until it meets the tolerance. `converged`: u is then the solution; else u is the
+    !> until it meets the tolerance, then up to finish_steps more if they finish the path
+    !> (take_chord_steps). `converged`: u is then the solution; else u is the
     !> best iterate (the caller solves from there as usual). A steady load step starts
     !> close enough that the chord steps contract like Newton steps, and costs one
     !> factorisation instead of two; the steps stop at the solve's own tolerance
     !> (docs/decisions.md, 'Friction steps: chord steps in every solve').
-    subroutine solve_chord(self, u, chord_steps, stats, converged, error)
+    subroutine solve_chord(self, u, chord_steps, finish_steps, stats, converged, error)
         class(newton_base_type), intent(inout) :: self
         real(wp), intent(inout) :: u(:)
-        integer, intent(in) :: chord_steps
+        !> Chord steps, and those beyond them that only finish (take_chord_steps).
+        integer, intent(in) :: chord_steps, finish_steps
         type(newton_stats_type), intent(inout) :: stats
         logical, intent(out) :: converged
         type(error_type), allocatable, intent(out) :: error
@@ -65,7 +67,8 @@ contains
                 history = [history, f]
                 ! The Newton step and the chord steps together within max_iterations.
                 call take_chord_steps(self, min(chord_steps, self%options%max_iterations - 1), &
-                    residual, f, history, stats)
+                    residual, f, history, stats, max_finish=min(finish_steps, &
+                    self%options%max_iterations - 1 - chord_steps))
             end if
             call finish_chord(self, u, f, history, stats, converged)
         end associate

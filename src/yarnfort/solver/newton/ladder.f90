@@ -56,7 +56,8 @@ contains
 
         call set_exact_law(self)
         if (options%chord_steps > 0 .and. .not. after_chord) then
-            call solve_chord(self, u, options%chord_steps, stats, converged, error)
+            call solve_chord(self, u, options%chord_steps, options%finish_steps, stats, &
+                converged, error)
             if (allocated(error) .or. converged) return
         end if
         call solve_once(self, u, options%quick, stats, exact_error)

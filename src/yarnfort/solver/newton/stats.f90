@@ -32,6 +32,9 @@ module yarnfort_solver_newton_stats
         logical :: quick = .false.
         !> Chord steps after the first Newton step of a solve (its factors reused); 0: none.
         integer :: chord_steps = 0
+        !> Chord steps beyond chord_steps that a path just short of the tolerance may take
+        !> to finish (take_chord_steps); 0: none.
+        integer :: finish_steps = 0
     end type solve_options_type
 
 contains

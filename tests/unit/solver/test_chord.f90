@@ -1,0 +1,161 @@
+! SPDX-License-Identifier: MIT
+!> newton_solver_type%try_chord's finishing steps (solve_options_type%finish_steps) on
+!> u_i + a u_i^3 = 1 from u = 0: the Newton step there has J = 1, so every chord step
+!> is u <- u - F(u) and contracts by about 3 a u*^2 (0.029 for a = 0.01, 0.085 for
+!> a = 0.03). Residuals by hand (a = 0.01): 1, 1e-2, 2.97e-4, 8.74e-6, 2.57e-7 after the
+!> three chord steps, then 7.6e-9, 2.2e-10, 6.5e-12: the tolerance 1e-10 needs all three
+!> finishing steps. For a = 0.03 the last chord step leaves 1.9e-5 at r = 0.085, which
+!> three more steps would take to 1.2e-8 only: none is taken.
+module test_chord
+    use yarnfort_kinds, only: wp, ik
+    use yarnfort_error, only: error_type
+    use yarnfort_testing, only: unittest_type, new_unittest, check, check_close
+    use yarnfort_input_config, only: solver_config_type
+    use yarnfort_linalg_linear_solver, only: linear_solver_type
+    use yarnfort_linalg_factory, only: new_linear_solver
+    use yarnfort_solver_problem, only: nonlinear_problem_type, regularisation_type
+    use yarnfort_solver_newton, only: newton_solver_type, new_newton_solver, newton_stats_type, &
+        solve_options_type
+    implicit none
+    private
+
+    public :: collect_chord
+
+    !> Two uncoupled rows u_i + a u_i^3 - 1, each judged at level 1 (no rounding noise).
+    type, extends(nonlinear_problem_type) :: cubic_problem_type
+        real(wp) :: a = 0.0_wp
+    contains
+        procedure :: evaluate_residual
+        procedure :: evaluate_jacobian
+        procedure :: get_row_levels
+    end type cubic_problem_type
+
+contains
+
+    subroutine collect_chord(testsuite)
+        type(unittest_type), allocatable, intent(out) :: testsuite(:)
+        testsuite = [ &
+            new_unittest('finishing_steps_save_a_factorisation', test_finishing), &
+            new_unittest('no_finishing_step_without_the_rate', test_slow_rate) ]
+    end subroutine collect_chord
+
+    subroutine evaluate_residual(self, u, values, error, law)
+        class(cubic_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
+        values = u + self%a * u**3 - 1.0_wp
+    end subroutine evaluate_residual
+
+    subroutine evaluate_jacobian(self, u, values, error, law)
+        class(cubic_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: values(:)
+        type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
+        values = 1.0_wp + 3.0_wp * self%a * u**2
+    end subroutine evaluate_jacobian
+
+    subroutine get_row_levels(self, u, level, noise, error, law)
+        class(cubic_problem_type), intent(inout) :: self
+        real(wp), intent(in) :: u(:)
+        real(wp), intent(out) :: level(:), noise(:)
+        type(error_type), allocatable, intent(out) :: error
+        type(regularisation_type), intent(in), optional :: law
+        level = 1.0_wp
+        noise = 0.0_wp
+    end subroutine get_row_levels
+
+    !> try_chord from u = 0 with 3 chord steps and `finish` finishing steps: its stats,
+    !> whether it converged, the solution and the solver's factorisations and solves.
+    subroutine run_chord(a, finish, u, stats, converged, n_factorisations, n_solves, error)
+        real(wp), intent(in) :: a
+        integer, intent(in) :: finish
+        real(wp), allocatable, intent(out) :: u(:)
+        type(newton_stats_type), intent(out) :: stats
+        logical, intent(out) :: converged
+        integer, intent(out) :: n_factorisations, n_solves
+        type(error_type), allocatable, intent(out) :: error
+        type(cubic_problem_type), target :: problem
+        type(newton_solver_type) :: newton
+        type(solver_config_type) :: options
+        class(linear_solver_type), allocatable :: linear
+        real(wp) :: t(5)
+
+        problem%a = a
+        problem%col_ptr = [0_ik, 1_ik, 2_ik]
+        problem%row_index = [0_ik, 1_ik]
+        call new_linear_solver(linear, 'klu', error)
+        if (allocated(error)) return
+        call new_newton_solver(newton, problem, linear, options, error)
+        if (allocated(error)) return
+        allocate(u(2), source=0.0_wp)
+        call newton%try_chord(u, stats, converged, error, &
+            solve_options_type(chord_steps=3, finish_steps=finish))
+        if (allocated(error)) return
+        call newton%get_timings(t(1), t(2), t(3), t(4), t(5), n_factorisations, n_solves)
+    end subroutine run_chord
+
+    !> a = 0.01: without finishing steps the path stops at 2.6e-7 (a second Newton step
+    !> would follow); with three it converges to the root on its one factorisation.
+    subroutine test_finishing(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(newton_stats_type) :: stats
+        real(wp), allocatable :: u(:)
+        real(wp) :: root
+        logical :: converged
+        integer :: n_factorisations, n_solves, k
+
+        call run_chord(0.01_wp, 0, u, stats, converged, n_factorisations, n_solves, error)
+        if (allocated(error)) return
+        call check(error, .not. converged .and. size(stats%residual_history) == 5, &
+            'without finishing steps: one Newton step and three chord steps, not converged')
+        if (allocated(error)) return
+        call check_close(error, stats%residual_norm, 2.57e-7_wp, 1.0e-2_wp, &
+            'residual after them')
+        if (allocated(error)) return
+
+        call run_chord(0.01_wp, 3, u, stats, converged, n_factorisations, n_solves, error)
+        if (allocated(error)) return
+        call check(error, converged .and. n_factorisations == 1 .and. n_solves == 7, &
+            'with three finishing steps: converged on one factorisation, seven solves')
+        if (allocated(error)) return
+        ! The root of u + 0.01 u^3 = 1 by bisection (independent of the solver).
+        block
+            real(wp) :: lo, hi
+            lo = 0.0_wp
+            hi = 1.0_wp
+            do k = 1, 200
+                root = 0.5_wp * (lo + hi)
+                if (root + 0.01_wp * root**3 > 1.0_wp) then
+                    hi = root
+                else
+                    lo = root
+                end if
+            end do
+        end block
+        call check_close(error, u(1), root, 1.0e-10_wp, 'solution')
+        if (allocated(error)) return
+        call check_close(error, u(2), root, 1.0e-10_wp, 'solution, second row')
+    end subroutine test_finishing
+
+    !> a = 0.03: the rate after the chord steps (0.085) does not reach the tolerance in
+    !> three more steps, so none is taken (four solves: the Newton step, three chord).
+    subroutine test_slow_rate(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(newton_stats_type) :: stats
+        real(wp), allocatable :: u(:)
+        logical :: converged
+        integer :: n_factorisations, n_solves
+
+        call run_chord(0.03_wp, 3, u, stats, converged, n_factorisations, n_solves, error)
+        if (allocated(error)) return
+        call check(error, .not. converged .and. n_factorisations == 1 .and. n_solves == 4, &
+            'no finishing step: not converged, one factorisation, four solves')
+        if (allocated(error)) return
+        call check_close(error, stats%residual_norm, 1.89e-5_wp, 1.0e-2_wp, &
+            'residual after the chord steps')
+    end subroutine test_slow_rate
+
+end module test_chord
