@@ -193,7 +193,12 @@ def draw(rows: dict[str, dict], dominated: dict[str, str], path: Path, title: st
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    inf = float("inf")
+
     figure, axes = plt.subplots(figsize=(7.5, 5.0))
+    stopped = {name: row["failed"] + "".join(f" on the {scene}" for scene, error
+                                             in row["scenes"].items() if error == inf)
+               for name, row in rows.items() if "failed" in row}
     rows = {name: row for name, row in rows.items() if "failed" not in row}
     for name, row in rows.items():
         preset = name in PRESETS or name == "defaults"
@@ -208,12 +213,23 @@ def draw(rows: dict[str, dict], dominated: dict[str, str], path: Path, title: st
                           xytext=(6, 4), fontsize=9)
     axes.scatter([], [], s=0, label="front: no setting faster and at least as accurate "
                  "on every scene")
-    for marker, color, label in (("o", "C3", "preset or defaults, on the front"),
-                                 ("o", "C1", "preset or defaults, dominated"),
-                                 ("o", "C0", "grid setting on the front"),
-                                 ("o", "0.6", "grid setting, dominated"),
-                                 ("s", "0.6", "staggered scheme")):
-        axes.scatter([], [], marker=marker, color=color, label=label)
+    kinds = {("o", "C3", "preset or defaults, on the front"): False,
+             ("o", "C1", "preset or defaults, dominated"): False,
+             ("o", "C0", "grid setting on the front"): False,
+             ("o", "0.6", "grid setting, dominated"): False,
+             ("s", "0.6", "staggered scheme"): False}
+    for name, row in rows.items():
+        preset = name in PRESETS or name == "defaults"
+        color = ("C3" if preset else "C0") if not dominated[name] else ("C1" if preset
+                                                                        else "0.6")
+        for marker, colour, label in kinds:
+            if (marker == "s") == ("staggered" in name) and (marker == "s" or colour == color):
+                kinds[(marker, colour, label)] = True
+    for (marker, color, label), drawn in kinds.items():
+        if drawn:
+            axes.scatter([], [], marker=marker, color=color, label=label)
+    for name in stopped:
+        axes.scatter([], [], s=0, label=f"{name}: {stopped[name]}")
     axes.set_xscale("log")
     axes.set_yscale("log")
     axes.set_xlabel("curve error (force per width, worst branch of the worst scene, "
@@ -238,7 +254,22 @@ def main() -> None:
     parser.add_argument("--only", nargs="*", help="settings to run (default: all)")
     parser.add_argument("--reference-step", type=float, default=REFERENCE_STEP,
                         help="max_step of the reference run")
+    parser.add_argument("--replot", type=Path,
+                        help="print and draw the measurements of --json FILE, run nothing")
     args = parser.parse_args()
+    if args.replot:
+        saved = json.loads(args.replot.read_text())
+        report(saved["rows"], saved["reference_errors"], saved["fixed"], args.png)
+    else:
+        rows, reference_errors, fixed = measure(args)
+        if args.json:
+            args.json.write_text(json.dumps({"rows": rows, "fixed": fixed,
+                                             "reference_errors": reference_errors}))
+        report(rows, reference_errors, fixed, args.png)
+
+
+def measure(args: argparse.Namespace) -> tuple[dict, dict, dict]:
+    """Rows per setting, the references' own errors and the steps every setting takes."""
     work = Path(tempfile.mkdtemp(prefix="presets_front_"))
     chosen = settings()
     if args.only:
@@ -285,8 +316,13 @@ def main() -> None:
     spent = resource.getrusage(resource.RUSAGE_CHILDREN)
     print(f"load average after: {os.getloadavg()[0]:.2f}; children's CPU "
           f"{spent.ru_utime + spent.ru_stime:.0f} s", file=sys.stderr)
+    return rows, reference_errors, fixed
+
+
+def report(rows: dict, reference_errors: dict, fixed: dict, png: Path) -> None:
+    """Print the tables and draw the picture."""
     dominated = front(rows)
-    names = list(scenes(args.cell, args.clamped))
+    names = list(reference_errors)
     print("Reference error (run at twice the step and 10x the tolerance against the "
           "reference): " + ", ".join(f"{s} {e:.1e}" for s, e in reference_errors.items()))
     print()
@@ -319,12 +355,9 @@ def main() -> None:
         if name in rows:
             print(f"| {name} | " + " | ".join(
                 f"{rows[name]['scene_cpu'].get(s, float('nan')):.2f}" for s in names) + " |")
-    if args.json:
-        args.json.write_text(json.dumps({"rows": rows, "fixed": fixed,
-                                         "reference_errors": reference_errors}, indent=1))
-    draw(rows, dominated, args.png, "&solver settings, one stretch cycle of each of\n"
+    draw(rows, dominated, png, "&solver settings, one stretch cycle of each of\n"
          + ", ".join(names))
-    print(f"\npicture: {args.png}")
+    print(f"\npicture: {png}")
 
 
 if __name__ == "__main__":
