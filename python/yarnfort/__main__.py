@@ -352,8 +352,9 @@ def _parser() -> argparse.ArgumentParser:
     export.add_argument("--component", nargs="+", required=True, metavar="C",
                         choices=["1", "2", "12"],
                         help="the component each RUN gives, in order (1, 2 or 12 for shear);"
-                        " one RUN with several components reads its e11/n11, e22/n22,"
-                        " gamma12/n12 columns")
+                        " one RUN with several components reads its e11/n11, e22/n22"
+                        " and gamma12 columns (12: against n12 cos(gamma12) - n22"
+                        " sin(gamma12), the shear in the yarns' frame)")
     export.add_argument("--format", default="abaqus", choices=["abaqus", "lsdyna", "csv"],
                         help="file format (default abaqus)")
     export.add_argument("--thickness", metavar="LENGTH",

@@ -19,7 +19,10 @@ membrane columns (``e11``, ``e22``, ``gamma12``; ``n11``, ``n22``, ``n12``) the 
 takes its own pair; otherwise components 1 and 2 take the uniaxial columns ``strain``
 and ``force_per_width`` (the cell stretched along x: give the run of the cell turned by
 90 degrees, or stretched in its other direction, as component 2). Shear has no such
-fallback.
+fallback. Its force is the shear in the yarns' frame, ``n12 cos(gamma12) - n22
+sin(gamma12)`` (the fabric models take their shear response apart from the tension
+along the yarns, which turns with the yarns by itself); a run where that is zero (a
+string net's crossings are pins: inputs/REFERENCE.md, *Shear*) is refused.
 
 Three formats (:func:`export_fabric`): an Abaqus/Explicit ``*FABRIC`` material block,
 LS-DYNA ``*DEFINE_CURVE_TITLE`` blocks, and a plain CSV. The keyword layouts, and where
@@ -53,6 +56,11 @@ COMPONENTS = ("1", "2", "12")
 #: columns components 1 and 2 fall back to.
 MEMBRANE_COLUMNS = {"1": ("e11", "n11"), "2": ("e22", "n22"), "12": ("gamma12", "n12")}
 UNIAXIAL_COLUMNS = ("strain", "force_per_width")
+#: Component 12's force: the shear in the yarns' frame, from these columns.
+FRAME_SHEAR = "n12 cos(gamma12) - n22 sin(gamma12)"
+#: A frame shear below this fraction of the largest n11, n22 is zero (the solver's
+#: rounding; the program's note on a sheared run uses the same bound).
+ZERO_SHEAR = 1e-8
 #: Abaqus names the shear component SHEAR (Keywords Guide, *UNIAXIAL).
 ABAQUS_COMPONENT = {"1": "1", "2": "2", "12": "SHEAR"}
 #: A strain change smaller than this fraction of the component's strain range is no
@@ -164,6 +172,27 @@ def _columns(curve: Curve, component: str, folder: Path, uniaxial: bool) -> tupl
                             f" curve.csv has no columns {needed}")
 
 
+def _frame_shear(curve: Curve, folder: Path) -> np.ndarray:
+    """The shear in the yarns' frame (N/m) at every step; refused where it is zero."""
+    missing = [c for c in ("n11", "n22") if c not in curve.columns]
+    if missing:
+        raise FabricExportError(f"run {str(folder)!r} has no data for component 12:"
+                                f" curve.csv has no columns {' and '.join(missing)}")
+    gamma, n12, n22, n11 = (np.asarray(curve[c], dtype=float)
+                            for c in ("gamma12", "n12", "n22", "n11"))
+    shear = n12 * np.cos(gamma) - n22 * np.sin(gamma)
+    scale = max(float(np.abs(n11).max()), float(np.abs(n22).max()))
+    if np.all(np.isfinite(shear)) and np.abs(shear).max() <= ZERO_SHEAR * scale:
+        raise FabricExportError(
+            f"run {str(folder)!r}, component 12: no shear stiffness: the shear in the"
+            f" yarns' frame, {FRAME_SHEAR}, is zero at every step (at most"
+            f" {np.abs(shear).max() / max(scale, np.finfo(float).tiny):.1e} of n11, n22):"
+            " the cell carries tension along its yarns only (n12 = n22 tan(gamma12)),"
+            " which the macro model's components 1 and 2 carry; a string net's crossings"
+            " are pins (inputs/REFERENCE.md, Shear)")
+    return shear
+
+
 def _primary_and_unloading(strain: np.ndarray) -> tuple[list[int], list[list[int]], int]:
     """Rows of the primary loading, rows of each unloading from a new peak, and the
     number of unloadings from below the largest strain reached before."""
@@ -252,6 +281,8 @@ def fabric_curves(folder: str | Path, component: str = "1", *,
             " is compressed); give the run that loads this component"
             + ("" if strain_column == UNIAXIAL_COLUMNS[0] or component == "12" else
                ", or read a turned cell's x direction with --uniaxial"))
+    if component == "12":
+        force, force_column = _frame_shear(curve, folder), FRAME_SHEAR
 
     def branch(kind: str, rows: list[int], peak: int) -> Branch:
         index = np.array(rows)

@@ -6,6 +6,7 @@ program yarnfort_main
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64, real64
     use yarnfort_error, only: error_type
     use yarnfort_version, only: yarnfort_version_string
+    use yarnfort_text, only: format_short
     use yarnfort_input_config, only: config_type
     use yarnfort_input_namelist, only: read_config_from_stdin, check_config
     use yarnfort_input_groups, only: input_help_lines => help_lines
@@ -83,8 +84,31 @@ program yarnfort_main
     if (writer%n_jumps > 0) write(error_unit, '(a, i0, a)') 'yarnfort: note: ', &
         writer%n_jumps, ' step(s) ended in a jump after a slip instability (curve.csv ' &
         // 'column jumped; inputs/REFERENCE.md, Slip instabilities)'
+    if (scene%periodic_cell .and. scene%cell_shear /= 0.0_real64) call note_shear()
 
 contains
+
+    !> Say whether the sheared cell showed any shear stiffness in the yarns' frame: a
+    !> string net resists shear only by the tension it turns (inputs/REFERENCE.md, Shear).
+    subroutine note_shear()
+        ! Below this fraction of the membrane forces the frame shear is the solver's
+        ! rounding (the built-in cells: 1e-11 at most; the sliding twill 9e-6).
+        real(real64), parameter :: zero_shear = 1.0e-8_real64
+        character(len=:), allocatable :: ratio
+
+        ratio = format_short(writer%frame_shear / max(writer%membrane_force, tiny(1.0_real64)))
+        if (writer%frame_shear <= zero_shear * writer%membrane_force) then
+            write(error_unit, '(a)') 'yarnfort: note: no shear stiffness: the shear in the ' &
+                // "yarns' frame, n12 cos(gamma12) - n22 sin(gamma12), is zero at every step (" &
+                // trim(adjustl(ratio)) // ' of n11, n22): the cell carries tension along ' &
+                // 'its periods only, n12 is that tension turned by the shear (a pin-jointed ' &
+                // 'net; inputs/REFERENCE.md, Shear)'
+        else
+            write(error_unit, '(a)') "yarnfort: note: the shear in the yarns' frame, n12 " &
+                // 'cos(gamma12) - n22 sin(gamma12), reached ' // trim(adjustl(ratio)) &
+                // ' of n11, n22 (sliding at the crossings; inputs/REFERENCE.md, Shear)'
+        end if
+    end subroutine note_shear
 
     subroutine handle_arguments()
         integer :: i

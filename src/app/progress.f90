@@ -8,6 +8,7 @@ module yarnfort_app_progress
     use yarnfort_scene_scene, only: scene_type
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_writer, only: output_writer_type
+    use yarnfort_output_membrane, only: get_membrane, get_frame_shear
     implicit none
     private
 
@@ -18,6 +19,9 @@ module yarnfort_app_progress
         logical :: residual_history = .false.
         !> Steps of this run that ended in a jump (named at the end, progress or not).
         integer :: n_jumps = 0
+        !> A sheared periodic cell: the largest shear in the yarns' frame and the largest
+        !> n11, n22 over the run (N/m), for the note on its shear stiffness.
+        real(wp) :: frame_shear = 0.0_wp, membrane_force = 0.0_wp
     contains
         procedure :: on_step
         procedure :: on_cut
@@ -37,6 +41,14 @@ contains
         call self%output_writer_type%on_step(scene, state, error)
         if (allocated(error)) return
         if (state%jump_steps > 0) self%n_jumps = self%n_jumps + 1
+        if (scene%periodic_cell .and. scene%cell_shear /= 0.0_wp) then
+            block
+                real(wp) :: values(6)
+                values = get_membrane(scene, state)
+                self%frame_shear = max(self%frame_shear, abs(get_frame_shear(values)))
+                self%membrane_force = max(self%membrane_force, maxval(abs(values(4:5))))
+            end block
+        end if
         if (.not. self%progress) return
         write(error_unit, '("step ", i5, "  t = ", f9.5)', advance='no') state%step, state%time
         ! The factor of every load channel (p_force and p_disp without &path channels).

@@ -17,7 +17,9 @@ module yarnfort_driver
     use yarnfort_solver_continuation, only: step_observer_type, run_continuation
     use yarnfort_contact_friction_stepper, only: friction_stepper_type, new_friction_stepper
     use yarnfort_solver_restart, only: restart_type
-    use yarnfort_solver_lateral_control, only: lateral_stepper_type, new_lateral_stepper
+    use yarnfort_solver_stepper, only: load_stepper_type
+    use yarnfort_solver_force_control, only: force_control_stepper_type, &
+        new_force_control_stepper
     implicit none
     private
 
@@ -56,22 +58,15 @@ contains
         class(linear_solver_type), allocatable :: linear
         type(elastic_stepper_type), target :: stepper
         type(friction_stepper_type), target :: friction_stepper
-        type(lateral_stepper_type) :: lateral
+        type(force_control_stepper_type), target :: lateral
+        type(force_control_stepper_type) :: axial
 
         if (present(stopped)) stopped = .false.
         ! Only a scene with sliding passages pays for the sliding machinery.
         if (scene%passages%size() > 0) then
             call new_friction_stepper(friction_stepper, scene, get_linear_solver_name(scene), error)
             if (allocated(error)) return
-            if (scene%lateral_channel > 0) then
-                ! A force-controlled y period: an outer iteration around every step.
-                call new_lateral_stepper(lateral, friction_stepper)
-                call run_continuation(scene, lateral, observer, error, restart, max_steps, &
-                    stopped)
-                return
-            end if
-            call run_continuation(scene, friction_stepper, observer, error, restart, max_steps, &
-                stopped)
+            call run_controlled(friction_stepper)
             return
         end if
         call new_linear_solver(linear, get_linear_solver_name(scene), error)
@@ -81,12 +76,30 @@ contains
         end if
         call new_elastic_stepper(stepper, scene, linear, error)
         if (allocated(error)) return
-        if (scene%lateral_channel > 0) then
-            call new_lateral_stepper(lateral, stepper)
-            call run_continuation(scene, lateral, observer, error, restart, max_steps, stopped)
-            return
-        end if
-        call run_continuation(scene, stepper, observer, error, restart, max_steps, stopped)
+        call run_controlled(stepper)
+    contains
+        !> Follow the path with `inner`, wrapped for each force-controlled period: an
+        !> outer iteration on e22 around every step, and one on e11 around that.
+        subroutine run_controlled(inner)
+            class(load_stepper_type), target, intent(inout) :: inner
+
+            if (scene%lateral_channel > 0) then
+                call new_force_control_stepper(lateral, inner, 2)
+                if (scene%axial_channel > 0) then
+                    call new_force_control_stepper(axial, lateral, 1)
+                    call run_continuation(scene, axial, observer, error, restart, max_steps, &
+                        stopped)
+                else
+                    call run_continuation(scene, lateral, observer, error, restart, max_steps, &
+                        stopped)
+                end if
+            else if (scene%axial_channel > 0) then
+                call new_force_control_stepper(axial, inner, 1)
+                call run_continuation(scene, axial, observer, error, restart, max_steps, stopped)
+            else
+                call run_continuation(scene, inner, observer, error, restart, max_steps, stopped)
+            end if
+        end subroutine run_controlled
     end subroutine run_scene
 
     !> Solve the built `scene` of `config` with its outputs: render the input's echo and

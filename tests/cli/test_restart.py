@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import os
 import signal
+import struct
 import subprocess
 import time
 import xml.etree.ElementTree as ET
@@ -240,6 +241,47 @@ def test_cut_short_restart_file_is_refused(run_yarnfort, tmp_path):
     run = run_yarnfort(with_output(VNET, "out", control="restart = .true."))
     assert run.returncode == 2
     assert "'out/restart.dat' is cut short or unreadable" in run.stderr
+
+
+#: Restart file format 5 ends with the two force-control slopes (float64), the end
+#: marker (16 bytes) and the checksum (16); format 4 had no slopes. The version (int32)
+#: follows the 16-byte magic.
+SLOPES, VERSION = slice(-48, -32), slice(16, 20)
+
+
+def test_restart_file_of_format_4_is_read(run_yarnfort, tmp_path):
+    """A file written before the slopes were added (format 4, made here from a format-5
+    file: the slopes, zero without force control, cut out) still restarts the run, to
+    the curve of the run that never stopped."""
+    from test_faults import checksum
+
+    assert run_yarnfort(with_output(CAPSTAN, "full")).returncode == 0
+    assert run_yarnfort(with_output(CAPSTAN, "parts", control="max_steps = 5")).returncode == 0
+    restart = tmp_path / "parts" / "restart.dat"
+    data = bytearray(restart.read_bytes())
+    assert struct.unpack("<i", data[VERSION]) == (5,)
+    assert struct.unpack("<2d", data[SLOPES]) == (0.0, 0.0)
+    del data[SLOPES]
+    data[VERSION] = struct.pack("<i", 4)
+    data[-16:] = checksum(bytes(data[:-16]))
+    restart.write_bytes(bytes(data))
+    run = run_yarnfort(with_output(CAPSTAN, "parts", control="restart = .true."))
+    assert run.returncode == 0, run.stderr
+    assert "restarting after step 5" in run.stderr
+    compare_curves(read_rows(tmp_path / "full"), read_rows(tmp_path / "parts"))
+
+
+@pytest.mark.parametrize("version", [3, 6])
+def test_restart_file_of_another_format_is_refused(run_yarnfort, tmp_path, version):
+    assert run_yarnfort(with_output(VNET, "out", control="max_steps = 3")).returncode == 0
+    restart = tmp_path / "out" / "restart.dat"
+    data = bytearray(restart.read_bytes())
+    data[VERSION] = struct.pack("<i", version)
+    restart.write_bytes(bytes(data))
+    run = run_yarnfort(with_output(VNET, "out", control="restart = .true."))
+    assert run.returncode == 2
+    assert (f"'out/restart.dat' has format version {version}, this yarnfort reads versions "
+            "4 to 5") in run.stderr
 
 
 def test_new_run_removes_an_old_restart_file(run_yarnfort, tmp_path):

@@ -50,10 +50,30 @@ KNIT = """
 """
 
 
-def _run(where: Path, name: str, *, strain: float, time: str, p_disp: str,
-         boundary: str = "periodic") -> Path:
-    text = KNIT.format(boundary=boundary, strain=strain, time=time, p_disp=p_disp,
-                       name=name)
+#: A periodic 2/2 twill with friction, sheared to 0.4 and released: its crossings slide
+#: and the shear in the yarns' frame is not zero (inputs/REFERENCE.md, Shear).
+TWILL = """
+&material name = 'warp', law = 'table', table_file = 'inputs/data/warp_yarn.csv',
+          prestress = 0.02 /
+&material name = 'weft', law = 'table', table_file = 'inputs/data/weft_yarn.csv',
+          prestress = 0.02 /
+&contact materials = 'warp', 'weft', law = 'adhesion', friction_coefficient = 0.3,
+         adhesion = 0.01 /
+&fabric kind = 'twill', cells = 4, 4, spacing = 1.0e-3, 0.5e-3, boundary = 'periodic',
+        strain = 0.0, shear = 0.4, warp_material = 'warp', weft_material = 'weft',
+        gap = 0.2e-3 /
+&path time = 0, 1, 2, p_disp = 0, 1, 0 /
+&solver max_step = 0.05 /
+&output folder = 'out/{name}' /
+"""
+
+
+def _run(where: Path, name: str, *, strain: float = 0.0, time: str = "", p_disp: str = "",
+         boundary: str = "periodic", template: str = KNIT, shear: float = 0.0) -> Path:
+    text = template.format(boundary=boundary, strain=strain, time=time, p_disp=p_disp,
+                           name=name)
+    if shear:
+        text = text.replace("gap = 0.3e-3 /", f"gap = 0.3e-3, shear = {shear} /")
     done = subprocess.run([str(yarnfort.program_path())], input=text, capture_output=True,
                           text=True, cwd=where, timeout=600)
     assert done.returncode == 0, done.stderr
@@ -71,6 +91,9 @@ def runs(tmp_path_factory) -> dict[str, Path]:
         "other": _run(where, "other", strain=0.6, time="0, 1, 2", p_disp="0, 1, 0"),
         "loading_only": _run(where, "loading_only", strain=0.3, time="0, 1",
                              p_disp="0, 1"),
+        "twill_shear": _run(where, "twill_shear", template=TWILL),
+        "knit_shear": _run(where, "knit_shear", strain=0.0, time="0, 1, 2",
+                           p_disp="0, 1, 0", shear=0.4),
     }
 
 
@@ -240,6 +263,41 @@ def test_shear_and_missing_components(runs, tmp_path):
                       uniaxial=True)
 
 
+def test_shear_round_trip(runs, tmp_path):
+    """Component 12 of a sheared twill (friction, sliding): Abaqus COMPONENT=SHEAR and an
+    LS-DYNA curve hold, at every step of the path's loading (time [0, 1]) and release
+    ([1, 2]), gamma12 and the shear in the yarns' frame worked out here from curve.csv's
+    n12, n22 and gamma12: tau = n12 cos(gamma12) - n22 sin(gamma12)."""
+    folder = runs["twill_shear"]
+    curve = read_curve(folder)
+    t, gamma = np.asarray(curve["time"]), np.asarray(curve["gamma12"])
+    tau = np.asarray(curve["n12"]) * np.cos(gamma) - np.asarray(curve["n22"]) * np.sin(gamma)
+    # Not zero: sliding at the twill's crossings (a pin-jointed net would give 0).
+    assert np.abs(tau).max() > 1e-5 * np.abs(curve["n22"]).max()
+    expected = {"loading": [np.column_stack([gamma[t <= 1], tau[t <= 1]])],
+                "unloading": [np.column_stack([gamma[t >= 1], tau[t >= 1]])]}
+    written = read_abaqus(export_fabric({"12": folder}, tmp_path / "twill.inp",
+                                        thickness="0.6mm", units="N,mm"))
+    assert sorted(written) == ["SHEAR"]
+    for branch in ("loading", "unloading"):
+        (points,) = written["SHEAR"][branch]
+        assert_points_match(np.column_stack([points[:, 1], points[:, 0] * 1e6 * THICKNESS_M]),
+                            expected[branch][0])
+    curves = read_lsdyna(export_fabric({"12": folder}, tmp_path / "twill.k", format="lsdyna",
+                                       thickness="0.6mm", units="N,m"))
+    for (_, _, points), rows in zip(curves, expected["loading"] + expected["unloading"]):
+        assert_points_match(np.column_stack([points[:, 0], points[:, 1] * THICKNESS_M]),
+                            rows)
+
+
+def test_shear_without_stiffness_refused(runs, tmp_path):
+    """The knit sheared: its crossings are pins, the shear in the yarns' frame is zero,
+    and component 12 is refused with the mechanism named, nothing written."""
+    with pytest.raises(FabricExportError, match="no shear stiffness.*crossings are pins"):
+        export_fabric({"12": runs["knit_shear"]}, tmp_path / "k.inp", thickness="1mm")
+    assert not (tmp_path / "k.inp").exists()
+
+
 def test_no_unloading_refused_or_left_out(runs, tmp_path):
     target = tmp_path / "a.inp"
     with pytest.raises(FabricExportError, match="no unloading"):
@@ -337,9 +395,13 @@ def test_membrane_columns_give_all_components(runs, tmp_path):
         for branch in ("loading", "unloading"):
             assert len(written[component][branch]) == len(expected[branch])
             for points, rows_ in zip(written[component][branch], expected[branch]):
+                # Shear: the force in the yarns' frame, n12 cos(gamma12) - n22
+                # sin(gamma12), with n12 = 0.3 f, n22 = 2 f, gamma12 = 0.1 strain.
+                factor = (0.3 * np.cos(0.1 * points[:, 1] / e) - 2.0 * np.sin(
+                    0.1 * points[:, 1] / e)) if component == "SHEAR" else n
                 assert_points_match(np.column_stack([points[:, 1] / e,
-                                                     points[:, 0] * 1e6 * THICKNESS_M / n]),
-                                    rows_)
+                                                     points[:, 0] * 1e6 * THICKNESS_M
+                                                     / factor]), rows_)
     # A cell turned by 90 degrees, given as component 2: its e22 does not grow, the
     # message points to --uniaxial, which reads its x direction (strain).
     for row in rows:

@@ -52,11 +52,16 @@ def set_names(curve) -> list[str]:
     return [name[:-3] for name in curve.columns if name.endswith("_rx")]
 
 
+@pytest.mark.parametrize("shear", [None, 0.3])
 @pytest.mark.parametrize("name", sorted(SCENES))
-def test_periodic_cell_reactions_balance(run_yarnfort, tmp_path, name):
+def test_periodic_cell_reactions_balance(run_yarnfort, tmp_path, name, shear):
+    """With `shear` too: the images one y period up then move along x with p_disp, and
+    the sets must balance as before."""
     base, values = SCENES[name]
     folder = tmp_path / name
     values = {**values, "output.node_reactions": True, "output.vtk_every": 0}
+    if shear is not None:
+        values["fabric.shear"] = shear
     result = run_yarnfort(patched_scene(base, values, folder), cwd=TOP)
     assert result.returncode == 0, result.stderr
     curve = read_curve(folder)

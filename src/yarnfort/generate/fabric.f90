@@ -9,7 +9,8 @@ module yarnfort_generate_fabric
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_input_config, only: config_type
     use yarnfort_input_groups, only: fabric_kind_choices, fabric_boundary_choices, &
-        fabric_sides_choices
+        fabric_sides_choices, fabric_lateral_control_choices, fabric_axial_control_choices, &
+        fabric_config_type
     use yarnfort_input_fields, only: check_range
     use yarnfort_input_network_checks, only: coincidence_tolerance
     use yarnfort_generate_net_builder, only: net_builder_type
@@ -72,6 +73,25 @@ contains
             if (allocated(error)) return
             call check_lateral_control(error)
             if (allocated(error)) return
+            call check_axial_control(error)
+            if (allocated(error)) return
+            call require_range(error, 'shear', fabric%shear, -10.0_wp, 10.0_wp)
+            if (allocated(error)) return
+            ! Only a periodic cell has a y period to tilt; a clamped sample's shear would
+            ! need its edges moved, which no support set here does.
+            if (fabric%shear /= 0.0_wp .and. fabric%boundary /= 'periodic') then
+                call fatal_error(error, label // 'shear = ' // format_real(fabric%shear) &
+                    // " needs boundary = 'periodic' (it tilts the y period of a periodic " &
+                    // 'cell; a clamped sample cannot be sheared)')
+                return
+            end if
+            ! The shear follows p_disp, which under a held x force scales that force.
+            if (fabric%shear /= 0.0_wp .and. fabric%axial_control == 'force') then
+                call fatal_error(error, label // 'shear = ' // format_real(fabric%shear) &
+                    // " needs axial_control = 'strain' (under 'force' p_disp scales the " &
+                    // 'force n11 held, not a deformation)')
+                return
+            end if
             if (fabric%kind == 'texgen') then
                 call require_range(error, 'strain', fabric%strain, -0.9_wp, 100.0_wp)
                 if (allocated(error)) return
@@ -190,6 +210,9 @@ contains
             type(error_type), allocatable, intent(out) :: error
 
             associate(fabric => config%fabric)
+                call require_choice(error, 'lateral_control', fabric%lateral_control, &
+                    fabric_lateral_control_choices)
+                if (allocated(error)) return
                 call require_range(error, 'lateral_force', fabric%lateral_force, 0.0_wp, &
                     huge(1.0_wp))
                 if (allocated(error)) return
@@ -208,6 +231,39 @@ contains
                 end if
             end associate
         end subroutine check_lateral_control
+
+        !> A held x force replaces the x strain of a periodic cell.
+        subroutine check_axial_control(error)
+            type(error_type), allocatable, intent(out) :: error
+            type(fabric_config_type) :: defaults
+
+            associate(fabric => config%fabric)
+                call require_choice(error, 'axial_control', fabric%axial_control, &
+                    fabric_axial_control_choices)
+                if (allocated(error)) return
+                if (fabric%axial_control == 'strain') then
+                    if (fabric%axial_force /= defaults%axial_force) &
+                        call fatal_error(error, label // 'axial_force = ' &
+                        // format_real(fabric%axial_force) // " is given with axial_control = " &
+                        // "'strain' (it is the x force held under axial_control = 'force')")
+                    return
+                end if
+                if (fabric%boundary /= 'periodic') then
+                    call fatal_error(error, label // "axial_control = 'force' needs boundary " &
+                        // "= 'periodic' (it holds the x period of a periodic cell)")
+                else if (fabric%strain /= defaults%strain) then
+                    call fatal_error(error, label // 'strain = ' // format_real(fabric%strain) &
+                        // " is given with axial_control = 'force' (the x period then follows " &
+                        // 'the force: leave strain out)')
+                else
+                    call check_range(error, '&fabric', 'axial_force', fabric%axial_force, &
+                        fabric%axial_force > 0.0_wp .and. fabric%axial_force <= huge(1.0_wp), &
+                        "must be a positive force (N/m): axial_control = 'force' holds n11 at " &
+                        // 'p_disp * axial_force, and a string network carries no compression; ' &
+                        // 'at n11 = 0 the cell collapses along x')
+                end if
+            end associate
+        end subroutine check_axial_control
         !> A finite real in [low, high] (the message by the input's generic range check).
         subroutine require_range(error, variable, value, low, high)
             type(error_type), allocatable, intent(out) :: error

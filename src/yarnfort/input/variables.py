@@ -353,6 +353,23 @@ GROUPS = [
                 'across an x-parallel cell edge per unit current edge length, as in curve.csv).'),
         Var('force_ratio', 'real', 1.0, unit='1', range='[0, 100]',
             doc="Periodic, `lateral_control = 'ratio'`: n22 / n11 held at every step."),
+        Var('axial_control', 'character', 'strain', length=16, lower=True,
+            choices=['strain', 'force'],
+            doc="Periodic: what holds the x period. `'strain'`: p_disp * `strain` (prescribed). "
+                "`'force'`: the membrane force n11 (N/m) is held at p_disp * `axial_force` at "
+                'every step, the strain e11 an unknown found like e22 under `lateral_control` '
+                '(with both, around it); p_disp must stay > 0 (n11 = 0 lets the cell collapse '
+                'along x: the run stops with that message). `strain` must then be left out.'),
+        Var('axial_force', 'real', 0.0, unit='N/m', range='> 0',
+            default_doc="required (`'force'`)",
+            doc="Periodic, `axial_control = 'force'`: the membrane force n11 held at p_disp = 1 "
+                '(force across a y-parallel cell edge per unit current edge length, as in '
+                'curve.csv).'),
+        Var('shear', 'real', 0.0, unit='1', range='[-10, 10]',
+            doc='Periodic: simple shear of the cell at p_disp = 1, prescribed: the y period '
+                'a2 = L20 (p_disp * shear e_x + (1 + e22) e_y), so an image one y period up '
+                'moves by p_disp * shear * L20 along x; curve.csv reports gamma12 = '
+                'atan(p_disp * shear / (1 + e22)) (rad). See *Shear* below.'),
         Var('sides', 'character', 'free', length=16, lower=True, choices=['free', 'rollers'],
             doc="Clamped: `'free'` side edges or `'rollers'`. Woven: rollers hold the weft ends "
                 'in y and z (a selvedge); free weft ends of pre-stressed weft yarns cannot carry '

@@ -4,7 +4,7 @@
 module yarnfort_output_curve
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_scene_scene, only: scene_type
+    use yarnfort_scene_scene, only: scene_type, get_fabric_strain
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_csv_rows, only: csv_rows_type
     use yarnfort_scene_channels, only: get_curve_columns, curve_column_length
@@ -107,8 +107,7 @@ contains
             end do
         end if
         if (scene%fabric_set > 0) then
-            ! A fabric has the two default channels: p_disp is channel 2.
-            call row%add(state%factors(2) * scene%fabric_strain)
+            call row%add(get_fabric_strain(scene, state%factors))
             call row%add(state%reaction(1, scene%fabric_set) / scene%fabric_width)
         end if
         if (scene%periodic_cell) call row%add(get_membrane(scene, state))

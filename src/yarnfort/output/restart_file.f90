@@ -46,7 +46,10 @@ module yarnfort_output_restart_file
     character(len=*), parameter :: synced_file_name = 'restart.sync'
     character(len=16), parameter :: magic = 'yarnfort-restart'
     character(len=16), parameter :: end_marker = 'end-of-restart'
-    integer, parameter :: format_version = 4
+    !> Version 5 added the force-control slopes (held_slope) before the end marker; a
+    !> version 4 file, without them, is read with slopes 0 (its restart agrees with the
+    !> uninterrupted run to the outer iteration's tolerance, not bit for bit).
+    integer, parameter :: format_version = 5, oldest_version = 4
     !> Most load channels a restart file may hold (&path channels has at most 8).
     integer, parameter :: max_restart_channels = 64
 
@@ -66,8 +69,9 @@ module yarnfort_output_restart_file
     !> Echo lines of variables added after restart files were first written, at their
     !> defaults: left out of the fingerprint, so that a restart file of an input without
     !> them stays valid (one that sets them is another input).
-    character(len=*), parameter :: unhashed_defaults(3) = [character(len=32) :: &
-        "    lateral_control = 'strain'", '    lateral_force = 0.0', '    force_ratio = 1.0']
+    character(len=*), parameter :: unhashed_defaults(6) = [character(len=32) :: &
+        "    lateral_control = 'strain'", '    lateral_force = 0.0', '    force_ratio = 1.0', &
+        "    axial_control = 'strain'", '    axial_force = 0.0', '    shear = 0.0']
     !> Bytes read at a time when an input file's content is hashed.
     integer, parameter :: hash_chunk = 65536
 
@@ -119,6 +123,7 @@ contains
                 merge(1, 0, s%have_older), merge(1, 0, s%set_repeated)
             if (status == 0) call put_reals(s%u_older, s%n_unknowns)
             if (status == 0) call put_reals(s%flow_older, s%n_passages)
+            if (status == 0) write(unit, iostat=status, iomsg=message) s%held_slope
             if (status == 0) write(unit, iostat=status, iomsg=message) end_marker
         end associate
         call close_new_file(unit, temporary, error, status, message)
@@ -210,12 +215,12 @@ contains
             return
         end if
         read(unit, iostat=status) version
-        if (status /= 0 .or. version /= format_version) then
+        if (status /= 0 .or. version < oldest_version .or. version > format_version) then
             close(unit)
             write(text, '(i0)') version
             call fatal_error(error, "&control restart: '" // path // "' has format version " &
-                // trim(text) // ', this yarnfort reads version ' &
-                // format_integer(format_version))
+                // trim(text) // ', this yarnfort reads versions ' &
+                // format_integer(oldest_version) // ' to ' // format_integer(format_version))
             return
         end if
         associate(s => snapshot)
@@ -239,8 +244,8 @@ contains
             ! What follows must be exactly the arrays of these sizes and the end marker.
             inquire(unit=unit, size=file_size, pos=position)
             expected = 8_int64 * (n_channels + 3_int64 * s%n_unknowns + s%n_elements &
-                + 3_int64 * s%n_passages + 1) + 4_int64 * (s%n_passages + 2) &
-                + len(end_marker) + len(checksum)
+                + 3_int64 * s%n_passages + 1 + merge(2, 0, version >= 5)) &
+                + 4_int64 * (s%n_passages + 2) + len(end_marker) + len(checksum)
             if (file_size - (position - 1) /= expected) then
                 close(unit)
                 write(text, '(i0)') file_size
@@ -263,7 +268,9 @@ contains
             end if
             read(unit, iostat=status) s%factors, s%u, s%u_old, s%length0, s%flow, &
                 s%flow_old, s%mode, s%load_older, have_older, set_repeated, s%u_older, &
-                s%flow_older, marker, checksum
+                s%flow_older
+            if (status == 0 .and. version >= 5) read(unit, iostat=status) s%held_slope
+            if (status == 0) read(unit, iostat=status) marker, checksum
             if (status == 0 .and. marker /= end_marker) status = -1
             s%have_older = have_older == 1
             s%set_repeated = set_repeated == 1
@@ -303,8 +310,11 @@ contains
         character(len=:), allocatable :: path, expected_stepper
         real(wp) :: t_start, t_end, span, scale
         real(wp), allocatable :: factors(:)
-        integer :: n_knots
+        integer :: n_knots, c
+        integer :: control(2)
 
+        ! The channels of force-controlled periods (0: none).
+        control = [scene%axial_channel, scene%lateral_channel]
         path = folder // '/' // restart_file_name
         write(file_sizes, '(i0, " nodes, ", i0, " elements, ", i0, " unknowns, ", i0, &
             & " passages")') snapshot%n_nodes, snapshot%n_elements, snapshot%n_unknowns, &
@@ -377,10 +387,14 @@ contains
         allocate(factors(scene%path%n_channels()))
         call scene%path%get_factors(snapshot%time, factors)
         scale = max(maxval(abs(scene%path%factor)), tiny(1.0_wp))
-        ! A force-controlled y period: its channel's factor is the e22 found, not the path's.
-        if (scene%lateral_channel > 0 .and. size(snapshot%factors) == size(factors)) then
-            if (abs(snapshot%factors(scene%lateral_channel)) <= 100.0_wp) &
-                factors(scene%lateral_channel) = snapshot%factors(scene%lateral_channel)
+        ! A force-controlled period: its channel's factor is the strain found, not the
+        ! path's.
+        if (size(snapshot%factors) == size(factors)) then
+            do c = 1, size(control)
+                if (control(c) == 0) cycle
+                if (abs(snapshot%factors(control(c))) <= 100.0_wp) &
+                    factors(control(c)) = snapshot%factors(control(c))
+            end do
         end if
         if (.not. all(abs(snapshot%factors - factors) <= factor_tolerance * scale)) then
             call damaged('its load factors ' // join_reals(snapshot%factors) // ' are not ' &
@@ -388,8 +402,10 @@ contains
                 // 'channels ' // join_names(scene%path%channel, ''))
             return
         end if
-        ! The continuation's load is the path's (the lateral channel's factor 0 there).
-        if (scene%lateral_channel > 0) factors(scene%lateral_channel) = 0.0_wp
+        ! The continuation's load is the path's (the control channels' factors 0 there).
+        do c = 1, size(control)
+            if (control(c) > 0) factors(control(c)) = 0.0_wp
+        end do
         if (.not. abs(snapshot%previous_load - sum(factors)) <= factor_tolerance &
                 * size(factors) * scale) then
             call damaged('its previous load ' // format_real(snapshot%previous_load) &
@@ -398,6 +414,11 @@ contains
         end if
         if (.not. finite_state(snapshot%previous_load, snapshot%u, snapshot%flow)) then
             call damaged('it holds a position or flow that is not a finite number')
+            return
+        end if
+        ! A secant slope is kept only when positive (a stretched period pulls harder).
+        if (.not. all(snapshot%held_slope >= 0.0_wp .and. ieee_is_finite(snapshot%held_slope))) then
+            call damaged('it holds a force-control slope that is not a number >= 0')
             return
         end if
         if (.not. all(snapshot%length0 > 0.0_wp .and. ieee_is_finite(snapshot%length0))) then
@@ -433,8 +454,8 @@ contains
                     return
                 end if
                 call scene%path%get_factors(snapshot%time_old, factors)
-                ! (Unknown under lateral control: it holds the previous step's e22.)
-                if (scene%lateral_channel == 0 .and. .not. abs(snapshot%load_old &
+                ! (Unknown under force control: it holds the previous step's strain.)
+                if (all(control == 0) .and. .not. abs(snapshot%load_old &
                         - sum(factors)) <= factor_tolerance * size(factors) * scale) then
                     call damaged('the load ' // format_real(snapshot%load_old) // ' of its ' &
                         // 'previous step is not the sum of the load factors at its time ' &

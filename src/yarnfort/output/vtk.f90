@@ -25,7 +25,7 @@ module yarnfort_output_vtk
     use, intrinsic :: iso_fortran_env, only: int8, int32, int64
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type
-    use yarnfort_scene_scene, only: scene_type, get_applied_force
+    use yarnfort_scene_scene, only: scene_type, get_applied_force, get_fabric_strain
     use yarnfort_solver_continuation, only: step_state_type
     use yarnfort_output_vtu, only: vtu_builder_type, start_vtu, finish_vtu, write_text_file, &
         add_text, add_reals, add_int32, vtk_vertex, vtk_line
@@ -271,6 +271,7 @@ contains
         allocate(period(3, n_links))
         do l = 1, n_links
             period(:, l) = scene%link_period(:, l) * (1.0_wp + p_disp * scene%link_strain(:, l))
+            period(1, l) = period(1, l) + p_disp * scene%cell_shear * scene%link_period(2, l)
         end do
         ! The force a link carries: what acts on its follower's node (element tensions,
         ! applied load) and on the nodes that follow that node, down the chain of links.
@@ -420,8 +421,7 @@ contains
                 field=.true.)
         end do
         if (scene%fabric_set > 0) then
-            ! A fabric has the two default channels: p_disp is channel 2.
-            call add_reals(vtu, 'strain', [state%factors(2) * scene%fabric_strain], 1, &
+            call add_reals(vtu, 'strain', [get_fabric_strain(scene, state%factors)], 1, &
                 field=.true.)
             call add_reals(vtu, 'force_per_width', &
                 [state%reaction(1, scene%fabric_set) / scene%fabric_width], 1, field=.true.)

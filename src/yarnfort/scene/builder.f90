@@ -8,7 +8,7 @@ module yarnfort_scene_builder
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error, prefix_error
     use yarnfort_input_config, only: config_type, name_length
-    use yarnfort_scene_scene, only: scene_type, lateral_channel_name
+    use yarnfort_scene_scene, only: scene_type, lateral_channel_name, axial_channel_name
     use yarnfort_scene_channels, only: get_channel_names, get_channel_factors
     use yarnfort_scene_builder_laws, only: new_force_law, new_friction_law
     use yarnfort_scene_builder_network, only: build_network, apply_prestress, &
@@ -45,17 +45,22 @@ contains
             end if
         end do
         scene%path%channel = get_channel_names(config%path)
-        ! A force-controlled y period of a periodic cell: e22 is the factor of a channel
-        ! of its own (the path leaves it at 0; the outer iteration sets it).
-        if (len_trim(config%fabric%kind) > 0 .and. config%fabric%boundary == 'periodic' &
-                .and. config%fabric%lateral_control /= 'strain') then
-            scene%path%channel = [character(len=name_length) :: scene%path%channel, &
-                lateral_channel_name]
-            scene%lateral_channel = size(scene%path%channel)
-            scene%lateral_control = config%fabric%lateral_control
-            scene%lateral_force = config%fabric%lateral_force
-            scene%force_ratio = config%fabric%force_ratio
+        ! A force-controlled x or y period of a periodic cell: e11 or e22 is the factor of
+        ! a channel of its own (the path leaves it at 0; the outer iteration sets it).
+        if (len_trim(config%fabric%kind) > 0 .and. config%fabric%boundary == 'periodic') then
+            if (config%fabric%axial_control /= 'strain') then
+                scene%axial_channel = size(scene%path%channel) + 1
+                scene%axial_force = config%fabric%axial_force
+            end if
+            if (config%fabric%lateral_control /= 'strain') then
+                scene%lateral_channel = size(scene%path%channel) + 1 &
+                    + merge(1, 0, scene%axial_channel > 0)
+                scene%lateral_control = config%fabric%lateral_control
+                scene%lateral_force = config%fabric%lateral_force
+                scene%force_ratio = config%fabric%force_ratio
+            end if
         end if
+        call append_control_channels()
         call build_network(scene, config, error)
         if (allocated(error)) return
         call apply_prestress(scene, config, error)
@@ -86,22 +91,32 @@ contains
             if (scene%periodic_cell) then
                 scene%cell_period = maxval(abs(scene%cell_lattice(1:2, :)), dim=2)
                 scene%cell_strain = [config%fabric%strain, config%fabric%lateral_strain]
+                scene%cell_shear = config%fabric%shear
             end if
         end if
         scene%path%time = config%path%time
         scene%path%channel = get_channel_names(config%path)
         scene%path%factor = get_channel_factors(config%path)
-        if (scene%lateral_channel > 0) then
-            scene%path%channel = [character(len=name_length) :: scene%path%channel, &
-                lateral_channel_name]
-            block
-                real(wp), allocatable :: factor(:, :)
-                allocate(factor(size(scene%path%time), scene%lateral_channel), source=0.0_wp)
-                factor(:, :scene%lateral_channel - 1) = scene%path%factor
-                call move_alloc(factor, scene%path%factor)
-            end block
-        end if
+        call append_control_channels()
         scene%length_scale = sum(scene%network%length0) / size(scene%network%length0)
+    contains
+        !> The channels of force-controlled periods after the path's (axial, then
+        !> lateral), with factor 0 at every knot where the path's factors are set.
+        subroutine append_control_channels()
+            real(wp), allocatable :: factor(:, :)
+            integer :: n
+
+            n = size(scene%path%channel)
+            if (scene%axial_channel > 0) scene%path%channel = &
+                [character(len=name_length) :: scene%path%channel, axial_channel_name]
+            if (scene%lateral_channel > 0) scene%path%channel = &
+                [character(len=name_length) :: scene%path%channel, lateral_channel_name]
+            if (.not. allocated(scene%path%factor)) return
+            if (size(scene%path%channel) == n) return
+            allocate(factor(size(scene%path%time), size(scene%path%channel)), source=0.0_wp)
+            factor(:, :n) = scene%path%factor
+            call move_alloc(factor, scene%path%factor)
+        end subroutine append_control_channels
     end subroutine new_scene
 
 end module yarnfort_scene_builder

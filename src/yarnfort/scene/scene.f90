@@ -12,8 +12,11 @@ module yarnfort_scene_scene
 
     public :: scene_type, law_holder_type, support_set_type, load_set_type, load_path_type
     public :: get_applied_force, get_loaded_nodes, get_force_scale, lateral_channel_name
+    public :: axial_channel_name, get_fabric_strain
 
-    !> The channel of a force-controlled y period (its factor, and column, is e22).
+    !> The channels of a force-controlled x and y period (their factors, and columns,
+    !> are e11 and e22).
+    character(len=*), parameter :: axial_channel_name = 'axial'
     character(len=*), parameter :: lateral_channel_name = 'lateral'
 
     !> One yarn type's force law.
@@ -86,19 +89,26 @@ module yarnfort_scene_scene
         real(wp), allocatable :: link_period(:, :), link_strain(:, :)
         !> A periodic cell (&fabric boundary = 'periodic'): each node's lattice vector at
         !> p_disp = 0 (3, n_nodes; zero for a node that follows no periodic image), the
-        !> reference periods along x and y (m) and their engineering strains at p_disp = 1.
-        !> A node's position is its root's plus lattice * (1 + p_disp * cell_strain),
-        !> componentwise (yarnfort_output_membrane).
+        !> reference periods along x and y (m), their engineering strains and the simple
+        !> shear at p_disp = 1. A node's position is its root's plus lattice * (1 + p_disp *
+        !> cell_strain), componentwise, plus p_disp * cell_shear * lattice_y along x
+        !> (yarnfort_output_membrane).
         logical :: periodic_cell = .false.
         real(wp), allocatable :: cell_lattice(:, :)
-        real(wp) :: cell_period(2) = 0.0_wp, cell_strain(2) = 0.0_wp
+        real(wp) :: cell_period(2) = 0.0_wp, cell_strain(2) = 0.0_wp, cell_shear = 0.0_wp
         !> A periodic cell whose y period follows a force (&fabric lateral_control 'force'
         !> or 'ratio'): the load channel (appended to the path's, factor 0 at every knot)
-        !> whose factor is e22, set by yarnfort_solver_lateral_control; 0 otherwise. The
+        !> whose factor is e22, set by yarnfort_solver_force_control; 0 otherwise. The
         !> n22 held, or the ratio n22 / n11 held.
         integer :: lateral_channel = 0
         character(len=16) :: lateral_control = 'strain'
         real(wp) :: lateral_force = 0.0_wp, force_ratio = 0.0_wp
+        !> A periodic cell whose x period follows a force (&fabric axial_control 'force'):
+        !> the load channel (appended to the path's before the lateral one, factor 0 at
+        !> every knot) whose factor is e11, set by yarnfort_solver_force_control; 0
+        !> otherwise. n11 is held at p_disp * axial_force.
+        integer :: axial_channel = 0
+        real(wp) :: axial_force = 0.0_wp
     end type scene_type
 
 contains
@@ -172,6 +182,20 @@ contains
             end do
         end do
     end subroutine get_loaded_nodes
+
+    !> The fabric's x strain at load `factors`: p_disp * strain, or the e11 found under
+    !> axial force control.
+    pure real(wp) function get_fabric_strain(scene, factors) result(strain)
+        type(scene_type), intent(in) :: scene
+        real(wp), intent(in) :: factors(:)
+
+        if (scene%axial_channel > 0) then
+            strain = factors(scene%axial_channel)
+        else
+            ! A fabric has the two default channels: p_disp is channel 2.
+            strain = factors(2) * scene%fabric_strain
+        end if
+    end function get_fabric_strain
 
     pure integer function n_channels(self)
         class(load_path_type), intent(in) :: self

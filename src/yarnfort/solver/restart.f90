@@ -47,6 +47,9 @@ module yarnfort_solver_restart
         logical :: have_older = .false., set_repeated = .false.
         real(wp) :: load_older = 0.0_wp
         real(wp), allocatable :: u_older(:), flow_older(:)
+        !> Force control (yarnfort_solver_force_control): the secant slope dn/de of the
+        !> x and the y period's outer iteration (0: none yet, or not force-controlled).
+        real(wp) :: held_slope(2) = 0.0_wp
     end type restart_type
 
 end module yarnfort_solver_restart

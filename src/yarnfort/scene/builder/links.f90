@@ -29,7 +29,7 @@ contains
         integer :: n_nodes, l, n, r, k, c, cr, hops, displacement_channel, s, i
         integer, allocatable :: leader(:), link_of(:), stretch_coordinates(:)
         integer, allocatable :: set_of(:), place_of(:)
-        real(wp) :: offset(3), macro(3), gap(3), step(3), lattice(3)
+        real(wp) :: offset(3), macro(3), gap(3), step(3), lattice(3), sheared
         character(len=200) :: buffer
 
         n_nodes = scene%network%n_nodes()
@@ -119,6 +119,12 @@ contains
                 r = leader(r)
             end do
             scene%cell_lattice(:, n) = lattice
+            ! A force-controlled x period: x = root + lattice_x * (1 + e11), whatever
+            ! `strain` (p_disp then scales the force held).
+            if (scene%axial_channel > 0) macro(1) = 0.0_wp
+            ! Simple shear: an image one y period up moves along x with p_disp (the y
+            ! strain's term above is componentwise; this one crosses from y to x).
+            sheared = macro(1) + config%fabric%shear * lattice(2)
             do k = 1, 3
                 c = 3 * (n - 1) + k
                 cr = 3 * (r - 1) + k
@@ -129,17 +135,21 @@ contains
                     scene%dofs%base(c) = scene%dofs%base(cr) + offset(k)
                     scene%dofs%delta(c, :) = scene%dofs%delta(cr, :)
                     scene%dofs%delta(c, displacement_channel) = &
-                        scene%dofs%delta(cr, displacement_channel) + macro(k)
+                        scene%dofs%delta(cr, displacement_channel) &
+                        + merge(sheared, macro(k), k == 1)
                 else
                     scene%dofs%base(c) = offset(k)
                     scene%dofs%delta(c, :) = 0.0_wp
-                    scene%dofs%delta(c, displacement_channel) = macro(k)
+                    scene%dofs%delta(c, displacement_channel) = merge(sheared, macro(k), k == 1)
                 end if
                 scene%dofs%gap(c) = gap(k)
                 ! A force-controlled y period: y = root + lattice_y * (1 + e22).
                 if (k == 2 .and. scene%lateral_channel > 0) &
                     scene%dofs%delta(c, scene%lateral_channel) = &
                     scene%dofs%delta(c, scene%lateral_channel) + lattice(2)
+                if (k == 1 .and. scene%axial_channel > 0) &
+                    scene%dofs%delta(c, scene%axial_channel) = &
+                    scene%dofs%delta(c, scene%axial_channel) + lattice(1)
                 if (scene%dofs%unknown(cr) == 0 .and. set_of(cr) > 0) then
                     associate(set => scene%supports(set_of(cr)))
                         set%followers = [set%followers, c]
@@ -147,7 +157,9 @@ contains
                     end associate
                 end if
             end do
-            if (macro(1) /= 0.0_wp) stretch_coordinates = [stretch_coordinates, 3 * n - 2]
+            ! The x coordinates the macroscopic stretch moves ('stretch', force_per_width).
+            if (macro(1) /= 0.0_wp .or. (scene%axial_channel > 0 .and. lattice(1) /= 0.0_wp)) &
+                stretch_coordinates = [stretch_coordinates, 3 * n - 2]
         end do
         call renumber_unknowns(scene%dofs%unknown, scene%dofs%n_unknowns)
         if (size(stretch_coordinates) > 0) then
