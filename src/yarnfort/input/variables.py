@@ -113,7 +113,9 @@ GROUPS = [
         # from verification/speed_accuracy/presets.py (every scene of
         # tests/verification/test_defaults.py against its exact reference): at these steps
         # the error follows the tolerance, the step sets how finely the curve is drawn, and
-        # the monolithic scheme was the faster one.
+        # the monolithic scheme was the faster one. Each is on the speed-accuracy front of
+        # benchmarks/presets_front.py; 'fast' was dropped (docs/decisions.md, *Presets on
+        # the speed-accuracy front*) and is refused in validate.f90.
         Var('preset', 'character', 'custom', length=16, lower=True,
             choices=['custom', 'balanced', 'accurate'],
             doc='Named defaults for `initial_step`, `max_step`, `residual_tolerance` and '
