@@ -664,7 +664,7 @@ class Scene:
         ``&control title``.
     solver, output, control : dict, optional
         Settings of ``&solver``, ``&output`` and ``&control`` by variable name (e.g.
-        ``solver={'preset': 'fast'}``, ``output={'folder': 'out/run1'}``).
+        ``solver={'preset': 'balanced'}``, ``output={'folder': 'out/run1'}``).
 
     Attributes
     ----------

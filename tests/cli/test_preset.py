@@ -17,8 +17,6 @@ REFERENCE = TOP / "inputs" / "REFERENCE.md"
 
 #: The presets as documented in inputs/REFERENCE.md (section Presets).
 PRESETS = {
-    "fast": dict(initial_step=0.25, max_step=0.25, residual_tolerance=1e-6,
-                 scheme="monolithic"),
     "balanced": dict(initial_step=0.05, max_step=0.05, residual_tolerance=1e-9,
                      scheme="monolithic"),
     "accurate": dict(initial_step=0.01, max_step=0.01, residual_tolerance=1e-11,
@@ -87,7 +85,7 @@ def test_explicit_values_override_the_preset(run_yarnfort):
 
 def test_explicit_value_equal_to_the_default_still_overrides(run_yarnfort):
     """Set is set: a value equal to the plain default is not mistaken for 'unset'."""
-    solver = effective_solver(run_yarnfort, "preset = 'fast', residual_tolerance = 1e-10,"
+    solver = effective_solver(run_yarnfort, "preset = 'balanced', residual_tolerance = 1e-10,"
                               " max_step = 0.25, initial_step = 0.1")
     assert_values(solver, dict(residual_tolerance=1e-10, max_step=0.25, initial_step=0.1))
 
@@ -108,7 +106,7 @@ def test_unknown_preset_is_rejected(run_yarnfort):
     run = run_yarnfort(VNET.replace("max_steps = 1", "check_only = .true.")
                        + "&solver preset = 'acurate' /\n")
     assert run.returncode == 2
-    assert ("&solver: preset = 'acurate' is unknown (use custom, fast, balanced, accurate);"
+    assert ("&solver: preset = 'acurate' is unknown (use custom, balanced, accurate);"
             " did you mean 'accurate'?") in run.stderr
 
 

@@ -27,7 +27,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 TOP = HERE.parents[1]
 TESTS = TOP / "tests" / "verification" / "test_defaults.py"
-SETTINGS = ("defaults", "fast", "balanced", "accurate")
+SETTINGS = ("defaults", "balanced", "accurate")
 #: Keys of the printed errors that are forces (the others are positions or lengths).
 FORCE_KEYS = {"tension", "reaction", "force", "gross_slip", "area", "sliding"}
 

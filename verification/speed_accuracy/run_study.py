@@ -64,7 +64,7 @@ TOLERANCE_STEPS = (0.25, 0.05)
 ELEMENTS = (1, 2, 3, 4)
 ELEMENT_STEPS = (0.25, 0.05, 0.01)
 #: The presets of &solver preset, run by name on every scene (see REFERENCE.md).
-PRESETS = ("fast", "balanced", "accurate")
+PRESETS = ("balanced", "accurate")
 #: The &solver variables a preset sets: removed from a scene run with a preset.
 PRESET_VARIABLES = ("initial_step", "max_step", "residual_tolerance", "scheme")
 #: Errors below this are plotted at this value (log axis).

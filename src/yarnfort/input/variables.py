@@ -113,11 +113,13 @@ GROUPS = [
         # from verification/speed_accuracy/presets.py (every scene of
         # tests/verification/test_defaults.py against its exact reference): at these steps
         # the error follows the tolerance, the step sets how finely the curve is drawn, and
-        # the monolithic scheme was the faster one.
+        # the monolithic scheme was the faster one. Each is on the speed-accuracy front of
+        # benchmarks/presets_front.py; 'fast' was dropped (docs/decisions.md, *Presets on
+        # the speed-accuracy front*) and is refused in validate.f90.
         Var('preset', 'character', 'custom', length=16, lower=True,
-            choices=['custom', 'fast', 'balanced', 'accurate'],
+            choices=['custom', 'balanced', 'accurate'],
             doc='Named defaults for `initial_step`, `max_step`, `residual_tolerance` and '
-                "`scheme`: `'fast'`, `'balanced'` or `'accurate'` (case-insensitive), chosen "
+                "`scheme`: `'balanced'` or `'accurate'` (case-insensitive), chosen "
                 "from a speed-accuracy study; `'custom'` keeps the defaults of this table. A "
                 'variable given in `&solver` overrides its preset value. See *Presets* below.'),
         Var('linear_solver', 'character', 'auto', length=16, lower=True,
@@ -133,7 +135,7 @@ GROUPS = [
                 "UMFPACK where KLU's analysis predicts 80 or more flops per factor nonzero "
                 '(decided per pattern, `docs/decisions.md`).'),
         Var('residual_tolerance', 'real', 1e-10, unit='1', range='> 0',
-            presets={'fast': 1e-6, 'balanced': 1e-9, 'accurate': 1e-11},
+            presets={'balanced': 1e-9, 'accurate': 1e-11},
             doc='Relative. Newton stops when every row meets \\|F_i\\| <= residual_tolerance * '
                 'level_i + noise_i. For a node, level_i is the largest force that meets there '
                 '(the tensions of its elements, its applied load), at least 1e-6 times the '
@@ -171,7 +173,7 @@ GROUPS = [
                 'the exact law from there. 0 switches both off (a net at zero tension then has a '
                 'singular tangent).'),
         Var('initial_step', 'real', 0.1, unit='knot interval', range='> 0',
-            presets={'fast': 0.25, 'balanced': 0.05, 'accurate': 0.01},
+            presets={'balanced': 0.05, 'accurate': 0.01},
             doc='First continuation step, as a fraction of the knot interval; at least '
                 'min_step, capped at max_step.'),
         Var('min_step', 'real', 1e-06, unit='knot interval', range='> 0',
@@ -182,7 +184,7 @@ GROUPS = [
                 'down to min_step jumps (see *Slip instabilities*); any other step that fails '
                 'there stops the run.'),
         Var('max_step', 'real', 0.25, unit='knot interval', range='> 0',
-            presets={'fast': 0.25, 'balanced': 0.05, 'accurate': 0.01},
+            presets={'balanced': 0.05, 'accurate': 0.01},
             doc='Largest step, as a fraction of the knot interval being followed: a path of N '
                 'knot intervals takes at least N / max_step steps, whatever the spacing of its '
                 'knots.'),
@@ -196,7 +198,7 @@ GROUPS = [
             doc='Give up after this many consecutive step cuts.'),
         Var('scheme', 'character', 'monolithic', length=16, lower=True,
             choices=['monolithic', 'staggered'],
-            presets={'fast': 'monolithic', 'balanced': 'monolithic', 'accurate': 'monolithic'},
+            presets={'balanced': 'monolithic', 'accurate': 'monolithic'},
             doc="Friction: `'monolithic'` solves positions and sliding together with a "
                 "stick/slip active set; `'staggered'` is the paper's two-step scheme (elastic "
                 'solve, then sliding); a step that its first round does not solve is finished '
