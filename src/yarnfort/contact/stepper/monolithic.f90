@@ -253,6 +253,9 @@ contains
                             if (dropped > 0) then
                                 where (failed_mode /= self%mode_trial) flips = good_flips
                                 new_slips = new_slips - dropped
+                                ! From a solved state, not a fallback's: its rounds may be
+                                ! provisional.
+                                failed_before = self%trace%failed_solves
                                 unknowns = start
                                 where (failed_mode /= self%mode_trial) &
                                     unknowns(n_x + 1:) = problem%flow_target
