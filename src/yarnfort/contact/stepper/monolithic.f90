@@ -193,6 +193,18 @@ contains
                         solved = .true.
                     end if
                 end if
+                if (have_good .and. .not. (solved .or. drop_tried) .and. chorded &
+                        .and. new_slips > 1) then
+                    ! New slips from a solved state whose first Newton step raised the
+                    ! scaled residual: the round fails without KINSOL and those flowing
+                    ! back stick (below; docs/decisions.md, "A failed round: its new slips
+                    ! flowing back stick").
+                    if (first_step_rose(carried)) then
+                        call fatal_error(error, 'the new slips diverge')
+                        stats = carried
+                        solved = .true.
+                    end if
+                end if
                 if (.not. solved) then
                     call self%newton_full%solve(unknowns, stats, error, full_options, &
                         after_chord=chorded)
