@@ -11,6 +11,7 @@ module test_contact
     use yarnfort_contact_friction_problem, only: friction_problem_type, new_friction_problem, &
         mode_stick, mode_forward, mode_backward
     use yarnfort_contact_wrap_angle, only: get_wrap_angle
+    use yarnfort_contact_stepper_active_set, only: drop_slips_flowing_back
     use yarnfort_generate_fabric, only: generate_fabric
     use two_pegs_scene, only: make_scene
     implicit none
@@ -33,7 +34,8 @@ contains
             new_unittest('jacobian_matches_fd_monolithic', test_jacobian_full), &
             new_unittest('jacobian_matches_fd_positions_frozen', test_jacobian_frozen), &
             new_unittest('jacobian_matches_fd_periodic_gap_holders', test_jacobian_links), &
-            new_unittest('links_follow_leaders', test_links_follow) ]
+            new_unittest('links_follow_leaders', test_links_follow), &
+            new_unittest('failed_round_drops_new_slips_flowing_back', test_drop_slips) ]
     end subroutine collect_contact
 
     !> A periodic 2 x 2 plain-weave cell from the generator: gap-holders at the crossings
@@ -106,6 +108,29 @@ contains
         call check_close(error, x(:, 10) - x(:, 9), [2.0_wp * (1.0_wp + 0.2_wp * p_disp), &
             0.0_wp, 0.0_wp], 1.0e-14_wp, 'periodic image offset')
     end subroutine test_links_follow
+
+    !> A failed round's new slips (stick in the solved set, slipping in the failed one)
+    !> whose flow increment has the wrong sign stick again; a passage already slipping
+    !> stays, and nothing changes when every new slip flows back.
+    subroutine test_drop_slips(error)
+        type(error_type), allocatable, intent(out) :: error
+        integer, parameter :: good(4) = [mode_stick, mode_stick, mode_stick, mode_forward]
+        integer :: mode(4), dropped
+        real(wp), parameter :: start(4) = [1.0_wp, 2.0_wp, 3.0_wp, 4.0_wp]
+
+        mode = [mode_forward, mode_backward, mode_forward, mode_forward]
+        ! Increments +1, +1 (backward: back), -1 (forward: back), -1 (not new).
+        call drop_slips_flowing_back(start + [1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp], start, &
+            good, mode, dropped)
+        call check(error, dropped == 2 .and. all(mode == [mode_forward, mode_stick, &
+            mode_stick, mode_forward]), 'the two new slips flowing back stick')
+        if (allocated(error)) return
+        mode = [mode_forward, mode_backward, mode_stick, mode_forward]
+        call drop_slips_flowing_back(start + [-1.0_wp, 1.0_wp, 0.0_wp, 1.0_wp], start, &
+            good, mode, dropped)
+        call check(error, dropped == 0 .and. all(mode == [mode_forward, mode_backward, &
+            mode_stick, mode_forward]), 'all new slips flowing back: none dropped')
+    end subroutine test_drop_slips
 
     subroutine test_passages(error)
         type(error_type), allocatable, intent(out) :: error

@@ -24,7 +24,8 @@ module yarnfort_contact_stepper_active_set
     implicit none
     private
 
-    public :: max_flips, update_active_set, stop_flowing_back, is_at_min_length, &
+    public :: max_flips, update_active_set, stop_flowing_back, drop_slips_flowing_back, &
+        is_at_min_length, &
         get_slip_tendency, check_damped, not_settled
 
     !> Flips of one passage's mode in a step before it is held in stick.
@@ -53,6 +54,24 @@ contains
             flow = accepted
         end where
     end subroutine stop_flowing_back
+
+    !> The new slips of a round whose solve failed (slipping in `mode`, stick in
+    !> `good_mode`) whose flows the first Newton step from the round's `start` sends back
+    !> (`iterate`) stick again, if some but not all of them did; `dropped`: how many.
+    subroutine drop_slips_flowing_back(iterate, start, good_mode, mode, dropped)
+        real(wp), intent(in) :: iterate(:), start(:)
+        integer, intent(in) :: good_mode(:)
+        integer, intent(inout) :: mode(:)
+        integer, intent(out) :: dropped
+        logical :: new(size(mode)), back(size(mode))
+
+        new = good_mode == mode_stick .and. mode /= mode_stick
+        back = new .and. flows_back(mode, iterate - start)
+        dropped = count(back)
+        if (dropped == count(new)) dropped = 0
+        if (dropped == 0) return
+        where (back) mode = mode_stick
+    end subroutine drop_slips_flowing_back
 
     !> A slipping passage (mode) whose flow `increment` has the wrong sign.
     elemental logical function flows_back(mode, increment)

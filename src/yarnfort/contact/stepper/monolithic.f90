@@ -11,7 +11,7 @@ module yarnfort_contact_stepper_monolithic
     use yarnfort_contact_stepper_base, only: friction_stepper_base_type, chord_steps
     use yarnfort_contact_stepper_trace, only: record_solve, record_step, record_changes
     use yarnfort_contact_stepper_active_set, only: max_flips, update_active_set, &
-        stop_flowing_back, check_damped, not_settled
+        stop_flowing_back, drop_slips_flowing_back, check_damped, not_settled
     use yarnfort_contact_stepper_predictor, only: predicted_state, reversed, predict, &
         predict_modes
     use yarnfort_solver_interrupt, only: interrupt_requested
@@ -44,11 +44,13 @@ contains
         integer, allocatable :: flips(:), good_mode(:), good_flips(:), failed_mode(:)
         logical, allocatable :: locked_forward(:), locked_backward(:)
         integer :: round, n_x, changed, cap, new_slips, outcome, provisional_rounds, pass
-        integer :: failed_before, q
+        integer :: failed_before, q, dropped
         logical, allocatable :: marched(:), good_marched(:)
         !> Active set of the last Newton step's factors (try_chord, take_newton_step).
         integer, allocatable :: factored_mode(:), passage_index(:)
         logical :: have_good, guessed, full_retry, sign_tried, stopped, solved, moved, chorded
+        !> The new slips of the last solved round's set were given a drop (below).
+        logical :: drop_tried
         !> The last round's set was solved (see `cap` where a round solves).
         logical :: solved_before
         type(error_type), allocatable :: step_error
@@ -95,6 +97,7 @@ contains
             problem%locked = 0
             cap = huge(1)
             have_good = .false.
+            drop_tried = .false.
             full_retry = .false.
             sign_tried = .false.
             provisional_rounds = 0
@@ -193,6 +196,18 @@ contains
                         solved = .true.
                     end if
                 end if
+                if (have_good .and. .not. (solved .or. drop_tried) .and. chorded &
+                        .and. new_slips > 1) then
+                    ! New slips from a solved state whose first Newton step raised the
+                    ! scaled residual: the round fails without KINSOL and those flowing
+                    ! back stick (below; docs/decisions.md, "A failed round: its new slips
+                    ! flowing back stick").
+                    if (first_step_rose(carried)) then
+                        call fatal_error(error, 'the new slips diverge')
+                        stats = carried
+                        solved = .true.
+                    end if
+                end if
                 if (.not. solved) then
                     call self%newton_full%solve(unknowns, stats, error, full_options, &
                         after_chord=chorded)
@@ -234,6 +249,36 @@ contains
                     ! solved state and let fewer passages start slipping at once (half as
                     ! many, most violated first); without such a state, restart from
                     ! all-stick (the elastic problem, which has a solution).
+                    if (have_good .and. new_slips > 1 .and. .not. drop_tried) then
+                        drop_tried = .true.
+                        ! A failed round's new slips whose flows its first Newton step
+                        ! sends back stick again and the rest is solved again from the same
+                        ! start: halving the new slips (below) kept such a passage among the
+                        ! most violated and failed again and again (docs/decisions.md,
+                        ! "A failed round: its new slips flowing back stick").
+                        direction = start
+                        call self%newton_full%take_newton_step(direction, step_error)
+                        factored_mode = problem%mode
+                        call record_step(self%trace)
+                        iterations = iterations + 1
+                        if (.not. allocated(step_error)) then
+                            failed_mode = self%mode_trial
+                            call drop_slips_flowing_back(direction(n_x + 1:), &
+                                start(n_x + 1:), good_mode, self%mode_trial, dropped)
+                            if (dropped > 0) then
+                                where (failed_mode /= self%mode_trial) flips = good_flips
+                                new_slips = new_slips - dropped
+                                ! From a solved state, not a fallback's: its rounds may be
+                                ! provisional.
+                                failed_before = self%trace%failed_solves
+                                unknowns = start
+                                where (failed_mode /= self%mode_trial) &
+                                    unknowns(n_x + 1:) = problem%flow_target
+                                deallocate(error)
+                                cycle
+                            end if
+                        end if
+                    end if
                     if (have_good) then
                         if (new_slips <= 1) then
                             if (.not. full_options%quick) return
@@ -276,6 +321,7 @@ contains
                 call problem%update_state(unknowns, error)
                 if (allocated(error)) return
                 have_good = .true.
+                drop_tried = .false.
                 ! A failed round halves the cap on new slips (above); two solved rounds in
                 ! a row double it again, so that the cap does not keep its lowest value
                 ! for the rest of the step (docs/decisions.md, "Slip cap doubled after two
