@@ -50,15 +50,16 @@ contains
             end block
         end if
         if (.not. self%progress) return
-        write(error_unit, '("step ", i5, "  t = ", f9.5)', advance='no') state%step, state%time
+        write(error_unit, '("step ", i5, "  t = ", a)', advance='no') state%step, &
+            fixed(state%time, '(f9.5)')
         ! The factor of every load channel (p_force and p_disp without &path channels).
         do c = 1, size(state%factors)
-            write(error_unit, '("  ", a, " = ", f8.4)', advance='no') &
-                trim(scene%path%channel(c)), state%factors(c)
+            write(error_unit, '("  ", a, " = ", a)', advance='no') &
+                trim(scene%path%channel(c)), fixed(state%factors(c), '(f8.4)')
         end do
-        write(error_unit, '("  newton ", i3, "  residual ", a, "  ", f8.3, " s")', &
-            advance='no') state%newton_iterations, format_short(state%newton%residual_norm), &
-            state%wall_time
+        write(error_unit, '("  newton ", a, "  residual ", a, "  ", a, " s")', &
+            advance='no') fixed_count(state%newton_iterations), &
+            format_short(state%newton%residual_norm), fixed(state%wall_time, '(f8.3)')
         if (state%n_passages > 0) then
             write(error_unit, '("  slipping ", i0, "/", i0)', advance='no') state%n_slipping, &
                 state%n_passages
@@ -95,5 +96,31 @@ contains
         write(error_unit, '(a, i0, a, g0.6)') 'yarnfort: restarting after step ', step, &
             ' at t = ', time
     end subroutine on_resume
+
+    !> `value` in the fixed edit descriptor `edit` (the columns line up), or in short
+    !> exponent form where it does not fit (never a field of asterisks).
+    function fixed(value, edit) result(text)
+        real(wp), intent(in) :: value
+        character(len=*), intent(in) :: edit
+        character(len=:), allocatable :: text
+        character(len=32) :: buffer
+
+        write(buffer, edit) value
+        if (index(buffer, '*') > 0) then
+            text = format_short(value)
+        else
+            text = trim(buffer)
+        end if
+    end function fixed
+
+    !> A count right-aligned in three columns, wider where it needs more.
+    function fixed_count(count) result(text)
+        integer, intent(in) :: count
+        character(len=:), allocatable :: text
+        character(len=16) :: buffer
+
+        write(buffer, '(i0)') count
+        text = repeat(' ', max(0, 3 - len_trim(buffer))) // trim(buffer)
+    end function fixed_count
 
 end module yarnfort_app_progress

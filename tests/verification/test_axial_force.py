@@ -11,6 +11,8 @@ the work balance of test_membrane.py under force control; the collapse refused.
 """
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -192,3 +194,18 @@ def test_restart_under_force_control_is_bitwise(run_yarnfort, tmp_path, case):
     values = {"axial": AXIAL, "both": {**AXIAL, **lateral, "path.p_disp": [0.2, 0.6, 0.2],
                                        "solver.linear_solver": "dense"}}[case]
     assert_restart_is_bitwise(run_yarnfort, tmp_path, values, 10)
+
+
+def test_progress_lines_print_every_number(run_yarnfort, tmp_path):
+    """The example with both periods held takes over 999 Newton iterations in a step
+    (every trial counts): its progress lines print the counts in full, as curve.csv has
+    them, and no field of asterisks."""
+    result = run_yarnfort(patched_scene("inputs/weave_force.nml", {"output.progress": True},
+                                        tmp_path), cwd=TOP)
+    assert result.returncode == 0, result.stderr
+    lines = [line for line in result.stderr.splitlines() if line.startswith("step ")]
+    assert lines and not any("*" in line for line in lines)
+    printed = [int(re.search(r"  newton +(\d+)  ", line)[1]) for line in lines]
+    curve = read_curve(tmp_path)
+    assert printed == [int(n) for n in curve["newton_iterations"]]
+    assert max(printed) > 999
