@@ -193,6 +193,27 @@ def test_work_balance_with_friction(run_yarnfort, tmp_path):
     assert residual[0] / residual[1] > 10, residual
 
 
+@pytest.mark.parametrize("cell", ["plain", "twill", "texgen_plain"])
+def test_work_balance_of_woven_cells_with_friction(run_yarnfort, tmp_path, cell):
+    """The woven cells with Coulomb friction (mu = 0.1) at their crossings: W = dU + D
+    converges with the square of the step. Stretched along both periods at once their
+    crossings mostly stick (D / W is 0 on the plain weaves, 8e-6 on the twill, whose
+    crossings slide a little), so this is the stuck-cell check with the friction law on."""
+    n_contacts = CELLS[cell][2]
+    friction = {f"contact[{c}].friction_coefficient": 0.1 for c in range(n_contacts)}
+    residual = []
+    for step in (0.1, 0.05):
+        curve, states, periods = run_cell(run_yarnfort, tmp_path / f"{step}", cell,
+                                          "frictionless", step, extra=friction)
+        energy = np.array([stored_energy(s) for s in states])
+        work = membrane_work(curve, periods)[-1]
+        dissipated = dissipation(states)[-1]
+        assert work > 0 and dissipated >= 0
+        residual.append(abs(work - (energy[-1] - energy[0]) - dissipated) / work)
+    assert 3.0 < residual[0] / residual[1] < 5.0, residual
+    assert residual[1] < 1e-3, residual
+
+
 def test_plain_weave_turned_by_90_degrees_swaps_11_and_22(run_yarnfort, tmp_path):
     """A square plain-weave cell of equal yarns turned by 90 degrees is the cell mirrored
     through its mid-plane (the yarn over at a crossing becomes the one under), which the
