@@ -165,19 +165,20 @@ def test_frictionless_knit_slides_without_dissipation(run_yarnfort, tmp_path):
     assert abs(dissipation(states)[-1]) <= 1e-9 * work
 
 
-def frictional_knit_balance(run_yarnfort, tmp_path, shear: float | None = None
-                            ) -> tuple[list[float], float]:
-    """The knit with Coulomb friction (mu = 0.3) at steps 0.1 and 0.025: the balance's
-    residual |W - dU - D| / W at each step, and D / W of the finer run."""
+def frictional_balance(run_yarnfort, tmp_path, cell: str = "knit", mu: float = 0.3,
+                       steps: tuple[float, float] = (0.1, 0.025),
+                       shear: float | None = None) -> tuple[list[float], float]:
+    """The cell with Coulomb friction `mu` at its contacts: the balance's residual
+    |W - dU - D| / W at each of `steps`, and D / W of the last run (>= 0)."""
+    friction = {f"contact[{c}].friction_coefficient": mu for c in range(CELLS[cell][2])}
     residual = []
-    for step in (0.1, 0.025):
-        curve, states, periods = run_cell(run_yarnfort, tmp_path / f"{step}", "knit",
-                                          "frictionless", step, shear=shear,
-                                          extra={"contact[0].friction_coefficient": 0.3,
-                                                 "contact[1].friction_coefficient": 0.3})
+    for step in steps:
+        curve, states, periods = run_cell(run_yarnfort, tmp_path / f"{step}", cell,
+                                          "frictionless", step, shear=shear, extra=friction)
         energy = np.array([stored_energy(s) for s in states])
         work = membrane_work(curve, periods)[-1]
         dissipated = dissipation(states)[-1]
+        assert work > 0 and dissipated >= 0
         residual.append(abs(work - (energy[-1] - energy[0]) - dissipated) / work)
     return residual, dissipated / work
 
@@ -187,7 +188,7 @@ def test_work_balance_with_friction(run_yarnfort, tmp_path):
     membrane forces is the change of stored energy plus the energy dissipated by sliding,
     to the trapezoid rule's order (a quarter of the step: residual / 16, here at least
     / 10; first order would give / 4)."""
-    residual, dissipated = frictional_knit_balance(run_yarnfort, tmp_path)
+    residual, dissipated = frictional_balance(run_yarnfort, tmp_path)
     # The dissipation is real: much larger than what is left of the balance.
     assert dissipated > 100 * residual[-1], (dissipated, residual)
     assert residual[0] / residual[1] > 10, residual
@@ -199,17 +200,7 @@ def test_work_balance_of_woven_cells_with_friction(run_yarnfort, tmp_path, cell)
     converges with the square of the step. Stretched along both periods at once their
     crossings mostly stick (D / W is 0 on the plain weaves, 8e-6 on the twill, whose
     crossings slide a little), so this is the stuck-cell check with the friction law on."""
-    n_contacts = CELLS[cell][2]
-    friction = {f"contact[{c}].friction_coefficient": 0.1 for c in range(n_contacts)}
-    residual = []
-    for step in (0.1, 0.05):
-        curve, states, periods = run_cell(run_yarnfort, tmp_path / f"{step}", cell,
-                                          "frictionless", step, extra=friction)
-        energy = np.array([stored_energy(s) for s in states])
-        work = membrane_work(curve, periods)[-1]
-        dissipated = dissipation(states)[-1]
-        assert work > 0 and dissipated >= 0
-        residual.append(abs(work - (energy[-1] - energy[0]) - dissipated) / work)
+    residual, _ = frictional_balance(run_yarnfort, tmp_path, cell, mu=0.1, steps=(0.1, 0.05))
     assert 3.0 < residual[0] / residual[1] < 5.0, residual
     assert residual[1] < 1e-3, residual
 
@@ -383,7 +374,7 @@ def test_sheared_images_and_gamma12(run_yarnfort, tmp_path):
 def test_work_balance_with_shear_and_friction(run_yarnfort, tmp_path):
     """The knit with Coulomb friction (mu = 0.3), stretched and sheared: W = dU + D to
     the trapezoid rule's order (a quarter of the step: residual / 16, at least / 10)."""
-    residual, dissipated = frictional_knit_balance(run_yarnfort, tmp_path, shear=SHEAR)
+    residual, dissipated = frictional_balance(run_yarnfort, tmp_path, shear=SHEAR)
     assert dissipated > 100 * residual[-1], (dissipated, residual)
     assert residual[0] / residual[1] > 10, residual
 
