@@ -51,6 +51,8 @@ contains
         logical :: have_good, guessed, full_retry, sign_tried, stopped, solved, moved, chorded
         !> The new slips of the last solved round's set were given a drop (below).
         logical :: drop_tried
+        !> Why a round is given up before KINSOL ('' when it is not).
+        character(len=:), allocatable :: diverged
         !> The last round's set was solved (see `cap` where a round solves).
         logical :: solved_before
         type(error_type), allocatable :: step_error
@@ -184,28 +186,27 @@ contains
                     end if
                 end if
                 full_retry = .false.
-                if (guessed .and. .not. (have_good .or. solved) .and. chorded) then
-                    ! A guessed start set (predict_modes, or stick at a turn) whose first
-                    ! Newton step raised the scaled residual is given up without KINSOL;
-                    ! the last step's set from the predicted state follows (below), as a
-                    ! set that diverges rarely recovers (docs/decisions.md, "A guessed
-                    ! start set that diverges gives way to the last step's set").
-                    if (first_step_rose(carried)) then
-                        call fatal_error(error, 'the guessed active set diverges')
-                        stats = carried
-                        solved = .true.
+                ! A set whose first Newton step raised the scaled residual is given up
+                ! without KINSOL where a better next set is known: a guessed start set
+                ! (predict_modes, or stick at a turn) gives way to the last step's set from
+                ! the predicted state (docs/decisions.md, "A guessed start set that
+                ! diverges gives way to the last step's set"); new slips from a solved
+                ! state fail the round, and those flowing back stick (below;
+                ! docs/decisions.md, "A failed round: its new slips flowing back stick").
+                if (chorded .and. .not. solved) then
+                    if (guessed .and. .not. have_good) then
+                        diverged = 'the guessed active set diverges'
+                    else if (have_good .and. .not. drop_tried .and. new_slips > 1) then
+                        diverged = 'the new slips diverge'
+                    else
+                        diverged = ''
                     end if
-                end if
-                if (have_good .and. .not. (solved .or. drop_tried) .and. chorded &
-                        .and. new_slips > 1) then
-                    ! New slips from a solved state whose first Newton step raised the
-                    ! scaled residual: the round fails without KINSOL and those flowing
-                    ! back stick (below; docs/decisions.md, "A failed round: its new slips
-                    ! flowing back stick").
-                    if (first_step_rose(carried)) then
-                        call fatal_error(error, 'the new slips diverge')
-                        stats = carried
-                        solved = .true.
+                    if (len(diverged) > 0) then
+                        if (first_step_rose(carried)) then
+                            call fatal_error(error, diverged)
+                            stats = carried
+                            solved = .true.
+                        end if
                     end if
                 end if
                 if (.not. solved) then
