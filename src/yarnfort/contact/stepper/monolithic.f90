@@ -24,16 +24,20 @@ module yarnfort_contact_stepper_monolithic
     !> (newton_solver_type%try_chord: one Newton step and its chord steps) when that is
     !> not yet the solution but cut the scaled residual by provisional_contraction, with
     !> the stick test's dead band widened to provisional_band times that iterate's scaled
-    !> residual; a set that changes there goes to the next round unsolved. The Newton
-    !> step's iterate is judged so first, before the path's chord steps, which then
-    !> follow only for a set that holds there. A set that
-    !> holds takes another such pass (up to provisional_passes), then is solved on
-    !> (KINSOL) and judged at its solution, which alone ends a step. At most
+    !> residual; a set that changes there goes to the next round unsolved. Where the
+    !> Newton step alone cut the scaled residual by newton_contraction, its iterate is
+    !> judged so first, before the path's chord steps, which then follow only for a set
+    !> that holds there (docs/decisions.md, "Provisional rounds judged at the Newton
+    !> step"). A set that holds takes another such pass (up to provisional_passes), then
+    !> is solved on (KINSOL) and judged at its solution, which alone ends a step. At most
     !> max_provisional_rounds set changes per step are provisional, none after a failed
     !> solve of the step. Why: most rounds' changes show well before convergence
     !> (docs/decisions.md, "Provisional active-set rounds (0.2 / 8 / 0.8)").
     integer, parameter :: max_provisional_rounds = 8, provisional_passes = 4
     real(wp), parameter :: provisional_contraction = 0.8_wp, provisional_band = 0.2_wp
+    !> Judged at a looser iterate, the widened band hides new slips that the path's end
+    !> shows, and they cost rounds (same entry).
+    real(wp), parameter :: newton_contraction = 0.02_wp
 
 contains
 
@@ -153,10 +157,11 @@ contains
                     ! Each pass is one Newton step: with the solve after them, within
                     ! max_iterations (a solve's limit).
                     do pass = 1, min(provisional_passes, scene%solver%max_iterations - 1)
-                        ! The set is first judged at the Newton step's iterate, before its
-                        ! chord steps: a set that changes there has no use for them, and
-                        ! one that holds takes the same path as before (docs/decisions.md,
-                        ! "Provisional rounds judged at the Newton step").
+                        ! The set is first judged at the Newton step's iterate where that
+                        ! step contracted fast, before its chord steps: a set that changes
+                        ! there has no use for them, and one that holds takes the same path
+                        ! as before (docs/decisions.md, "Provisional rounds judged at the
+                        ! Newton step").
                         newton_first = full_options%chord_steps > 0
                         step_options = full_options
                         if (newton_first) then
@@ -173,7 +178,7 @@ contains
                         if (allocated(step_error) .or. solved) exit
                         if (.not. allocated(stats%residual_history)) exit
                         if (newton_first) then
-                            if (stats%residual_norm <= provisional_contraction &
+                            if (stats%residual_norm <= newton_contraction &
                                     * stats%residual_history(1)) then
                                 call judge_provisional(problem, unknowns(n_x + 1:), &
                                     stats%residual_norm, changed)
