@@ -129,6 +129,9 @@ def _check_value(group: str, var: dict[str, Any], value: Any, where: str) -> Non
                                  f" {var['length']} characters")
             choices = var["choices"]
             folded = entry.lower() if var["lower"] else entry
+            advice = (var.get("retired") or {}).get(folded)
+            if advice:
+                raise SceneError(f"{where} {name} = {entry!r} is no longer offered: {advice}")
             if choices and not var["checked_by"] and folded not in choices:
                 raise SceneError(f"{where} {name}: {entry!r} is not one of "
                                  + ", ".join(repr(c) for c in choices))

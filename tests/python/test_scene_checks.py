@@ -74,6 +74,17 @@ def test_shapes_types_ranges_and_choices():
         Scene.from_namelist(yarnfort.make_namelist({"solvr": {"max_step": 0.1}}))
 
 
+def test_a_retired_choice_is_refused_with_the_programs_advice():
+    """preset = 'fast' was dropped: Python refuses it as the program does, with what to
+    use instead, not as an unknown value (the text is the bad-input catalogue's)."""
+    expected = (TOP / "tests/data/input/bad_preset_fast.nml").read_text().splitlines()[0]
+    expected = expected.removeprefix("! expect: &solver: ")
+    with pytest.raises(SceneError) as info:
+        Scene(solver={"preset": "FAST"})
+    assert str(info.value).endswith(expected.replace("'fast'", "'FAST'"))
+    assert "not one of" not in str(info.value)
+
+
 def test_echoed_inputs_read_back_without_markers(tmp_path, monkeypatch):
     """An echoed input leaves unset law parameters out (no value means 'not set', issue
     38); reading it gives None, and the scene writes and checks as before."""

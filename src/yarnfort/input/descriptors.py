@@ -23,6 +23,7 @@ class Var:
     unit: str = ""
     range: str | None = None
     choices: list[str] | None = None
+    retired: dict[str, str] | None = None
     lower: bool = False
     adjust: bool = True
     selects: bool = False
@@ -41,6 +42,8 @@ class Var:
             raise ValueError(f"{self.name}: a list has no default (it is empty)")
         if not self.doc:
             raise ValueError(f"{self.name}: no doc")
+        if self.retired and set(self.retired) & set(self.choices or []):
+            raise ValueError(f"{self.name}: a retired value is still a choice")
 
     @property
     def optional(self) -> bool:

@@ -16,7 +16,7 @@ module yarnfort_input_fields
     public :: max_list, max_coordinates, indent
     public :: group_label, take_scalar, take_optional, take_array, list_length, is_assigned
     public :: optional_text
-    public :: check_range, check_choice, check_law_parameter
+    public :: check_range, check_choice, check_retired, check_law_parameter
     public :: suggestion, quoted_list, check_name, check_item_name, put, put_list
 
     !> Most node ids in one &yarn, &support or &load group, and most knots in &path.
@@ -373,6 +373,17 @@ contains
                 // suggestion(value, choices))
         end if
     end subroutine check_choice
+
+    !> A value no longer offered (variables.py `retired`): refused with `advice` (what to
+    !> use instead), not as unknown, so that an old input says what changed.
+    subroutine check_retired(error, label, variable, value, retired, advice)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: label, variable, value, retired, advice
+
+        if (value /= retired) return
+        call fatal_error(error, label // ': ' // variable // " = '" // retired &
+            // "' is no longer offered: " // trim(advice))
+    end subroutine check_retired
 
     !> Parameter `variable` of a law: needed by the selected law `law` and then to be set,
     !> or not used by it and then not to be set; `text` is its value for the message.

@@ -188,6 +188,10 @@ def check_routine(group: Group) -> list[str]:
     for var in checked:
         if var.laws:
             continue
+        for value, advice in (var.retired or {}).items():
+            pieces = " // ".join(f'"{piece} "' for piece in textwrap.wrap(advice, 50))
+            body.append((0, f"call check_retired(error, label, '{var.name}', "
+                            f"value%{var.name}, '{value}', {pieces})"))
         if var.choices:
             required = ".true." if var.selects else ".false."
             body.append((0, f"call check_choice(error, label, '{var.name}', value%{var.name}, "
@@ -414,8 +418,8 @@ def fortran_module() -> str:
 
         """, at="", publics=", ".join(publics), choices=", ".join(choices),
         fields="max_list, max_coordinates, group_label, take_scalar, take_array, list_length, "
-        "is_assigned, check_range, check_choice, check_law_parameter, put, put_list, indent, "
-        "take_optional, optional_text",
+        "is_assigned, check_range, check_choice, check_retired, check_law_parameter, put, "
+        "put_list, indent, take_optional, optional_text",
         lengths=[f"integer, parameter :: {k} = {v}" for k, v in LENGTHS.items()],
         group_names=[string_array("group_names", [g.name for g in GROUPS])],
         singleton_names=[string_array("singleton_names",

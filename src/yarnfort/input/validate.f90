@@ -73,14 +73,6 @@ contains
         type(solver_config_type), intent(in) :: solver
         type(error_type), allocatable, intent(out) :: error
 
-        ! The preset 'fast' was dropped: it was not faster than the defaults at any error
-        ! (docs/decisions.md, *Presets on the speed-accuracy front*); say so, not "unknown".
-        if (solver%preset == 'fast') then
-            call fatal_error(error, "&solver: preset = 'fast' is no longer offered: it ran " &
-                // 'no faster than the defaults (inputs/REFERENCE.md, *Presets*); leave ' &
-                // "preset out for the defaults, or use 'balanced' or 'accurate'")
-            return
-        end if
         call check_solver_variables(solver, '&solver', error)
         if (allocated(error)) return
         if (solver%min_step > solver%max_step) then

@@ -8,7 +8,8 @@ A group: name, kind (singleton or repeatable), one line of documentation, variab
 A variable: name, type (character, real, integer, logical), default; optional: length
 (character), shape (a size or "list"), max (most entries of a list, a Fortran name),
 unit, range (">= 0", "> 0", "(0, 1)", "[a, b]", "finite"), choices (allowed values,
-case-folded), lower (fold the value to lower case), adjust (drop leading blanks),
+case-folded), retired (values no longer offered, each with the advice its refusal
+gives), lower (fold the value to lower case), adjust (drop leading blanks),
 selects (the variable choosing the law whose parameters the others are), laws (the
 values of the selecting variable that use this one: required for those, an error for
 the others), presets (the value each named preset of the group's `preset` variable
@@ -115,9 +116,12 @@ GROUPS = [
         # the error follows the tolerance, the step sets how finely the curve is drawn, and
         # the monolithic scheme was the faster one. Each is on the speed-accuracy front of
         # benchmarks/presets_front.py; 'fast' was dropped (docs/decisions.md, *Presets on
-        # the speed-accuracy front*) and is refused in validate.f90.
+        # the speed-accuracy front*): refused with what to use instead.
         Var('preset', 'character', 'custom', length=16, lower=True,
             choices=['custom', 'balanced', 'accurate'],
+            retired={'fast': 'it ran no faster than the defaults (inputs/REFERENCE.md, '
+                             "*Presets*); leave preset out for the defaults, or use "
+                             "'balanced' or 'accurate'"},
             doc='Named defaults for `initial_step`, `max_step`, `residual_tolerance` and '
                 "`scheme`: `'balanced'` or `'accurate'` (case-insensitive), chosen "
                 "from a speed-accuracy study; `'custom'` keeps the defaults of this table. A "
