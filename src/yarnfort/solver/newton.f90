@@ -24,7 +24,7 @@ module yarnfort_solver_newton
     use yarnfort_solver_newton_kinsol, only: new_kinsol
     use yarnfort_solver_newton_base, only: newton_base_type, start_newton, newton_step, &
         set_exact_law
-    use yarnfort_solver_newton_chord, only: solve_chord, solve_row_update
+    use yarnfort_solver_newton_chord, only: solve_chord, resume_chord, solve_row_update
     use yarnfort_solver_newton_ladder, only: solve_with_fallbacks
     implicit none
     private
@@ -41,6 +41,8 @@ module yarnfort_solver_newton
         !> The first Newton step and its chord steps only (no fallback): converged, or
         !> the best iterate to judge before solving on.
         procedure :: try_chord
+        !> The chord steps of a try_chord path stopped after its Newton step.
+        procedure :: resume_try_chord
         !> Chord steps of a problem whose rows `rows` changed since the last Newton step,
         !> with that step's factors and a low-rank correction (no factorisation).
         procedure :: try_row_update
@@ -119,6 +121,20 @@ contains
         call solve_chord(self, u, options%chord_steps, options%finish_steps, stats, converged, &
             error)
     end subroutine try_chord
+
+    !> The chord steps (options%chord_steps, finish_steps) of a try_chord path that took
+    !> none, from its Newton step's iterate with that step's factors (resume_chord): the
+    !> path try_chord with those steps would have taken; u and `converged` as there.
+    subroutine resume_try_chord(self, u, stats, converged, options)
+        class(newton_solver_type), intent(inout) :: self
+        real(wp), intent(inout) :: u(:)
+        type(newton_stats_type), intent(out) :: stats
+        logical, intent(out) :: converged
+        type(solve_options_type), intent(in) :: options
+
+        call resume_chord(self, u, options%chord_steps, options%finish_steps, stats, &
+            converged)
+    end subroutine resume_try_chord
 
     !> Chord steps from u for a problem that differs from the one of the last Newton
     !> step in its rows `rows` only, with that step's factors (solve_row_update).

@@ -5,7 +5,8 @@
 !> a = 0.03). Residuals by hand (a = 0.01): 1, 1e-2, 2.97e-4, 8.74e-6, 2.57e-7 after the
 !> three chord steps, then 7.6e-9, 2.2e-10, 6.5e-12: the tolerance 1e-10 needs all three
 !> finishing steps. For a = 0.03 the last chord step leaves 1.9e-5 at r = 0.085, which
-!> three more steps would take to 1.2e-8 only: none is taken.
+!> three more steps would take to 1.2e-8 only: none is taken. A path stopped after its
+!> Newton step and resumed (resume_try_chord) is the same path.
 module test_chord
     use yarnfort_kinds, only: wp, ik
     use yarnfort_error, only: error_type
@@ -36,7 +37,9 @@ contains
         type(unittest_type), allocatable, intent(out) :: testsuite(:)
         testsuite = [ &
             new_unittest('finishing_steps_save_a_factorisation', test_finishing), &
-            new_unittest('no_finishing_step_without_the_rate', test_slow_rate) ]
+            new_unittest('no_finishing_step_without_the_rate', test_slow_rate), &
+            new_unittest('resumed_path_is_the_whole_path', test_resumed), &
+            new_unittest('no_resume_after_other_factors', test_no_resume) ]
     end subroutine collect_chord
 
     subroutine evaluate_residual(self, u, values, error, law)
@@ -157,5 +160,107 @@ contains
         call check_close(error, stats%residual_norm, 1.89e-5_wp, 1.0e-2_wp, &
             'residual after the chord steps')
     end subroutine test_slow_rate
+
+    !> The root of u + a u^3 = 1 by bisection (independent of the solver).
+    pure real(wp) function cubic_root(a) result(root)
+        real(wp), intent(in) :: a
+        real(wp) :: lo, hi
+        integer :: k
+        lo = 0.0_wp
+        hi = 1.0_wp
+        root = 0.5_wp
+        do k = 1, 200
+            root = 0.5_wp * (lo + hi)
+            if (root + a * root**3 > 1.0_wp) then
+                hi = root
+            else
+                lo = root
+            end if
+        end do
+    end function cubic_root
+
+    !> A new solver of the two cubic rows (a = 0.01) from u = 0.
+    subroutine new_cubic(problem, newton, u, error)
+        type(cubic_problem_type), target, intent(inout) :: problem
+        type(newton_solver_type), intent(out) :: newton
+        real(wp), allocatable, intent(out) :: u(:)
+        type(error_type), allocatable, intent(out) :: error
+        type(solver_config_type) :: options
+        class(linear_solver_type), allocatable :: linear
+
+        problem%a = 0.01_wp
+        problem%col_ptr = [0_ik, 1_ik, 2_ik]
+        problem%row_index = [0_ik, 1_ik]
+        call new_linear_solver(linear, 'klu', error)
+        if (allocated(error)) return
+        call new_newton_solver(newton, problem, linear, options, error)
+        if (allocated(error)) return
+        allocate(u(2), source=0.0_wp)
+    end subroutine new_cubic
+
+    !> a = 0.01, the Newton step alone (residual 1e-2 by hand), then resumed with three
+    !> chord and three finishing steps: the six residuals by hand (2.97e-4 ... 6.5e-12),
+    !> the root, one factorisation and seven solves, as the whole path (test_finishing).
+    subroutine test_resumed(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(cubic_problem_type), target :: problem
+        type(newton_solver_type) :: newton
+        type(newton_stats_type) :: stats
+        real(wp), allocatable :: u(:)
+        real(wp) :: t(5)
+        real(wp), parameter :: by_hand(6) = [2.97e-4_wp, 8.74e-6_wp, 2.57e-7_wp, &
+            7.6e-9_wp, 2.2e-10_wp, 6.5e-12_wp]
+        logical :: converged
+        integer :: n_factorisations, n_solves, k
+
+        call new_cubic(problem, newton, u, error)
+        if (allocated(error)) return
+        call newton%try_chord(u, stats, converged, error, &
+            solve_options_type(chord_steps=0, finish_steps=0))
+        if (allocated(error)) return
+        call check(error, .not. converged .and. size(stats%residual_history) == 2, &
+            'stopped after the Newton step')
+        if (allocated(error)) return
+        call check_close(error, stats%residual_norm, 1.0e-2_wp, 1.0e-2_wp, &
+            'residual after the Newton step')
+        if (allocated(error)) return
+        call newton%resume_try_chord(u, stats, converged, &
+            solve_options_type(chord_steps=3, finish_steps=3))
+        call newton%get_timings(t(1), t(2), t(3), t(4), t(5), n_factorisations, n_solves)
+        call check(error, converged .and. n_factorisations == 1 .and. n_solves == 7 &
+            .and. size(stats%residual_history) == 6, &
+            'resumed: converged on one factorisation, seven solves, six residuals')
+        if (allocated(error)) return
+        do k = 1, 6
+            call check_close(error, stats%residual_history(k), by_hand(k), 2.0e-2_wp, &
+                'residual of the resumed path')
+            if (allocated(error)) return
+        end do
+        call check_close(error, u(1), cubic_root(0.01_wp), 1.0e-10_wp, 'solution')
+    end subroutine test_resumed
+
+    !> After another Newton step (new factors) a stopped path is not resumed: u stays.
+    subroutine test_no_resume(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(cubic_problem_type), target :: problem
+        type(newton_solver_type) :: newton
+        type(newton_stats_type) :: stats
+        real(wp), allocatable :: u(:), kept(:)
+        logical :: converged
+
+        call new_cubic(problem, newton, u, error)
+        if (allocated(error)) return
+        call newton%try_chord(u, stats, converged, error, &
+            solve_options_type(chord_steps=0, finish_steps=0))
+        if (allocated(error)) return
+        kept = u
+        call newton%take_newton_step(kept, error)
+        if (allocated(error)) return
+        kept = u
+        call newton%resume_try_chord(u, stats, converged, &
+            solve_options_type(chord_steps=3, finish_steps=3))
+        call check(error, .not. converged .and. all(u == kept) &
+            .and. .not. allocated(stats%residual_history), 'not resumed, u unchanged')
+    end subroutine test_no_resume
 
 end module test_chord

@@ -24,14 +24,20 @@ module yarnfort_contact_stepper_monolithic
     !> (newton_solver_type%try_chord: one Newton step and its chord steps) when that is
     !> not yet the solution but cut the scaled residual by provisional_contraction, with
     !> the stick test's dead band widened to provisional_band times that iterate's scaled
-    !> residual; a set that changes there goes to the next round unsolved. A set that
-    !> holds takes another such pass (up to provisional_passes), then is solved on
-    !> (KINSOL) and judged at its solution, which alone ends a step. At most
+    !> residual; a set that changes there goes to the next round unsolved. Where the
+    !> Newton step alone cut the scaled residual by newton_contraction, its iterate is
+    !> judged so first, before the path's chord steps, which then follow only for a set
+    !> that holds there (docs/decisions.md, "Provisional rounds judged at the Newton
+    !> step"). A set that holds takes another such pass (up to provisional_passes), then
+    !> is solved on (KINSOL) and judged at its solution, which alone ends a step. At most
     !> max_provisional_rounds set changes per step are provisional, none after a failed
     !> solve of the step. Why: most rounds' changes show well before convergence
     !> (docs/decisions.md, "Provisional active-set rounds (0.2 / 8 / 0.8)").
     integer, parameter :: max_provisional_rounds = 8, provisional_passes = 4
     real(wp), parameter :: provisional_contraction = 0.8_wp, provisional_band = 0.2_wp
+    !> Judged at a looser iterate, the widened band hides new slips that the path's end
+    !> shows, and they cost rounds (same entry).
+    real(wp), parameter :: newton_contraction = 0.02_wp
 
 contains
 
@@ -49,6 +55,10 @@ contains
         !> Active set of the last Newton step's factors (try_chord, take_newton_step).
         integer, allocatable :: factored_mode(:), passage_index(:)
         logical :: have_good, guessed, full_retry, sign_tried, stopped, solved, moved, chorded
+        !> A provisional pass judges the set at its Newton step's iterate first.
+        logical :: newton_first
+        type(solve_options_type) :: step_options
+        real(wp) :: newton_residual
         !> The new slips of the last solved round's set were given a drop (below).
         logical :: drop_tried
         !> Why a round is given up before KINSOL ('' when it is not).
@@ -147,8 +157,19 @@ contains
                     ! Each pass is one Newton step: with the solve after them, within
                     ! max_iterations (a solve's limit).
                     do pass = 1, min(provisional_passes, scene%solver%max_iterations - 1)
+                        ! The set is first judged at the Newton step's iterate where that
+                        ! step contracted fast, before its chord steps: a set that changes
+                        ! there has no use for them, and one that holds takes the same path
+                        ! as before (docs/decisions.md, "Provisional rounds judged at the
+                        ! Newton step").
+                        newton_first = full_options%chord_steps > 0
+                        step_options = full_options
+                        if (newton_first) then
+                            step_options%chord_steps = 0
+                            step_options%finish_steps = 0
+                        end if
                         call self%newton_full%try_chord(unknowns, stats, solved, step_error, &
-                            full_options)
+                            step_options)
                         factored_mode = problem%mode
                         iterations = iterations + stats%iterations
                         call stats%add_earlier(carried)
@@ -156,6 +177,26 @@ contains
                         chorded = .not. allocated(step_error)
                         if (allocated(step_error) .or. solved) exit
                         if (.not. allocated(stats%residual_history)) exit
+                        if (newton_first) then
+                            if (stats%residual_norm <= newton_contraction &
+                                    * stats%residual_history(1)) then
+                                call judge_provisional(problem, unknowns(n_x + 1:), &
+                                    stats%residual_norm, changed)
+                                moved = changed > 0
+                                if (moved) exit
+                            end if
+                            ! The set holds there: the path's chord steps, with this Newton
+                            ! step's factors (the path try_chord takes with them).
+                            newton_residual = stats%residual_norm
+                            call self%newton_full%resume_try_chord(unknowns, stats, solved, &
+                                full_options)
+                            ! Not resumed (other factors held): as after the Newton step.
+                            if (.not. allocated(stats%residual_history)) &
+                                stats%residual_norm = newton_residual
+                            call stats%add_earlier(carried)
+                            carried = stats
+                            if (solved) exit
+                        end if
                         if (.not. (stats%residual_norm <= provisional_contraction &
                             * stats%residual_history(1))) then
                             ! Not contracting, in a round after a solved state: its stops

@@ -37,6 +37,11 @@ module yarnfort_solver_newton_base
         !> factors are still the linear solver's (the row update).
         real(wp), allocatable :: kept_values(:)
         integer :: kept_factorisation = -1
+        !> A chord path stopped after its Newton step (solve_chord with no chord steps):
+        !> the residual at self%u, the path's scaled residuals and the factorisation
+        !> count then; resume_chord goes on from there while that count holds.
+        real(wp), allocatable :: path_residual(:), path_history(:)
+        integer :: path_factorisation = -1
     contains
         !> Timing and counters of assembly and linear algebra so far.
         procedure :: get_timings
@@ -138,6 +143,7 @@ contains
         if (allocated(error)) return
         ! New row weights (prepare_solve): the kept factors no longer match them.
         self%kept_factorisation = -1
+        self%path_factorisation = -1
         call self%problem%problem%prepare_solve(u, error, self%problem%law)
         if (allocated(error)) return
         self%u = u

@@ -13,7 +13,7 @@ module yarnfort_solver_newton_chord
     implicit none
     private
 
-    public :: solve_chord, solve_row_update
+    public :: solve_chord, resume_chord, solve_row_update
 
     !> Most rows that solve_row_update replaces (it stores as many vectors of the order
     !> of the system).
@@ -69,10 +69,46 @@ contains
                 call take_chord_steps(self, min(chord_steps, self%options%max_iterations - 1), &
                     residual, f, history, stats, max_finish=min(finish_steps, &
                     self%options%max_iterations - 1 - chord_steps))
+                ! A path stopped after its Newton step, for resume_chord.
+                if (chord_steps == 0 .and. finish_steps == 0) then
+                    self%path_residual = residual
+                    self%path_history = history
+                    self%path_factorisation = self%adapter%n_factorisations
+                end if
             end if
             call finish_chord(self, u, f, history, stats, converged)
         end associate
     end subroutine solve_chord
+
+    !> The chord steps of a path that solve_chord, with no chord steps, stopped after its
+    !> Newton step (that step's iterate self%u, its residual and factors, still held):
+    !> the path solve_chord with those steps would have taken, from the same iterate
+    !> and history; u and `converged` as there, stats of these steps only. Nothing is
+    !> tried (converged false, u unchanged) when the linear solver holds other factors
+    !> or self%u moved since (start_newton, solve_row_update).
+    subroutine resume_chord(self, u, chord_steps, finish_steps, stats, converged)
+        class(newton_base_type), intent(inout) :: self
+        real(wp), intent(inout) :: u(:)
+        integer, intent(in) :: chord_steps, finish_steps
+        type(newton_stats_type), intent(inout) :: stats
+        logical, intent(out) :: converged
+        real(wp), allocatable :: residual(:), history(:)
+        real(wp) :: f
+        integer :: n_path
+
+        converged = .false.
+        if (self%path_factorisation /= self%adapter%n_factorisations) return
+        self%path_factorisation = -1
+        call move_alloc(self%path_residual, residual)
+        call move_alloc(self%path_history, history)
+        n_path = size(history)
+        f = history(n_path)
+        call take_chord_steps(self, min(chord_steps, self%options%max_iterations - 1), &
+            residual, f, history, stats, max_finish=min(finish_steps, &
+            self%options%max_iterations - 1 - chord_steps))
+        call finish_chord(self, u, f, history, stats, converged)
+        stats%residual_history = history(n_path + 1:)
+    end subroutine resume_chord
 
     !> Chord steps from u for a problem that differs from the one of the last Newton
     !> step in its rows `rows` only (a friction step's active-set round: passages turned
@@ -99,6 +135,8 @@ contains
         converged = .false.
         n_rows = size(rows)
         if (n_rows == 0 .or. n_rows > max_update_rows) return
+        ! self%u moves: a stopped chord path (resume_chord) is not resumed after this.
+        self%path_factorisation = -1
         if (self%kept_factorisation /= self%adapter%n_factorisations) return
         if (.not. allocated(self%kept_values)) return
         associate(tol => self%options%residual_tolerance, n => size(u))
