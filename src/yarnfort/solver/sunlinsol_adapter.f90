@@ -27,6 +27,11 @@ module yarnfort_solver_sunlinsol_adapter
         logical :: pattern_changed = .false.
         !> Counters and accumulated wall time of analyses, factorisations and solves.
         integer :: n_analyses = 0, n_factorisations = 0, n_solves = 0
+        !> Factorisations not repeated: the matrix was the one whose factors are held.
+        integer :: n_refactorisations_skipped = 0
+        !> The values of the held factors (valid while `holds_factors`).
+        real(wp), allocatable :: factored_values(:)
+        logical :: holds_factors = .false.
         real(wp) :: analyse_time = 0.0_wp, factor_time = 0.0_wp, solve_time = 0.0_wp
         !> The last failure, for the caller to report.
         type(error_type), allocatable :: error
@@ -106,6 +111,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         real(wp) :: start
         start = wall_time()
+        adapter%holds_factors = .false.
         call adapter%solver%analyse(n, col_ptr, row_index, error)
         adapter%analyse_time = adapter%analyse_time + (wall_time() - start)
         adapter%n_analyses = adapter%n_analyses + 1
@@ -118,10 +124,25 @@ contains
         real(wp), intent(in) :: values(:)
         type(error_type), allocatable, intent(out) :: error
         real(wp) :: start
+
+        ! The matrix of the held factors again (a solve that starts where a Newton step
+        ! was factored, e.g. after a chord path whose first step rose): same factors.
+        if (adapter%holds_factors) then
+            if (size(values) == size(adapter%factored_values)) then
+                if (all(values == adapter%factored_values)) then
+                    adapter%n_refactorisations_skipped = adapter%n_refactorisations_skipped + 1
+                    return
+                end if
+            end if
+        end if
         start = wall_time()
+        adapter%holds_factors = .false.
         call adapter%solver%factor(values, error)
         adapter%factor_time = adapter%factor_time + (wall_time() - start)
         adapter%n_factorisations = adapter%n_factorisations + 1
+        if (allocated(error)) return
+        adapter%factored_values = values
+        adapter%holds_factors = .true.
     end subroutine factor_counted
 
     !> x <- A^{-1} x with the last factorisation, counted and timed.
