@@ -75,6 +75,12 @@ module yarnfort_contact_friction_problem
         !> [coordinates of the node before, the node, the node after, own flow, flow at
         !> the start of the element before, flow at the end of the element after].
         integer, allocatable :: element_slot(:, :, :), passage_slot(:, :, :)
+        !> The slots the Jacobian fills, packed after keep_used_entries (the clique
+        !> tables above are then freed): each element's 6x6 tangent (element slots
+        !> (1:6, 1:6)) and its flow columns ((1:6, 7:8)), each passage's row ((10, 1:12)).
+        !> Contiguous per element and passage: read from the clique tables, the
+        !> Jacobian's scatter touched a cache line per entry of a passage row.
+        integer, allocatable :: tangent_slot(:, :, :), flow_slot(:, :, :), row_slot(:, :)
         integer, allocatable :: element_clique(:, :), passage_clique(:, :)
         !> Work arrays (besides x and length0).
         real(wp), allocatable :: internal(:), tension(:), stretch(:)
@@ -189,6 +195,10 @@ contains
             self%passage_slot = slots(:, :, n_elements + 1:)
         end block
         call keep_used_entries(self)
+        self%tangent_slot = self%element_slot(1:6, 1:6, :)
+        self%flow_slot = self%element_slot(1:6, 7:8, :)
+        self%row_slot = self%passage_slot(10, :, :)
+        deallocate(self%element_slot, self%passage_slot)
     contains
         integer function x_column(node, k)
             integer, intent(in) :: node, k
@@ -533,7 +543,7 @@ contains
             if (.not. self%positions_frozen) then
                 ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2,
                 ! from the tangents' own evaluation of each element.
-                call add_element_tangents(scene, self%element_slot, self%x, self%length0, &
+                call add_element_tangents(scene, self%tangent_slot, self%x, self%length0, &
                     values, error, used%spring, used%tangent_spring, self%dforce_dl0, &
                     used%stiffness_cap)
                 if (allocated(error)) return
@@ -542,7 +552,7 @@ contains
                     dforce_dl0 = self%dforce_dl0(:, e) * scene%passages%share(e)
                     do b = 7, 8
                         do a = 1, 6
-                            slot = self%element_slot(a, b, e)
+                            slot = self%flow_slot(a, b - 6, e)
                             if (slot == 0) cycle
                             ! L0 grows with the flow at its start, shrinks with the one at its end.
                             values(slot) = values(slot) + merge(1.0_wp, -1.0_wp, b == 7) &
@@ -563,7 +573,7 @@ contains
             integer :: k
 
             if (self%mode(p) == mode_stick) then
-                slot = self%passage_slot(10, 10, p)
+                slot = self%row_slot(10, p)
                 values(slot) = values(slot) + self%stick_scale
                 return
             end if
@@ -585,7 +595,7 @@ contains
             ! Tangent only: neutral modes (module notes).
             row(10) = row(10) + sign(neutral_shift * maxval(abs(row(10:12))), row(10))
             do k = 1, 12
-                slot = self%passage_slot(10, k, p)
+                slot = self%row_slot(k, p)
                 if (slot /= 0) values(slot) = values(slot) + row(k)
             end do
         end subroutine add_passage_row
