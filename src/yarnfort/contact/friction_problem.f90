@@ -75,6 +75,12 @@ module yarnfort_contact_friction_problem
         !> [coordinates of the node before, the node, the node after, own flow, flow at
         !> the start of the element before, flow at the end of the element after].
         integer, allocatable :: element_slot(:, :, :), passage_slot(:, :, :)
+        !> The slots the Jacobian fills, packed after keep_used_entries (the clique
+        !> tables above are then freed): each element's 6x6 tangent (element slots
+        !> (1:6, 1:6)) and its flow columns ((1:6, 7:8)), each passage's row ((10, 1:12)).
+        !> Contiguous per element and passage: read from the clique tables, the
+        !> Jacobian's scatter touched a cache line per entry of a passage row.
+        integer, allocatable :: tangent_slot(:, :, :), flow_slot(:, :, :), row_slot(:, :)
         integer, allocatable :: element_clique(:, :), passage_clique(:, :)
         !> Work arrays (besides x and length0).
         real(wp), allocatable :: internal(:), tension(:), stretch(:)
@@ -96,6 +102,13 @@ module yarnfort_contact_friction_problem
         logical :: state_valid = .false.
         real(wp), allocatable :: state_u(:), state_u_frozen(:), state_factors(:)
         real(wp) :: state_spring = 0.0_wp, state_stiffness_cap = 0.0_wp
+        !> Each slipping passage's tensions, wrap angle and its gradient, and its row's
+        !> critical tension, at the state of the last update_state and for the mode
+        !> slip_mode(p) they were taken in (mode_stick: not taken): the row levels, the
+        !> residual and the Jacobian at one iterate share them (take_slip_row).
+        integer, allocatable :: slip_mode(:)
+        real(wp), allocatable :: slip_before(:), slip_after(:), slip_angle(:), &
+            slip_dangle(:, :, :), slip_critical(:), slip_dcrit_dt(:), slip_dcrit_da(:)
     contains
         procedure :: get_size
         procedure :: evaluate_residual
@@ -134,6 +147,11 @@ contains
         allocate(self%locked(self%n_p), source=0)
         allocate(self%flow_target(self%n_p), source=0.0_wp)
         allocate(self%slip_weight(self%n_p), source=1.0_wp)
+        allocate(self%slip_mode(self%n_p), source=mode_stick)
+        allocate(self%slip_before(self%n_p), self%slip_after(self%n_p), &
+            self%slip_angle(self%n_p), self%slip_dangle(3, 3, self%n_p), &
+            self%slip_critical(self%n_p), self%slip_dcrit_dt(self%n_p), &
+            self%slip_dcrit_da(self%n_p))
         allocate(self%u_frozen(self%n_x), source=0.0_wp)
         allocate(self%x(3, scene%network%n_nodes()), self%length0(n_elements))
         allocate(self%internal(3 * scene%network%n_nodes()))
@@ -177,6 +195,10 @@ contains
             self%passage_slot = slots(:, :, n_elements + 1:)
         end block
         call keep_used_entries(self)
+        self%tangent_slot = self%element_slot(1:6, 1:6, :)
+        self%flow_slot = self%element_slot(1:6, 7:8, :)
+        self%row_slot = self%passage_slot(10, :, :)
+        deallocate(self%element_slot, self%passage_slot)
     contains
         integer function x_column(node, k)
             integer, intent(in) :: node, k
@@ -275,6 +297,7 @@ contains
             end if
         end if
         self%state_valid = .false.
+        self%slip_mode = mode_stick
         associate(scene => self%scene)
             call set_load(self)
             ! dofs%expand, with the prescribed part kept.
@@ -332,6 +355,24 @@ contains
         end associate
     end subroutine get_passage_state
 
+    !> Passage p's slip quantities (the slip_* arrays) at the state of the last
+    !> update_state, for its mode (a slip mode), taken once per state and mode: the
+    !> critical tension of the side that is the minimum in that mode.
+    subroutine take_slip_row(self, p)
+        type(friction_problem_type), intent(inout) :: self
+        integer, intent(in) :: p
+        real(wp) :: t_min
+
+        if (self%slip_mode(p) == self%mode(p)) return
+        call self%get_passage_state(p, self%slip_before(p), self%slip_after(p), &
+            self%slip_angle(p), self%slip_dangle(:, :, p))
+        t_min = merge(self%slip_before(p), self%slip_after(p), self%mode(p) == mode_forward)
+        call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
+            t_min, self%slip_angle(p), self%slip_critical(p), self%slip_dcrit_dt(p), &
+            self%slip_dcrit_da(p))
+        self%slip_mode(p) = self%mode(p)
+    end subroutine take_slip_row
+
     !> Reject a solution whose flows leave an element a reference length <= 0. Newton's
     !> iterates may pass there (forbidding it made KINSOL's five step halvings too few on
     !> test_friction's bollard), but a string with L0 <= 0 counts as slack, so such a
@@ -363,7 +404,6 @@ contains
         type(error_type), allocatable, intent(out) :: error
         type(regularisation_type), intent(in), optional :: law
         integer :: p
-        real(wp) :: t_before, t_after, angle, t_min, critical, dcrit_dt, dcrit_da
 
         self%slip_weight = 1.0_wp
         call self%update_state(u, error, law)
@@ -374,11 +414,8 @@ contains
         if (all(self%mode == mode_stick)) return
         do p = 1, self%n_p
             if (self%mode(p) == mode_stick) cycle
-            call self%get_passage_state(p, t_before, t_after, angle)
-            t_min = merge(t_before, t_after, self%mode(p) == mode_forward)
-            call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
-                t_min, angle, critical, dcrit_dt, dcrit_da)
-            self%slip_weight(p) = max(1.0_wp, dcrit_dt)
+            call take_slip_row(self, p)
+            self%slip_weight(p) = max(1.0_wp, self%slip_dcrit_dt(p))
         end do
     end subroutine prepare_solve
 
@@ -405,8 +442,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         type(regularisation_type), intent(in), optional :: law
         real(wp), allocatable :: node_level(:), node_noise(:)
-        real(wp) :: max_force, t_before, t_after, angle, t_lo, critical, dcrit_dt, dcrit_da
-        real(wp) :: noise_lo, noise_hi
+        real(wp) :: max_force, noise_lo, noise_hi
         integer :: p, row, lo, hi
 
         call self%update_state(u, error, law)
@@ -429,23 +465,20 @@ contains
                 level(row + p) = self%stick_scale * self%length_scale
                 cycle
             end if
-            call self%get_passage_state(p, t_before, t_after, angle)
+            call take_slip_row(self, p)
             if (self%mode(p) == mode_forward) then
                 lo = self%scene%passages%element_before(p)
                 hi = self%scene%passages%element_after(p)
-                t_lo = t_before
             else
                 lo = self%scene%passages%element_after(p)
                 hi = self%scene%passages%element_before(p)
-                t_lo = t_after
             end if
-            call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
-                t_lo, angle, critical, dcrit_dt, dcrit_da)
-            level(row + p) = max(t_before, t_after, node_level_floor * max_force) &
-                / self%slip_weight(p)
+            level(row + p) = max(self%slip_before(p), self%slip_after(p), &
+                node_level_floor * max_force) / self%slip_weight(p)
             noise_lo = self%get_element_noise(lo)
             noise_hi = self%get_element_noise(hi)
-            noise(row + p) = (abs(dcrit_dt) * noise_lo + noise_hi) / self%slip_weight(p)
+            noise(row + p) = (abs(self%slip_dcrit_dt(p)) * noise_lo + noise_hi) &
+                / self%slip_weight(p)
         end do
     end subroutine get_row_levels
 
@@ -463,7 +496,7 @@ contains
         type(error_type), allocatable, intent(out) :: error
         type(regularisation_type), intent(in), optional :: law
         integer :: p, row
-        real(wp) :: t_before, t_after, angle, critical, dcrit_dt, dcrit_da, flow
+        real(wp) :: flow
 
         call self%update_state(u, error, law)
         if (allocated(error)) return
@@ -479,17 +512,15 @@ contains
             case (mode_stick)
                 values(row + p) = self%stick_scale * (flow - self%flow_target(p))
             case (mode_forward)
-                call self%get_passage_state(p, t_before, t_after, angle)
-                call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
-                    t_before, angle, critical, dcrit_dt, dcrit_da)
-                values(row + p) = (critical - t_after + self%viscosity * self%stick_scale &
-                    * (flow - self%flow_target(p))) / self%slip_weight(p)
+                call take_slip_row(self, p)
+                values(row + p) = (self%slip_critical(p) - self%slip_after(p) &
+                    + self%viscosity * self%stick_scale * (flow - self%flow_target(p))) &
+                    / self%slip_weight(p)
             case (mode_backward)
-                call self%get_passage_state(p, t_before, t_after, angle)
-                call self%scene%friction(self%scene%passages%law(p))%law%get_critical_tension( &
-                    t_after, angle, critical, dcrit_dt, dcrit_da)
-                values(row + p) = (t_before - critical + self%viscosity * self%stick_scale &
-                    * (flow - self%flow_target(p))) / self%slip_weight(p)
+                call take_slip_row(self, p)
+                values(row + p) = (self%slip_before(p) - self%slip_critical(p) &
+                    + self%viscosity * self%stick_scale * (flow - self%flow_target(p))) &
+                    / self%slip_weight(p)
             end select
         end do
     end subroutine evaluate_residual
@@ -512,7 +543,7 @@ contains
             if (.not. self%positions_frozen) then
                 ! Dependence on L0: d(force on node 2)/dL0 = c dT/dL0, dT/dL0 = -T' l/L0^2,
                 ! from the tangents' own evaluation of each element.
-                call add_element_tangents(scene, self%element_slot, self%x, self%length0, &
+                call add_element_tangents(scene, self%tangent_slot, self%x, self%length0, &
                     values, error, used%spring, used%tangent_spring, self%dforce_dl0, &
                     used%stiffness_cap)
                 if (allocated(error)) return
@@ -521,7 +552,7 @@ contains
                     dforce_dl0 = self%dforce_dl0(:, e) * scene%passages%share(e)
                     do b = 7, 8
                         do a = 1, 6
-                            slot = self%element_slot(a, b, e)
+                            slot = self%flow_slot(a, b - 6, e)
                             if (slot == 0) cycle
                             ! L0 grows with the flow at its start, shrinks with the one at its end.
                             values(slot) = values(slot) + merge(1.0_wp, -1.0_wp, b == 7) &
@@ -538,25 +569,23 @@ contains
         !> Derivatives of passage p's row with respect to its clique's unknowns.
         subroutine add_passage_row(p)
             integer, intent(in) :: p
-            real(wp) :: t_before, t_after, angle, dangle(3, 3), critical, dcrit_dt, dcrit_da
             real(wp) :: row(12), d_before(12), d_after(12)
             integer :: k
 
             if (self%mode(p) == mode_stick) then
-                slot = self%passage_slot(10, 10, p)
+                slot = self%row_slot(10, p)
                 values(slot) = values(slot) + self%stick_scale
                 return
             end if
-            call self%get_passage_state(p, t_before, t_after, angle, dangle)
+            call take_slip_row(self, p)
             call tension_derivative(self%scene%passages%element_before(p), 1, 11, 10, d_before)
             call tension_derivative(self%scene%passages%element_after(p), 4, 10, 12, d_after)
-            associate(law => self%scene%friction(self%scene%passages%law(p))%law)
+            associate(dcrit_dt => self%slip_dcrit_dt(p), dcrit_da => self%slip_dcrit_da(p), &
+                    dangle => self%slip_dangle(:, :, p))
                 if (self%mode(p) == mode_forward) then
-                    call law%get_critical_tension(t_before, angle, critical, dcrit_dt, dcrit_da)
                     row = dcrit_dt * d_before - d_after
                     row(1:9) = row(1:9) + dcrit_da * reshape(dangle, [9])
                 else
-                    call law%get_critical_tension(t_after, angle, critical, dcrit_dt, dcrit_da)
                     row = d_before - dcrit_dt * d_after
                     row(1:9) = row(1:9) - dcrit_da * reshape(dangle, [9])
                 end if
@@ -566,7 +595,7 @@ contains
             ! Tangent only: neutral modes (module notes).
             row(10) = row(10) + sign(neutral_shift * maxval(abs(row(10:12))), row(10))
             do k = 1, 12
-                slot = self%passage_slot(10, k, p)
+                slot = self%row_slot(k, p)
                 if (slot /= 0) values(slot) = values(slot) + row(k)
             end do
         end subroutine add_passage_row

@@ -155,6 +155,10 @@ contains
                             reached(self%candidate_row(k)) = .true.
                     end do
                     call move_alloc(reached, wanted)
+                    ! The sweeps only add rows: once past max_extra, the test below
+                    ! takes the exact set whatever the later sweeps add.
+                    if (count(wanted(self%first_candidate:), kind=ik) - n_must &
+                        > max_extra) exit
                 end do
                 ! Too many neighbours (a large part of the flows slips): the exact set.
                 if (count(wanted(self%first_candidate:), kind=ik) - n_must > max_extra) &
