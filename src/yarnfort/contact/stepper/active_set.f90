@@ -2,8 +2,7 @@
 !> The stick/slip active-set rules, per passage, after each solve:
 !>   stick -> slip forward  if T_after  > T_crit(T_before, alpha) (beyond tolerance);
 !>   stick -> slip backward if T_before > T_crit(T_after, alpha);
-!>   slip -> stick if the flow increment of the step (since a lock at the minimum length
-!>   that stuck the passage in this step, if one did) has the wrong sign (at a held node:
+!>   slip -> stick if the flow increment of the step has the wrong sign (at a held node:
 !>   is not beyond the flows' accuracy in the right one);
 !>   and the stick passages that the new slips' fronts pass along their yarns, by the
 !>   capstan relation, start to slip in the same round (yarnfort_contact_stepper_slip_front;
@@ -140,14 +139,6 @@ contains
                 min_after = scene%solver%min_length_ratio * scene%network%length0(after)
                 new_mode = mode(p)
                 increment = flow(p) - accepted(p)
-                ! A passage that a lock at its minimum length stuck in this step and that
-                ! slips away from the lock started that slip there (its flow_target), not at
-                ! the step's start: judged from the start, its slip "flowed back", it stuck at
-                ! the lock again beyond its limit, and so on for ever (docs/decisions.md, "A
-                ! slip away from a lock is judged from the lock").
-                if ((mode(p) == mode_forward .and. locked_backward(p)) .or. &
-                    (mode(p) == mode_backward .and. locked_forward(p))) &
-                    increment = flow(p) - problem%flow_target(p)
                 ! A slipping passage at a held node must move beyond the solve's accuracy
                 ! of a flow (a stick row's tolerance), else it sticks: its flow is its only
                 ! motion, so one that stays at its limit without moving is stuck, as the
