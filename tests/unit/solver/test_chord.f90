@@ -82,18 +82,10 @@ contains
         type(error_type), allocatable, intent(out) :: error
         type(cubic_problem_type), target :: problem
         type(newton_solver_type) :: newton
-        type(solver_config_type) :: options
-        class(linear_solver_type), allocatable :: linear
         real(wp) :: t(5)
 
-        problem%a = a
-        problem%col_ptr = [0_ik, 1_ik, 2_ik]
-        problem%row_index = [0_ik, 1_ik]
-        call new_linear_solver(linear, 'klu', error)
+        call new_cubic(a, problem, newton, u, error)
         if (allocated(error)) return
-        call new_newton_solver(newton, problem, linear, options, error)
-        if (allocated(error)) return
-        allocate(u(2), source=0.0_wp)
         call newton%try_chord(u, stats, converged, error, &
             solve_options_type(chord_steps=3, finish_steps=finish))
         if (allocated(error)) return
@@ -179,8 +171,9 @@ contains
         end do
     end function cubic_root
 
-    !> A new solver of the two cubic rows (a = 0.01) from u = 0.
-    subroutine new_cubic(problem, newton, u, error)
+    !> A new solver of the two cubic rows with coefficient a from u = 0.
+    subroutine new_cubic(a, problem, newton, u, error)
+        real(wp), intent(in) :: a
         type(cubic_problem_type), target, intent(inout) :: problem
         type(newton_solver_type), intent(out) :: newton
         real(wp), allocatable, intent(out) :: u(:)
@@ -188,7 +181,7 @@ contains
         type(solver_config_type) :: options
         class(linear_solver_type), allocatable :: linear
 
-        problem%a = 0.01_wp
+        problem%a = a
         problem%col_ptr = [0_ik, 1_ik, 2_ik]
         problem%row_index = [0_ik, 1_ik]
         call new_linear_solver(linear, 'klu', error)
@@ -213,7 +206,7 @@ contains
         logical :: converged
         integer :: n_factorisations, n_solves, k
 
-        call new_cubic(problem, newton, u, error)
+        call new_cubic(0.01_wp, problem, newton, u, error)
         if (allocated(error)) return
         call newton%try_chord(u, stats, converged, error, &
             solve_options_type(chord_steps=0, finish_steps=0))
@@ -248,7 +241,7 @@ contains
         real(wp), allocatable :: u(:), kept(:)
         logical :: converged
 
-        call new_cubic(problem, newton, u, error)
+        call new_cubic(0.01_wp, problem, newton, u, error)
         if (allocated(error)) return
         call newton%try_chord(u, stats, converged, error, &
             solve_options_type(chord_steps=0, finish_steps=0))
