@@ -211,9 +211,11 @@ GROUPS = [
                 'Case-insensitive.'),
         Var('max_friction_iterations', 'integer', 200, range='>= 1',
             doc='Friction: most stick/slip active-set updates (monolithic) or elastic/sliding '
-                'alternations (staggered) per load step. A slip front advances by about one '
-                'passage per monolithic round, so a yarn over many contact nodes may need as '
-                'many rounds in its first slipping step.'),
+                'alternations (staggered) per load step. Along contacts at held nodes (pins, '
+                'supports) a slip front moves along its yarn in one monolithic round (the '
+                'capstan relation); across free crossings (knits, weaves) by about one passage '
+                'per round, so a large clamped sample may need many rounds where its slip zone '
+                'opens.'),
         Var('min_length_ratio', 'real', 0.05, unit='1', range='(0, 1)',
             doc="Friction: sliding never makes an element's reference length (and so its "
                 "segment's) shorter than this fraction of its initial length. The passage then "
