@@ -271,11 +271,7 @@ contains
                         ! flowing back stick").
                         sign_tried = .true.
                         failed_mode = self%mode_trial
-                        direction = start
-                        call self%newton_full%take_newton_step(direction, step_error)
-                        factored_mode = problem%mode
-                        call record_step(self%trace)
-                        iterations = iterations + 1
+                        call step_from_start(problem)
                         if (.not. allocated(step_error)) then
                             unknowns = start
                             call stop_flowing_back(direction(n_x + 1:), self%flow, &
@@ -298,11 +294,7 @@ contains
                         ! start: halving the new slips (below) kept such a passage among the
                         ! most violated and failed again and again (docs/decisions.md,
                         ! "A failed round: its new slips flowing back stick").
-                        direction = start
-                        call self%newton_full%take_newton_step(direction, step_error)
-                        factored_mode = problem%mode
-                        call record_step(self%trace)
-                        iterations = iterations + 1
+                        call step_from_start(problem)
                         if (.not. allocated(step_error)) then
                             failed_mode = self%mode_trial
                             call drop_slips_flowing_back(direction(n_x + 1:), &
@@ -394,6 +386,17 @@ contains
             self%unsettled = .true.
         end associate
     contains
+        !> direction <- the round's start plus one Newton step of its set (the flows it
+        !> sends back tell which passages stop), counted as an iteration.
+        subroutine step_from_start(problem)
+            type(friction_problem_type), intent(in) :: problem
+            direction = start
+            call self%newton_full%take_newton_step(direction, step_error)
+            factored_mode = problem%mode
+            call record_step(self%trace)
+            iterations = iterations + 1
+        end subroutine step_from_start
+
         !> The active set judged at a provisional iterate (flows `flow`) as at a solved
         !> state; kept, with the rounds' bookkeeping, only if it changed (`changed`).
         subroutine judge_provisional(problem, flow, residual, changed, cap_here)
