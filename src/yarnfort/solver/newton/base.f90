@@ -32,10 +32,9 @@ module yarnfort_solver_newton_base
         type(adapter_type), pointer :: adapter => null()
         type(solver_config_type) :: options
         class(linear_solver_type), pointer :: linear => null()
-        !> The Jacobian values of the last Newton step (newton_step) and the linear
-        !> solver's factorisation count just after it: while that count holds, its
-        !> factors are still the linear solver's (the row update).
-        real(wp), allocatable :: kept_values(:)
+        !> The linear solver's factorisation count just after the last Newton step
+        !> (newton_step): while that count holds, its factors, and their values
+        !> (adapter%factored_values), are still the linear solver's (the row update).
         integer :: kept_factorisation = -1
         !> A chord path stopped after its Newton step (solve_chord with no chord steps):
         !> the residual at self%u, the path's scaled residuals and the factorisation
@@ -162,7 +161,6 @@ contains
         if (allocated(error)) return
         call factor_counted(self%adapter, values, error)
         if (allocated(error)) return
-        call move_alloc(values, self%kept_values)
         self%kept_factorisation = self%adapter%n_factorisations
         step = -residual
         call solve_counted(self%adapter, step, error)

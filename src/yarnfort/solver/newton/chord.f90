@@ -138,7 +138,7 @@ contains
         ! self%u moves: a stopped chord path (resume_chord) is not resumed after this.
         self%path_factorisation = -1
         if (self%kept_factorisation /= self%adapter%n_factorisations) return
-        if (.not. allocated(self%kept_values)) return
+        if (.not. self%adapter%holds_factors) return
         associate(tol => self%options%residual_tolerance, n => size(u))
             self%u = u
             allocate(residual(n))
@@ -156,7 +156,7 @@ contains
                 stats%jacobian_evaluations = stats%jacobian_evaluations + 1
                 if (allocated(trial_error)) return
                 call new_row_update(update, self%adapter, rows, self%problem%problem%col_ptr, &
-                    self%problem%problem%row_index, values, self%kept_values, trial_error)
+                    self%problem%problem%row_index, values, self%adapter%factored_values, trial_error)
                 if (allocated(trial_error)) return
                 deallocate(values)
                 call take_chord_steps(self, max_update_steps, residual, f, history, stats, &
