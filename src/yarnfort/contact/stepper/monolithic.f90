@@ -242,8 +242,22 @@ contains
                     else
                         diverged = ''
                     end if
-                    if (len(diverged) > 0) then
-                        if (first_step_rose(carried)) then
+                    if (len(diverged) > 0 .and. first_step_rose(carried)) then
+                        if (have_good) then
+                            ! New slips: the round fails only where some of them flow back
+                            ! (they stick, the rest goes on from the same start); where
+                            ! none does, the set goes to KINSOL as any other: halving new
+                            ! slips that all slip on cost rounds without end under a held
+                            ! force (docs/decisions.md, "A failed round: its new slips
+                            ! flowing back stick").
+                            call drop_slips_back(problem, dropped)
+                            if (dropped > 0) then
+                                call record_solve(self%trace, carried, .true.)
+                                solved_before = .false.
+                                failed_before = self%trace%failed_solves
+                                cycle
+                            end if
+                        else
                             call fatal_error(error, diverged)
                             stats = carried
                             solved = .true.
@@ -288,29 +302,13 @@ contains
                     ! many, most violated first); without such a state, restart from
                     ! all-stick (the elastic problem, which has a solution).
                     if (have_good .and. new_slips > 1 .and. .not. drop_tried) then
-                        drop_tried = .true.
-                        ! A failed round's new slips whose flows its first Newton step
-                        ! sends back stick again and the rest is solved again from the same
-                        ! start: halving the new slips (below) kept such a passage among the
-                        ! most violated and failed again and again (docs/decisions.md,
-                        ! "A failed round: its new slips flowing back stick").
-                        call step_from_start(problem)
-                        if (.not. allocated(step_error)) then
-                            failed_mode = self%mode_trial
-                            call drop_slips_flowing_back(direction(n_x + 1:), &
-                                start(n_x + 1:), good_mode, self%mode_trial, dropped)
-                            if (dropped > 0) then
-                                where (failed_mode /= self%mode_trial) flips = good_flips
-                                new_slips = new_slips - dropped
-                                ! From a solved state, not a fallback's: its rounds may be
-                                ! provisional.
-                                failed_before = self%trace%failed_solves
-                                unknowns = start
-                                where (failed_mode /= self%mode_trial) &
-                                    unknowns(n_x + 1:) = problem%flow_target
-                                deallocate(error)
-                                cycle
-                            end if
+                        call drop_slips_back(problem, dropped)
+                        if (dropped > 0) then
+                            ! From a solved state, not a fallback's: its rounds may be
+                            ! provisional.
+                            failed_before = self%trace%failed_solves
+                            deallocate(error)
+                            cycle
                         end if
                     end if
                     if (have_good) then
@@ -396,6 +394,29 @@ contains
             call record_step(self%trace)
             iterations = iterations + 1
         end subroutine step_from_start
+
+        !> A failed round's new slips whose flows its first Newton step sends back stick
+        !> again (`dropped` of them) and the round starts again from its start: halving
+        !> the new slips kept such a passage among the most violated and failed again
+        !> and again (docs/decisions.md, "A failed round: its new slips flowing back
+        !> stick"). Once per solved state (drop_tried).
+        subroutine drop_slips_back(problem, dropped)
+            type(friction_problem_type), intent(in) :: problem
+            integer, intent(out) :: dropped
+
+            drop_tried = .true.
+            dropped = 0
+            call step_from_start(problem)
+            if (allocated(step_error)) return
+            failed_mode = self%mode_trial
+            call drop_slips_flowing_back(direction(n_x + 1:), start(n_x + 1:), good_mode, &
+                self%mode_trial, dropped)
+            if (dropped == 0) return
+            where (failed_mode /= self%mode_trial) flips = good_flips
+            new_slips = new_slips - dropped
+            unknowns = start
+            where (failed_mode /= self%mode_trial) unknowns(n_x + 1:) = problem%flow_target
+        end subroutine drop_slips_back
 
         !> The active set judged at a provisional iterate (flows `flow`) as at a solved
         !> state; kept, with the rounds' bookkeeping, only if it changed (`changed`).
