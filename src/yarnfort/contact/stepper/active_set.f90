@@ -75,15 +75,13 @@ contains
         where (back) mode = mode_stick
     end subroutine drop_slips_flowing_back
 
-    !> A passage that a lock at the minimum length stuck in this step (at flow `lock`) and
-    !> that then slipped away from the lock, to `flow`, strictly between the lock and the
-    !> step's start (`start`): it moved towards the lock over the step but did not reach
-    !> it, so it slips that way (towards the lock, from the start), unlocked, and the
-    !> next solve tells whether it reaches the lock. Stuck at the lock instead (the test
-    !> from the start says its slip flowed back), it exceeded its limit away from the
-    !> lock and slipped off again, for ever: such locks come from provisional iterates
-    !> that overshoot (docs/decisions.md, "A slip away from a lock that it never
-    !> reached").
+    !> A passage that a lock at the minimum length stuck in this step (at flow `lock`)
+    !> and that slipped away from it ends at `flow`, strictly between the lock and the
+    !> step's start `start`: over the step it moved towards the lock without reaching
+    !> it, so it slips that way, unlocked, and the next solve tells whether it reaches
+    !> the lock. Such locks come from provisional iterates that overshoot; stuck at them
+    !> again, the passage slipped off and stuck for ever (docs/decisions.md, "A slip
+    !> away from a lock it never reached").
     elemental logical function lifted_lock(lock, flow, start)
         real(wp), intent(in) :: lock, flow, start
         lifted_lock = (lock < flow .and. flow < start) .or. (start < flow .and. flow < lock)

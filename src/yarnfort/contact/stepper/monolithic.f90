@@ -132,7 +132,8 @@ contains
                 ! So is an all-stick set that is not the step's first (a fallback after
                 ! failed sets, not the step from rest): it is far from the last state, and
                 ! Newton's fallbacks took hundreds of iterations to fail or reach a spurious
-                ! state; a cut is cheaper.
+                ! state; a cut is cheaper (docs/decisions.md, "A slip away from a lock it
+                ! never reached").
                 fallback_stick = round > 1 .and. .not. (self%from_initial .or. self%staggered)
                 full_options = solve_options_type(quick=(any(self%mode_trial /= mode_stick) &
                     .or. fallback_stick) .and. .not. full_retry, &
