@@ -607,6 +607,41 @@ def test_material_running_out_of_an_element(run_yarnfort, tmp_path, scheme):
     assert not np.any(contacts["mode"][~first] == "locked")
 
 
+@pytest.mark.parametrize("scheme", ["monolithic", "staggered"])
+def test_slip_towards_a_lock_not_reached(run_yarnfort, tmp_path, scheme):
+    """The scene of test_material_running_out_of_an_element on its way to the lock (far
+    end moved up by half its travel, the near end under 1 % of F). The yarn slides
+    towards the near end over both pegs all the way: both passages slip forward and the
+    tensions are those of the capstan relation, wrap pi/2 at each peg (the ends hang
+    straight below their pegs): T_near = F, T_middle = F exp(-mu pi/2), T_far = F
+    exp(-mu pi), at every step. The first step's rounds meet states in which the far
+    element runs out (a lock far past anything the step reaches); a slip judged from
+    such a lock took the far passage backward while its flow went forward, with
+    T_far = T_middle exp(+mu pi/2)."""
+    ratio, travel, force = 1e-3, 0.9995, 0.01
+    net = peg_net([[-0.5, 1, 0], [0.5, 1, 0]], [-0.5, 0, 0], [0.5, 0, 0],
+                  pull=(0.0, 0.0, 0.0))
+    net["supports"][0]["displacement"] = [0.0, travel, 0.0]
+    net["supports"][1]["fix"] = "xz"
+    net["loads"] = [dict(nodes=[4], force=[0.0, -1.0, 0.0])]
+    text = namelist(net, [contact("yarn", "peg", LAWS["coulomb"])], scheme,
+                    path=dict(time=[0, 1], p_disp=[0, 0.5], p_force=[force, force]),
+                    step=0.02, solver=dict(min_length_ratio=ratio))
+    run, curve, states = run_scene(run_yarnfort, tmp_path, "towards_lock", text)
+    expected = force * np.exp(-MU * np.pi / 2 * np.arange(3)[::-1])  # far, middle, near
+    worst = max(np.max(np.abs(s.tension[:3] - expected) / force) for s in states)
+    contacts = read_contacts(tmp_path / "towards_lock" / "out")
+    later = contacts["step"] > 0
+    flows = {p: contacts["flow"][contacts["passage"] == p] for p in (1, 2)}
+    print(f"slip towards a lock ({scheme}): {len(states)} states, tensions off the "
+          f"capstan relation by {worst:.1e} of F, modes {set(contacts['mode'][later])}, "
+          f"Newton iterations {int(curve['newton_iterations'].sum())}")
+    assert worst <= CLOSED_FORM_RTOL
+    assert np.all(contacts["mode"][later] == "forward")
+    for flow in flows.values():
+        assert np.all(np.diff(flow) > 0.0)
+
+
 @pytest.mark.parametrize("offset", [0.0, 1e-10, 1e-7])
 @pytest.mark.parametrize("scheme", ["monolithic", "staggered"])
 def test_nearly_straight_passage(run_yarnfort, tmp_path, scheme, offset):

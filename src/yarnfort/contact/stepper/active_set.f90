@@ -3,7 +3,9 @@
 !>   stick -> slip forward  if T_after  > T_crit(T_before, alpha) (beyond tolerance);
 !>   stick -> slip backward if T_before > T_crit(T_after, alpha);
 !>   slip -> stick if the flow increment of the step has the wrong sign (at a held node:
-!>   is not beyond the flows' accuracy in the right one);
+!>   is not beyond the flows' accuracy in the right one), or -> slip the other way,
+!>   unlocked, if it slipped away from a lock set in the step and stopped short of it
+!>   (lifted_lock);
 !>   and the stick passages that the new slips' fronts pass along their yarns, by the
 !>   capstan relation, start to slip in the same round (yarnfort_contact_stepper_slip_front;
 !>   docs/decisions.md, "Slip fronts: the capstan march").
@@ -72,6 +74,18 @@ contains
         if (dropped == 0) return
         where (back) mode = mode_stick
     end subroutine drop_slips_flowing_back
+
+    !> A passage that a lock at the minimum length stuck in this step (at flow `lock`)
+    !> and that slipped away from it ends at `flow`, strictly between the lock and the
+    !> step's start `start`: over the step it moved towards the lock without reaching
+    !> it, so it slips that way, unlocked, and the next solve tells whether it reaches
+    !> the lock. Such locks come from provisional iterates that overshoot; stuck at them
+    !> again, the passage slipped off and stuck for ever (docs/decisions.md, "A slip
+    !> away from a lock it never reached").
+    elemental logical function lifted_lock(lock, flow, start)
+        real(wp), intent(in) :: lock, flow, start
+        lifted_lock = (lock < flow .and. flow < start) .or. (start < flow .and. flow < lock)
+    end function lifted_lock
 
     !> A slipping passage (mode) whose flow `increment` has the wrong sign.
     elemental logical function flows_back(mode, increment)
@@ -172,6 +186,12 @@ contains
                     if (direction_p /= mode_stick) call add_candidate(direction_p, measure)
                 case (mode_forward)
                     if (flows_back(mode(p), increment - still)) new_mode = mode_stick
+                    if (new_mode == mode_stick .and. locked_backward(p)) then
+                        if (lifted_lock(problem%flow_target(p), flow(p), accepted(p))) then
+                            new_mode = mode_backward
+                            call lift_lock(locked_backward(p))
+                        end if
+                    end if
                     ! Forward flow shortens the element before the node.
                     if (problem%length0(before) < min_before) then
                         new_mode = mode_stick
@@ -182,6 +202,12 @@ contains
                     end if
                 case (mode_backward)
                     if (flows_back(mode(p), increment + still)) new_mode = mode_stick
+                    if (new_mode == mode_stick .and. locked_forward(p)) then
+                        if (lifted_lock(problem%flow_target(p), flow(p), accepted(p))) then
+                            new_mode = mode_forward
+                            call lift_lock(locked_forward(p))
+                        end if
+                    end if
                     if (problem%length0(after) < min_after) then
                         new_mode = mode_stick
                         locked_backward(p) = .true.
@@ -224,6 +250,15 @@ contains
             end if
         end associate
     contains
+        !> Passage p's lock is lifted: its element is above the minimum length again, and
+        !> it sticks (if it does) at the step's start, not at the lock.
+        subroutine lift_lock(locked)
+            logical, intent(inout) :: locked
+            locked = .false.
+            problem%locked(p) = 0
+            problem%flow_target(p) = accepted(p)
+        end subroutine lift_lock
+
         subroutine add_candidate(new_direction, measure)
             integer, intent(in) :: new_direction
             real(wp), intent(in) :: measure

@@ -61,6 +61,8 @@ contains
         real(wp) :: newton_residual
         !> The new slips of the last solved round's set were given a drop (below).
         logical :: drop_tried
+        !> This round's set is all-stick after other sets of the step (see full_options).
+        logical :: fallback_stick
         !> Why a round is given up before KINSOL ('' when it is not).
         character(len=:), allocatable :: diverged
         !> The last round's set was solved (see `cap` where a round solves).
@@ -127,8 +129,15 @@ contains
                 ! is solved again with the fallbacks. A chord path just short of the
                 ! tolerance finishes with chord steps (docs/decisions.md, "Chord paths
                 ! finish at the tolerance").
-                full_options = solve_options_type(quick=any(self%mode_trial /= mode_stick) &
-                    .and. .not. full_retry, chord_steps=merge(0, chord_steps, self%staggered), &
+                ! So is an all-stick set that is not the step's first (a fallback after
+                ! failed sets, not the step from rest): it is far from the last state, and
+                ! Newton's fallbacks took hundreds of iterations to fail or reach a spurious
+                ! state; a cut is cheaper (docs/decisions.md, "A slip away from a lock it
+                ! never reached").
+                fallback_stick = round > 1 .and. .not. (self%from_initial .or. self%staggered)
+                full_options = solve_options_type(quick=(any(self%mode_trial /= mode_stick) &
+                    .or. fallback_stick) .and. .not. full_retry, &
+                    chord_steps=merge(0, chord_steps, self%staggered), &
                     finish_steps=merge(0, chord_steps, self%staggered))
                 start = unknowns
                 solved = .false.
