@@ -443,7 +443,10 @@ def _abaqus(all_curves: Sequence[ComponentCurves], scale: _Scale, name: str,
     lines += ["** Layout: Abaqus Keywords Guide, *FABRIC, *UNIAXIAL, *LOADING DATA,",
               "** *UNLOADING DATA (see docs/fabric_export.md). Data lines: stress, strain.",
               "** Unloading curves: DEFINITION=INTERPOLATED CURVE, each curve from its lowest",
-              "** strain up to its peak on the loading curve, one after the other."]
+              "** strain up to its peak on the loading curve, one after the other.",
+              "** Not found in the manual pages we could read: the order of stress and strain",
+              "** in a fabric data line and how the unloading curves are told apart: check",
+              "** in your Abaqus version (docs/fabric_export.md, Check before use)."]
     for curves in all_curves:
         lines += _describe(curves, scale, "**")
     for curves in all_curves:
@@ -455,8 +458,9 @@ def _abaqus(all_curves: Sequence[ComponentCurves], scale: _Scale, name: str,
                 " < 0 (compression); the Abaqus curves are written as tension data"
                 " (DIRECTION=TENSION, positive strains): export a run that stays in"
                 " tension, or use --format csv")
-        # Abaqus' damage unloading curves run from zero strain up to their peak and a new
-        # curve begins where the strain drops: a partial release fits neither.
+        # This writer's layout (not confirmed by the manual, docs/fabric_export.md): each
+        # unloading curve from the start strain up to its peak, a new curve where the
+        # strain drops. A partial release fits it with no start of its own: refused.
         start = float(curves.loading.strain[0])
         tolerance = STRAIN_NOISE * max(1.0, curves.loading.peak_strain)
         for k, branch in enumerate(curves.unloading if unloading else [], start=1):
@@ -464,9 +468,9 @@ def _abaqus(all_curves: Sequence[ComponentCurves], scale: _Scale, name: str,
                 raise FabricExportError(
                     f"run {str(curves.run)!r}, component {curves.component}: unloading {k}"
                     f" (from strain {branch.peak_strain:.6g}) stops at strain"
-                    f" {branch.strain.min():.6g}, not at the start {start:.6g}; Abaqus'"
-                    " interpolated unloading curves run down to zero strain: release the"
-                    " cell fully, or use --format lsdyna or csv")
+                    f" {branch.strain.min():.6g}, not at the start {start:.6g}; the Abaqus"
+                    " unloading curves are written from the start strain up to their peak:"
+                    " release the cell fully, or use --format lsdyna or csv")
     lines += [f"*MATERIAL, NAME={name}", "*FABRIC"]
     for curves in all_curves:
         lines.append(f"*UNIAXIAL, COMPONENT={ABAQUS_COMPONENT[curves.component]}")

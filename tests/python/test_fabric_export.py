@@ -125,11 +125,25 @@ def assert_points_match(points: np.ndarray, expected: np.ndarray) -> None:
 
 # -- readers of the written files (independent of the writer) --------------------------
 
+#: What the Keywords Guide (6.14, *LOADING DATA and *UNLOADING DATA, "... uniaxial tests of
+#: fabric materials") documents and the reader below checks: the five unloading
+#: definitions; TYPE=DAMAGE and TYPE=PERMANENT DEFORMATION only with DIRECTION; a
+#: nonelastic loading needs unloading data; a data line's first line holds the two
+#: values, the temperature and up to five field variables (8 entries; more lines only
+#: with DEPENDENCIES > 5); the data lines are repeated for every point of every curve.
+UNLOADING_DEFINITIONS = {"COMBINED", "EXPONENTIAL", "INTERPOLATED CURVE", "QUADRATIC",
+                         "SHIFTED CURVE"}
+FIRST_LINE_ENTRIES = 8
+
+
 def read_abaqus(path: Path) -> dict[str, dict[str, list[np.ndarray]]]:
     """{component: {'loading': [points], 'unloading': [points, ...]}} of a *FABRIC block,
-    stress and strain as written (the unloading curves split where the strain drops)."""
+    as written. The documented rules (above) are asserted; the rest is this writer's
+    layout, not found in the manual pages read (docs/fabric_export.md): a data line's
+    first two entries are stress, strain, and the unloading curves split where the
+    strain drops."""
     out: dict[str, dict[str, list]] = {}
-    component = block = None
+    component = block = loading_type = None
     keywords = []
     for line in path.read_text().splitlines():
         if line.startswith("**") or not line.strip():
@@ -139,23 +153,37 @@ def read_abaqus(path: Path) -> dict[str, dict[str, list[np.ndarray]]]:
             keywords.append(words[0])
             options = dict(w.split("=", 1) for w in words[1:] if "=" in w)
             if words[0] == "UNIAXIAL":
+                assert loading_type in (None, "ELASTIC") or block == "unloading", \
+                    "nonelastic loading data without unloading data"
+                assert keywords[-2] in ("FABRIC", "LOADING DATA", "UNLOADING DATA")
                 component = options["COMPONENT"]
+                assert component in ("1", "2", "SHEAR")
                 out[component] = {"loading": [], "unloading": []}
+                block = loading_type = None
             elif words[0] in ("LOADING DATA", "UNLOADING DATA"):
+                assert keywords[-2] == ("UNIAXIAL" if words[0] == "LOADING DATA"
+                                        else "LOADING DATA")
                 block = "loading" if words[0] == "LOADING DATA" else "unloading"
                 if block == "unloading":
+                    assert options["DEFINITION"] in UNLOADING_DEFINITIONS
                     assert options["DEFINITION"] == "INTERPOLATED CURVE"
                 else:
+                    loading_type = options.get("TYPE", "ELASTIC")
+                    if loading_type != "ELASTIC":
+                        assert "DIRECTION" in options
                     assert options["DIRECTION"] == "TENSION"
                     assert options["REGULARIZE"] == "OFF"
             else:
                 block = None
             continue
-        stress, strain = (float(v) for v in line.split(","))
+        entries = line.split(",")
+        assert 2 <= len(entries) <= FIRST_LINE_ENTRIES, line
+        stress, strain = (float(v) for v in entries[:2])
         curves = out[component][block]
         if not curves or (block == "unloading" and strain < curves[-1][-1][1]):
             curves.append([])
         curves[-1].append((stress, strain))
+    assert loading_type in (None, "ELASTIC") or block == "unloading"
     assert keywords[:2] == ["MATERIAL", "FABRIC"]
     return {c: {b: [np.array(p) for p in v] for b, v in d.items()} for c, d in out.items()}
 
@@ -420,7 +448,7 @@ def test_membrane_columns_give_all_components(runs, tmp_path):
 
 def test_partial_release_refused_for_abaqus_only(runs, tmp_path):
     """A release to half the peak strain is an unloading curve for LS-DYNA and CSV, but
-    not one Abaqus' interpolated curves (from zero strain up) can hold."""
+    has no place in the Abaqus layout written (each curve from the start strain up)."""
     with pytest.raises(FabricExportError, match="stops at strain 0.3"):
         export_fabric({"1": runs["partial"]}, tmp_path / "a.inp", thickness="1mm")
     assert not (tmp_path / "a.inp").exists()

@@ -148,6 +148,31 @@ def test_both_periods_force_controlled(run_yarnfort, tmp_path):
         assert np.ptp(curve["e11"]) > 0.02 and np.ptp(curve["e22"]) > 0.01
 
 
+def test_steps_grow_back_after_a_cut_under_force_control(run_yarnfort, tmp_path):
+    """inputs/knit_biaxial.nml (n22 held, e11 0 -> 0.6 -> 0, max_step 0.05 of a knot
+    interval of 1): its steps are cut (by step_cut 0.5) where the yarns start to slide;
+    afterwards they grow by step_growth (1.5) per easy step, judged by the trial that held
+    the force: from three cuts (1/8 of max_step) 6 easy steps suffice (1.5^6 > 8); 8 steps
+    are allowed. Before, every trial's iterations counted, and after a cut the steps did
+    not grow back (430 steps instead of 46)."""
+    curve = run_knit_file(run_yarnfort, tmp_path, "inputs/knit_biaxial.nml")
+    dt = np.diff(np.asarray(curve["time"]))
+    cuts = np.flatnonzero(np.asarray(curve["step_cuts"])[1:])
+    assert len(cuts) > 0
+    for cut in cuts:
+        after = dt[cut:cut + 8]
+        assert np.any(after >= 0.05 * (1 - 1e-12)), (cut, after)
+    held = np.abs(np.asarray(curve["n22"]) - 20.0)
+    scale = np.maximum(np.abs(np.asarray(curve["n11"])), 20.0)
+    assert np.all(held <= HOLD * scale)
+
+
+def run_knit_file(run_yarnfort, folder, scene):
+    result = run_yarnfort(patched_scene(scene, {"output.vtk_every": 0}, folder), cwd=TOP)
+    assert result.returncode == 0, result.stderr
+    return read_curve(folder)
+
+
 def test_axial_collapse_is_refused(run_yarnfort, tmp_path):
     """n11 held at 0 (p_disp = 0): the yarns along x are slack and the x period is free
     to shrink: no state, so no curve (exit 1, the message names the mechanism). Released

@@ -197,7 +197,8 @@ GROUPS = [
         Var('step_cut', 'real', 0.5, unit='1', range='(0, 1)',
             doc='Step cut factor after a failed step.'),
         Var('easy_iterations', 'integer', 4, range='>= 0',
-            doc='A step that converges in at most this many Newton iterations is "easy".'),
+            doc='A step that converges in at most this many Newton iterations is "easy" '
+                '(under force control: those of the trial that holds the force).'),
         Var('max_step_cuts', 'integer', 30, range='>= 0',
             doc='Give up after this many consecutive step cuts.'),
         Var('scheme', 'character', 'monolithic', length=16, lower=True,

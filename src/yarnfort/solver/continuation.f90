@@ -191,7 +191,8 @@ contains
                 call stepper%accept()
                 step = step + 1
                 state%time = t_next
-                if (iterations <= scene%solver%easy_iterations .and. cuts == 0) then
+                if (stepper%growth_iterations(iterations) <= scene%solver%easy_iterations &
+                        .and. cuts == 0) then
                     dt = min((t_next - t) / interval * scene%solver%step_growth, &
                         scene%solver%max_step)
                 else

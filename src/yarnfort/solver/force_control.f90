@@ -49,11 +49,15 @@ module yarnfort_solver_force_control
         integer :: axis = 2
         !> dn/de of the last step's secant (0: none yet); in the restart snapshot.
         real(wp) :: slope = 0.0_wp
+        !> The iterations the inner stepper's step-size rule counts for the trial that
+        !> held the force (growth_iterations).
+        integer, private :: held_trial_iterations = 0
         type(restart_type), private :: snapshot
         type(step_state_type), private :: state
     contains
         procedure :: try_step
         procedure :: accept
+        procedure :: growth_iterations
         procedure :: get_state
         procedure :: save_state
         procedure :: restore_state
@@ -84,7 +88,7 @@ contains
         real(wp), allocatable :: trial(:)
         real(wp) :: e(0:1), g(0:1), low, high, g_low, g_high, e_new, scale, tolerance
         real(wp) :: held, n_other, n_now
-        integer :: channel, n, side
+        integer :: channel, n, side, used
         logical :: bracketed, have_low, have_high
         character(len=:), allocatable :: history
         character(len=3) :: strain_name, force_name, other_name
@@ -132,6 +136,7 @@ contains
                 ! mechanism), no curve.
                 if (abs(held) > tolerance * scale) then
                     self%factors = self%inner%factors
+                    self%held_trial_iterations = self%inner%growth_iterations(used)
                     return
                 end if
                 call restore(error)
@@ -197,7 +202,6 @@ contains
             real(wp), intent(in) :: strain
             real(wp), intent(out) :: g
             type(error_type), allocatable, intent(out) :: error
-            integer :: used
             real(wp) :: values(6)
 
             trial(channel) = strain
@@ -269,6 +273,17 @@ contains
     end subroutine try_step
 
     !> The inner stepper accepted the trial that holds the force in try_step.
+    !> A step is judged by the trial that held the force, not by all trials: each trial
+    !> is a step of that size from the accepted state, and the number of trials says how
+    !> well the secant guessed the strain, not how hard the step is (docs/decisions.md,
+    !> "Step growth under force control: the held trial's iterations").
+    pure integer function growth_iterations(self, iterations) result(n)
+        class(force_control_stepper_type), intent(in) :: self
+        integer, intent(in) :: iterations
+
+        n = self%held_trial_iterations
+    end function growth_iterations
+
     subroutine accept(self)
         class(force_control_stepper_type), intent(inout) :: self
     end subroutine accept

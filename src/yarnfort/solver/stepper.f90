@@ -30,6 +30,9 @@ module yarnfort_solver_stepper
         procedure :: try_jump
         !> Make the last successful trial the accepted state (default: u and factors).
         procedure :: accept => accept_trial
+        !> The Newton iterations by which the step-size control judges the last successful
+        !> try_step, given all it used; default: all of them.
+        procedure :: growth_iterations
         !> The accepted state (positions, tensions, reactions, friction counts); default:
         !> without sliding, the reference lengths of the scene.
         procedure :: get_state
@@ -78,6 +81,14 @@ contains
         iterations = 0
         attempted = .false.
     end subroutine try_jump
+
+    !> The default: the step is judged by all its iterations.
+    pure integer function growth_iterations(self, iterations) result(n)
+        class(load_stepper_type), intent(in) :: self
+        integer, intent(in) :: iterations
+
+        n = iterations
+    end function growth_iterations
 
     subroutine accept_trial(self)
         class(load_stepper_type), intent(inout) :: self
