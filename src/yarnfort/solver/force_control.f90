@@ -272,7 +272,6 @@ contains
         end function mechanism
     end subroutine try_step
 
-    !> The inner stepper accepted the trial that holds the force in try_step.
     !> A step is judged by the trial that held the force, not by all trials: each trial
     !> is a step of that size from the accepted state, and the number of trials says how
     !> well the secant guessed the strain, not how hard the step is (docs/decisions.md,
@@ -284,6 +283,7 @@ contains
         n = self%held_trial_iterations
     end function growth_iterations
 
+    !> The inner stepper accepted the trial that holds the force in try_step.
     subroutine accept(self)
         class(force_control_stepper_type), intent(inout) :: self
     end subroutine accept
