@@ -41,6 +41,8 @@ EXIT_BAD_INPUT = 2
 DEFAULT_PLOT = "plot.png"
 #: File name of the default state plot inside the output folder.
 DEFAULT_STATES_PLOT = "states.png"
+#: File written by ``plot-membrane`` into the run's folder unless told otherwise.
+DEFAULT_MEMBRANE_PLOT = "membrane.png"
 
 
 class CommandError(Exception):
@@ -176,21 +178,13 @@ def summary_figure(folder: Path, support: str | None = None, *, channel: str | N
         For a missing folder or curve, a curve without rows, an unknown support,
         channel or step.
     """
-    if not folder.is_dir():
-        raise CommandError(f"no output folder {str(folder)!r}")
-    if not (folder / "curve.csv").is_file():
-        raise CommandError(f"{str(folder)!r} holds no curve.csv: not a yarnfort output"
-                           " folder")
+    curve = read_run_curve(folder)
     from matplotlib.figure import Figure
 
     from .plots import (DEFAULT_UNIT, LENGTH_UNITS, choose_driver, driver_response, load_drivers,
                         peak_step, plot_fabric_hysteresis, plot_history, plot_hysteresis,
                         plot_load_displacement, plot_network)
 
-    curve = read_curve(folder)
-    if len(curve) == 0:
-        raise CommandError(f"{folder / 'curve.csv'} has no rows (only its header): the run"
-                           " wrote no converged step, nothing to plot")
     states = read_states(folder)
     scene = _scene(folder)
     if support is not None:
@@ -254,6 +248,26 @@ def summary_figure(folder: Path, support: str | None = None, *, channel: str | N
         right.set_axis_off()
         right.text(0.5, 0.5, "no states written", ha="center", va="center")
     return figure
+
+
+def read_run_curve(folder: Path) -> Curve:
+    """The curve of output folder `folder`, with at least one row.
+
+    Raises
+    ------
+    CommandError
+        For a missing folder or curve, or a curve without rows.
+    """
+    if not folder.is_dir():
+        raise CommandError(f"no output folder {str(folder)!r}")
+    if not (folder / "curve.csv").is_file():
+        raise CommandError(f"{str(folder)!r} holds no curve.csv: not a yarnfort output"
+                           " folder")
+    curve = read_curve(folder)
+    if len(curve) == 0:
+        raise CommandError(f"{folder / 'curve.csv'} has no rows (only its header): the run"
+                           " wrote no converged step, nothing to plot")
+    return curve
 
 
 def _scene(folder: Path) -> Any:
@@ -331,6 +345,15 @@ def _parser() -> argparse.ArgumentParser:
     states.add_argument("--depth-scale", type=float, default=1.0, metavar="F",
                         help="draw z this many times stretched (default 1)")
     states.add_argument("--title", help="figure title")
+    membrane = commands.add_parser(
+        "plot-membrane", help="write a PNG: membrane forces of a periodic-cell run",
+        description="Write a PNG of a periodic-cell run's membrane forces: n11, n22 and"
+        " e22 against e11, one panel each (forces from zero: a held force is a flat"
+        " line); a shear run: n12 (with n22 tan(gamma12)), n11 and e22 against gamma12.")
+    membrane.add_argument("folder", type=Path, help="output folder of a periodic-cell run"
+                          " (holds curve.csv)")
+    membrane.add_argument("-o", "--out", type=Path, metavar="FILE",
+                          help=f"PNG to write (default: <folder>/{DEFAULT_MEMBRANE_PLOT})")
     examples = commands.add_parser(
         "examples", help="write the example scenes and their tables into a folder",
         description="Write the example scenes (inputs/*.nml), their tables (inputs/data/)"
@@ -394,6 +417,18 @@ def plot_states_command(args: argparse.Namespace) -> Path:
                        else args.folder / DEFAULT_STATES_PLOT)
 
 
+def plot_membrane_command(args: argparse.Namespace) -> Path:
+    """Write the membrane plot that ``plot-membrane`` asks for; the PNG written."""
+    from .plots import plot_membrane, save_figure
+
+    curve = read_run_curve(args.folder)
+    scene = _scene(args.folder)
+    title = str(scene.get("control", {}).get("title", "")) if scene is not None else ""
+    figure = plot_membrane(curve, title)
+    return save_figure(figure, args.out if args.out is not None
+                       else args.folder / DEFAULT_MEMBRANE_PLOT, dpi=110)
+
+
 def export_fabric_command(args: argparse.Namespace) -> Path:
     """Write the file that ``export-fabric`` asks for; the path written."""
     from .fabric_export import export_fabric
@@ -447,6 +482,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "plot":
             path = plot_folder(args.folder, args.support, args.out, channel=args.channel,
                                step=args.step)
+        elif args.command == "plot-membrane":
+            path = plot_membrane_command(args)
         else:
             path = plot_states_command(args)
         print(f"yarnfort: wrote {path}")

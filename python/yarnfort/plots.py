@@ -213,6 +213,64 @@ def plot_fabric_hysteresis(curve: Curve, ax: Axes | None = None) -> Axes:
     return ax
 
 
+#: Columns a periodic-cell run's curve.csv has (plot_membrane).
+MEMBRANE_COLUMNS = ("e11", "e22", "n11", "n22")
+
+
+def plot_membrane(curve: Curve, title: str = "") -> Figure:
+    """Membrane forces of a periodic-cell run, one panel each: n11, n22 and e22 against
+    e11; a shear run (gamma12 changes more than e11) draws n12 (with n22 tan(gamma12)
+    dashed: the yarn tension turned by the shear), n11 and e22 against gamma12. Loading
+    and unloading as in :func:`plot_hysteresis`; forces from zero, so that a held force
+    is a flat line, not its rounding magnified.
+
+    Parameters
+    ----------
+    curve : Curve
+        The curve of a periodic-cell run (columns e11, e22, n11, n22, direction).
+    title : str, optional
+        Figure title.
+
+    Returns
+    -------
+    Figure
+
+    Raises
+    ------
+    ValueError
+        The curve has no rows or no membrane columns (not a periodic-cell run).
+    """
+    missing = [c for c in MEMBRANE_COLUMNS if c not in curve.names]
+    if missing or len(curve) == 0:
+        raise ValueError(f"{curve.path}: no rows or no columns {', '.join(missing)} (not a"
+                         " periodic-cell run)")
+    figure = Figure(figsize=(13.2, 4.2), layout="constrained")
+    panels = figure.subplots(1, 3)
+    shear = ("gamma12" in curve.names
+             and np.ptp(curve["gamma12"]) > np.ptp(curve["e11"]))
+    x, first = ("gamma12", "n12") if shear else ("e11", "n11")
+    unit = "rad" if shear else "1"
+    second = "n11" if shear else "n22"
+    for axes, name in zip(panels, (first, second, "e22")):
+        _plot_branches(axes, curve[x], curve[name], curve["direction"])
+        if name == "n12":
+            gamma = np.asarray(curve["gamma12"])
+            axes.plot(gamma, np.asarray(curve["n22"]) * np.tan(gamma), "k--", lw=1,
+                      label="n22 tan(gamma12)")
+        axes.set_xlabel(f"{x} ({unit})")
+        axes.set_ylabel(f"{name} ({'1' if name == 'e22' else 'N/m'})")
+        axes.grid(True, alpha=0.3)
+        axes.legend()
+        axes.ticklabel_format(axis="y", useOffset=False)
+        if name != "e22":
+            values = np.asarray(curve[name], dtype=float)
+            axes.set_ylim(min(0.0, 1.1 * float(values.min())),
+                          max(0.0, 1.1 * float(values.max())) or 1.0)
+    if title:
+        figure.suptitle(title)
+    return figure
+
+
 def _plot_branches(ax: Axes, abscissa: np.ndarray, ordinate: np.ndarray,
                    direction: np.ndarray) -> None:
     """Loading and unloading runs of a curve, each segment starting at the step
