@@ -88,7 +88,8 @@ RELATIVE_FLOOR = 1.0e-3
 #: The uncertainty comes from central differences at this many times ``diff_step``,
 #: checked against the fit's forward differences; a column differing by more than
 #: SMOOTHNESS_TOLERANCE (relative) means the curve ripples with the parameter
-#: (docs/decisions.md, "Calibration: the derivative check").
+#: (docs/decisions.md, "Calibration: relative errors, identifiability, the derivative
+#: check").
 CHECK_STEP_FACTOR = 10.0
 SMOOTHNESS_TOLERANCE = 0.1
 #: Names accepted for the branch column of a measured CSV.
