@@ -190,7 +190,8 @@ def plot_hysteresis(curve: Curve, support: str, component: str = "y", x: str = "
 def plot_fabric_hysteresis(curve: Curve, ax: Axes | None = None) -> Axes:
     """Effective curve of a generated fabric (``&fabric``): force per unit width
     against macroscopic strain, loading and unloading drawn as in
-    :func:`plot_hysteresis`.
+    :func:`plot_hysteresis`. The width is the reference (undeformed) one, as in
+    ``force_per_width``: n11 (1 + e22) of a periodic cell, not n11.
 
     Parameters
     ----------
@@ -206,7 +207,9 @@ def plot_fabric_hysteresis(curve: Curve, ax: Axes | None = None) -> Axes:
     ax = _axes(ax)
     _plot_branches(ax, curve["strain"], curve["force_per_width"], curve["direction"])
     ax.set_xlabel("macroscopic strain (1)")
-    ax.set_ylabel("force per unit width (N/m)")
+    # force_per_width is over the undeformed width; n11 (plot-membrane) is over the
+    # current one: a cell that narrows shows two values, so the label says which.
+    ax.set_ylabel("force per unit reference width (N/m)")
     ax.grid(True, alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend()

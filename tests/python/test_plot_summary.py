@@ -30,11 +30,12 @@ MM = 1e3  # millimetres per metre
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory) -> Path:
-    """vnet, capstan_pins, ring_sideways, knit and weave_shear run in one folder
-    (out/<name>)."""
+    """vnet, capstan_pins, ring_sideways, knit, weave_shear and knit_biaxial run in one
+    folder (out/<name>)."""
     where = tmp_path_factory.mktemp("runs")
     shutil.copytree(TOP / "inputs", where / "inputs")  # the knit's tables
-    for name in ("vnet", "capstan_pins", "ring_sideways", "knit", "weave_shear"):
+    for name in ("vnet", "capstan_pins", "ring_sideways", "knit", "weave_shear",
+                 "knit_biaxial"):
         with open(TOP / "inputs" / f"{name}.nml") as scene:
             done = subprocess.run([str(yarnfort.program_path())], stdin=scene,
                                   capture_output=True, text=True, cwd=where, timeout=600)
@@ -192,3 +193,18 @@ def test_sheared_cell_shows_its_shear_curve_not_anchor_noise(runs):
     assert marker.get_ydata()[0] == pytest.approx(50.0 * np.tan(gamma), rel=1e-6)
     x, y = branches(left)
     np.testing.assert_allclose(y, 50.0 * np.tan(x), rtol=1e-6, atol=1e-6 * 50.0)
+
+
+def test_fabric_curve_is_labelled_per_reference_width(runs):
+    """knit_biaxial narrows to e22 = -0.44 with n22 held: its force per width is over the
+    undeformed width, n11 (per current width) times (1 + e22), 0.56 n11 at the peak; the
+    label says so, since plot-membrane draws n11 for the same run."""
+    curve = read_curve(runs / "knit_biaxial")
+    left = summary_figure(runs / "knit_biaxial").axes[0]
+    assert left.get_ylabel() == "force per unit reference width (N/m)"
+    x, y = branches(left)
+    loading = [line for line in left.get_lines() if line.get_gid() == "loading"][0]
+    rows = len(loading.get_ydata())
+    per_reference = curve["n11"][:rows] * (1.0 + curve["e22"][:rows])
+    np.testing.assert_allclose(loading.get_ydata(), per_reference, rtol=1e-9)
+    assert curve["e22"].min() < -0.4  # the widths differ: the label matters here
