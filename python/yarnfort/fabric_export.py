@@ -600,8 +600,8 @@ def export_fabric(runs: Mapping[str, str | Path] | Iterable[tuple[str, str | Pat
         ``'abaqus'`` (a ``*MATERIAL`` with ``*FABRIC``, ``*UNIAXIAL``, ``*LOADING DATA``,
         ``*UNLOADING DATA, DEFINITION=INTERPOLATED CURVE``), ``'lsdyna'``
         (``*DEFINE_CURVE_TITLE`` blocks, strain against stress) or ``'csv'`` (one row
-        per point: component, branch, curve, peak strain, step, strain, force per width
-        and, with a thickness, stress).
+        per point: component, branch, curve, peak strain, step, strain, membrane
+        force, with a thickness stress, and the curve.csv column the force is from).
     thickness : str, optional
         The fabric's thickness with its unit (``'0.6mm'``): stress is the membrane force
         per width divided by it. Required for ``abaqus`` and ``lsdyna`` (their curves
