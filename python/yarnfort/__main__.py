@@ -149,8 +149,9 @@ def summary_figure(folder: Path, support: str | None = None, *, channel: str | N
     """The summary plot of an output folder.
 
     Panels: the force against the displacement of what drives the run (a moving support
-    or a load; a fabric: force per unit width against strain), force positive in
-    tension; the network at the step of the largest force (or ``step``), coloured by
+    or a load; a fabric: force per unit width against strain; a periodic cell without
+    force_per_width, e.g. sheared: its membrane force against the strain it changes
+    most, n12 against gamma12), force positive in tension; the network at the step of the largest force (or ``step``), coloured by
     tension; for a scene with rings or obstacles, their history (ring position, obstacle
     reaction) against the load. Lengths in mm, as ``plot-states``.
 
@@ -182,8 +183,9 @@ def summary_figure(folder: Path, support: str | None = None, *, channel: str | N
     from matplotlib.figure import Figure
 
     from .plots import (DEFAULT_UNIT, LENGTH_UNITS, choose_driver, driver_response, load_drivers,
-                        peak_step, plot_fabric_hysteresis, plot_history, plot_hysteresis,
-                        plot_load_displacement, plot_network)
+                        membrane_pair, peak_step, plot_fabric_hysteresis, plot_history,
+                        plot_hysteresis, plot_load_displacement, plot_membrane_curve,
+                        plot_network)
 
     states = read_states(folder)
     scene = _scene(folder)
@@ -195,6 +197,10 @@ def summary_figure(folder: Path, support: str | None = None, *, channel: str | N
     except ValueError as error:
         raise CommandError(str(error)) from None
     fabric = support is None and channel is None and "force_per_width" in curve.names
+    # A periodic cell without force_per_width (sheared, say) has its membrane curve,
+    # where a reaction of its anchor would be rounding noise.
+    pair = (membrane_pair(curve) if support is None and channel is None and not fabric
+            and driver is None else None)
     history = 0
     if driver is not None and not fabric and scene is not None:
         history = int(bool(scene.get("ring"))) + int(any(
@@ -208,6 +214,10 @@ def summary_figure(folder: Path, support: str | None = None, *, channel: str | N
         left.set_title("effective curve of the fabric")
         force = curve["force_per_width"]
         abscissa = curve["strain"]
+    elif pair is not None:
+        plot_membrane_curve(curve, ax=left)
+        left.set_title("membrane curve of the cell")
+        abscissa, force = curve[pair[0]], curve[pair[1]]
     elif driver is not None:
         plot_load_displacement(curve, driver, ax=left, support=support)
         left.set_title(f"load-displacement ({driver.channel})")
@@ -307,7 +317,7 @@ def _parser() -> argparse.ArgumentParser:
         "plot", help="write a PNG: force-displacement loop, network at the peak, history",
         description="Write a PNG with the force against the displacement (mm) of what"
         " drives the run (a moving support or a load; a fabric: force per width against"
-        " strain), force positive in tension; the network at the step of the largest force"
+        " strain; a sheared periodic cell: n12 against gamma12), force positive in tension; the network at the step of the largest force"
         " coloured by tension; and for rings and obstacles their history against the"
         " load.")
     plot.add_argument("folder", type=Path, help="output folder of a run (holds curve.csv)")

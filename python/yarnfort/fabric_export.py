@@ -415,8 +415,8 @@ def _describe(curves: ComponentCurves, scale: _Scale, comment: str) -> list[str]
     lines = [f"{comment} component {curves.component}: run {curves.run},"
              f" columns {curves.columns[0]} and {curves.columns[1]}",
              f"{comment}   loading: steps {_ranges([int(s) for s in loading.steps])},"
-             f" strain {loading.strain[0]:.6g} to {loading.peak_strain:.6g}; force per"
-             f" width at the first step {loading.force_per_width[0]:.6g} N/m"]
+             f" strain {loading.strain[0]:.6g} to {loading.peak_strain:.6g};"
+             f" {curves.columns[1]} at the first step {loading.force_per_width[0]:.6g} N/m"]
     for k, branch in enumerate(curves.unloading, start=1):
         lines.append(f"{comment}   unloading {k}: steps {int(branch.steps[0])}-"
                      f"{int(branch.steps[-1])}, from strain {branch.peak_strain:.6g} to"
@@ -539,10 +539,14 @@ def _lsdyna(all_curves: Sequence[ComponentCurves], scale: _Scale, first_id: int,
 def _csv(all_curves: Sequence[ComponentCurves], scale: _Scale, unloading: bool) -> str:
     stream = io.StringIO()
     writer = csv.writer(stream, lineterminator="\n")
+    # The force is n11, n22, the frame shear or force_per_width by run and component:
+    # one neutral name, and each row names its source (n11 is over the current width,
+    # curve.csv's force_per_width over the undeformed one).
     header = ["component", "branch", "curve", "peak_strain", "step", "strain",
-              f"force_per_width ({scale.width_unit})"]
+              f"membrane_force ({scale.width_unit})"]
     if scale.thickness is not None:
         header.append(f"stress ({scale.stress_unit})")
+    header.append("force_from")
     writer.writerow(header)
     for curves in all_curves:
         branches = [curves.loading] + (curves.unloading if unloading else [])
@@ -556,6 +560,7 @@ def _csv(all_curves: Sequence[ComponentCurves], scale: _Scale, unloading: bool) 
                        int(step), _number(strain), _number(width)]
                 if stress is not None:
                     row.append(_number(stress))
+                row.append(curves.columns[1])
                 writer.writerow(row)
     return stream.getvalue()
 
@@ -595,8 +600,8 @@ def export_fabric(runs: Mapping[str, str | Path] | Iterable[tuple[str, str | Pat
         ``'abaqus'`` (a ``*MATERIAL`` with ``*FABRIC``, ``*UNIAXIAL``, ``*LOADING DATA``,
         ``*UNLOADING DATA, DEFINITION=INTERPOLATED CURVE``), ``'lsdyna'``
         (``*DEFINE_CURVE_TITLE`` blocks, strain against stress) or ``'csv'`` (one row
-        per point: component, branch, curve, peak strain, step, strain, force per width
-        and, with a thickness, stress).
+        per point: component, branch, curve, peak strain, step, strain, membrane
+        force, with a thickness stress, and the curve.csv column the force is from).
     thickness : str, optional
         The fabric's thickness with its unit (``'0.6mm'``): stress is the membrane force
         per width divided by it. Required for ``abaqus`` and ``lsdyna`` (their curves

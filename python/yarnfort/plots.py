@@ -29,7 +29,7 @@ __all__ = ["plot_curve", "plot_hysteresis", "plot_fabric_hysteresis", "plot_netw
            "plot_states", "nearest_states", "plot_fan", "save_figure", "supports",
            "reaction_component", "Driver", "load_drivers", "choose_driver",
            "driver_response", "plot_load_displacement", "plot_history", "peak_step",
-           "tension_norm"]
+           "tension_norm", "membrane_pair", "plot_membrane_curve"]
 
 #: Index of each Cartesian component in a reaction or position row.
 COMPONENTS: dict[str, int] = {"x": 0, "y": 1, "z": 2}
@@ -190,7 +190,8 @@ def plot_hysteresis(curve: Curve, support: str, component: str = "y", x: str = "
 def plot_fabric_hysteresis(curve: Curve, ax: Axes | None = None) -> Axes:
     """Effective curve of a generated fabric (``&fabric``): force per unit width
     against macroscopic strain, loading and unloading drawn as in
-    :func:`plot_hysteresis`.
+    :func:`plot_hysteresis`. The width is the reference (undeformed) one, as in
+    ``force_per_width``: n11 (1 + e22) of a periodic cell, not n11.
 
     Parameters
     ----------
@@ -206,7 +207,9 @@ def plot_fabric_hysteresis(curve: Curve, ax: Axes | None = None) -> Axes:
     ax = _axes(ax)
     _plot_branches(ax, curve["strain"], curve["force_per_width"], curve["direction"])
     ax.set_xlabel("macroscopic strain (1)")
-    ax.set_ylabel("force per unit width (N/m)")
+    # force_per_width is over the undeformed width; n11 (plot-membrane) is over the
+    # current one: a cell that narrows shows two values, so the label says which.
+    ax.set_ylabel("force per unit reference width (N/m)")
     ax.grid(True, alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend()
@@ -215,6 +218,67 @@ def plot_fabric_hysteresis(curve: Curve, ax: Axes | None = None) -> Axes:
 
 #: Columns a periodic-cell run's curve.csv has (plot_membrane).
 MEMBRANE_COLUMNS = ("e11", "e22", "n11", "n22")
+#: The membrane strain of a periodic cell, its conjugate force and the strain's unit.
+MEMBRANE_PAIRS = (("e11", "n11", "1"), ("e22", "n22", "1"), ("gamma12", "n12", "rad"))
+
+
+def membrane_pair(curve: Curve) -> tuple[str, str, str] | None:
+    """The membrane strain that a periodic-cell run changes most, its force and the
+    strain's unit: ``('gamma12', 'n12', 'rad')`` for a sheared cell, ``('e11', 'n11',
+    '1')`` for one stretched along x, ``('e22', 'n22', '1')`` along y.
+
+    Parameters
+    ----------
+    curve : Curve
+        A run's curve.
+
+    Returns
+    -------
+    tuple of str or None
+        None for a curve without membrane columns or rows (not a periodic cell).
+    """
+    pairs = [pair for pair in MEMBRANE_PAIRS
+             if pair[0] in curve.names and pair[1] in curve.names]
+    if not pairs or len(curve) == 0:
+        return None
+    return max(pairs, key=lambda pair: float(np.ptp(curve[pair[0]])))
+
+
+def plot_membrane_curve(curve: Curve, ax: Axes | None = None) -> Axes:
+    """The membrane force of a periodic cell against the strain that drives it
+    (:func:`membrane_pair`: n12 against gamma12 for a sheared cell), loading and
+    unloading as in :func:`plot_hysteresis`. For a cell whose curve has no
+    ``force_per_width`` (a shear run), the curve the summary plot draws.
+
+    Parameters
+    ----------
+    curve : Curve
+        The curve of a periodic-cell run.
+    ax : Axes, optional
+        Where to draw; a new figure when omitted.
+
+    Returns
+    -------
+    Axes
+
+    Raises
+    ------
+    ValueError
+        The curve has no rows or no membrane columns (not a periodic-cell run).
+    """
+    pair = membrane_pair(curve)
+    if pair is None:
+        raise ValueError(f"{curve.path}: no rows or no membrane columns (not a"
+                         " periodic-cell run)")
+    strain, force, unit = pair
+    ax = _axes(ax)
+    _plot_branches(ax, curve[strain], curve[force], curve["direction"])
+    ax.set_xlabel(f"{strain} ({unit})")
+    ax.set_ylabel(f"membrane force {force} (N/m)")
+    ax.grid(True, alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend()
+    return ax
 
 
 def plot_membrane(curve: Curve, title: str = "") -> Figure:

@@ -234,15 +234,30 @@ def _support_names(scene: f90nml.Namelist) -> list[str]:
     return names
 
 
+def _moving_support(scene: f90nml.Namelist) -> str | None:
+    """The first ``&support`` with a nonzero prescribed displacement, or None."""
+    groups = scene.get("support")
+    groups = [] if groups is None else (
+        [groups] if isinstance(groups, f90nml.Namelist) else list(groups))
+    for group in groups:
+        values = [0.0 if v is None else float(v)
+                  for v in np.atleast_1d(group.get("displacement", [0.0]))]
+        if "name" in group and any(v != 0.0 for v in values):
+            return str(group["name"])
+    return None
+
+
 def _check_support(scene: f90nml.Namelist, support: str | None) -> str:
     """The support to summarise: checked against the scene's ``&support`` names (a
-    generated ``&fabric`` names its own, which are checked on the first curve)."""
+    generated ``&fabric`` names its own, which are checked on the first curve). By
+    default the first that moves, as ``plot`` draws: the first listed is often a fixed
+    end, whose reaction is not the force that drives the run."""
     names = _support_names(scene)
     if support is None:
         if not names:
             raise ValueError("the scene has no &support: name the support whose reaction"
                              " is summarised (support=...)")
-        return names[0]
+        return _moving_support(scene) or names[0]
     if names and "fabric" not in scene and support not in names:
         raise ValueError(f"support {support!r}: the scene's supports are "
                          + ", ".join(names))
@@ -315,7 +330,9 @@ def run_sweep(scene_path: str | os.PathLike,
     progress : bool
         Show a progress bar on stderr.
     support : str, optional
-        Support set whose reaction is summarised (default: the scene's first &support).
+        Support set whose reaction is summarised (default: the scene's first &support
+        with a nonzero displacement, else its first &support; the ``support`` column
+        names it).
     component : {'x', 'y', 'z', 0, 1, 2}, optional
         Reaction component summarised; default the magnitude |R|.
     work_dir : path, optional
@@ -334,7 +351,8 @@ def run_sweep(scene_path: str | os.PathLike,
         ``error`` (the program's message, ``''`` when ok), ``n_steps`` (converged steps
         written, initial state included), ``final_reaction`` and ``max_reaction`` (the
         summarised reaction at the last step and the one of largest magnitude, N; NaN for
-        a failed run), ``wall_time`` (s, per run, process start included).
+        a failed run), ``support`` (the set summarised), ``wall_time`` (s, per run,
+        process start included).
 
     Raises
     ------
@@ -389,4 +407,5 @@ def run_sweep(scene_path: str | os.PathLike,
     for key in ("status", "error", "n_steps", "final_reaction", "max_reaction",
                 "wall_time"):
         table[key] = np.array([row[key] for row in rows])
+    table["support"] = np.array([support] * len(rows))
     return table

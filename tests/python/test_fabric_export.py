@@ -69,11 +69,14 @@ TWILL = """
 
 
 def _run(where: Path, name: str, *, strain: float = 0.0, time: str = "", p_disp: str = "",
-         boundary: str = "periodic", template: str = KNIT, shear: float = 0.0) -> Path:
+         boundary: str = "periodic", template: str = KNIT, shear: float = 0.0,
+         extra: str = "") -> Path:
     text = template.format(boundary=boundary, strain=strain, time=time, p_disp=p_disp,
                            name=name)
     if shear:
         text = text.replace("gap = 0.3e-3 /", f"gap = 0.3e-3, shear = {shear} /")
+    if extra:
+        text = text.replace("gap = 0.3e-3 /", f"gap = 0.3e-3, {extra} /")
     done = subprocess.run([str(yarnfort.program_path())], input=text, capture_output=True,
                           text=True, cwd=where, timeout=600)
     assert done.returncode == 0, done.stderr
@@ -94,6 +97,9 @@ def runs(tmp_path_factory) -> dict[str, Path]:
         "twill_shear": _run(where, "twill_shear", template=TWILL),
         "knit_shear": _run(where, "knit_shear", strain=0.0, time="0, 1, 2",
                            p_disp="0, 1, 0", shear=0.4),
+        # n22 held at 20 N/m: the cell narrows as it is stretched (knit_biaxial).
+        "narrowing": _run(where, "narrowing", strain=0.6, time="0, 1, 2", p_disp="0, 1, 0",
+                          extra="lateral_control = 'force', lateral_force = 20.0"),
     }
 
 
@@ -260,7 +266,7 @@ def test_csv_round_trip(runs, tmp_path):
         assert len(curves) == len(expected[branch])
         for curve, want in zip(curves, expected[branch]):
             mine = [r for r in rows if r["branch"] == branch and int(r["curve"]) == curve]
-            points = np.array([(float(r["strain"]), float(r["force_per_width (N/mm)"]) * 1e3)
+            points = np.array([(float(r["strain"]), float(r["membrane_force (N/mm)"]) * 1e3)
                                for r in mine])        # N/mm -> N/m
             assert_points_match(points, want)
 
@@ -272,7 +278,7 @@ def test_inch_units(runs, tmp_path):
     with open(out, newline="") as stream:
         rows = list(csv.DictReader(stream))
     psi = np.array([float(r["stress (lbf/in^2)"]) for r in rows])
-    width = np.array([float(r["force_per_width (lbf/in)"]) for r in rows])
+    width = np.array([float(r["membrane_force (lbf/in)"]) for r in rows])
     n = psi * 4.4482216152605 / 0.0254 ** 2 * (0.025 * 0.0254)    # -> Pa -> N/m
     np.testing.assert_allclose(width * 4.4482216152605 / 0.0254, n, rtol=1e-11)
     expected = segments(runs["other"])
@@ -456,3 +462,28 @@ def test_partial_release_refused_for_abaqus_only(runs, tmp_path):
                                        format="lsdyna", thickness="1mm"))
     assert len(curves) == 2
     np.testing.assert_allclose(curves[1][2][[0, -1], 0], [0.3, 0.6], rtol=1e-12)
+
+
+def test_csv_names_the_force_it_holds(runs, tmp_path):
+    """A cell that narrows (n22 held, e22 down to -0.4): component 1 is n11, per current
+    width, not curve.csv's force_per_width, per undeformed width (n11 (1 + e22), 0.6 n11
+    at the peak). The CSV's force column has a neutral name and every row names its
+    source; --uniaxial gives force_per_width itself."""
+    folder = runs["narrowing"]
+    curve = read_curve(folder)
+    row_of = {int(step): k for k, step in enumerate(curve["step"])}
+    assert curve["e22"].min() < -0.3  # the two widths differ: the name matters here
+    for uniaxial, source in ((False, "n11"), (True, "force_per_width")):
+        out = export_fabric({"1": folder}, tmp_path / f"{source}.csv", format="csv",
+                            units="N,m", uniaxial=uniaxial)
+        with open(out, newline="") as stream:
+            rows = list(csv.DictReader(stream))
+        assert "force_per_width (N/m)" not in rows[0]
+        assert {r["force_from"] for r in rows} == {source}
+        k = np.array([row_of[int(r["step"])] for r in rows])
+        force = np.array([float(r["membrane_force (N/m)"]) for r in rows])
+        per_undeformed_width = force * (1.0 + curve["e22"][k]) if source == "n11" else force
+        np.testing.assert_allclose(per_undeformed_width, curve["force_per_width"][k],
+                                   rtol=1e-9)
+    text = export_fabric({"1": folder}, tmp_path / "n.inp", thickness="0.6mm").read_text()
+    assert "n11 at the first step" in text

@@ -30,10 +30,12 @@ MM = 1e3  # millimetres per metre
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory) -> Path:
-    """vnet, capstan_pins, ring_sideways and knit run in one folder (out/<name>)."""
+    """vnet, capstan_pins, ring_sideways, knit, weave_shear and knit_biaxial run in one
+    folder (out/<name>)."""
     where = tmp_path_factory.mktemp("runs")
     shutil.copytree(TOP / "inputs", where / "inputs")  # the knit's tables
-    for name in ("vnet", "capstan_pins", "ring_sideways", "knit"):
+    for name in ("vnet", "capstan_pins", "ring_sideways", "knit", "weave_shear",
+                 "knit_biaxial"):
         with open(TOP / "inputs" / f"{name}.nml") as scene:
             done = subprocess.run([str(yarnfort.program_path())], stdin=scene,
                                   capture_output=True, text=True, cwd=where, timeout=600)
@@ -170,3 +172,39 @@ def test_another_support_and_a_fabric_support(runs):
     assert "(mm)" in pulled.get_xlabel() and "+x" in pulled.get_xlabel()
     assert x.max() == pytest.approx(knit["stretch_ux"].max() * MM, rel=1e-12)
     assert y.max() == pytest.approx(knit["stretch_rx"].max(), rel=1e-12)
+
+
+def test_sheared_cell_shows_its_shear_curve_not_anchor_noise(runs):
+    """inputs/weave_shear.nml has no force_per_width (no x stretch) and no moving support:
+    the summary draws n12 against gamma12, not its anchor's reaction (rounding, 1e-13 N),
+    and shows the state at full shear (p_disp = 1 at t = 1, the path's peak), where the
+    pin-jointed net carries n12 = n22 tan(gamma12) with n22 held at 50 N/m and
+    gamma12 = atan(0.4 / (1 + e22)) (REFERENCE.md, *Shear*)."""
+    curve = read_curve(runs / "weave_shear")
+    figure = summary_figure(runs / "weave_shear")
+    left = figure.axes[0]
+    assert left.get_xlabel() == "gamma12 (rad)"
+    assert "n12 (N/m)" in left.get_ylabel()
+    peak = int(np.flatnonzero(curve["time"] == 1.0)[0])
+    assert shown_step(figure) == curve["step"][peak]
+    gamma = np.arctan(0.4 / (1.0 + curve["e22"][peak]))
+    marker = [line for line in left.get_lines() if line.get_gid() == "shown_step"][0]
+    assert marker.get_xdata()[0] == pytest.approx(gamma, rel=1e-12)
+    assert marker.get_ydata()[0] == pytest.approx(50.0 * np.tan(gamma), rel=1e-6)
+    x, y = branches(left)
+    np.testing.assert_allclose(y, 50.0 * np.tan(x), rtol=1e-6, atol=1e-6 * 50.0)
+
+
+def test_fabric_curve_is_labelled_per_reference_width(runs):
+    """knit_biaxial narrows to e22 = -0.44 with n22 held: its force per width is over the
+    undeformed width, n11 (per current width) times (1 + e22), 0.56 n11 at the peak; the
+    label says so, since plot-membrane draws n11 for the same run."""
+    curve = read_curve(runs / "knit_biaxial")
+    left = summary_figure(runs / "knit_biaxial").axes[0]
+    assert left.get_ylabel() == "force per unit reference width (N/m)"
+    x, y = branches(left)
+    loading = [line for line in left.get_lines() if line.get_gid() == "loading"][0]
+    rows = len(loading.get_ydata())
+    per_reference = curve["n11"][:rows] * (1.0 + curve["e22"][:rows])
+    np.testing.assert_allclose(loading.get_ydata(), per_reference, rtol=1e-9)
+    assert curve["e22"].min() < -0.4  # the widths differ: the label matters here

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from yarnfort import program_path
+from yarnfort import program_path, read_curve
+from yarnfort.results import read_contacts
 from yarnfort.sweep import parameter_grid, run_sweep
 
 TOP = Path(__file__).resolve().parents[2]
@@ -101,3 +102,27 @@ def test_dask_cluster_gives_the_same_table(local_table):
         table = run_sweep(CAPSTAN, GRID, scheduler=cluster.scheduler_address,
                           progress=False, support="pull", component="y")
     assert_same_table(table, local_table)
+
+
+def test_default_summary_is_the_pulled_support(tmp_path):
+    """Without support=..., the table summarises the capstan's pulled end ('pull', the
+    first &support that moves), not its first &support (the fixed end), and names it.
+    At the peak all three pegs slip, so the pull is the capstan law with adhesion,
+    dT/dalpha = max(mu T, beta), integrated from the fixed end's tension over the summed
+    wrap angle (contacts.csv)."""
+    mu, beta = 0.3, 0.05  # inputs/capstan.nml
+    table = run_sweep(CAPSTAN, {MU: [mu]}, workers=1, progress=False, work_dir=tmp_path)
+    assert list(table["status"]) == ["ok"] and list(table["support"]) == ["pull"]
+    out = tmp_path / "run_00000" / "out"
+    curve = read_curve(out)
+    peak = int(np.argmax(curve["p_disp"]))
+    contacts = read_contacts(out)
+    at_peak = np.asarray(contacts["step"]) == curve["step"][peak]
+    assert set(np.asarray(contacts["mode"])[at_peak]) == {"forward"}  # gross slip
+    angle = float(np.sum(np.asarray(contacts["wrap_angle"])[at_peak]))
+    low = float(np.linalg.norm(curve.reaction("fixed")[peak]))
+    knee = beta / mu  # the tension where the exponential law takes over
+    used = min(angle, max(knee - low, 0.0) / beta)
+    high = (low + beta * used) * np.exp(mu * (angle - used))
+    assert table["max_reaction"][0] == pytest.approx(high, rel=1e-8)
+    assert table["max_reaction"][0] > 2.0 * low  # not the fixed end's reaction
