@@ -13,6 +13,11 @@ An address names one variable of one namelist group:
   ones from the end), e.g. one knot value of the gap-factor table. The list must be set
   already and have that entry: its length is the scene's to choose.
 
+A variable the scene gives from a later entry (``displacement(2) = -0.3``) is read and
+set counted from its first entry, as the program reads it: ``displacement[1]`` is -0.3,
+``displacement`` reads ``[None, -0.3]`` (None: unset, the default), and a value set for
+the whole variable starts at its first entry.
+
 Group and variable names are case-insensitive; a group name is matched exactly. Setting a
 variable that the group does not have yet adds it, and setting a variable of a group the
 scene lacks adds the group, when the address has no index (or index 0): that is how a
@@ -141,12 +146,35 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _from_first(instance: f90nml.Namelist, variable: str) -> Any:
+    """A variable's value counted from its first entry. f90nml keeps ``x(2) = 5`` as
+    ``[5]`` with a start index 2: read as it is, entry 0 would be x(2). Entries before
+    the start are None (null when written: the default stays)."""
+    value = instance[variable]
+    start = (getattr(instance, "start_index", None) or {}).get(variable)
+    if not start or all(index is None or index <= 1 for index in start):
+        return value
+    if len(start) > 1:
+        raise AddressError(f"{variable}{tuple(start)}: an array given from that index in"
+                           " more than one dimension; give it whole in the scene")
+    return [None] * (start[0] - 1) + (list(value) if isinstance(value, list) else [value])
+
+
+def _store(instance: f90nml.Namelist, variable: str, value: Any) -> None:
+    """Set a variable from its first entry (a start index read from the file no longer
+    applies: it would shift the new values)."""
+    instance[variable] = value
+    starts = getattr(instance, "start_index", None)
+    if starts:
+        starts.pop(variable, None)
+
+
 def _entry(instance: f90nml.Namelist, where: Address) -> tuple[list, int]:
     """The list that an address with an entry names, and the entry's position in it."""
     if where.variable not in instance:
         raise AddressError(f"{where.text!r}: &{where.group} has no variable"
                            f" {where.variable!r} set (an entry needs the list set)")
-    value = instance[where.variable]
+    value = _from_first(instance, where.variable)
     items = list(value) if isinstance(value, list) else [value]
     if not -len(items) <= where.element < len(items):
         raise AddressError(f"{where.text!r}: &{where.group} {where.variable} has"
@@ -182,7 +210,7 @@ def get_parameter(nml: f90nml.Namelist, address: str) -> Any:
     if where.variable not in instance:
         raise AddressError(f"{address!r}: &{where.group} has no variable"
                            f" {where.variable!r} set")
-    return instance[where.variable]
+    return _from_first(instance, where.variable)
 
 
 def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Namelist:
@@ -219,10 +247,10 @@ def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Name
         instance = _find_group(nml, where, create=False)
         items, position = _entry(instance, where)
         items[position] = _like(items[position], value)
-        instance[where.variable] = items
+        _store(instance, where.variable, items)
         return nml
     instance = _find_group(nml, where, create=True)
-    instance[where.variable] = _like(instance.get(where.variable), value)
+    _store(instance, where.variable, _like(instance.get(where.variable), value))
     return nml
 
 
