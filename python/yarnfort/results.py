@@ -16,6 +16,7 @@ from __future__ import annotations
 import csv
 import errno
 import re
+import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -611,12 +612,20 @@ def read_run(folder: str | Path) -> Any:
     Returns
     -------
     RunResult
-        ``outcome`` is ``'read'`` (not run here), ``n_steps`` the rows of its curve.
+        ``outcome`` is ``'read'`` (not run here), or ``'incomplete'`` when the curve
+        ends before the end of the load path of the run's ``input.nml`` (a failed step,
+        Ctrl-C, ``max_steps``, a killed run or one still going); ``n_steps`` the rows
+        of its curve.
 
     Raises
     ------
     ResultError
         If the folder holds no readable ``curve.csv``.
+
+    Warns
+    -----
+    RuntimeWarning
+        For an incomplete run, naming where its curve ends and where the path does.
     """
     from .runner import RunResult
 
@@ -624,4 +633,35 @@ def read_run(folder: str | Path) -> Any:
     if not folder.is_dir():
         raise ResultError(f"no output folder {str(folder)!r}")
     curve = read_curve(folder)
-    return RunResult(folder.resolve(), len(curve), "read")
+    missing = _path_left(folder, curve)
+    if missing:
+        warnings.warn(f"{folder}: {missing}", RuntimeWarning, stacklevel=2)
+    return RunResult(folder.resolve(), len(curve), "incomplete" if missing else "read")
+
+
+#: A curve ends at the path's end when its last time is within this fraction of the
+#: path's largest |time| (steps land on the knots; only round-off is forgiven).
+PATH_END_TOLERANCE = 1e-9
+
+
+def _path_left(folder: Path, curve: Curve) -> str:
+    """Why the run of `folder` did not reach the end of its load path ('' if it did, or
+    if its input.nml gives no path to judge by)."""
+    try:
+        import f90nml
+
+        times = np.atleast_1d(np.asarray(f90nml.read(folder / "input.nml")["path"]["time"],
+                                         dtype=float))
+    except Exception:  # noqa: BLE001 - no echo to judge by: nothing is claimed
+        return ""
+    times = times[np.isfinite(times)]
+    if times.size == 0 or "time" not in curve.columns:
+        return ""
+    end = float(times[-1])
+    if len(curve) and curve["time"][-1] >= end - PATH_END_TOLERANCE * np.abs(times).max():
+        return ""
+    reached = (f"the curve ends at step {int(curve['step'][-1])}, time"
+               f" {float(curve['time'][-1]):g}" if len(curve) else "the curve has no step")
+    return (f"incomplete run: {reached}, the load path at {end:g} (a failed step, Ctrl-C,"
+            " max_steps, a killed run or one still going; &control restart = .true."
+            " goes on)")
