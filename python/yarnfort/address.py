@@ -35,7 +35,8 @@ from typing import Any
 import f90nml
 import numpy as np
 
-__all__ = ["Address", "AddressError", "parse_address", "get_parameter", "set_parameter"]
+__all__ = ["Address", "AddressError", "parse_address", "check_address", "get_parameter",
+           "set_parameter"]
 
 _ADDRESS = re.compile(r"^\s*(\w+)\s*(?:\[\s*([^\]]*?)\s*\])?\s*\.\s*(\w+)\s*"
                       r"(?:\[\s*([+-]?\d+)\s*\])?\s*$")
@@ -103,6 +104,44 @@ def parse_address(address: str) -> Address:
         where = index.strip("'\"")
     return Address(group.lower(), where, variable.lower(), address,
                    None if element is None else int(element))
+
+
+def check_address(address: str) -> Address:
+    """Parse an address and check that its group and variable are input variables (the
+    one description of the input): a sweep or fit of a misspelled name is refused before
+    it runs, not left to fail in every run.
+
+    Parameters
+    ----------
+    address : str
+        The address.
+
+    Returns
+    -------
+    Address
+
+    Raises
+    ------
+    AddressError
+        If the address is malformed, or names a group or variable the input does not
+        have (the message suggests the name meant).
+    """
+    import difflib
+
+    from .resources import input_description
+
+    where = parse_address(address)
+    groups = {group["name"]: [v["name"] for v in group["variables"]]
+              for group in input_description()["groups"]}
+    for name, known, what in ((where.group, list(groups), "group"),
+                              (where.variable, groups.get(where.group), "variable")):
+        if known is not None and name not in known:
+            close = difflib.get_close_matches(name, known, n=1)
+            owner = "the input" if what == "group" else f"&{where.group}"
+            raise AddressError(f"{address!r}: {owner} has no {what} {name!r}"
+                               + (f"; did you mean {close[0]!r}?" if close else "")
+                               + " (python -m yarnfort reference)")
+    return where
 
 
 def _instances(nml: f90nml.Namelist, group: str) -> list[f90nml.Namelist]:

@@ -68,7 +68,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ._native import YarnfortError
-from .address import parse_address
+from .address import check_address
 from .results import Curve
 from .sweep import _check_support, run_patched
 from .units import force_factor, split_header, strain_factor
@@ -677,8 +677,8 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
     ------
     ValueError
         For bounds with lower >= upper or an initial value outside them, fewer measured
-        points than parameters plus one, a malformed parameter address (an
-        :class:`~yarnfort.AddressError`), an unknown component or support, an unreadable
+        points than parameters plus one, a malformed parameter address or one of a
+        group or variable the input does not have (an :class:`~yarnfort.AddressError`), an unknown component or support, an unreadable
         measured curve, a force per sample against a force per width without ``width``,
         or data with more load cycles than the scene's path.
     YarnfortError
@@ -697,8 +697,8 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
         raise ValueError("each parameter needs lower < upper and initial within them")
     span = upper - lower
     index = _component_index(component)
-    for name in names:
-        parse_address(name)
+    for name in (*names, *(fixed or {})):
+        check_address(name)
     data = measured if isinstance(measured, Measured) else read_measured(
         measured, strain_unit=strain_unit, force_unit=force_unit)
     m, n = data.force.size, len(names)

@@ -19,9 +19,10 @@ for ``yarnfort < scene.nml`` and :func:`yarnfort.run_scene` run from there.
 Parameter addresses
 -------------------
 The grammar of :mod:`yarnfort.address`: ``'solver.max_step'``,
-``'contact[0].friction_coefficient'``, ``'support[pull].displacement'``. Addresses and
-the summarised support are checked before any run starts (:class:`ValueError`); a value
-the program rejects gives a row with status ``'bad_input'`` and its message.
+``'contact[0].friction_coefficient'``, ``'support[pull].displacement'``. Addresses (their
+form, and that the group and variable are input variables) and the summarised support
+are checked before any run starts (:class:`ValueError`); a value the
+program rejects gives a row with status ``'bad_input'`` and its message.
 
 Dask
 ----
@@ -49,7 +50,7 @@ import numpy as np
 
 from ._native import YarnfortError
 from ._program import program_path
-from .address import AddressError, parse_address, set_parameter
+from .address import AddressError, check_address, set_parameter
 from .results import Curve, read_curve
 
 __all__ = ["run_sweep", "run_patched", "parameter_grid"]
@@ -99,6 +100,16 @@ def _summary(curve: Curve, support: str, component: int | None) -> tuple[float, 
     return float(value[-1]), float(value[np.argmax(np.abs(value))])
 
 
+def _stamp(path: Path) -> tuple[int, int, int] | None:
+    """Identity of a file (inode, modification time, size), None if there is none: the
+    program writes curve.csv as a new file, so a run that wrote one changes it."""
+    try:
+        info = path.stat()
+    except OSError:
+        return None
+    return info.st_ino, info.st_mtime_ns, info.st_size
+
+
 def _execute(task: _Task) -> dict[str, Any]:
     """Run one task and summarise it; never raises (errors become the row's message)."""
     start = time.perf_counter()
@@ -110,6 +121,8 @@ def _execute(task: _Task) -> dict[str, Any]:
         folder.mkdir(parents=True, exist_ok=True)
         text = task.text.replace("@FOLDER@", str(folder / "out"))
         (folder / "input.nml").write_text(text)
+        curve_file = folder / "out" / "curve.csv"
+        before = _stamp(curve_file)  # a kept work_dir may hold an earlier sweep's curve
         env = dict(os.environ)
         env.setdefault("OMP_NUM_THREADS", "1")  # one core per run: runs are the parallelism
         program = task.program or str(program_path())
@@ -119,8 +132,8 @@ def _execute(task: _Task) -> dict[str, Any]:
         if proc.returncode != 0:
             lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
             row["error"] = lines[-1] if lines else f"exit code {proc.returncode}"
-        curve_file = folder / "out" / "curve.csv"
-        if curve_file.is_file():
+        # Exit 2 writes nothing, and a curve this run did not replace is an earlier one.
+        if proc.returncode != 2 and curve_file.is_file() and _stamp(curve_file) != before:
             curve = read_curve(curve_file)
             row["n_steps"] = len(curve["step"])
             known = [name[:-3] for name in curve.names if name.endswith("_rx")]
@@ -357,7 +370,8 @@ def run_sweep(scene_path: str | os.PathLike,
     Raises
     ------
     ValueError
-        For a malformed parameter address, an unknown component, or a support the scene
+        For a malformed parameter address or one of a group or variable the input does
+        not have, an unknown component, or a support the scene
         does not have (checked before any run against its ``&support`` groups; for a
         generated ``&fabric``, on the runs' curves); the program's failures do not raise
         (they are rows).
@@ -369,7 +383,7 @@ def run_sweep(scene_path: str | os.PathLike,
     names = list(dict.fromkeys(name for run in runs for name in run))
     for name in names:
         try:
-            parse_address(name)
+            check_address(name)
         except AddressError as error:
             raise ValueError(str(error)) from None
     support = _check_support(scene, support)

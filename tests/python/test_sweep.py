@@ -126,3 +126,27 @@ def test_default_summary_is_the_pulled_support(tmp_path):
     high = (low + beta * used) * np.exp(mu * (angle - used))
     assert table["max_reaction"][0] == pytest.approx(high, rel=1e-8)
     assert table["max_reaction"][0] > 2.0 * low  # not the fixed end's reaction
+
+
+def test_a_misspelled_group_or_variable_is_rejected_before_any_run(tmp_path):
+    # Each run would otherwise fail alone, as a bad_input row.
+    with pytest.raises(ValueError, match="no variable 'friction_coeficient'; did you mean"
+                       " 'friction_coefficient'"):
+        run_sweep(CAPSTAN, {"contact[0].friction_coeficient": [0.2]}, progress=False,
+                  work_dir=tmp_path)
+    with pytest.raises(ValueError, match="no group 'solvr'; did you mean 'solver'"):
+        run_sweep(CAPSTAN, {"solvr.max_step": [0.2]}, progress=False, work_dir=tmp_path)
+    assert not list(tmp_path.iterdir())  # nothing ran
+
+
+def test_a_failed_run_in_a_kept_folder_does_not_report_an_earlier_curve(tmp_path):
+    run_sweep(CAPSTAN, {MU: [0.25]}, workers=1, progress=False, work_dir=tmp_path)
+    earlier = tmp_path / "run_00000" / "out" / "curve.csv"
+    rows = len(read_curve(earlier))
+    assert rows > 1
+    text = earlier.read_bytes()
+    table = run_sweep(CAPSTAN, {MU: [-0.25]}, workers=1, progress=False,
+                      work_dir=tmp_path)
+    # Bad input writes nothing: the row has no step, the earlier curve stays as it was.
+    assert list(table["status"]) == ["bad_input"] and list(table["n_steps"]) == [0]
+    assert earlier.read_bytes() == text
