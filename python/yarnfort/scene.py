@@ -124,9 +124,14 @@ def _check_value(group: str, var: dict[str, Any], value: Any, where: str) -> Non
         if kind == "character":
             if not isinstance(entry, str):
                 raise SceneError(f"{where} {name}: expected a string, got {entry!r}")
-            if len(entry) > var["length"]:
+            # The reader counts bytes: 'ü' is two in UTF-8.
+            if len(entry.encode("utf-8")) > var["length"]:
                 raise SceneError(f"{where} {name}: {entry!r} is longer than"
-                                 f" {var['length']} characters")
+                                 f" {var['length']} characters (bytes in UTF-8)")
+            # f90nml writes a line break as the two characters '\n': refused, not changed.
+            if any(ord(char) < 32 and char != "\t" or ord(char) == 127 for char in entry):
+                raise SceneError(f"{where} {name}: {entry!r} holds a line break or other"
+                                 " control character, which a namelist string cannot hold")
             choices = var["choices"]
             folded = entry.lower() if var["lower"] else entry
             advice = (var.get("retired") or {}).get(folded)
@@ -197,6 +202,9 @@ def _ids(value: ArrayLike, where: str, minimum: int = 1) -> np.ndarray:
 def _optional_float(value: Any, where: str) -> float | None:
     if value is None:
         return None
+    # float(True) and float('10') would pass as 1.0 and 10.0: a number is asked for.
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise SceneError(f"{where}: expected a number, got {value!r}")
     try:
         number = float(value)
     except (TypeError, ValueError):
