@@ -24,13 +24,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .namelist import read_scene
-from .results import Curve, read_curve, read_states
+from .results import Curve, incomplete_reason, read_curve, read_states
 
 # matplotlib (through .plots) is imported only once a plot is to be made, so that
 # --help and argument errors answer quickly.
@@ -277,6 +278,8 @@ def read_run_curve(folder: Path) -> Curve:
     if len(curve) == 0:
         raise CommandError(f"{folder / 'curve.csv'} has no rows (only its header): the run"
                            " wrote no converged step, nothing to plot")
+    if reason := incomplete_reason(folder, curve):
+        warnings.warn(f"{folder}: {reason}", RuntimeWarning, stacklevel=2)
     return curve
 
 
@@ -471,6 +474,21 @@ def main(argv: list[str] | None = None) -> int:
         The exit code: 0 success, 2 bad arguments or unusable inputs.
     """
     args = _parser().parse_args(argv)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RuntimeWarning)
+        code = _command(args)
+    # After the command's own lines, as the program's last lines (an incomplete run).
+    for warning in caught:
+        if issubclass(warning.category, RuntimeWarning):
+            print(f"yarnfort {args.command}: warning: {warning.message}", file=sys.stderr)
+        else:
+            warnings.showwarning(warning.message, warning.category, warning.filename,
+                                 warning.lineno)
+    return code
+
+
+def _command(args: argparse.Namespace) -> int:
+    """Run the command `args` asks for; its exit code."""
     try:
         if args.command == "reference":
             from .resources import reference_text

@@ -633,7 +633,7 @@ def read_run(folder: str | Path) -> Any:
     if not folder.is_dir():
         raise ResultError(f"no output folder {str(folder)!r}")
     curve = read_curve(folder)
-    missing = _path_left(folder, curve)
+    missing = incomplete_reason(folder, curve)
     if missing:
         warnings.warn(f"{folder}: {missing}", RuntimeWarning, stacklevel=2)
     return RunResult(folder.resolve(), len(curve), "incomplete" if missing else "read")
@@ -644,7 +644,7 @@ def read_run(folder: str | Path) -> Any:
 PATH_END_TOLERANCE = 1e-9
 
 
-def _path_left(folder: Path, curve: Curve) -> str:
+def incomplete_reason(folder: Path, curve: Curve) -> str:
     """Why the run of `folder` did not reach the end of its load path ('' if it did, or
     if its input.nml gives no path to judge by)."""
     try:
