@@ -357,6 +357,13 @@ def read_curve(path: str | Path) -> Curve:
         a number (the message names the file, line and column).
     OSError
         If the file cannot be read.
+
+    Warns
+    -----
+    RuntimeWarning
+        If the last row has no line end (a run killed while writing it): that row is
+        left out (as a restart drops it), as in :func:`read_reactions` and
+        :func:`read_contacts`.
     """
     return _read_csv(_curve_file(path), ())
 
@@ -369,7 +376,14 @@ def _read_csv(path: Path, text_columns: tuple[str, ...]) -> Curve:
     """A step file of the run: a header line, then rows of numbers (text in the named
     `text_columns`, kept as str)."""
     with open(path, newline="") as stream:
-        rows = list(csv.reader(stream))
+        text = stream.read()
+    rows = list(csv.reader(text.splitlines()))
+    # Every row the program writes ends with a line end; a last row without one was cut
+    # short by a kill (its last number may be cut to another valid one): left out.
+    if len(rows) > 1 and not text.endswith(("\n", "\r")):
+        warnings.warn(f"{path}, line {len(rows)}: the last row has no line end (cut short"
+                      " by a killed run); it is left out", RuntimeWarning, stacklevel=3)
+        rows = rows[:-1]
     if not rows or not any(cell.strip() for cell in rows[0]):
         raise ResultError(f"{path}: empty file (no header line): not a complete"
                           " yarnfort curve")

@@ -35,3 +35,18 @@ def test_a_run_stopped_by_max_steps_reads_incomplete_then_whole_after_restart(tm
         read = yarnfort.read_run(tmp_path / "out")
     assert read.outcome == "read" and read.n_steps == 21  # 0..2 in steps of 0.1
     assert read.curve["time"][-1] == pytest.approx(2.0, rel=1e-12)
+
+
+def test_a_last_row_cut_short_by_a_kill_is_left_out_with_a_warning(tmp_path):
+    # Cut inside the exponent, '2.5E-05' reads as the valid number 2.5.
+    (tmp_path / "curve.csv").write_text("step,time,p_force,pull_ry\n"
+                                        "0,0.0,0.0,0.0\n"
+                                        "1,0.1,0.1,1.5E-05\n"
+                                        "2,0.2,0.2,2.5E-0")
+    with pytest.warns(RuntimeWarning, match=r"line 4: the last row has no line end"):
+        curve = yarnfort.read_curve(tmp_path)
+    assert list(curve["step"]) == [0, 1] and curve["pull_ry"][-1] == 1.5e-5
+    (tmp_path / "curve.csv").write_text("step,time\n0,0.0\n1,0.1\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # whole rows: no warning
+        assert list(yarnfort.read_curve(tmp_path)["step"]) == [0, 1]
