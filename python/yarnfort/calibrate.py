@@ -678,8 +678,8 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
     ValueError
         For bounds with lower >= upper or an initial value outside them, fewer measured
         points than parameters plus one, a malformed parameter address or one of a
-        group or variable the input does not have (an :class:`~yarnfort.AddressError`), an unknown component or support, an unreadable
-        measured curve, a force per sample against a force per width without ``width``,
+        group or variable the input does not have (an :class:`~yarnfort.AddressError`),
+        an unknown component or support, an unreadable measured curve, a force per sample against a force per width without ``width``,
         or data with more load cycles than the scene's path.
     YarnfortError
         If a run fails; the message names the parameter values.

@@ -217,9 +217,19 @@ def parameter_grid(parameters: Mapping[str, Sequence[Any]] | Sequence[Mapping[st
     -------
     list of dict
         One dict address -> value per run.
+
+    Raises
+    ------
+    TypeError
+        If the values of an address are a string (not a list of values).
     """
     if isinstance(parameters, Mapping):
         names = list(parameters)
+        for name in names:
+            # A string is a sequence too: 'table' would be swept as 't', 'a', 'b', ...
+            if isinstance(parameters[name], (str, bytes)):
+                raise TypeError(f"{name!r}: expected a list of values, got the string"
+                                f" {parameters[name]!r} (for one value: [{parameters[name]!r}])")
         return [dict(zip(names, combo))
                 for combo in itertools.product(*(list(parameters[n]) for n in names))]
     return [dict(values) for values in parameters]

@@ -150,3 +150,11 @@ def test_a_failed_run_in_a_kept_folder_does_not_report_an_earlier_curve(tmp_path
     # Bad input writes nothing: the row has no step, the earlier curve stays as it was.
     assert list(table["status"]) == ["bad_input"] and list(table["n_steps"]) == [0]
     assert earlier.read_bytes() == text
+
+
+def test_a_string_is_not_a_list_of_values():
+    # list('table') would be five runs of laws 't', 'a', 'b', 'l', 'e'.
+    with pytest.raises(TypeError, match=r"'material\[0\].law': expected a list of values"):
+        parameter_grid({"material[0].law": "table"})
+    assert parameter_grid({"material[0].law": ["table"], MU: [0.1, 0.2]}) == [
+        {"material[0].law": "table", MU: 0.1}, {"material[0].law": "table", MU: 0.2}]
