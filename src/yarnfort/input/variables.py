@@ -266,7 +266,7 @@ GROUPS = [
             default_doc='not set',
             doc='`table`: initial length of the tensile specimen; required when the strain '
                 'column is an elongation (a length unit), an error otherwise: strain = '
-                'elongation / gauge_length.'),
+                'elongation / gauge_length. At most 5 m (500 mm is 0.5).'),
         Var('prestress', 'real', 0.0, unit='N', range='>= 0',
             doc='Pre-stress: every element of this yarn type starts with reference length L0 = l '
                 '/ lambda_p, where f(lambda_p) = prestress and l is its length in the initial '
