@@ -14,6 +14,7 @@ module yarnfort_units
 
     public :: unit_type, find_unit, unit_names, to_scene_unit, get_header_unit
     public :: get_header_units, get_note_units, same_unit, note_unit_message
+    public :: header_shape_message
     public :: strain_kind, length_kind, force_kind
 
     !> The kinds of quantity a unit measures.
@@ -156,6 +157,39 @@ contains
                 stated(c))
         end do
     end subroutine get_header_units
+
+    !> '' for a header line of two comma-separated fields (whose units are read), or for
+    !> one that states no unit in brackets; otherwise the message (starting ', line L: ')
+    !> for a header whose units would not be read: 'Elongation (%),Force (cN),' (a third,
+    !> empty field), 'Elongation (%);Force (cN)', or the fields separated by tabs.
+    pure function header_shape_message(header, header_line, names) result(message)
+        character(len=*), intent(in) :: header, names
+        integer, intent(in) :: header_line
+        character(len=:), allocatable :: message
+        type(unit_type) :: unit
+        integer :: comma, first, last
+        logical :: found
+
+        message = ''
+        comma = index(header, ',')
+        if (comma > 0) then
+            if (index(header(comma + 1:), ',') == 0) return
+        end if
+        ! Every (...) and [...] of the line: the first that holds a known unit.
+        last = 0
+        do
+            first = last + scan(header(last + 1:), '([')
+            if (first == last) return
+            last = first + scan(header(first + 1:), ')]')
+            if (last == first) return
+            call find_unit(trim(adjustl(header(first + 1:last - 1))), unit, found)
+            if (found) exit
+        end do
+        message = ', line ' // format_integer(header_line) // ': the header states the ' &
+            // 'unit ' // quote_string(trim(unit%name)) // ' but is not two comma-separated ' &
+            // 'fields (' // names // '), so its units would not be read: write it as ' &
+            // 'two fields separated by one comma, without a trailing comma'
+    end function header_shape_message
 
     !> The units a note before a table's rows (a '#' comment, an earlier header line)
     !> states, where it reads as a header of the two columns: both fields state a unit

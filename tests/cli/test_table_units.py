@@ -147,6 +147,13 @@ def test_units_stated_with_a_note_run_as_the_si_table(run_yarnfort, tmp_path, ta
     ("Strain,Force\n0,0\n0.01,0.08\n", "", None),
     ("Elongation (%),Tenacity\n0,0\n1,8\n", "",
      ["yarn.csv', line 1, column 2 ('Tenacity'): names a quantity that is not a force"]),
+    # A header with units but not two comma-separated fields: its units were not read.
+    ("Elongation (%),Force (cN),\n0,0\n1,8\n2,20\n", "",
+     ["yarn.csv', line 1: the header states the unit '%' but is not two comma-separated"]),
+    ("Elongation (%);Force (cN)\n0,0\n1,8\n2,20\n", "",
+     ["yarn.csv', line 1: the header states the unit '%' but is not two comma-separated"]),
+    ("Elongation (%)\tForce (cN)\n0,0\n1,8\n2,20\n", "",
+     ["yarn.csv', line 1: the header states the unit '%' but is not two comma-separated"]),
     (elongation_table(), "gauge_length = 500",
      ["gauge_length = 500.0 m is longer than any tensile specimen", "(500 mm is 0.5)"]),
 ])

@@ -32,7 +32,8 @@ module yarnfort_friction_general
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
     use yarnfort_text, only: format_integer, format_real, quote_string, string_type
     use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &
-        get_header_units, get_note_units, same_unit, note_unit_message, force_kind
+        get_header_units, get_note_units, same_unit, note_unit_message, &
+        header_shape_message, force_kind
     use yarnfort_friction_law, only: friction_law_type, tension_limit, rate_limit, no_kink, &
         scaled_exp, capped_product, capped_quotient, expm1, cap_critical_tension
     implicit none
@@ -280,6 +281,13 @@ contains
         logical :: stated(2), found
         integer :: c
 
+        if (header_line > 0) then
+            text = header_shape_message(header, header_line, 'T, g')
+            if (len(text) > 0) then
+                call fatal_error(error, text)
+                return
+            end if
+        end if
         call get_header_units(header, fields, texts, stated)
         do c = 1, 2
             text = 'N'

@@ -28,8 +28,8 @@ module yarnfort_material_table
     use yarnfort_text, only: format_real, format_integer, quote_string, string_type, to_lower
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
     use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &
-        get_header_units, get_note_units, same_unit, note_unit_message, strain_kind, &
-        length_kind, force_kind
+        get_header_units, get_note_units, same_unit, note_unit_message, &
+        header_shape_message, strain_kind, length_kind, force_kind
     implicit none
     private
 
@@ -296,6 +296,7 @@ contains
     !> The header's column names in the table's order, strain then force: a header that
     !> names a force in column 1 or a strain in column 2 ('Force,Elongation') is a table
     !> whose columns are swapped, and one that names a stress or a tenacity is not a force.
+    !> A header with units must be two comma-separated fields (`header_shape_message`).
     subroutine check_column_names(header, header_line, error)
         character(len=*), intent(in) :: header
         integer, intent(in) :: header_line
@@ -306,6 +307,11 @@ contains
         integer :: c
 
         if (header_line == 0) return
+        problem = header_shape_message(header, header_line, 'strain, force')
+        if (len(problem) > 0) then
+            call fatal_error(error, problem)
+            return
+        end if
         call get_header_units(header, fields, texts, stated)
         do c = 1, 2
             problem = ''
