@@ -244,8 +244,9 @@ GROUPS = [
                       '`neo_hookean`: undeformed cross-section S(1).'),
         Var('table_file', 'character', '', length='path_length', adjust=False, laws=['table'],
             doc='`table`: CSV file of (strain, force). The material code reads it. A '
-                "relative name is taken relative to the input file's folder (the working "
-                'directory when the input comes from standard input). Its units: the header '
+                'relative name is taken from the working directory of the run, also from '
+                "Python (README, *Relative paths*), not from the input file's folder. Its "
+                'units: the header '
                 '(`Elongation (%),Force (cN)`), `strain_unit` and `force_unit`, else 1 and N; '
                 'see *Table files* below.'),
         Var('strain_unit', 'character', '', length=16, checked_by='table',
@@ -300,7 +301,7 @@ GROUPS = [
             default_doc="`''` (none)",
             doc='`general`: CSV file of (T in N, g in N/rad), the rate of the general law T\' = '
                 'g(T) (paper eqs. 37-39), read like a `&material table_file` (same CSV rules; '
-                "a relative name is taken relative to the input file's folder). The first row "
+                'a relative name is taken from the working directory of the run). The first row '
                 'is T = 0 with g >= 0, T strictly increasing, g > 0 for T > 0, all finite; g is '
                 'linear between rows and continues with the last slope beyond the last row, '
                 'which therefore may not fall. See *The general friction law* below.'),
@@ -416,8 +417,8 @@ GROUPS = [
               doc=GAP_FACTOR) for name in ('gap_factor_p_disp', 'gap_factor')],
         Var('texgen_file', 'character', '', length='path_length', adjust=False,
             default_doc='required (texgen)',
-            doc="TexGen: the model file (`.tg3`, TexGen's XML), relative to the input file's "
-                'folder (the working directory for stdin). Read without TexGen: one textile, '
+            doc="TexGen: the model file (`.tg3`, TexGen's XML), relative to the working "
+                'directory of the run (as `table_file`). Read without TexGen: one textile, '
                 'periodic yarns with repeats along x and y (the cell), master nodes, '
                 'interpolation, section width and height, GeometryScale. See *TexGen import* '
                 'below.'),
