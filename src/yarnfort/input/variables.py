@@ -424,8 +424,9 @@ GROUPS = [
                 'below.'),
         Var('texgen_materials', 'character', '', length='name_length', shape=64,
             default_doc='required (texgen)',
-            doc="TexGen: the `&material` of TexGen's yarn 0, 1, 2, ... (by index); yarns "
-                'beyond the last name given take that one, so one name serves all yarns.'),
+            doc="TexGen: the `&material` of TexGen's yarn 0, 1, 2, ... (by index): one "
+                'name for every yarn, or one per yarn of the file (another count is an '
+                'error: the yarns after a short list took its last name).'),
         Var('texgen_contact_tolerance', 'real', 0.05, unit='1', range='[0, 1]',
             doc='TexGen: two yarns are in contact where their centre lines come within (1 + '
                 'this) times the sum of their half thicknesses (TexGen yarns that touch are '
