@@ -376,6 +376,11 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     except ValueError as error:
         raise ValueError(f"{path}: {error}") from None
     position = {name.lower(): k for k, (name, _) in enumerate(header)}
+    for name in ("strain", "force", "cycle", *BRANCH_COLUMNS):
+        twice = [header[k][0] for k in range(len(header)) if header[k][0].lower() == name]
+        if len(twice) > 1:  # the last would be read, the others dropped
+            raise ValueError(f"{path}: the header names the column {name!r} "
+                             f"{len(twice)} times ({', '.join(rows[0])}); keep one")
     missing = [name for name in ("strain", "force") if name not in position]
     if missing:
         raise ValueError(f"{path}: missing column(s) {', '.join(missing)}")

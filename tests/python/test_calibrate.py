@@ -133,6 +133,14 @@ def test_rows_with_more_cells_than_the_header_are_refused(tmp_path, row, cells):
     np.testing.assert_allclose(read_measured(lab).force, [0.0, 2.5], rtol=1e-15)
 
 
+def test_a_column_named_twice_is_refused(tmp_path):
+    """'force (N)' and 'force (cN)': the last was read, the first dropped."""
+    lab = tmp_path / "lab.csv"
+    lab.write_text("strain (%),force (N),force (cN)\n0,0,0\n5,2.5,250\n")
+    with pytest.raises(ValueError, match="names the column 'force' 2 times"):
+        read_measured(lab)
+
+
 def test_a_byte_order_mark_is_not_part_of_the_first_name(tmp_path):
     lab = tmp_path / "lab.csv"
     lab.write_bytes(b"\xef\xbb\xbfstrain (%),force (cN)\r\n0,0\r\n5,250\r\n")
