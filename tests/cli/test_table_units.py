@@ -142,8 +142,10 @@ def test_units_stated_with_a_note_run_as_the_si_table(run_yarnfort, tmp_path, ta
     # A note line between the header with units and the rows.
     ("Elongation (%),Force (cN)\nspecimen 1\n0,0\n1,8\n2,20\n", "",
      ["yarn.csv', line 1, column 1 ('Elongation (%)'): states the unit '%'"]),
-    ("Load (N),Extension (mm)\n0,0\n0.08,5\n", "gauge_length = 0.5",
-     ["yarn.csv', line 1, column 1 ('Load (N)'): names a force", "swap the columns"]),
+    ("Load,Elongation\n0,0\n0.08,0.01\n0.2,0.02\n", "",
+     ["yarn.csv', line 1, column 1 ('Load'): names a force", "swap the columns"]),
+    ("Strain,Extension\n0,0\n0.01,0.08\n", "",
+     ["yarn.csv', line 1, column 2 ('Extension'): names a strain", "swap the columns"]),
     ("Strain,Force\n0,0\n0.01,0.08\n", "", None),
     ("Elongation (%),Tenacity\n0,0\n1,8\n", "",
      ["yarn.csv', line 1, column 2 ('Tenacity'): names a quantity that is not a force"]),

@@ -150,13 +150,9 @@ contains
         call read_csv_pairs(path, context, [character(len=6) :: 'strain', 'force'], &
             check_row, strain, force, lines, error, header, header_line, notes, note_lines)
         if (allocated(error)) return
-        call check_column_names(header, header_line, error)
-        if (allocated(error)) then
-            error%message = context // error%message
-            return
-        end if
         call get_column_units(header, header_line, strain_unit, force_unit, gauge_length, &
             units, error)
+        if (.not. allocated(error)) call check_column_names(header, header_line, error)
         if (.not. allocated(error)) call check_note_units(notes, note_lines, header, &
             header_line, strain_unit, force_unit, units, error)
         if (allocated(error)) then
