@@ -225,11 +225,12 @@ def test_restart_under_force_control_is_bitwise(run_yarnfort, tmp_path, case):
 
 
 def test_progress_lines_print_every_number(run_yarnfort, tmp_path):
-    """The example with both periods held takes over 999 Newton iterations in a step
-    (every trial counts): its progress lines print the counts in full, as curve.csv has
-    them, and no field of asterisks."""
-    result = run_yarnfort(patched_scene("inputs/weave_force.nml", {"output.progress": True},
-                                        tmp_path), cwd=TOP)
+    """The knit with both periods held, in steps of half the path, takes over 999 Newton
+    iterations in a step (every trial and cut counts): its progress lines print the counts
+    in full, as curve.csv has them, and no field of asterisks."""
+    values = {**AXIAL, "fabric.lateral_control": "force", "fabric.lateral_force": 20.0,
+              "solver.initial_step": 0.5, "solver.max_step": 0.5, "output.progress": True}
+    result = run_yarnfort(patched_scene("inputs/knit.nml", values, tmp_path), cwd=TOP)
     assert result.returncode == 0, result.stderr
     lines = [line for line in result.stderr.splitlines() if line.startswith("step ")]
     assert lines and not any("*" in line for line in lines)

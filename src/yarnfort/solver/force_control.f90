@@ -12,7 +12,10 @@
 !> holds the force (so friction sees one step from the accepted state to the final strain,
 !> as with a prescribed strain). The root is found by the secant rule, kept inside a
 !> bracket once one is known (Illinois); the strain stays in [-0.9, 100] like `strain`
-!> and `lateral_strain`. No strain gives the force where the cell collapses along the axis:
+!> and `lateral_strain`. A step's first guess takes the slope dn/de of the trials nearest
+!> the last root; with both periods held, each trial of e11 starts the y period at the
+!> e22 its earlier trials of the step found, extrapolated in e11 (docs/decisions.md,
+!> "Held forces: the slope at the root and the y period's start"). No strain gives the force where the cell collapses along the axis:
 !> a string network carries no compression and has no resistance to compaction, so below
 !> the tension its yarns carry along that axis at the smallest strain, the force cannot be
 !> held; the step then fails and says so.
@@ -41,6 +44,9 @@ module yarnfort_solver_force_control
     real(wp), parameter :: smallest_strain = -0.9_wp, largest_strain = 100.0_wp
     !> Where n11 and n22 are in get_membrane's values.
     integer, parameter :: force_column(2) = [4, 5]
+    !> A secant slope is kept only from two trials whose forces differ by more than this
+    !> many times the tolerance: nearer, their difference is mostly the forces' error.
+    real(wp), parameter :: slope_noise_factor = 1.0e3_wp
 
     type, extends(load_stepper_type) :: force_control_stepper_type
         class(load_stepper_type), pointer :: inner => null()
@@ -49,6 +55,11 @@ module yarnfort_solver_force_control
         integer :: axis = 2
         !> dn/de of the last step's secant (0: none yet); in the restart snapshot.
         real(wp) :: slope = 0.0_wp
+        !> The y period wrapped by the x one: the strains (`found`) that held the force at
+        !> this step's trials so far, against the other period's strain (`other`), the
+        !> latest last; emptied by the x stepper at the start of each of its steps.
+        integer, private :: n_found = 0
+        real(wp), private :: found(2) = 0.0_wp, other(2) = 0.0_wp
         !> The iterations the inner stepper's step-size rule counts for the trial that
         !> held the force (growth_iterations).
         integer, private :: held_trial_iterations = 0
@@ -120,6 +131,14 @@ contains
         have_high = .false.
         side = 0
         e(1) = self%inner%factors(channel)
+        if (self%axis == 1) then
+            select type (inner => self%inner)
+            type is (force_control_stepper_type)
+                inner%n_found = 0
+            end select
+        else if (self%scene%axial_channel > 0) then
+            e(1) = start_from_found(self, e(1), factors(self%scene%axial_channel))
+        end if
         do n = 1, max_trials
             call evaluate(e(1), g(1), error)
             if (allocated(error)) then
@@ -130,12 +149,21 @@ contains
                 e(1) = 0.5_wp * (e(0) + e(1))
                 cycle
             end if
+            ! The slope for the next step's first guess: the latest secant whose forces
+            ! differ beyond their error, so at the root that of the trials nearest it.
+            if (n > 1 .and. e(1) /= e(0)) then
+                if ((g(1) - g(0)) / (e(1) - e(0)) > 0.0_wp .and. abs(g(1) - g(0)) &
+                        > slope_noise_factor * tolerance * scale) &
+                    self%slope = (g(1) - g(0)) / (e(1) - e(0))
+            end if
             if (abs(g(1)) <= tolerance * scale) then
                 ! A zero force: every string across a cut parallel to the other axis is
                 ! slack, so the period may shrink on at no force: no one state (a
                 ! mechanism), no curve.
                 if (abs(held) > tolerance * scale) then
                     self%factors = self%inner%factors
+                    if (self%axis == 2 .and. self%scene%axial_channel > 0) &
+                        call remember_found(self, e(1), factors(self%scene%axial_channel))
                     self%held_trial_iterations = self%inner%growth_iterations(used)
                     return
                 end if
@@ -169,8 +197,6 @@ contains
                 e_new = (low * g_high - high * g_low) / (g_high - g_low)
             else if (n > 1 .and. e(1) /= e(0) .and. g(1) /= g(0)) then
                 e_new = e(1) - g(1) * (e(1) - e(0)) / (g(1) - g(0))
-                if ((g(1) - g(0)) / (e(1) - e(0)) > 0.0_wp) self%slope = (g(1) - g(0)) &
-                    / (e(1) - e(0))
             else if (self%slope > 0.0_wp) then
                 e_new = e(1) - g(1) / self%slope
             else
@@ -271,6 +297,38 @@ contains
             end if
         end function mechanism
     end subroutine try_step
+
+    !> The first trial strain of the y period wrapped by the x one, at the other period's
+    !> strain `other_now`: the strain found at this step's last trial (`accepted` if none),
+    !> or the line through the last two, within the strain's range. Why: each trial of
+    !> e11 moved e22 from the accepted one again, and the y period took about as many
+    !> trials for it as the x period (docs/decisions.md, "Held forces: the slope at the
+    !> root and the y period's start").
+    pure real(wp) function start_from_found(self, accepted, other_now) result(start)
+        class(force_control_stepper_type), intent(in) :: self
+        real(wp), intent(in) :: accepted, other_now
+
+        start = accepted
+        if (self%n_found == 0) return
+        start = self%found(2)
+        if (self%n_found >= 2 .and. self%other(2) /= self%other(1)) start = self%found(2) &
+            + (other_now - self%other(2)) * (self%found(2) - self%found(1)) &
+            / (self%other(2) - self%other(1))
+        if (.not. (start > smallest_strain .and. start < largest_strain)) &
+            start = self%found(2)
+    end function start_from_found
+
+    !> Keep the strain that held the force at the other period's strain `other_now`.
+    pure subroutine remember_found(self, strain, other_now)
+        class(force_control_stepper_type), intent(inout) :: self
+        real(wp), intent(in) :: strain, other_now
+
+        self%found(1) = self%found(2)
+        self%other(1) = self%other(2)
+        self%found(2) = strain
+        self%other(2) = other_now
+        self%n_found = self%n_found + 1
+    end subroutine remember_found
 
     !> A step is judged by the trial that held the force, not by all trials: each trial
     !> is a step of that size from the accepted state, and the number of trials says how
