@@ -338,7 +338,8 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     branch column (``branch``: loading/unloading, or ``direction``/``sign``: +1/-1) and
     a ``cycle`` column. Without a branch column, the branch follows the sign of the
     strain increments (so noisy strains need one). Lines starting with ``#`` are
-    comments.
+    comments; one before the header that names the strain or force column with another
+    unit than the one the column is read in is an error (its unit would be ignored).
 
     Parameters
     ----------
@@ -362,8 +363,8 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     """
     # utf-8-sig: a byte order mark (Excel's "CSV UTF-8") is not part of the first name.
     with open(path, newline="", encoding="utf-8-sig") as stream:
-        numbered = [(number, line) for number, line in enumerate(stream, start=1)
-                    if not line.startswith("#")]
+        every = list(enumerate(stream, start=1))
+    numbered = [(number, line) for number, line in every if not line.startswith("#")]
     # Each non-blank row with its file line (the header is the first of them).
     records = [(number, row) for number, line in numbered
                for row in csv.reader([line]) if any(cell.strip() for cell in row)]
@@ -384,6 +385,10 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     missing = [name for name in ("strain", "force") if name not in position]
     if missing:
         raise ValueError(f"{path}: missing column(s) {', '.join(missing)}")
+    given = {"strain": strain_unit, "force": force_unit}
+    for column in ("strain", "force"):
+        if header[position[column]][1] is None and given[column] is None:
+            _check_comment_units(path, every, records[0][0], column)
     try:
         s_unit = _unit(strain_unit, header[position["strain"]][1], "strain")
         f_unit = _unit(force_unit, header[position["force"]][1], "force")
@@ -419,6 +424,34 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
                     strain_unit=s_unit or "1", force_unit=f_unit or "N",
                     strain_factor=s_factor, force_factor=f_factor, per_width=per_width,
                     path=Path(path))
+
+
+def _check_comment_units(path: str | os.PathLike, lines: list[tuple[int, str]],
+                         header_line: int, column: str) -> None:
+    """A ValueError where a '#' comment before the header names ``column`` with a unit
+    other than the default (1, N) that the header and the arguments do not state: it
+    would be read in the default ('# strain (%),force (cN)' above 'strain,force')."""
+    default = {"strain": "1", "force": "N"}[column]
+    for number, line in lines:
+        if number >= header_line:
+            return
+        if not line.startswith("#"):
+            continue
+        for cell in next(csv.reader([line[1:]]), []):
+            name, unit = split_header(cell)
+            if name.lower() != column or unit is None:
+                continue
+            try:  # the default's factor (1, or N and not per width) reads the same
+                same = (strain_factor(unit) == 1.0 if column == "strain"
+                        else force_factor(unit) == (1.0, False))
+            except ValueError:  # not a unit: a note
+                continue
+            if not same:
+                raise ValueError(f"{path}, line {number}: the comment names the {column} "
+                                 f"column with the unit {unit!r}, but the header (line "
+                                 f"{header_line}) gives none, so it would be read in "
+                                 f"{default!r}: put the unit in the header "
+                                 f"('{column} ({unit})') or give {column}_unit={unit!r}")
 
 
 def _number(text: str | None, name: str) -> float:

@@ -133,6 +133,24 @@ def test_rows_with_more_cells_than_the_header_are_refused(tmp_path, row, cells):
     np.testing.assert_allclose(read_measured(lab).force, [0.0, 2.5], rtol=1e-15)
 
 
+def test_units_only_in_a_comment_are_refused(tmp_path):
+    """'# strain (%),force (cN)' above 'strain,force': read in 1 and N before."""
+    lab = tmp_path / "lab.csv"
+    lab.write_text("# strain (%),force (cN)\nstrain,force\n0,0\n5,250\n")
+    with pytest.raises(ValueError, match="lab.csv, line 1: the comment names the strain "
+                       "column with the unit '%', but the header \\(line 2\\) gives none"):
+        read_measured(lab)
+    with pytest.raises(ValueError, match="the comment names the force column with the "
+                       "unit 'cN'"):
+        read_measured(lab, strain_unit="%")
+    data = read_measured(lab, strain_unit="%", force_unit="cN")
+    np.testing.assert_allclose(data.force, [0.0, 2.5], rtol=1e-15)
+    # Comments that agree with the units read, or are notes, change nothing.
+    lab.write_text("# strain (-), force (N)\n# sample 3, 20 mm wide\nstrain,force\n0,0\n"
+                   "0.05,2.5\n")
+    np.testing.assert_allclose(read_measured(lab).force, [0.0, 2.5], rtol=1e-15)
+
+
 def test_a_column_named_twice_is_refused(tmp_path):
     """'force (N)' and 'force (cN)': the last was read, the first dropped."""
     lab = tmp_path / "lab.csv"
