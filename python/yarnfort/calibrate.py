@@ -18,8 +18,9 @@ measured one where its branch (given, or the sign of the strain increments) or i
 direction 0, holds, belong to no branch). Measured branch k is interpolated linearly on
 simulated branch k (from the point where that branch starts), so several load cycles
 are matched cycle by cycle. The scene's path must have at least as many branches as the
-data, starting the same way; otherwise :func:`calibrate` says so. Points beyond a
-branch's simulated range take its end value.
+data, starting the same way, and cover each branch's strains at the initial values (to
+:data:`COVERAGE_TOLERANCE` of the branch's span); otherwise :func:`calibrate` says so.
+Points that a fitted value's branch no longer reaches take its end value.
 
 Uncertainty and identifiability
 -------------------------------
@@ -92,6 +93,9 @@ RELATIVE_FLOOR = 1.0e-3
 #: check").
 CHECK_STEP_FACTOR = 10.0
 SMOOTHNESS_TOLERANCE = 0.1
+#: A measured point may lie this fraction of its branch's strain span beyond the
+#: simulated branch (the test machine's overshoot at a turning point); further is refused.
+COVERAGE_TOLERANCE = 0.01
 #: Names accepted for the branch column of a measured CSV.
 BRANCH_COLUMNS = ("branch", "direction", "sign")
 #: The model quantity of a fabric, and its abscissa.
@@ -334,7 +338,8 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     branch column (``branch``: loading/unloading, or ``direction``/``sign``: +1/-1) and
     a ``cycle`` column. Without a branch column, the branch follows the sign of the
     strain increments (so noisy strains need one). Lines starting with ``#`` are
-    comments.
+    comments; one before the header that names the strain or force column with another
+    unit than the one the column is read in is an error (its unit would be ignored).
 
     Parameters
     ----------
@@ -352,12 +357,14 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     Raises
     ------
     ValueError
-        For a file without data rows or the columns, an unknown unit, or a cell that is
-        not a number (the message names the file and line).
+        For a file without data rows or the columns, an unknown unit, a cell that is
+        not a number, or a row with more cells than the header has names (a decimal comma
+        or a thousands separator; the message names the file and line).
     """
-    with open(path, newline="") as stream:
-        numbered = [(number, line) for number, line in enumerate(stream, start=1)
-                    if not line.startswith("#")]
+    # utf-8-sig: a byte order mark (Excel's "CSV UTF-8") is not part of the first name.
+    with open(path, newline="", encoding="utf-8-sig") as stream:
+        every = list(enumerate(stream, start=1))
+    numbered = [(number, line) for number, line in every if not line.startswith("#")]
     # Each non-blank row with its file line (the header is the first of them).
     records = [(number, row) for number, line in numbered
                for row in csv.reader([line]) if any(cell.strip() for cell in row)]
@@ -370,9 +377,18 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     except ValueError as error:
         raise ValueError(f"{path}: {error}") from None
     position = {name.lower(): k for k, (name, _) in enumerate(header)}
+    for name in ("strain", "force", "cycle", *BRANCH_COLUMNS):
+        twice = [header[k][0] for k in range(len(header)) if header[k][0].lower() == name]
+        if len(twice) > 1:  # the last would be read, the others dropped
+            raise ValueError(f"{path}: the header names the column {name!r} "
+                             f"{len(twice)} times ({', '.join(rows[0])}); keep one")
     missing = [name for name in ("strain", "force") if name not in position]
     if missing:
         raise ValueError(f"{path}: missing column(s) {', '.join(missing)}")
+    given = {"strain": strain_unit, "force": force_unit}
+    for column in ("strain", "force"):
+        if header[position[column]][1] is None and given[column] is None:
+            _check_comment_units(path, every, records[0][0], column)
     try:
         s_unit = _unit(strain_unit, header[position["strain"]][1], "strain")
         f_unit = _unit(force_unit, header[position["force"]][1], "force")
@@ -384,6 +400,13 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
     cycle_at = position.get("cycle")
     strain, force, signs, cycles = [], [], [], []
     for number, row in zip(lines, rows[1:]):
+        if any(text.strip() for text in row[len(header):]):
+            # A decimal comma or a thousands separator splits a number into two cells:
+            # reading the cells under the header would shift every column after it.
+            raise ValueError(f"{path}, line {number}: {len(row)} cells "
+                             f"({','.join(row)!r}) but the header names {len(header)} "
+                             "columns (a decimal comma or a thousands separator? write "
+                             "numbers as 1234.5)")
         cell = row + [""] * (len(header) - len(row))  # a short row's missing cells
         try:
             strain.append(_number(cell[position["strain"]], "strain"))
@@ -401,6 +424,34 @@ def read_measured(path: str | os.PathLike, *, strain_unit: str | None = None,
                     strain_unit=s_unit or "1", force_unit=f_unit or "N",
                     strain_factor=s_factor, force_factor=f_factor, per_width=per_width,
                     path=Path(path))
+
+
+def _check_comment_units(path: str | os.PathLike, lines: list[tuple[int, str]],
+                         header_line: int, column: str) -> None:
+    """A ValueError where a '#' comment before the header names ``column`` with a unit
+    other than the default (1, N) that the header and the arguments do not state: it
+    would be read in the default ('# strain (%),force (cN)' above 'strain,force')."""
+    default = {"strain": "1", "force": "N"}[column]
+    for number, line in lines:
+        if number >= header_line:
+            return
+        if not line.startswith("#"):
+            continue
+        for cell in next(csv.reader([line[1:]]), []):
+            name, unit = split_header(cell)
+            if name.lower() != column or unit is None:
+                continue
+            try:  # the default's factor (1, or N and not per width) reads the same
+                same = (strain_factor(unit) == 1.0 if column == "strain"
+                        else force_factor(unit) == (1.0, False))
+            except ValueError:  # not a unit: a note
+                continue
+            if not same:
+                raise ValueError(f"{path}, line {number}: the comment names the {column} "
+                                 f"column with the unit {unit!r}, but the header (line "
+                                 f"{header_line}) gives none, so it would be read in "
+                                 f"{default!r}: put the unit in the header "
+                                 f"('{column} ({unit})') or give {column}_unit={unit!r}")
 
 
 def _number(text: str | None, name: str) -> float:
@@ -517,6 +568,27 @@ def simulated_force(curve: Curve, strain: np.ndarray, branch: np.ndarray, *,
         order = np.argsort(x[rows], kind="stable")
         result[wanted] = np.interp(strain[wanted], x[rows][order], force[rows][order])
     return result
+
+
+def _check_coverage(curve: Curve, data: Measured, support: str | None, component: int,
+                    x_column: str | None, x_scale: float, force_scale: float) -> None:
+    """A ValueError where a measured point lies beyond the strains of its simulated
+    branch by more than COVERAGE_TOLERANCE of that branch's span."""
+    x, _ = _model_curve(curve, support, component, x_column, x_scale, force_scale)
+    simulated = simulated_branches(curve["direction"])
+    for k in range(int(data.segment.max()) + 1 if data.segment.size else 0):
+        strain = data.strain[data.segment == k]
+        low, high = float(np.min(x[simulated[k][1]])), float(np.max(x[simulated[k][1]]))
+        slack = COVERAGE_TOLERANCE * (high - low)
+        if np.min(strain) >= low - slack and np.max(strain) <= high + slack:
+            continue
+        factor = data.strain_factor
+        raise ValueError(
+            f"branch {k + 1} of the data spans strain {np.min(strain) / factor:g} to "
+            f"{np.max(strain) / factor:g} ({data.strain_unit}), the scene's path "
+            f"{low / factor:g} to {high / factor:g}: points beyond would be compared with "
+            "the branch's end value. Give the &path the test's range, or state the "
+            "strain column's unit (a header 'strain (%)', or strain_unit='%')")
 
 
 @contextlib.contextmanager
@@ -679,8 +751,10 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
         For bounds with lower >= upper or an initial value outside them, fewer measured
         points than parameters plus one, a malformed parameter address or one of a
         group or variable the input does not have (an :class:`~yarnfort.AddressError`),
-        an unknown component or support, an unreadable measured curve, a force per sample against a force per width without ``width``,
-        or data with more load cycles than the scene's path.
+        an unknown component or support, an unreadable measured curve, a force per sample
+        against a force per width without ``width``, data with more load cycles than the
+        scene's path, or a branch of the data beyond the strains the path reaches at the
+        initial values.
     YarnfortError
         If a run fails; the message names the parameter values.
 
@@ -748,7 +822,14 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
         def residual(z: np.ndarray) -> np.ndarray:
             return weight * (model(simulate(lower + span * z)) - target)
 
-        fit = least_squares(residual, (initial - lower) / span, bounds=(0.0, 1.0),
+        # The data must lie on the branches the scene draws at the initial values: a
+        # point beyond one would be compared with its end value (a strain column read in
+        # the wrong unit, or a path shorter than the test).
+        z0 = (initial - lower) / span
+        start = simulate(lower + span * z0)  # the fit's first run, cached
+        model(start)
+        _check_coverage(start, data, support, index, x_column, x_scale, force_scale)
+        fit = least_squares(residual, z0, bounds=(0.0, 1.0),
                             diff_step=diff_step, max_nfev=max_nfev, ftol=tolerance,
                             xtol=tolerance, gtol=tolerance, verbose=verbose)
         values = lower + span * fit.x

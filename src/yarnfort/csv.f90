@@ -5,12 +5,15 @@
 !>
 !> Rows are "a,b" (spaces and tabs allowed). Lines before the first row that start with a
 !> non-numeric character and do not read as two numbers are headers; blank lines and lines
-!> starting with '#' are skipped anywhere; a UTF-8 byte order mark is dropped.
+!> starting with '#' are skipped anywhere; a UTF-8 byte order mark is dropped. The lines
+!> before the first row other than the last header (comments, earlier headers) are notes,
+!> which a reader checks for units that its header does not state.
 module yarnfort_csv
     use, intrinsic :: iso_fortran_env, only: iostat_end
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
-    use yarnfort_text, only: format_integer, read_line, is_folder, drop_byte_order_mark
+    use yarnfort_text, only: format_integer, read_line, is_folder, drop_byte_order_mark, &
+        string_type
     implicit none
     private
 
@@ -18,6 +21,9 @@ module yarnfort_csv
 
     !> Rows allocated before the first growth while reading a file.
     integer, parameter :: initial_rows = 16
+
+    !> Lines before the first row kept as notes (a tester's export has a few dozen).
+    integer, parameter :: max_notes = 1000
 
     !> Longest piece of an input line quoted in a message.
     integer, parameter :: max_quote = 60
@@ -53,9 +59,11 @@ contains
     !> `names` are the columns (for messages: 'expected "strain,force"'); `first`, `second`
     !> the values, `lines` the line of each row. Messages start with `context` (e.g.
     !> "table 'cotton.csv'") and name the line. `header` is the last header line before
-    !> the first row (the column names; '' if none) and `header_line` its line (0 if none).
+    !> the first row (the column names; '' if none) and `header_line` its line (0 if none);
+    !> `notes` the other lines before the first row (comments without their '#', earlier
+    !> header lines) and `note_lines` their lines.
     subroutine read_csv_pairs(path, context, names, check, first, second, lines, error, &
-            header, header_line)
+            header, header_line, notes, note_lines)
         character(len=*), intent(in) :: path, context
         character(len=*), intent(in) :: names(2)
         procedure(row_check_interface) :: check
@@ -64,13 +72,20 @@ contains
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable, intent(out), optional :: header
         integer, intent(out), optional :: header_line
-        character(len=:), allocatable :: line, message
+        type(string_type), allocatable, intent(out), optional :: notes(:)
+        integer, allocatable, intent(out), optional :: note_lines(:)
+        type(string_type), allocatable :: before(:)
+        integer, allocatable :: before_lines(:)
+        character(len=:), allocatable :: line, message, comment
         character(len=512) :: iomsg
         type(csv_row_type) :: row, previous
-        integer :: unit, stat, line_number, nrow, outcome
+        integer :: unit, stat, line_number, nrow, outcome, header_at, n_before
 
         if (present(header)) header = ''
         if (present(header_line)) header_line = 0
+        allocate(before(0), before_lines(0))
+        n_before = 0
+        header_at = 0
         if (is_folder(path)) then
             call fatal_error(error, context // ': is a folder, not a file')
             return
@@ -96,11 +111,19 @@ contains
             end if
             if (line_number == 1) call drop_byte_order_mark(line)
             call parse_line(line, names, row, outcome, message)
-            if (outcome == line_skip) cycle
+            if (outcome == line_skip) then
+                comment = clean_line(line)
+                if (nrow == 0 .and. len(comment) > 0) call append_note(before, before_lines, &
+                    n_before, trim(adjustl(comment(2:))), line_number)
+                cycle
+            end if
             if (outcome == line_bad) then
                 if (nrow == 0 .and. is_header(line)) then
                     if (present(header)) header = clean_line(line)
                     if (present(header_line)) header_line = line_number
+                    header_at = line_number
+                    call append_note(before, before_lines, n_before, clean_line(line), &
+                        line_number)
                     cycle
                 end if
                 call fatal_error(error, context // ', line ' // format_integer(line_number) &
@@ -122,6 +145,10 @@ contains
         end do
         close(unit)
         if (allocated(error)) return
+        ! Notes: the lines before the first row but the last header.
+        if (present(notes)) notes = pack(before(:n_before), before_lines(:n_before) /= header_at)
+        if (present(note_lines)) note_lines = pack(before_lines(:n_before), &
+            before_lines(:n_before) /= header_at)
         first = first(:nrow)
         second = second(:nrow)
         lines = lines(:nrow)
@@ -223,6 +250,29 @@ contains
             quoted = "'" // text // "'"
         end if
     end function quote
+
+    !> Keep a line before the first row as a note (the first `max_notes` of them).
+    pure subroutine append_note(notes, lines, n, text, line)
+        type(string_type), allocatable, intent(inout) :: notes(:)
+        integer, allocatable, intent(inout) :: lines(:)
+        integer, intent(inout) :: n
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: line
+        type(string_type), allocatable :: grown(:)
+        integer, allocatable :: grown_lines(:)
+
+        if (n == max_notes) return
+        if (n == size(notes)) then
+            allocate(grown(max(2 * n, initial_rows)), grown_lines(max(2 * n, initial_rows)))
+            grown(:n) = notes(:n)
+            grown_lines(:n) = lines(:n)
+            call move_alloc(grown, notes)
+            call move_alloc(grown_lines, lines)
+        end if
+        n = n + 1
+        notes(n)%text = text
+        lines(n) = line
+    end subroutine append_note
 
     !> Append one row, growing the arrays geometrically.
     pure subroutine append_row(first, second, lines, nrow, value, new_line)

@@ -8,12 +8,13 @@
 !> double as a hand-written 0.05.
 module yarnfort_units
     use yarnfort_kinds, only: wp
-    use yarnfort_text, only: to_lower, string_type
+    use yarnfort_text, only: to_lower, string_type, format_integer, quote_string
     implicit none
     private
 
     public :: unit_type, find_unit, unit_names, to_scene_unit, get_header_unit
-    public :: get_header_units
+    public :: get_header_units, get_note_units, same_unit, note_unit_message
+    public :: header_shape_message
     public :: strain_kind, length_kind, force_kind
 
     !> The kinds of quantity a unit measures.
@@ -156,5 +157,88 @@ contains
                 stated(c))
         end do
     end subroutine get_header_units
+
+    !> '' for a header line of two comma-separated fields (whose units are read), or for
+    !> one that states no unit in brackets; otherwise the message (starting ', line L: ')
+    !> for a header whose units would not be read: 'Elongation (%),Force (cN),' (a third,
+    !> empty field), 'Elongation (%);Force (cN)', or the fields separated by tabs.
+    pure function header_shape_message(header, header_line, names) result(message)
+        character(len=*), intent(in) :: header, names
+        integer, intent(in) :: header_line
+        character(len=:), allocatable :: message
+        type(unit_type) :: unit
+        integer :: comma, first, last
+        logical :: found
+
+        message = ''
+        comma = index(header, ',')
+        if (comma > 0) then
+            if (index(header(comma + 1:), ',') == 0) return
+        end if
+        ! Every (...) and [...] of the line: the first that holds a known unit.
+        last = 0
+        do
+            first = last + scan(header(last + 1:), '([')
+            if (first == last) return
+            last = first + scan(header(first + 1:), ')]')
+            if (last == first) return
+            call find_unit(trim(adjustl(header(first + 1:last - 1))), unit, found)
+            if (found) exit
+        end do
+        message = ', line ' // format_integer(header_line) // ': the header states the ' &
+            // 'unit ' // quote_string(trim(unit%name)) // ' but is not two comma-separated ' &
+            // 'fields (' // names // '), so its units would not be read: write it as ' &
+            // 'two fields separated by one comma, without a trailing comma'
+    end function header_shape_message
+
+    !> The units a note before a table's rows (a '#' comment, an earlier header line)
+    !> states, where it reads as a header of the two columns: both fields state a unit
+    !> (`get_header_units`) and neither has a digit outside it ('gauge 500 mm, 0.5 cN'
+    !> records settings, not column names). `stated` is false otherwise.
+    pure subroutine get_note_units(note, fields, texts, stated)
+        character(len=*), intent(in) :: note
+        type(string_type), intent(out) :: fields(2), texts(2)
+        logical, intent(out) :: stated(2)
+        character(len=:), allocatable :: name
+        integer :: c, at
+
+        call get_header_units(note, fields, texts, stated)
+        if (.not. all(stated)) then
+            stated(:) = .false.
+            return
+        end if
+        do c = 1, 2
+            at = index(fields(c)%text, texts(c)%text, back=.true.)
+            name = fields(c)%text(:at - 1) // fields(c)%text(at + len(texts(c)%text):)
+            if (scan(name, '0123456789') > 0) stated(:) = .false.
+        end do
+    end subroutine get_note_units
+
+    !> Whether two units measure the same kind with the same factor ('1' and '-').
+    elemental logical function same_unit(a, b)
+        type(unit_type), intent(in) :: a, b
+
+        same_unit = a%kind == b%kind .and. a%numerator == b%numerator .and. &
+            a%denominator == b%denominator
+    end function same_unit
+
+    !> The message for a note on line `line` whose field `field` states the unit `stated`
+    !> for column `column`, which is read in `used` (no header or variable states one):
+    !> the units of a table come from its last header line only, so the note's would be
+    !> ignored. `remedy` says how else to state it.
+    pure function note_unit_message(line, column, field, stated, used, remedy) &
+            result(message)
+        integer, intent(in) :: line, column
+        character(len=*), intent(in) :: field, stated, used, remedy
+        character(len=:), allocatable :: message
+
+        message = ', line ' // format_integer(line) // ', column ' // format_integer(column) &
+            // ' (' // quote_string(field) // '): states the unit ' // quote_string(stated) &
+            // ', but units are read ' &
+            // 'only from the last header line before the rows (not from a ''#'' comment ' &
+            // 'or an earlier line), which states none for this column: it would be read ' &
+            // 'in ' // quote_string(used) // '. Make this line that header (without ''#'', ' &
+            // 'directly before the rows), or ' // remedy
+    end function note_unit_message
 
 end module yarnfort_units

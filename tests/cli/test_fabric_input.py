@@ -3,6 +3,8 @@
 value, and nothing written. The base input is a valid periodic plain-weave cell."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 BASE = """
@@ -173,3 +175,18 @@ def test_clamped_knit_with_edge_material_is_valid(run_yarnfort, tmp_path):
     assert run.returncode == 0, run.stderr
     header = (tmp_path / "out" / "curve.csv").read_text().splitlines()[0].split(",")
     assert "edge_right_rx" in header and "edge_left_rx" in header
+
+
+@pytest.mark.parametrize("materials, count", [("'warp', 'weft'", 2),
+                                              ("'warp', 'warp', 'weft', 'weft', 'weft'", 5)])
+def test_texgen_materials_one_or_one_per_yarn(run_yarnfort, tmp_path, materials, count):
+    """inputs/texgen_weave.tg3 has 4 TexGen yarns (0, 1 along x, 2, 3 along y): two names
+    gave yarn 1, along x, the weft's material; five name a yarn the file lacks."""
+    top = Path(__file__).resolve().parents[2]
+    scene = (top / "inputs" / "texgen_weave.nml").read_text()
+    given = "texgen_materials = 'warp', 'warp', 'weft', 'weft'"
+    assert given in scene
+    run = run_yarnfort(scene.replace(given, f"texgen_materials = {materials}"), cwd=top)
+    assert run.returncode == 2, run.stderr
+    assert (f"texgen_file 'inputs/texgen_weave.tg3': texgen_materials names {count} "
+            "materials for the 4 TexGen yarns of the file") in run.stderr

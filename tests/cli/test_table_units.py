@@ -102,6 +102,84 @@ def test_misread_table_refused_nothing_written(run_yarnfort, tmp_path, table, wo
     assert sorted(p.name for p in tmp_path.iterdir()) == ["yarn.csv"]
 
 
+@pytest.mark.parametrize("notes", [
+    # Notes of settings (values with units), not column names.
+    "# tested 2026-03-02, gauge 500 mm, pretension 0.5 cN\n",
+    # Column names with the units the columns are read in (strain 1, N).
+    "# strain (-), force (N)\n",
+    "Strain (1),Force [N]\nspecimen 1\n",
+])
+def test_notes_that_agree_with_the_units_read_run_as_the_si_table(run_yarnfort, tmp_path,
+                                                                  notes):
+    si = run_table(run_yarnfort, tmp_path, "si", SI_TABLE)
+    noted = run_table(run_yarnfort, tmp_path, "noted", notes + SI_TABLE)
+    same_curve(noted, si)
+
+
+@pytest.mark.parametrize("table, extra", [
+    # The units in a comment, also stated in &material (then the comment is a note).
+    ("# Elongation (%),Force (cN)\n" + LAB_TABLE.split("Force (cN)\n")[1],
+     "strain_unit = '%', force_unit = 'cN'"),
+    # A units line below the names: the last header line states them.
+    ("Elongation,Force\n%,cN\n" + LAB_TABLE.split("Force (cN)\n")[1], ""),
+])
+def test_units_stated_with_a_note_run_as_the_si_table(run_yarnfort, tmp_path, table,
+                                                       extra):
+    si = run_table(run_yarnfort, tmp_path, "si", SI_TABLE)
+    lab = run_table(run_yarnfort, tmp_path, "lab", table, extra)
+    same_curve(lab, si)
+
+
+@pytest.mark.parametrize("table, extra, words", [
+    # numpy.savetxt(header=...) writes the header as a comment: 8 % would be a strain of 8.
+    ("# Elongation (%),Force (cN)\n0,0\n1,8\n2,20\n5,60\n8,110\n", "",
+     ["yarn.csv', line 1, column 1 ('Elongation (%)'): states the unit '%'",
+      "it would be read in '1'", "strain_unit = '%'"]),
+    # The strain's unit given in &material, the force's only in the comment.
+    ("# Elongation (%),Force (cN)\n0,0\n1,8\n2,20\n5,60\n8,110\n", "strain_unit = '%'",
+     ["yarn.csv', line 1, column 2 ('Force (cN)'): states the unit 'cN'",
+      "it would be read in 'N'", "force_unit = 'cN'"]),
+    # A note line between the header with units and the rows.
+    ("Elongation (%),Force (cN)\nspecimen 1\n0,0\n1,8\n2,20\n", "",
+     ["yarn.csv', line 1, column 1 ('Elongation (%)'): states the unit '%'"]),
+    ("Load,Elongation\n0,0\n0.08,0.01\n0.2,0.02\n", "",
+     ["yarn.csv', line 1, column 1 ('Load'): names a force", "swap the columns"]),
+    ("Strain,Extension\n0,0\n0.01,0.08\n", "",
+     ["yarn.csv', line 1, column 2 ('Extension'): names a strain", "swap the columns"]),
+    ("Strain,Force\n0,0\n0.01,0.08\n", "", None),
+    ("Elongation (%),Tenacity\n0,0\n1,8\n", "",
+     ["yarn.csv', line 1, column 2 ('Tenacity'): names a quantity that is not a force"]),
+    # A header with units but not two comma-separated fields: its units were not read.
+    ("Elongation (%),Force (cN),\n0,0\n1,8\n2,20\n", "",
+     ["yarn.csv', line 1: the header states the unit '%' but is not two comma-separated"]),
+    ("Elongation (%);Force (cN)\n0,0\n1,8\n2,20\n", "",
+     ["yarn.csv', line 1: the header states the unit '%' but is not two comma-separated"]),
+    ("Elongation (%)\tForce (cN)\n0,0\n1,8\n2,20\n", "",
+     ["yarn.csv', line 1: the header states the unit '%' but is not two comma-separated"]),
+    (elongation_table(), "gauge_length = 500",
+     ["gauge_length = 500.0 m is longer than any tensile specimen", "(500 mm is 0.5)"]),
+])
+def test_table_read_otherwise_than_meant_refused(run_yarnfort, tmp_path, table, extra,
+                                                 words):
+    (tmp_path / "yarn.csv").write_text(table)
+    run = run_yarnfort(table_scene("out", extra), cwd=tmp_path)
+    if words is None:  # the control: the same scene with plain names runs
+        assert run.returncode == 0, run.stderr
+        return
+    assert run.returncode == 2, run.stderr
+    for word in words:
+        assert word in run.stderr, run.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["yarn.csv"]
+
+
+def test_largest_gauge_length_runs(run_yarnfort, tmp_path):
+    """5 m, the limit, is read: the table's strains are the elongations over it."""
+    table = "Extension (m),Load (N)\n0,0\n0.05,0.08\n0.1,0.2\n0.25,0.6\n0.5,1.5\n1,4\n"
+    si = run_table(run_yarnfort, tmp_path, "si", SI_TABLE)
+    long = run_table(run_yarnfort, tmp_path, "long", table, "gauge_length = 5.0")
+    same_curve(long, si)
+
+
 def test_geometry_in_mm_runs_as_the_geometry_in_m(run_yarnfort, tmp_path):
     for name in ("grid.geo", "grid_mm.geo", "valid_geometry.nml"):
         shutil.copy(DATA / name, tmp_path)

@@ -117,6 +117,73 @@ def test_units_in_headers_give_si_values(tmp_path):
         read_measured(per_width, force_unit="kp")
 
 
+@pytest.mark.parametrize("row, cells", [
+    ("0,5,12,3", 4),      # decimal commas: strain 0.5 and force 12.3 are four cells
+    ("1,1,234.5", 3),     # a thousands separator: 1,234.5 cN
+])
+def test_rows_with_more_cells_than_the_header_are_refused(tmp_path, row, cells):
+    """Read under the header, '0,5,12,3' was strain 0 and force 5 (the rest dropped)."""
+    lab = tmp_path / "lab.csv"
+    lab.write_text(f"strain (%),force (cN)\n0,0\n{row}\n")
+    with pytest.raises(ValueError, match=f"lab.csv, line 3: {cells} cells .* but the header "
+                       "names 2 columns"):
+        read_measured(lab)
+    # Empty trailing cells (a spreadsheet's export) are no values.
+    lab.write_text("strain (%),force (cN),\n0,0,\n5,250,,\n")
+    np.testing.assert_allclose(read_measured(lab).force, [0.0, 2.5], rtol=1e-15)
+
+
+def test_units_only_in_a_comment_are_refused(tmp_path):
+    """'# strain (%),force (cN)' above 'strain,force': read in 1 and N before."""
+    lab = tmp_path / "lab.csv"
+    lab.write_text("# strain (%),force (cN)\nstrain,force\n0,0\n5,250\n")
+    with pytest.raises(ValueError, match="lab.csv, line 1: the comment names the strain "
+                       "column with the unit '%', but the header \\(line 2\\) gives none"):
+        read_measured(lab)
+    with pytest.raises(ValueError, match="the comment names the force column with the "
+                       "unit 'cN'"):
+        read_measured(lab, strain_unit="%")
+    data = read_measured(lab, strain_unit="%", force_unit="cN")
+    np.testing.assert_allclose(data.force, [0.0, 2.5], rtol=1e-15)
+    # Comments that agree with the units read, or are notes, change nothing.
+    lab.write_text("# strain (-), force (N)\n# sample 3, 20 mm wide\nstrain,force\n0,0\n"
+                   "0.05,2.5\n")
+    np.testing.assert_allclose(read_measured(lab).force, [0.0, 2.5], rtol=1e-15)
+
+
+def test_a_column_named_twice_is_refused(tmp_path):
+    """'force (N)' and 'force (cN)': the last was read, the first dropped."""
+    lab = tmp_path / "lab.csv"
+    lab.write_text("strain (%),force (N),force (cN)\n0,0,0\n5,2.5,250\n")
+    with pytest.raises(ValueError, match="names the column 'force' 2 times"):
+        read_measured(lab)
+
+
+def test_a_byte_order_mark_is_not_part_of_the_first_name(tmp_path):
+    lab = tmp_path / "lab.csv"
+    lab.write_bytes(b"\xef\xbb\xbfstrain (%),force (cN)\r\n0,0\r\n5,250\r\n")
+    data = read_measured(lab)
+    np.testing.assert_allclose(data.strain, [0.0, 0.05], rtol=1e-15)
+    np.testing.assert_allclose(data.force, [0.0, 2.5], rtol=1e-15)
+
+
+def test_data_beyond_the_path_are_refused(synthetic, tmp_path):
+    """The synthetic curve's strains times 10 (a column in permille read as 1/100, say)
+    lie beyond the capstan path's p_disp 0..1: refused before the fit, not compared with
+    the end values of the branches."""
+    lines = synthetic.read_text().splitlines()
+    header = next(k for k, line in enumerate(lines) if not line.startswith("#"))
+    scaled = lines[:header + 1] + [
+        ",".join([repr(10 * float(line.split(",")[0]))] + line.split(",")[1:])
+        for line in lines[header + 1:]]
+    wide = tmp_path / "wide.csv"
+    wide.write_text("\n".join(scaled) + "\n")
+    with pytest.raises(ValueError, match="branch 1 of the data spans strain .* to 10 \\(1\\), "
+                       "the scene's path 0 to 1: points beyond"):
+        calibrate(CAPSTAN, wide, START, support="pull", component="y", force_scale=-1.0,
+                  fixed=COARSE, max_nfev=1)
+
+
 def test_cycles_are_split_into_monotone_branches(tmp_path):
     # Two cycles 0 -> 2 -> 0 without a branch column, then with a cycle column.
     bare = tmp_path / "bare.csv"

@@ -32,7 +32,8 @@ module yarnfort_friction_general
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
     use yarnfort_text, only: format_integer, format_real, quote_string, string_type
     use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &
-        get_header_units, force_kind
+        get_header_units, get_note_units, same_unit, note_unit_message, &
+        header_shape_message, force_kind
     use yarnfort_friction_law, only: friction_law_type, tension_limit, rate_limit, no_kink, &
         scaled_exp, capped_product, capped_quotient, expm1, cap_critical_tension
     implicit none
@@ -232,15 +233,18 @@ contains
         type(error_type), allocatable, intent(out) :: error
         character(len=:), allocatable :: context, header
         real(wp), allocatable :: tension(:), rate(:)
-        integer, allocatable :: lines(:)
+        integer, allocatable :: lines(:), note_lines(:)
+        type(string_type), allocatable :: notes(:)
         type(unit_type) :: units(2)
         integer :: n, header_line
 
         context = "rate_table '" // path // "'"
         call read_csv_pairs(path, context, [character(len=1) :: 'T', 'g'], check_rate_row, &
-            tension, rate, lines, error, header, header_line)
+            tension, rate, lines, error, header, header_line, notes, note_lines)
         if (allocated(error)) return
         call get_rate_units(header, header_line, units, error)
+        if (.not. allocated(error)) call check_rate_notes(notes, note_lines, header, &
+            header_line, units, error)
         if (allocated(error)) then
             error%message = context // error%message
             return
@@ -277,15 +281,18 @@ contains
         logical :: stated(2), found
         integer :: c
 
+        if (header_line > 0) then
+            text = header_shape_message(header, header_line, 'T, g')
+            if (len(text) > 0) then
+                call fatal_error(error, text)
+                return
+            end if
+        end if
         call get_header_units(header, fields, texts, stated)
         do c = 1, 2
             text = 'N'
             if (stated(c) .and. header_line > 0) text = texts(c)%text
-            if (c == 2 .and. len(text) > 4) then
-                if (text(len(text) - 3:) == '/rad') text = text(:len(text) - 4)
-            end if
-            call find_unit(text, units(c), found)
-            if (found) found = units(c)%kind == force_kind
+            call find_rate_unit(text, c, units(c), found)
             if (.not. found) then
                 if (c == 1) then
                     text = 'force unit (' // unit_names(force_kind) // ')'
@@ -299,6 +306,54 @@ contains
             end if
         end do
     end subroutine get_rate_units
+
+    !> The unit of column `column` of a rate table spelled `text`: a force unit for T, a
+    !> force unit or one per radian for g; `found` false for another.
+    pure subroutine find_rate_unit(text, column, unit, found)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: column
+        type(unit_type), intent(out) :: unit
+        logical, intent(out) :: found
+        character(len=:), allocatable :: force
+
+        force = text
+        if (column == 2 .and. len(force) > 4) then
+            if (force(len(force) - 3:) == '/rad') force = force(:len(force) - 4)
+        end if
+        call find_unit(force, unit, found)
+        if (found) found = unit%kind == force_kind
+    end subroutine find_rate_unit
+
+    !> A note before the rows (a '#' comment, an earlier header line) that states a unit
+    !> other than N for a column whose header states none is an error: it would be read
+    !> in N (as a `&material table_file`'s notes).
+    subroutine check_rate_notes(notes, note_lines, header, header_line, units, error)
+        type(string_type), intent(in) :: notes(:)
+        integer, intent(in) :: note_lines(:), header_line
+        character(len=*), intent(in) :: header
+        type(unit_type), intent(in) :: units(2)
+        type(error_type), allocatable, intent(out) :: error
+        type(string_type) :: fields(2), texts(2)
+        type(unit_type) :: unit
+        logical :: open_column(2), stated(2), found
+        integer :: c, k
+
+        call get_header_units(header, fields, texts, stated)
+        open_column = .not. (stated .and. header_line > 0)
+        do k = 1, size(notes)
+            call get_note_units(notes(k)%text, fields, texts, stated)
+            do c = 1, 2
+                if (.not. (stated(c) .and. open_column(c))) cycle
+                call find_rate_unit(texts(c)%text, c, unit, found)
+                if (.not. found) cycle
+                if (same_unit(unit, units(c))) cycle
+                call fatal_error(error, note_unit_message(note_lines(k), c, fields(c)%text, &
+                    texts(c)%text, trim(units(c)%name), 'state the units in that header ' &
+                    // '(''T (cN),g (cN/rad)'')'))
+                return
+            end do
+        end do
+    end subroutine check_rate_notes
 
     !> One row of a rate table on its own (the first: T = 0, g >= 0) or after the previous.
     pure subroutine check_rate_row(row, previous, error)

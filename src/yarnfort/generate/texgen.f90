@@ -7,7 +7,8 @@
 !> (the periodic cell's network) and tiling.f90 (a clamped sample of copies).
 module yarnfort_generate_texgen
     use yarnfort_kinds, only: wp
-    use yarnfort_error, only: error_type
+    use yarnfort_error, only: error_type, fatal_error
+    use yarnfort_text, only: format_integer
     use yarnfort_input_config, only: fabric_config_type
     use yarnfort_generate_net_builder, only: net_builder_type
     use yarnfort_generate_xml_subset, only: xml_document_type, read_xml_file
@@ -50,6 +51,8 @@ contains
         if (allocated(error)) goto 100
         call read_model(document, fabric%texgen_samples, yarns, cell, scale, error)
         if (allocated(error)) goto 100
+        call check_material_count(fabric, size(yarns), error)
+        if (allocated(error)) goto 100
         n_yarns = size(yarns)
         call find_contacts(yarns, cell, fabric%texgen_contact_tolerance, contacts)
         n_contacts = size(contacts)
@@ -78,5 +81,22 @@ contains
         return
 100     error%message = "texgen_file '" // trim(path) // "': " // error%message
     end subroutine generate_texgen
+
+    !> `texgen_materials` names one material (for every yarn) or one per TexGen yarn: a
+    !> shorter list gave the yarns after it the last name ('warp', 'weft' for a weave of
+    !> 2 + 2 yarns made yarn 1, along x, of weft), a longer one names yarns the file lacks.
+    subroutine check_material_count(fabric, n_yarns, error)
+        type(fabric_config_type), intent(in) :: fabric
+        integer, intent(in) :: n_yarns
+        type(error_type), allocatable, intent(out) :: error
+        integer :: given
+
+        given = count(len_trim(fabric%texgen_materials) > 0)
+        if (given == 1 .or. given == n_yarns) return
+        call fatal_error(error, 'texgen_materials names ' // format_integer(given) &
+            // ' materials for the ' // format_integer(n_yarns) // ' TexGen yarns of the ' &
+            // 'file: give one name (for every yarn) or one per yarn, in TexGen''s order ' &
+            // '(yarn 0, 1, ...)')
+    end subroutine check_material_count
 
 end module yarnfort_generate_texgen

@@ -244,8 +244,9 @@ GROUPS = [
                       '`neo_hookean`: undeformed cross-section S(1).'),
         Var('table_file', 'character', '', length='path_length', adjust=False, laws=['table'],
             doc='`table`: CSV file of (strain, force). The material code reads it. A '
-                "relative name is taken relative to the input file's folder (the working "
-                'directory when the input comes from standard input). Its units: the header '
+                'relative name is taken from the working directory of the run, also from '
+                "Python (README, *Relative paths*), not from the input file's folder. Its "
+                'units: the header '
                 '(`Elongation (%),Force (cN)`), `strain_unit` and `force_unit`, else 1 and N; '
                 'see *Table files* below.'),
         Var('strain_unit', 'character', '', length=16, checked_by='table',
@@ -266,7 +267,7 @@ GROUPS = [
             default_doc='not set',
             doc='`table`: initial length of the tensile specimen; required when the strain '
                 'column is an elongation (a length unit), an error otherwise: strain = '
-                'elongation / gauge_length.'),
+                'elongation / gauge_length. At most 5 m (500 mm is 0.5).'),
         Var('prestress', 'real', 0.0, unit='N', range='>= 0',
             doc='Pre-stress: every element of this yarn type starts with reference length L0 = l '
                 '/ lambda_p, where f(lambda_p) = prestress and l is its length in the initial '
@@ -300,7 +301,7 @@ GROUPS = [
             default_doc="`''` (none)",
             doc='`general`: CSV file of (T in N, g in N/rad), the rate of the general law T\' = '
                 'g(T) (paper eqs. 37-39), read like a `&material table_file` (same CSV rules; '
-                "a relative name is taken relative to the input file's folder). The first row "
+                'a relative name is taken from the working directory of the run). The first row '
                 'is T = 0 with g >= 0, T strictly increasing, g > 0 for T > 0, all finite; g is '
                 'linear between rows and continues with the last slope beyond the last row, '
                 'which therefore may not fall. See *The general friction law* below.'),
@@ -416,15 +417,16 @@ GROUPS = [
               doc=GAP_FACTOR) for name in ('gap_factor_p_disp', 'gap_factor')],
         Var('texgen_file', 'character', '', length='path_length', adjust=False,
             default_doc='required (texgen)',
-            doc="TexGen: the model file (`.tg3`, TexGen's XML), relative to the input file's "
-                'folder (the working directory for stdin). Read without TexGen: one textile, '
+            doc="TexGen: the model file (`.tg3`, TexGen's XML), relative to the working "
+                'directory of the run (as `table_file`). Read without TexGen: one textile, '
                 'periodic yarns with repeats along x and y (the cell), master nodes, '
                 'interpolation, section width and height, GeometryScale. See *TexGen import* '
                 'below.'),
         Var('texgen_materials', 'character', '', length='name_length', shape=64,
             default_doc='required (texgen)',
-            doc="TexGen: the `&material` of TexGen's yarn 0, 1, 2, ... (by index); yarns "
-                'beyond the last name given take that one, so one name serves all yarns.'),
+            doc="TexGen: the `&material` of TexGen's yarn 0, 1, 2, ... (by index): one "
+                'name for every yarn, or one per yarn of the file (another count is an '
+                'error: the yarns after a short list took its last name).'),
         Var('texgen_contact_tolerance', 'real', 0.05, unit='1', range='[0, 1]',
             doc='TexGen: two yarns are in contact where their centre lines come within (1 + '
                 'this) times the sum of their half thicknesses (TexGen yarns that touch are '

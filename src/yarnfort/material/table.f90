@@ -25,10 +25,11 @@ module yarnfort_material_table
     use yarnfort_kinds, only: wp
     use yarnfort_error, only: error_type, fatal_error
     use yarnfort_material_force_law, only: force_law_type
-    use yarnfort_text, only: format_real, format_integer, quote_string, string_type
+    use yarnfort_text, only: format_real, format_integer, quote_string, string_type, to_lower
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
     use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &
-        get_header_units, strain_kind, length_kind, force_kind
+        get_header_units, get_note_units, same_unit, note_unit_message, &
+        header_shape_message, strain_kind, length_kind, force_kind
     implicit none
     private
 
@@ -45,6 +46,20 @@ module yarnfort_material_table
     !> elongation at break of any textile yarn, elastane included (docs/decisions.md,
     !> "Largest strain of a table file"); a larger one is a column misread.
     real(wp), parameter :: max_table_strain = 10.0_wp
+
+    !> Longest gauge length accepted, m: 10 times the longest specimen of the textile
+    !> tensile standards (500 mm, ISO 2062), below the 10 of a length in mm read as m
+    !> (docs/decisions.md, "Largest gauge length of a table file").
+    real(wp), parameter :: max_gauge_length = 5.0_wp
+
+    !> Words that name a column of a force or of a strain in a table header, and words
+    !> of quantities that are neither ('Stress', 'Tenacity': a force per area or tex).
+    character(len=*), parameter :: force_words(*) = [character(len=10) :: 'force', 'load', &
+        'tension']
+    character(len=*), parameter :: strain_words(*) = [character(len=10) :: 'strain', &
+        'elongation', 'extension', 'stretch']
+    character(len=*), parameter :: other_words(*) = [character(len=10) :: 'stress', &
+        'tenacity']
 
     !> Longest unit text taken from a `&material` variable.
     integer, parameter :: max_unit_text = 64
@@ -126,16 +141,20 @@ contains
         real(wp), intent(in), optional :: gauge_length
         character(len=:), allocatable :: context, header
         real(wp), allocatable :: strain(:), force(:)
-        integer, allocatable :: lines(:)
+        integer, allocatable :: lines(:), note_lines(:)
+        type(string_type), allocatable :: notes(:)
         type(unit_type) :: units(2)
         integer :: header_line
 
         context = "table '" // path // "'"
         call read_csv_pairs(path, context, [character(len=6) :: 'strain', 'force'], &
-            check_row, strain, force, lines, error, header, header_line)
+            check_row, strain, force, lines, error, header, header_line, notes, note_lines)
         if (allocated(error)) return
         call get_column_units(header, header_line, strain_unit, force_unit, gauge_length, &
             units, error)
+        if (.not. allocated(error)) call check_column_names(header, header_line, error)
+        if (.not. allocated(error)) call check_note_units(notes, note_lines, header, &
+            header_line, strain_unit, force_unit, units, error)
         if (allocated(error)) then
             error%message = context // error%message
             return
@@ -219,11 +238,128 @@ contains
                 // ', not a length (remove it, or state the length unit of the elongation)')
         else if (present(gauge_length)) then
             ! Nested tests: no ordered comparison with a NaN.
-            if (.not. (ieee_is_finite(gauge_length) .and. gauge_length > 0.0_wp)) &
+            if (.not. (ieee_is_finite(gauge_length) .and. gauge_length > 0.0_wp)) then
                 call fatal_error(error, ': gauge_length = ' // format_real(gauge_length) &
                     // ' must be positive and finite')
+            else if (gauge_length > max_gauge_length) then
+                call fatal_error(error, ': gauge_length = ' // format_real(gauge_length) &
+                    // ' m is longer than any tensile specimen (at most ' &
+                    // format_real(max_gauge_length) // ' m): gauge_length is in m (500 mm ' &
+                    // 'is 0.5)')
+            end if
         end if
     end subroutine get_column_units
+
+    !> A note before the rows (a '#' comment, an earlier header line) that states a unit
+    !> for a column whose unit neither the header nor `strain_unit`/`force_unit` states is
+    !> an error unless it is the unit the column is read in: 'Elongation (%),Force (cN)'
+    !> as a comment, or above a line of notes, would otherwise be read in 1 and N.
+    subroutine check_note_units(notes, note_lines, header, header_line, strain_unit, &
+            force_unit, units, error)
+        type(string_type), intent(in) :: notes(:)
+        integer, intent(in) :: note_lines(:), header_line
+        character(len=*), intent(in) :: header
+        character(len=*), intent(in), optional :: strain_unit, force_unit
+        type(unit_type), intent(in) :: units(2)
+        type(error_type), allocatable, intent(out) :: error
+        character(len=*), parameter :: names(2) = [character(len=11) :: 'strain_unit', &
+            'force_unit']
+        type(error_type), allocatable :: unknown
+        type(string_type) :: fields(2), texts(2)
+        type(unit_type) :: unit
+        logical :: open_column(2), stated(2)
+        integer :: c, k
+
+        call get_header_units(header, fields, texts, stated)
+        open_column = .not. (stated .and. header_line > 0)
+        if (present(strain_unit)) open_column(1) = open_column(1) .and. len_trim(strain_unit) == 0
+        if (present(force_unit)) open_column(2) = open_column(2) .and. len_trim(force_unit) == 0
+        do k = 1, size(notes)
+            call get_note_units(notes(k)%text, fields, texts, stated)
+            do c = 1, 2
+                if (.not. (stated(c) .and. open_column(c))) cycle
+                call take_unit(texts(c)%text, c, unit, unknown)
+                if (allocated(unknown)) cycle
+                if (same_unit(unit, units(c))) cycle
+                call fatal_error(error, note_unit_message(note_lines(k), c, fields(c)%text, &
+                    texts(c)%text, trim(units(c)%name), 'set &material ' // trim(names(c)) &
+                    // ' = ' // quote_string(texts(c)%text)))
+                return
+            end do
+        end do
+    end subroutine check_note_units
+
+    !> The header's column names in the table's order, strain then force: a header that
+    !> names a force in column 1 or a strain in column 2 ('Force,Elongation') is a table
+    !> whose columns are swapped, and one that names a stress or a tenacity is not a force.
+    !> A header with units must be two comma-separated fields (`header_shape_message`).
+    subroutine check_column_names(header, header_line, error)
+        character(len=*), intent(in) :: header
+        integer, intent(in) :: header_line
+        type(error_type), allocatable, intent(out) :: error
+        type(string_type) :: fields(2), texts(2)
+        character(len=:), allocatable :: place, problem
+        logical :: stated(2)
+        integer :: c
+
+        if (header_line == 0) return
+        problem = header_shape_message(header, header_line, 'strain, force')
+        if (len(problem) > 0) then
+            call fatal_error(error, problem)
+            return
+        end if
+        call get_header_units(header, fields, texts, stated)
+        do c = 1, 2
+            problem = ''
+            if (names_any(fields(c)%text, other_words)) then
+                problem = 'names a quantity that is not a ' // trim(merge('strain', 'force ', &
+                    c == 1)) // ' (a table''s columns are strain, then the yarn''s force; a ' &
+                    // 'stress or tenacity times the cross-section area or linear density ' &
+                    // 'is that force)'
+            else if (c == 1 .and. names_any(fields(c)%text, force_words) .and. .not. &
+                    names_any(fields(c)%text, strain_words)) then
+                problem = 'names a force, but column 1 is the strain (a table''s columns ' &
+                    // 'are strain, then force: swap the columns)'
+            else if (c == 2 .and. names_any(fields(c)%text, strain_words) .and. .not. &
+                    names_any(fields(c)%text, force_words)) then
+                problem = 'names a strain, but column 2 is the force (a table''s columns ' &
+                    // 'are strain, then force: swap the columns)'
+            end if
+            if (len(problem) == 0) cycle
+            place = ', line ' // format_integer(header_line) // ', column ' &
+                // format_integer(c) // ' (' // quote_string(fields(c)%text) // '): '
+            call fatal_error(error, place // problem)
+            return
+        end do
+    end subroutine check_column_names
+
+    !> Whether a header field has one of `words` as a word of its own (letters only,
+    !> any case: 'Extension' is not 'tension').
+    pure logical function names_any(field, words)
+        character(len=*), intent(in) :: field
+        character(len=*), intent(in) :: words(:)
+        character(len=*), parameter :: letters = 'abcdefghijklmnopqrstuvwxyz'
+        character(len=:), allocatable :: text
+        integer :: first, last
+
+        names_any = .false.
+        text = to_lower(field)
+        first = scan(text, letters)
+        do while (first > 0)
+            last = verify(text(first:), letters)
+            if (last == 0) then
+                last = len(text)
+            else
+                last = first + last - 2
+            end if
+            if (any(words == text(first:last))) then
+                names_any = .true.
+                return
+            end if
+            first = scan(text(last + 1:), letters)
+            if (first > 0) first = first + last
+        end do
+    end function names_any
 
     !> The unit spelled `text` for column `column` (1: a strain or a length, 2: a force).
     pure subroutine take_unit(text, column, unit, error)

@@ -41,6 +41,8 @@ contains
             new_unittest('elongation over a gauge length', test_elongation_table), &
             new_unittest('plain headers and none: 1 and N', test_default_units), &
             new_unittest('bad units and misread strains refused', test_refused_tables), &
+            new_unittest('units only in a note, header shapes, column names', &
+                test_notes_and_names), &
             new_unittest('rate table in cN and cN/rad', test_rate_table_units) &
             ]
     end subroutine collect_table_units
@@ -239,6 +241,45 @@ contains
         if (allocated(error)) return
         call same_law(error, bare, plain, 0.0_wp)
     end subroutine test_default_units
+
+    !> Lines before the rows whose units would not be read, and headers that name the
+    !> columns otherwise than strain, force: refused with the line and column. Notes that
+    !> record settings, or agree with the units read, leave the table as in SI.
+    subroutine test_notes_and_names(error)
+        type(error_type), allocatable, intent(out) :: error
+        type(table_law_type) :: plain, noted
+
+        call expect_refused(error, '# Elongation (%),Force (cN)' // lf // percent_cn_rows, &
+            [character(len=60) :: path, "line 1, column 1 ('Elongation (%)')", &
+            "states the unit '%'", "read in '1'"])
+        if (allocated(error)) return
+        call expect_refused(error, 'Elongation (%),Force (cN)' // lf // 'sample 2' // lf &
+            // percent_cn_rows, [character(len=60) :: "line 1, column 1", "read in '1'"])
+        if (allocated(error)) return
+        call expect_refused(error, 'Elongation,Force' // lf // '# %,cN' // lf &
+            // percent_cn_rows, [character(len=60) :: "line 2, column 1 ('%')"])
+        if (allocated(error)) return
+        call expect_refused(error, 'Elongation (%),Force (cN),' // lf // percent_cn_rows, &
+            [character(len=60) :: "line 1: the header states the unit '%'", &
+            'not two comma-separated'])
+        if (allocated(error)) return
+        call expect_refused(error, 'Force,Strain' // lf // si_rows, &
+            [character(len=60) :: "line 1, column 1 ('Force'): names a force"])
+        if (allocated(error)) return
+        call expect_refused(error, 'Strain,Tenacity' // lf // si_rows, &
+            [character(len=60) :: "line 1, column 2 ('Tenacity'): names a quantity"])
+        if (allocated(error)) return
+
+        call write_file(path, 'strain,force' // lf // si_rows)
+        call read_expect_ok(error, plain)
+        if (allocated(error)) return
+        ! Settings with values, units that agree with 1 and N, 'Extension' is not 'tension'.
+        call write_file(path, '# gauge 500 mm, pretension 0.5 cN' // lf &
+            // '# Strain (-),Force [N]' // lf // 'Extension,Tension' // lf // si_rows)
+        call read_expect_ok(error, noted)
+        if (allocated(error)) return
+        call same_law(error, noted, plain, 0.0_wp)
+    end subroutine test_notes_and_names
 
     !> Unknown units, wrong kinds, disagreements, gauge lengths and strains read in the
     !> wrong unit: each refused with the file, the line and the column.
