@@ -8,7 +8,8 @@ An address names one variable of one namelist group:
 - ``'contact[0].friction_coefficient'``: of the first ``&contact`` group in file
   order (indices from 0; negative ones count from the end, ``'yarn[-1].material'``);
 - ``'support[pull].displacement'``: of the group whose ``name`` is ``pull`` (quotes
-  around the name are optional: ``support['pull']``);
+  around the name are optional: ``support['pull']``; needed for a name of digits, and
+  ``support[1]`` is refused when another group than the second is named ``1``);
 - ``'fabric.gap_factor[2]'``: one entry of a list variable (indices from 0, negative
   ones from the end), e.g. one knot value of the gap-factor table. The list must be set
   already and have that entry: its length is the scene's to choose.
@@ -167,6 +168,14 @@ def _find_group(nml: f90nml.Namelist, address: Address, create: bool) -> f90nml.
         if not -len(instances) <= index < len(instances):
             raise AddressError(f"{address.text!r}: the scene has {len(instances)}"
                                f" &{group} group(s)")
+        # A group named '1' is not always the one at position 1: refused, not guessed.
+        named = [k for k, instance in enumerate(instances)
+                 if str(instance.get("name", "")) == str(index)]
+        if named and named != [index % len(instances)]:
+            raise AddressError(f"{address.text!r}: ambiguous, a &{group} is named"
+                               f" '{index}' (position {named[0]}); write"
+                               f" {group}['{index}'].{address.variable} for the name,"
+                               f" {group}[{named[0]}].{address.variable} for its position")
         return instances[index]
     for instance in instances:
         if str(instance.get("name", "")) == index:

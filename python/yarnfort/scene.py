@@ -569,14 +569,15 @@ class LoadPath:
     def __post_init__(self) -> None:
         self.time = np.atleast_1d(_reals(self.time, "&path time"))
         if self.time.ndim != 1 or self.time.size < 2:
-            raise SceneError("&path time: expected at least two knots")
+            raise SceneError(f"&path time: expected a list of at least two knots, got shape"
+                             f" {self.time.shape}")
         for key in ("p_force", "p_disp"):
             value = getattr(self, key)
             if value is not None:
                 array = np.atleast_1d(_reals(value, f"&path {key}"))
                 if array.shape != self.time.shape:
-                    raise SceneError(f"&path {key}: {array.size} values for"
-                                     f" {self.time.size} knots")
+                    raise SceneError(f"&path {key}: shape {array.shape} for"
+                                     f" {self.time.size} knots (one value per knot)")
                 setattr(self, key, array)
         if self.channels is not None:
             names = [self.channels] if isinstance(self.channels, str) else list(self.channels)

@@ -70,3 +70,15 @@ def test_a_list_given_from_a_later_entry_is_addressed_from_its_first(tmp_path):
     scene = read_scene(tmp_path / "given.nml")
     set_parameter(scene, "support[ends].displacement", [0.1, 0.2, 0.3])
     assert _echoed_displacement(scene, tmp_path, "whole") == [0.1, 0.2, 0.3]
+
+
+def test_a_position_that_is_another_groups_name_is_refused():
+    import f90nml
+
+    scene = f90nml.reads("&support name = '1', nodes = 1 /\n&support name = 'b', nodes = 2 /")
+    with pytest.raises(AddressError, match=r"ambiguous, a &support is named '1' \(position"
+                       r" 0\); write support\['1'\].nodes for the name"):
+        get_parameter(scene, "support[1].nodes")
+    assert get_parameter(scene, "support['1'].nodes") == 1
+    assert get_parameter(scene, "support[0].nodes") == 1  # position and name agree
+    assert get_parameter(scene, "support[b].nodes") == 2

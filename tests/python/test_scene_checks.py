@@ -181,3 +181,12 @@ def test_a_string_is_measured_in_bytes_and_holds_no_line_break(tmp_path, monkeyp
     # f90nml would write the break as the two characters '\n'.
     with pytest.raises(SceneError, match="title: 'two\\\\nlines' holds a line break"):
         vnet("two\nlines")
+
+
+def test_a_path_of_another_shape_is_named_by_its_shape():
+    # A (2, 1) column of two values used to be '2 values for 2 knots'.
+    with pytest.raises(SceneError, match=r"p_force: shape \(2, 1\) for 2 knots"):
+        LoadPath(time=[0, 1], p_force=[[0], [1]])
+    with pytest.raises(SceneError, match=r"time: expected a list of at least two knots, got"
+                       r" shape \(1, 2\)"):
+        LoadPath(time=[[0, 1]])
