@@ -372,7 +372,7 @@ def parse_length(text: str | float, what: str = "--thickness") -> float:
                                 ) from None
     metres = value * WIDTH_UNITS[unit]
     if not (np.isfinite(metres) and metres > 0):
-        raise FabricExportError(f"{what} {text!r}: a thickness must be positive and finite")
+        raise FabricExportError(f"{what} {text!r}: must be positive and finite")
     return metres
 
 
