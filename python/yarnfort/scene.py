@@ -715,7 +715,11 @@ class Scene:
         """The settings dicts (and the extras of &nodes) against the description: they
         can change after construction, so :meth:`validate` checks them again."""
         for group in _SETTINGS:
-            _check_group(group, getattr(self, group), f"Scene {group}")
+            settings = getattr(self, group)
+            for key, value in settings.items():  # output={'folder': Path(...)}: a name
+                if isinstance(value, os.PathLike):
+                    settings[key] = os.fspath(value)
+            _check_group(group, settings, f"Scene {group}")
         _check_group("nodes", self.nodes_extra, "&nodes")
 
     def __repr__(self) -> str:

@@ -190,3 +190,12 @@ def test_a_path_of_another_shape_is_named_by_its_shape():
     with pytest.raises(SceneError, match=r"time: expected a list of at least two knots, got"
                        r" shape \(1, 2\)"):
         LoadPath(time=[[0, 1]])
+
+
+def test_an_output_folder_may_be_a_path(tmp_path):
+    built = Scene("path", output={"folder": tmp_path / "out"})
+    assert built.output["folder"] == str(tmp_path / "out")
+    built.control["title"] = Path("later")  # set after construction: written as text
+    built.add_material("yarn", "linear", stiffness=1.0)
+    built.path = LoadPath(time=[0, 1])
+    assert built.to_namelist()["control"]["title"] == "later"
