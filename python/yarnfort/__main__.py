@@ -253,8 +253,12 @@ def summary_figure(folder: Path, support: str | None = None, *, channel: str | N
         left.plot(abscissa[row], force[row], "o", color="black", markersize=6,
                   label=f"step {shown} (right)", gid="shown_step")
         left.legend()
-        right.set_title(("largest force" if step is None else "chosen step")
-                        + f": step {shown}")
+        title = ("largest force" if step is None else "chosen step") + f": step {shown}"
+        peak = peak_step(curve, force, [int(s) for s in curve["step"]])
+        if step is None and peak != shown:  # vtk_every > 1: the peak may have no state
+            title = (f"largest force of the saved states: step {shown}\n(the peak, step"
+                     f" {peak}, has no saved state)")
+        right.set_title(title)
     else:
         right.set_axis_off()
         right.text(0.5, 0.5, "no states written", ha="center", va="center")
