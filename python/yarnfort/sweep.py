@@ -51,7 +51,7 @@ import numpy as np
 from ._native import YarnfortError
 from ._program import program_path
 from .address import AddressError, check_address, set_parameter
-from .results import Curve, read_curve
+from .results import Curve, incomplete_reason, read_curve
 
 __all__ = ["run_sweep", "run_patched", "parameter_grid"]
 
@@ -146,6 +146,10 @@ def _execute(task: _Task) -> dict[str, Any]:
             elif proc.returncode == 0:
                 row["final_reaction"], row["max_reaction"] = _summary(
                     curve, task.support, task.component)
+                # Exit 0 also ends a run at &control max_steps: its last step is not
+                # the path's end.
+                if reason := incomplete_reason(curve_file.parent, curve):
+                    row["status"], row["error"] = "max_steps", reason
     except subprocess.TimeoutExpired:
         row["status"], row["error"] = "error", f"timed out after {task.timeout} s"
     except Exception as error:  # noqa: BLE001 - a row reports any failure of its run
@@ -183,8 +187,9 @@ def run_patched(scene_path: str | os.PathLike, values: Mapping[str, Any],
     Raises
     ------
     YarnfortError
-        If the program fails (status 1 failed solve, 2 bad input); the message is the
-        program's.
+        If the program fails (status 1 failed solve, 2 bad input; the message is the
+        program's), or stops before the end of the load path (status 1: ``&control
+        max_steps``).
     """
     scene = f90nml.read(Path(scene_path))
     folder = Path(folder).resolve()
@@ -200,7 +205,11 @@ def run_patched(scene_path: str | os.PathLike, values: Mapping[str, Any],
         lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
         raise YarnfortError(lines[-1] if lines else f"exit code {proc.returncode}",
                             proc.returncode)
-    return read_curve(folder / "out")
+    curve = read_curve(folder / "out")
+    # Exit 0 also ends a run at &control max_steps: a fit would compare a cut curve.
+    if reason := incomplete_reason(folder / "out", curve):
+        raise YarnfortError(f"{reason} (&control max_steps in the scene?)", 1)
+    return curve
 
 
 def parameter_grid(parameters: Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]]
@@ -370,7 +379,9 @@ def run_sweep(scene_path: str | os.PathLike,
     -------
     dict of str to numpy.ndarray
         One entry per run, in the order of the runs: a column per parameter address, and
-        ``status`` (``'ok'``, ``'solve_failed'``, ``'bad_input'`` or ``'error'``),
+        ``status`` (``'ok'``, ``'max_steps'`` (stopped before the path's end by
+        ``&control max_steps``; its reactions are those of its last step),
+        ``'solve_failed'``, ``'bad_input'`` or ``'error'``),
         ``error`` (the program's message, ``''`` when ok), ``n_steps`` (converged steps
         written, initial state included), ``final_reaction`` and ``max_reaction`` (the
         summarised reaction at the last step and the one of largest magnitude, N; NaN for

@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import yarnfort
 from yarnfort import program_path, read_curve
 from yarnfort.results import read_contacts
-from yarnfort.sweep import parameter_grid, run_sweep
+from yarnfort.sweep import parameter_grid, run_patched, run_sweep
 
 TOP = Path(__file__).resolve().parents[2]
 CAPSTAN = TOP / "inputs" / "capstan.nml"
@@ -158,3 +159,13 @@ def test_a_string_is_not_a_list_of_values():
         parameter_grid({"material[0].law": "table"})
     assert parameter_grid({"material[0].law": ["table"], MU: [0.1, 0.2]}) == [
         {"material[0].law": "table", MU: 0.1}, {"material[0].law": "table", MU: 0.2}]
+
+
+def test_a_run_stopped_by_max_steps_is_not_ok(tmp_path):
+    # capstan's path ends at time 2; 3 steps of at most 0.1 end well before it.
+    runs = [{MU: 0.3, "control.max_steps": 3}, {MU: 0.3}]
+    table = run_sweep(CAPSTAN, runs, workers=1, progress=False, support="pull")
+    assert list(table["status"]) == ["max_steps", "ok"]
+    assert list(table["n_steps"])[0] == 4 and "incomplete run" in table["error"][0]
+    with pytest.raises(yarnfort.YarnfortError, match="incomplete run.*max_steps"):
+        run_patched(CAPSTAN, {"control.max_steps": 3}, tmp_path)
