@@ -392,10 +392,11 @@ def run_sweep(scene_path: str | os.PathLike,
     ------
     ValueError
         For a malformed parameter address or one of a group or variable the input does
-        not have, an unknown component, or a support the scene
-        does not have (checked before any run against its ``&support`` groups; for a
-        generated ``&fabric``, on the runs' curves); the program's failures do not raise
-        (they are rows).
+        not have, or of ``output.folder``, ``output.progress`` or (without ``vtk``)
+        ``output.vtk_every``, which the sweep sets itself; an unknown component, or a
+        support the scene does not have (checked before any run against its ``&support``
+        groups; for a generated ``&fabric``, on the runs' curves); the program's failures
+        do not raise (they are rows).
     FileNotFoundError
         If the installation has no program.
     """
@@ -404,9 +405,16 @@ def run_sweep(scene_path: str | os.PathLike,
     names = list(dict.fromkeys(name for run in runs for name in run))
     for name in names:
         try:
-            check_address(name)
+            where = check_address(name)
         except AddressError as error:
             raise ValueError(str(error)) from None
+        # The sweep sets these for every run: a swept value would be overwritten.
+        if where.group == "output" and (where.variable in ("folder", "progress") or (
+                where.variable == "vtk_every" and not vtk)):
+            raise ValueError(f"{name!r}: the sweep sets &output {where.variable} of every"
+                             " run itself (its own folder, no progress lines"
+                             + (", vtk_every = 0 unless vtk=True)" if where.variable ==
+                                "vtk_every" else ")"))
     support = _check_support(scene, support)
     if isinstance(component, str):
         if component.lower() not in _COMPONENTS:

@@ -169,3 +169,9 @@ def test_a_run_stopped_by_max_steps_is_not_ok(tmp_path):
     assert list(table["n_steps"])[0] == 4 and "incomplete run" in table["error"][0]
     with pytest.raises(yarnfort.YarnfortError, match="incomplete run.*max_steps"):
         run_patched(CAPSTAN, {"control.max_steps": 3}, tmp_path)
+
+
+def test_an_output_setting_the_sweep_makes_itself_is_refused():
+    for address in ("output.folder", "output.progress", "output.vtk_every"):
+        with pytest.raises(ValueError, match=f"'{address}': the sweep sets &output"):
+            run_sweep(CAPSTAN, {address: [1]}, progress=False)
