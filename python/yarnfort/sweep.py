@@ -392,8 +392,8 @@ def run_sweep(scene_path: str | os.PathLike,
     ------
     ValueError
         For a malformed parameter address or one of a group or variable the input does
-        not have, or of ``output.folder``, ``output.progress`` or (without ``vtk``)
-        ``output.vtk_every``, which the sweep sets itself; an unknown component, or a
+        not have, or a value of ``output.folder``, ``output.progress`` or (without
+        ``vtk``) ``output.vtk_every`` other than the sweep sets; an unknown component, or a
         support the scene does not have (checked before any run against its ``&support``
         groups; for a generated ``&fabric``, on the runs' curves); the program's failures
         do not raise (they are rows).
@@ -408,13 +408,15 @@ def run_sweep(scene_path: str | os.PathLike,
             where = check_address(name)
         except AddressError as error:
             raise ValueError(str(error)) from None
-        # The sweep sets these for every run: a swept value would be overwritten.
-        if where.group == "output" and (where.variable in ("folder", "progress") or (
-                where.variable == "vtk_every" and not vtk)):
+        # The sweep sets these for every run: a swept value other than its own would be
+        # overwritten (every folder is: the sentinel equals no value).
+        own = {"folder": object(), "progress": False, "vtk_every": 0}
+        if (where.group == "output" and where.variable in own
+                and not (where.variable == "vtk_every" and vtk)
+                and any(name in run and run[name] != own[where.variable] for run in runs)):
             raise ValueError(f"{name!r}: the sweep sets &output {where.variable} of every"
-                             " run itself (its own folder, no progress lines"
-                             + (", vtk_every = 0 unless vtk=True)" if where.variable ==
-                                "vtk_every" else ")"))
+                             " run itself (its own folder, no progress lines, vtk_every ="
+                             " 0 unless vtk=True)")
     support = _check_support(scene, support)
     if isinstance(component, str):
         if component.lower() not in _COMPONENTS:

@@ -172,6 +172,7 @@ def test_a_run_stopped_by_max_steps_is_not_ok(tmp_path):
 
 
 def test_an_output_setting_the_sweep_makes_itself_is_refused():
-    for address in ("output.folder", "output.progress", "output.vtk_every"):
+    for address, value in (("output.folder", "out/mine"), ("output.progress", True),
+                           ("output.vtk_every", 5)):
         with pytest.raises(ValueError, match=f"'{address}': the sweep sets &output"):
-            run_sweep(CAPSTAN, {address: [1]}, progress=False)
+            run_sweep(CAPSTAN, {address: [value]}, progress=False)
