@@ -24,13 +24,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .namelist import read_scene
-from .results import Curve, read_curve, read_states
+from .results import Curve, incomplete_reason, read_curve, read_states
 
 # matplotlib (through .plots) is imported only once a plot is to be made, so that
 # --help and argument errors answer quickly.
@@ -252,8 +253,12 @@ def summary_figure(folder: Path, support: str | None = None, *, channel: str | N
         left.plot(abscissa[row], force[row], "o", color="black", markersize=6,
                   label=f"step {shown} (right)", gid="shown_step")
         left.legend()
-        right.set_title(("largest force" if step is None else "chosen step")
-                        + f": step {shown}")
+        title = ("largest force" if step is None else "chosen step") + f": step {shown}"
+        peak = peak_step(curve, force, [int(s) for s in curve["step"]])
+        if step is None and peak != shown:  # vtk_every > 1: the peak may have no state
+            title = (f"largest force of the saved states: step {shown}\n(the peak, step"
+                     f" {peak}, has no saved state)")
+        right.set_title(title)
     else:
         right.set_axis_off()
         right.text(0.5, 0.5, "no states written", ha="center", va="center")
@@ -277,6 +282,8 @@ def read_run_curve(folder: Path) -> Curve:
     if len(curve) == 0:
         raise CommandError(f"{folder / 'curve.csv'} has no rows (only its header): the run"
                            " wrote no converged step, nothing to plot")
+    if reason := incomplete_reason(folder, curve):
+        warnings.warn(f"{folder}: {reason}", RuntimeWarning, stacklevel=2)
     return curve
 
 
@@ -471,6 +478,21 @@ def main(argv: list[str] | None = None) -> int:
         The exit code: 0 success, 2 bad arguments or unusable inputs.
     """
     args = _parser().parse_args(argv)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RuntimeWarning)
+        code = _command(args)
+    # After the command's own lines, as the program's last lines (an incomplete run).
+    for warning in caught:
+        if issubclass(warning.category, RuntimeWarning):
+            print(f"yarnfort {args.command}: warning: {warning.message}", file=sys.stderr)
+        else:
+            warnings.showwarning(warning.message, warning.category, warning.filename,
+                                 warning.lineno)
+    return code
+
+
+def _command(args: argparse.Namespace) -> int:
+    """Run the command `args` asks for; its exit code."""
     try:
         if args.command == "reference":
             from .resources import reference_text

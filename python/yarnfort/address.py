@@ -8,10 +8,16 @@ An address names one variable of one namelist group:
 - ``'contact[0].friction_coefficient'``: of the first ``&contact`` group in file
   order (indices from 0; negative ones count from the end, ``'yarn[-1].material'``);
 - ``'support[pull].displacement'``: of the group whose ``name`` is ``pull`` (quotes
-  around the name are optional: ``support['pull']``);
+  around the name are optional: ``support['pull']``; needed for a name of digits, and
+  ``support[1]`` is refused when another group than the second is named ``1``);
 - ``'fabric.gap_factor[2]'``: one entry of a list variable (indices from 0, negative
   ones from the end), e.g. one knot value of the gap-factor table. The list must be set
   already and have that entry: its length is the scene's to choose.
+
+A variable the scene gives from a later entry (``displacement(2) = -0.3``) is read and
+set counted from its first entry, as the program reads it: ``displacement[1]`` is -0.3,
+``displacement`` reads ``[None, -0.3]`` (None: unset, the default), and a value set for
+the whole variable starts at its first entry.
 
 Group and variable names are case-insensitive; a group name is matched exactly. Setting a
 variable that the group does not have yet adds it, and setting a variable of a group the
@@ -30,7 +36,8 @@ from typing import Any
 import f90nml
 import numpy as np
 
-__all__ = ["Address", "AddressError", "parse_address", "get_parameter", "set_parameter"]
+__all__ = ["Address", "AddressError", "parse_address", "check_address", "get_parameter",
+           "set_parameter"]
 
 _ADDRESS = re.compile(r"^\s*(\w+)\s*(?:\[\s*([^\]]*?)\s*\])?\s*\.\s*(\w+)\s*"
                       r"(?:\[\s*([+-]?\d+)\s*\])?\s*$")
@@ -100,6 +107,44 @@ def parse_address(address: str) -> Address:
                    None if element is None else int(element))
 
 
+def check_address(address: str) -> Address:
+    """Parse an address and check that its group and variable are input variables (the
+    one description of the input): a sweep or fit of a misspelled name is refused before
+    it runs, not left to fail in every run.
+
+    Parameters
+    ----------
+    address : str
+        The address.
+
+    Returns
+    -------
+    Address
+
+    Raises
+    ------
+    AddressError
+        If the address is malformed, or names a group or variable the input does not
+        have (the message suggests the name meant).
+    """
+    import difflib
+
+    from .resources import input_description
+
+    where = parse_address(address)
+    groups = {group["name"]: [v["name"] for v in group["variables"]]
+              for group in input_description()["groups"]}
+    for name, known, what in ((where.group, list(groups), "group"),
+                              (where.variable, groups.get(where.group), "variable")):
+        if known is not None and name not in known:
+            close = difflib.get_close_matches(name, known, n=1)
+            owner = "the input" if what == "group" else f"&{where.group}"
+            raise AddressError(f"{address!r}: {owner} has no {what} {name!r}"
+                               + (f"; did you mean {close[0]!r}?" if close else "")
+                               + " (python -m yarnfort reference)")
+    return where
+
+
 def _instances(nml: f90nml.Namelist, group: str) -> list[f90nml.Namelist]:
     found = nml[group]
     return list(found) if isinstance(found, list) else [found]
@@ -123,6 +168,14 @@ def _find_group(nml: f90nml.Namelist, address: Address, create: bool) -> f90nml.
         if not -len(instances) <= index < len(instances):
             raise AddressError(f"{address.text!r}: the scene has {len(instances)}"
                                f" &{group} group(s)")
+        # A group named '1' is not always the one at position 1: refused, not guessed.
+        named = [k for k, instance in enumerate(instances)
+                 if str(instance.get("name", "")) == str(index)]
+        if named and named != [index % len(instances)]:
+            raise AddressError(f"{address.text!r}: ambiguous, a &{group} is named"
+                               f" '{index}' (position {named[0]}); write"
+                               f" {group}['{index}'].{address.variable} for the name,"
+                               f" {group}[{named[0]}].{address.variable} for its position")
         return instances[index]
     for instance in instances:
         if str(instance.get("name", "")) == index:
@@ -141,12 +194,35 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _from_first(instance: f90nml.Namelist, variable: str) -> Any:
+    """A variable's value counted from its first entry. f90nml keeps ``x(2) = 5`` as
+    ``[5]`` with a start index 2: read as it is, entry 0 would be x(2). Entries before
+    the start are None (null when written: the default stays)."""
+    value = instance[variable]
+    start = (getattr(instance, "start_index", None) or {}).get(variable)
+    if not start or all(index is None or index <= 1 for index in start):
+        return value
+    if len(start) > 1:
+        raise AddressError(f"{variable}{tuple(start)}: an array given from that index in"
+                           " more than one dimension; give it whole in the scene")
+    return [None] * (start[0] - 1) + (list(value) if isinstance(value, list) else [value])
+
+
+def _store(instance: f90nml.Namelist, variable: str, value: Any) -> None:
+    """Set a variable from its first entry (a start index read from the file no longer
+    applies: it would shift the new values)."""
+    instance[variable] = value
+    starts = getattr(instance, "start_index", None)
+    if starts:
+        starts.pop(variable, None)
+
+
 def _entry(instance: f90nml.Namelist, where: Address) -> tuple[list, int]:
     """The list that an address with an entry names, and the entry's position in it."""
     if where.variable not in instance:
         raise AddressError(f"{where.text!r}: &{where.group} has no variable"
                            f" {where.variable!r} set (an entry needs the list set)")
-    value = instance[where.variable]
+    value = _from_first(instance, where.variable)
     items = list(value) if isinstance(value, list) else [value]
     if not -len(items) <= where.element < len(items):
         raise AddressError(f"{where.text!r}: &{where.group} {where.variable} has"
@@ -182,7 +258,7 @@ def get_parameter(nml: f90nml.Namelist, address: str) -> Any:
     if where.variable not in instance:
         raise AddressError(f"{address!r}: &{where.group} has no variable"
                            f" {where.variable!r} set")
-    return instance[where.variable]
+    return _from_first(instance, where.variable)
 
 
 def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Namelist:
@@ -219,10 +295,10 @@ def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Name
         instance = _find_group(nml, where, create=False)
         items, position = _entry(instance, where)
         items[position] = _like(items[position], value)
-        instance[where.variable] = items
+        _store(instance, where.variable, items)
         return nml
     instance = _find_group(nml, where, create=True)
-    instance[where.variable] = _like(instance.get(where.variable), value)
+    _store(instance, where.variable, _like(instance.get(where.variable), value))
     return nml
 
 

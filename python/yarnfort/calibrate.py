@@ -69,7 +69,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ._native import YarnfortError
-from .address import parse_address
+from .address import check_address
 from .results import Curve
 from .sweep import _check_support, run_patched
 from .units import force_factor, split_header, strain_factor
@@ -608,6 +608,39 @@ def _scene_file(scene: Any) -> Iterator[Path]:
         yield path
 
 
+#: Largest sample width (m) taken as a bare number: lab samples are centimetres wide, so
+#: a larger number is a width in mm or cm given as metres (50 for 50 mm: 1000 times off).
+PLAIN_WIDTH_LIMIT = 1.0
+
+
+def sample_width(width: float | str | None) -> float | None:
+    """A sample width in m: a number of metres, or a length with its unit (``'50 mm'``).
+
+    Raises
+    ------
+    ValueError
+        For a width that is not positive and finite, a bare number above
+        :data:`PLAIN_WIDTH_LIMIT` (a width in mm or cm, the unit left out), or a string
+        without a length unit.
+    """
+    if width is None:
+        return None
+    if isinstance(width, str):
+        from .fabric_export import parse_length
+
+        return parse_length(width, "width")
+    if isinstance(width, (bool, np.bool_)) or not isinstance(width, (int, float, np.number)):
+        raise ValueError(f"width {width!r}: expected a number of metres or a length with its"
+                         " unit ('50 mm')")
+    if not (np.isfinite(width) and width > 0):
+        raise ValueError(f"width = {width!r}: must be positive and finite (m)")
+    if width > PLAIN_WIDTH_LIMIT:
+        raise ValueError(f"width = {width!r}: a sample {width!r} m wide? give it in metres"
+                         f" ({width!r} mm is {width * 1e-3:g}) or with its unit"
+                         f" (width='{width!r} mm')")
+    return float(width)
+
+
 def _conversion(measured: Measured, model_per_width: bool, width: float | None) -> float:
     """Factor from the model's SI quantity to the data's unit."""
     factor = 1.0 / measured.force_factor
@@ -718,9 +751,10 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
     force_scale : float
         The simulated force is ``force_scale`` times the reaction (e.g. -1 for a pull
         along -y) or the force per width.
-    width : float, optional
-        Width of the measured sample (m), when the data are a force per sample and the
-        model a force per width, or the reverse.
+    width : float or str, optional
+        Width of the measured sample, in m or with its unit (``'50 mm'``; a bare number
+        above 1 is refused as a width in mm or cm), when the data are a force per sample
+        and the model a force per width, or the reverse.
     strain_unit, force_unit : str, optional
         Units of columns whose header gives none (see :func:`read_measured`).
     errors : {'equal', 'relative'}
@@ -749,11 +783,12 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
     ------
     ValueError
         For bounds with lower >= upper or an initial value outside them, fewer measured
-        points than parameters plus one, a malformed parameter address (an
-        :class:`~yarnfort.AddressError`), an unknown component or support, an unreadable
-        measured curve, a force per sample against a force per width without ``width``,
-        data with more load cycles than the scene's path, or a branch of the data beyond
-        the strains the path reaches at the initial values.
+        points than parameters plus one, a malformed parameter address or one of a
+        group or variable the input does not have (an :class:`~yarnfort.AddressError`),
+        an unknown component or support, an unreadable measured curve, a force per sample
+        against a force per width without ``width``, data with more load cycles than the
+        scene's path, or a branch of the data beyond the strains the path reaches at the
+        initial values.
     YarnfortError
         If a run fails; the message names the parameter values.
 
@@ -763,6 +798,7 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
         When a parameter is not identifiable (see the module notes).
     """
     started = time.perf_counter()
+    width = sample_width(width)
     names = tuple(parameters)
     initial, lower, upper = (np.array([float(parameters[n][k]) for n in names])
                              for k in range(3))
@@ -770,8 +806,8 @@ def calibrate(scene: Any, measured: str | os.PathLike | Measured,
         raise ValueError("each parameter needs lower < upper and initial within them")
     span = upper - lower
     index = _component_index(component)
-    for name in names:
-        parse_address(name)
+    for name in (*names, *(fixed or {})):
+        check_address(name)
     data = measured if isinstance(measured, Measured) else read_measured(
         measured, strain_unit=strain_unit, force_unit=force_unit)
     m, n = data.force.size, len(names)
@@ -949,9 +985,9 @@ def write_synthetic_curve(scene: Any, values: Mapping[str, Any], path: str | os.
         As in :func:`calibrate`.
     strain_unit, force_unit : str
         Units of the written columns (in their headers), e.g. ``'%'`` and ``'cN'``.
-    width : float, optional
-        Sample width (m), to write a fabric's force per width as a force per sample
-        (or a support's force as a force per width).
+    width : float or str, optional
+        Sample width (m, or with its unit as in :func:`calibrate`), to write a fabric's
+        force per width as a force per sample (or a support's force as a force per width).
     noise : float
         Relative standard deviation of the noise.
     seed : int
@@ -963,6 +999,7 @@ def write_synthetic_curve(scene: Any, values: Mapping[str, Any], path: str | os.
         The written CSV (columns strain, force, branch).
     """
     index = _component_index(component)
+    width = sample_width(width)
     s_factor = strain_factor(strain_unit)
     f_factor, per_width = force_factor(force_unit)
     unit = Measured(np.zeros(0), np.zeros(0), np.zeros(0, int), np.zeros(0, int),

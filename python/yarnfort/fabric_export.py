@@ -35,6 +35,7 @@ import csv
 import io
 import os
 import re
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence
@@ -42,7 +43,7 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 
 from .namelist import read_scene
-from .results import Curve, read_curve
+from .results import Curve, incomplete_reason, read_curve
 from .units import UNITS, WIDTH_UNITS, find_unit
 
 __all__ = ["FabricExportError", "Branch", "ComponentCurves", "fabric_curves",
@@ -253,6 +254,11 @@ def fabric_curves(folder: str | Path, component: str = "1", *,
         without the component's columns or rows, or a strain that never grows.
     ResultError, OSError
         If curve.csv cannot be read.
+
+    Warns
+    -----
+    RuntimeWarning
+        If the run stopped before the end of its load path (its curves are cut short).
     """
     component = str(component)
     if component not in COMPONENTS:
@@ -263,6 +269,9 @@ def fabric_curves(folder: str | Path, component: str = "1", *,
         raise FabricExportError(f"no output folder {str(folder)!r}")
     _check_periodic(folder)
     curve = read_curve(folder)
+    if reason := incomplete_reason(folder, curve):
+        warnings.warn(f"{folder}: {reason}; the exported curves end there", RuntimeWarning,
+                      stacklevel=2)
     strain_column, force_column = _columns(curve, component, folder, uniaxial)
     if len(curve) < 2:
         raise FabricExportError(f"run {str(folder)!r}: curve.csv has {len(curve)} rows,"
@@ -363,7 +372,7 @@ def parse_length(text: str | float, what: str = "--thickness") -> float:
                                 ) from None
     metres = value * WIDTH_UNITS[unit]
     if not (np.isfinite(metres) and metres > 0):
-        raise FabricExportError(f"{what} {text!r}: a thickness must be positive and finite")
+        raise FabricExportError(f"{what} {text!r}: must be positive and finite")
     return metres
 
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 import csv
 import errno
 import re
+import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -356,6 +357,13 @@ def read_curve(path: str | Path) -> Curve:
         a number (the message names the file, line and column).
     OSError
         If the file cannot be read.
+
+    Warns
+    -----
+    RuntimeWarning
+        If the last row has no line end (a run killed while writing it): that row is
+        left out (as a restart drops it), as in :func:`read_reactions` and
+        :func:`read_contacts`.
     """
     return _read_csv(_curve_file(path), ())
 
@@ -368,7 +376,14 @@ def _read_csv(path: Path, text_columns: tuple[str, ...]) -> Curve:
     """A step file of the run: a header line, then rows of numbers (text in the named
     `text_columns`, kept as str)."""
     with open(path, newline="") as stream:
-        rows = list(csv.reader(stream))
+        text = stream.read()
+    rows = list(csv.reader(text.splitlines()))
+    # Every row the program writes ends with a line end; a last row without one was cut
+    # short by a kill (its last number may be cut to another valid one): left out.
+    if len(rows) > 1 and not text.endswith(("\n", "\r")):
+        warnings.warn(f"{path}, line {len(rows)}: the last row has no line end (cut short"
+                      " by a killed run); it is left out", RuntimeWarning, stacklevel=3)
+        rows = rows[:-1]
     if not rows or not any(cell.strip() for cell in rows[0]):
         raise ResultError(f"{path}: empty file (no header line): not a complete"
                           " yarnfort curve")
@@ -611,12 +626,20 @@ def read_run(folder: str | Path) -> Any:
     Returns
     -------
     RunResult
-        ``outcome`` is ``'read'`` (not run here), ``n_steps`` the rows of its curve.
+        ``outcome`` is ``'read'`` (not run here), or ``'incomplete'`` when the curve
+        ends before the end of the load path of the run's ``input.nml`` (a failed step,
+        Ctrl-C, ``max_steps``, a killed run or one still going); ``n_steps`` the rows
+        of its curve.
 
     Raises
     ------
     ResultError
         If the folder holds no readable ``curve.csv``.
+
+    Warns
+    -----
+    RuntimeWarning
+        For an incomplete run, naming where its curve ends and where the path does.
     """
     from .runner import RunResult
 
@@ -624,4 +647,35 @@ def read_run(folder: str | Path) -> Any:
     if not folder.is_dir():
         raise ResultError(f"no output folder {str(folder)!r}")
     curve = read_curve(folder)
-    return RunResult(folder.resolve(), len(curve), "read")
+    missing = incomplete_reason(folder, curve)
+    if missing:
+        warnings.warn(f"{folder}: {missing}", RuntimeWarning, stacklevel=2)
+    return RunResult(folder.resolve(), len(curve), "incomplete" if missing else "read")
+
+
+#: A curve ends at the path's end when its last time is within this fraction of the
+#: path's largest |time| (steps land on the knots; only round-off is forgiven).
+PATH_END_TOLERANCE = 1e-9
+
+
+def incomplete_reason(folder: Path, curve: Curve) -> str:
+    """Why the run of `folder` did not reach the end of its load path ('' if it did, or
+    if its input.nml gives no path to judge by)."""
+    try:
+        import f90nml
+
+        times = np.atleast_1d(np.asarray(f90nml.read(folder / "input.nml")["path"]["time"],
+                                         dtype=float))
+    except Exception:  # noqa: BLE001 - no echo to judge by: nothing is claimed
+        return ""
+    times = times[np.isfinite(times)]
+    if times.size == 0 or "time" not in curve.columns:
+        return ""
+    end = float(times[-1])
+    if len(curve) and curve["time"][-1] >= end - PATH_END_TOLERANCE * np.abs(times).max():
+        return ""
+    reached = (f"the curve ends at step {int(curve['step'][-1])}, time"
+               f" {float(curve['time'][-1]):g}" if len(curve) else "the curve has no step")
+    return (f"incomplete run: {reached}, the load path at {end:g} (a failed step, Ctrl-C,"
+            " max_steps, a killed run or one still going; &control restart = .true."
+            " goes on)")

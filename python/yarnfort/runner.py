@@ -96,7 +96,8 @@ class RunResult:
         ``&control max_steps``), ``'stopped'`` (stopped by the call-back),
         ``'interrupted'`` (Ctrl-C) or ``'failed'`` (a failed solve; see
         :class:`~yarnfort.YarnfortError`); ``'read'`` for a folder read by
-        :func:`~yarnfort.read_run`.
+        :func:`~yarnfort.read_run`, ``'incomplete'`` for one whose curve ends before its
+        load path does.
     """
 
     folder: Path

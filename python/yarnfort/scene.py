@@ -124,9 +124,14 @@ def _check_value(group: str, var: dict[str, Any], value: Any, where: str) -> Non
         if kind == "character":
             if not isinstance(entry, str):
                 raise SceneError(f"{where} {name}: expected a string, got {entry!r}")
-            if len(entry) > var["length"]:
+            # The reader counts bytes: 'ü' is two in UTF-8.
+            if len(entry.encode("utf-8")) > var["length"]:
                 raise SceneError(f"{where} {name}: {entry!r} is longer than"
-                                 f" {var['length']} characters")
+                                 f" {var['length']} characters (bytes in UTF-8)")
+            # f90nml writes a line break as the two characters '\n': refused, not changed.
+            if any(ord(char) < 32 and char != "\t" or ord(char) == 127 for char in entry):
+                raise SceneError(f"{where} {name}: {entry!r} holds a line break or other"
+                                 " control character, which a namelist string cannot hold")
             choices = var["choices"]
             folded = entry.lower() if var["lower"] else entry
             advice = (var.get("retired") or {}).get(folded)
@@ -197,6 +202,9 @@ def _ids(value: ArrayLike, where: str, minimum: int = 1) -> np.ndarray:
 def _optional_float(value: Any, where: str) -> float | None:
     if value is None:
         return None
+    # float(True) and float('10') would pass as 1.0 and 10.0: a number is asked for.
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise SceneError(f"{where}: expected a number, got {value!r}")
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -561,14 +569,15 @@ class LoadPath:
     def __post_init__(self) -> None:
         self.time = np.atleast_1d(_reals(self.time, "&path time"))
         if self.time.ndim != 1 or self.time.size < 2:
-            raise SceneError("&path time: expected at least two knots")
+            raise SceneError(f"&path time: expected a list of at least two knots, got shape"
+                             f" {self.time.shape}")
         for key in ("p_force", "p_disp"):
             value = getattr(self, key)
             if value is not None:
                 array = np.atleast_1d(_reals(value, f"&path {key}"))
                 if array.shape != self.time.shape:
-                    raise SceneError(f"&path {key}: {array.size} values for"
-                                     f" {self.time.size} knots")
+                    raise SceneError(f"&path {key}: shape {array.shape} for"
+                                     f" {self.time.size} knots (one value per knot)")
                 setattr(self, key, array)
         if self.channels is not None:
             names = [self.channels] if isinstance(self.channels, str) else list(self.channels)
@@ -706,7 +715,11 @@ class Scene:
         """The settings dicts (and the extras of &nodes) against the description: they
         can change after construction, so :meth:`validate` checks them again."""
         for group in _SETTINGS:
-            _check_group(group, getattr(self, group), f"Scene {group}")
+            settings = getattr(self, group)
+            for key, value in settings.items():  # output={'folder': Path(...)}: a name
+                if isinstance(value, os.PathLike):
+                    settings[key] = os.fspath(value)
+            _check_group(group, settings, f"Scene {group}")
         _check_group("nodes", self.nodes_extra, "&nodes")
 
     def __repr__(self) -> str:

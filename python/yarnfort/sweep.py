@@ -19,9 +19,10 @@ for ``yarnfort < scene.nml`` and :func:`yarnfort.run_scene` run from there.
 Parameter addresses
 -------------------
 The grammar of :mod:`yarnfort.address`: ``'solver.max_step'``,
-``'contact[0].friction_coefficient'``, ``'support[pull].displacement'``. Addresses and
-the summarised support are checked before any run starts (:class:`ValueError`); a value
-the program rejects gives a row with status ``'bad_input'`` and its message.
+``'contact[0].friction_coefficient'``, ``'support[pull].displacement'``. Addresses (their
+form, and that the group and variable are input variables) and the summarised support
+are checked before any run starts (:class:`ValueError`); a value the
+program rejects gives a row with status ``'bad_input'`` and its message.
 
 Dask
 ----
@@ -49,8 +50,8 @@ import numpy as np
 
 from ._native import YarnfortError
 from ._program import program_path
-from .address import AddressError, parse_address, set_parameter
-from .results import Curve, read_curve
+from .address import AddressError, check_address, set_parameter
+from .results import Curve, incomplete_reason, read_curve
 
 __all__ = ["run_sweep", "run_patched", "parameter_grid"]
 
@@ -99,6 +100,16 @@ def _summary(curve: Curve, support: str, component: int | None) -> tuple[float, 
     return float(value[-1]), float(value[np.argmax(np.abs(value))])
 
 
+def _stamp(path: Path) -> tuple[int, int, int] | None:
+    """Identity of a file (inode, modification time, size), None if there is none: the
+    program writes curve.csv as a new file, so a run that wrote one changes it."""
+    try:
+        info = path.stat()
+    except OSError:
+        return None
+    return info.st_ino, info.st_mtime_ns, info.st_size
+
+
 def _execute(task: _Task) -> dict[str, Any]:
     """Run one task and summarise it; never raises (errors become the row's message)."""
     start = time.perf_counter()
@@ -110,6 +121,8 @@ def _execute(task: _Task) -> dict[str, Any]:
         folder.mkdir(parents=True, exist_ok=True)
         text = task.text.replace("@FOLDER@", str(folder / "out"))
         (folder / "input.nml").write_text(text)
+        curve_file = folder / "out" / "curve.csv"
+        before = _stamp(curve_file)  # a kept work_dir may hold an earlier sweep's curve
         env = dict(os.environ)
         env.setdefault("OMP_NUM_THREADS", "1")  # one core per run: runs are the parallelism
         program = task.program or str(program_path())
@@ -119,8 +132,8 @@ def _execute(task: _Task) -> dict[str, Any]:
         if proc.returncode != 0:
             lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
             row["error"] = lines[-1] if lines else f"exit code {proc.returncode}"
-        curve_file = folder / "out" / "curve.csv"
-        if curve_file.is_file():
+        # Exit 2 writes nothing, and a curve this run did not replace is an earlier one.
+        if proc.returncode != 2 and curve_file.is_file() and _stamp(curve_file) != before:
             curve = read_curve(curve_file)
             row["n_steps"] = len(curve["step"])
             known = [name[:-3] for name in curve.names if name.endswith("_rx")]
@@ -133,6 +146,10 @@ def _execute(task: _Task) -> dict[str, Any]:
             elif proc.returncode == 0:
                 row["final_reaction"], row["max_reaction"] = _summary(
                     curve, task.support, task.component)
+                # Exit 0 also ends a run at &control max_steps: its last step is not
+                # the path's end.
+                if reason := incomplete_reason(curve_file.parent, curve):
+                    row["status"], row["error"] = "max_steps", reason
     except subprocess.TimeoutExpired:
         row["status"], row["error"] = "error", f"timed out after {task.timeout} s"
     except Exception as error:  # noqa: BLE001 - a row reports any failure of its run
@@ -170,8 +187,9 @@ def run_patched(scene_path: str | os.PathLike, values: Mapping[str, Any],
     Raises
     ------
     YarnfortError
-        If the program fails (status 1 failed solve, 2 bad input); the message is the
-        program's.
+        If the program fails (status 1 failed solve, 2 bad input; the message is the
+        program's), or stops before the end of the load path (status 1: ``&control
+        max_steps``).
     """
     scene = f90nml.read(Path(scene_path))
     folder = Path(folder).resolve()
@@ -187,7 +205,11 @@ def run_patched(scene_path: str | os.PathLike, values: Mapping[str, Any],
         lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
         raise YarnfortError(lines[-1] if lines else f"exit code {proc.returncode}",
                             proc.returncode)
-    return read_curve(folder / "out")
+    curve = read_curve(folder / "out")
+    # Exit 0 also ends a run at &control max_steps: a fit would compare a cut curve.
+    if reason := incomplete_reason(folder / "out", curve):
+        raise YarnfortError(f"{reason} (&control max_steps in the scene?)", 1)
+    return curve
 
 
 def parameter_grid(parameters: Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]]
@@ -204,9 +226,19 @@ def parameter_grid(parameters: Mapping[str, Sequence[Any]] | Sequence[Mapping[st
     -------
     list of dict
         One dict address -> value per run.
+
+    Raises
+    ------
+    TypeError
+        If the values of an address are a string (not a list of values).
     """
     if isinstance(parameters, Mapping):
         names = list(parameters)
+        for name in names:
+            # A string is a sequence too: 'table' would be swept as 't', 'a', 'b', ...
+            if isinstance(parameters[name], (str, bytes)):
+                raise TypeError(f"{name!r}: expected a list of values, got the string"
+                                f" {parameters[name]!r} (for one value: [{parameters[name]!r}])")
         return [dict(zip(names, combo))
                 for combo in itertools.product(*(list(parameters[n]) for n in names))]
     return [dict(values) for values in parameters]
@@ -347,7 +379,9 @@ def run_sweep(scene_path: str | os.PathLike,
     -------
     dict of str to numpy.ndarray
         One entry per run, in the order of the runs: a column per parameter address, and
-        ``status`` (``'ok'``, ``'solve_failed'``, ``'bad_input'`` or ``'error'``),
+        ``status`` (``'ok'``, ``'max_steps'`` (stopped before the path's end by
+        ``&control max_steps``; its reactions are those of its last step),
+        ``'solve_failed'``, ``'bad_input'`` or ``'error'``),
         ``error`` (the program's message, ``''`` when ok), ``n_steps`` (converged steps
         written, initial state included), ``final_reaction`` and ``max_reaction`` (the
         summarised reaction at the last step and the one of largest magnitude, N; NaN for
@@ -357,10 +391,12 @@ def run_sweep(scene_path: str | os.PathLike,
     Raises
     ------
     ValueError
-        For a malformed parameter address, an unknown component, or a support the scene
-        does not have (checked before any run against its ``&support`` groups; for a
-        generated ``&fabric``, on the runs' curves); the program's failures do not raise
-        (they are rows).
+        For a malformed parameter address or one of a group or variable the input does
+        not have, or a value of ``output.folder``, ``output.progress`` or (without
+        ``vtk``) ``output.vtk_every`` other than the sweep sets; an unknown component, or a
+        support the scene does not have (checked before any run against its ``&support``
+        groups; for a generated ``&fabric``, on the runs' curves); the program's failures
+        do not raise (they are rows).
     FileNotFoundError
         If the installation has no program.
     """
@@ -369,9 +405,18 @@ def run_sweep(scene_path: str | os.PathLike,
     names = list(dict.fromkeys(name for run in runs for name in run))
     for name in names:
         try:
-            parse_address(name)
+            where = check_address(name)
         except AddressError as error:
             raise ValueError(str(error)) from None
+        # The sweep sets these for every run: a swept value other than its own would be
+        # overwritten (every folder is: the sentinel equals no value).
+        own = {"folder": object(), "progress": False, "vtk_every": 0}
+        if (where.group == "output" and where.variable in own
+                and not (where.variable == "vtk_every" and vtk)
+                and any(name in run and run[name] != own[where.variable] for run in runs)):
+            raise ValueError(f"{name!r}: the sweep sets &output {where.variable} of every"
+                             " run itself (its own folder, no progress lines, vtk_every ="
+                             " 0 unless vtk=True)")
     support = _check_support(scene, support)
     if isinstance(component, str):
         if component.lower() not in _COMPONENTS:

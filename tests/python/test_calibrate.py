@@ -340,3 +340,24 @@ def test_the_derivative_check_differences_and_compares_columns():
     np.testing.assert_allclose(_mismatch(a, a), [0.0, 0.0])
     np.testing.assert_allclose(_mismatch(a, a * [1.0, -1.0]), [0.0, 2.0])
     assert _mismatch(np.zeros((2, 1)), np.zeros((2, 1)))[0] == 0.0
+
+
+def test_a_sample_width_in_mm_given_as_metres_is_refused(tmp_path, monkeypatch):
+    from yarnfort.calibrate import sample_width
+
+    # By hand: 50 mm = 0.05 m, 5 cm = 0.05 m, 2 in = 2 x 0.0254 m.
+    assert sample_width("50 mm") == pytest.approx(0.05, rel=1e-15)
+    assert sample_width("5cm") == pytest.approx(0.05, rel=1e-15)
+    assert sample_width("2 in") == pytest.approx(0.0508, rel=1e-15)
+    assert sample_width(0.05) == 0.05 and sample_width(None) is None
+    with pytest.raises(ValueError, match=r"width = 50: a sample 50 m wide\? .*50 mm is 0.05"):
+        sample_width(50)
+    for bad in (0.0, -0.05, float("nan"), True, "50"):
+        with pytest.raises(ValueError, match="width"):
+            sample_width(bad)
+    # A strip of 50 mm given as width=50 would scale the model's force 1000 times.
+    monkeypatch.chdir(TOP)
+    csv = tmp_path / "sample.csv"
+    csv.write_text("strain (%),force (N)\n1,2\n2,4\n3,6\n")
+    with pytest.raises(ValueError, match="width = 50"):
+        calibrate(BELT, csv, {GAP: (0.9, 0.3, 1.0)}, width=50)

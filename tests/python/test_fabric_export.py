@@ -18,6 +18,7 @@ import csv
 import shutil
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -487,3 +488,22 @@ def test_csv_names_the_force_it_holds(runs, tmp_path):
                                    rtol=1e-9)
     text = export_fabric({"1": folder}, tmp_path / "n.inp", thickness="0.6mm").read_text()
     assert "n11 at the first step" in text
+
+
+def test_a_run_cut_short_is_exported_with_a_warning(runs, tmp_path):
+    # Stopped after 6 steps of 0.1 (max_steps, as Ctrl-C or a failed step would): its
+    # loading ends at strain 0.36 of the path's 0.6 and it has no unloading.
+    where = runs["partial"].parents[1]
+    cut = _run(where, "cut", strain=0.6, time="0, 1, 2", p_disp="0, 1, 0",
+               template=KNIT + "&control max_steps = 6 /\n")
+    with pytest.warns(RuntimeWarning, match=r"incomplete run: the curve ends at step 6,"
+                      r" time 0\.6, the load path at 2"):
+        curves = yarnfort.fabric_curves(cut, "1", uniaxial=True)
+    assert curves.loading.strain[-1] == pytest.approx(0.6 * 0.6, rel=WRITTEN)
+    done = _cli(str(cut), "--component", "1", "--uniaxial", "--format", "csv",
+                "--no-unloading", "-o", str(tmp_path / "cut.csv"))
+    assert done.returncode == 0 and "warning:" in done.stderr
+    assert "incomplete run" in done.stderr
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a whole run: no warning
+        yarnfort.fabric_curves(runs["other"], "1", uniaxial=True)

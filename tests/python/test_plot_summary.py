@@ -208,3 +208,17 @@ def test_fabric_curve_is_labelled_per_reference_width(runs):
     per_reference = curve["n11"][:rows] * (1.0 + curve["e22"][:rows])
     np.testing.assert_allclose(loading.get_ydata(), per_reference, rtol=1e-9)
     assert curve["e22"].min() < -0.4  # the widths differ: the label matters here
+
+
+def test_a_peak_without_a_saved_state_is_said(tmp_path):
+    # vnet in steps of 0.1 peaks at step 10 (p_force = 1, 0.5 N); with vtk_every = 4
+    # the states are steps 0, 4, 8, 12, ...: the network shown is step 8 (0.4 N).
+    scene = yarnfort.read_scene(TOP / "inputs" / "vnet.nml")
+    yarnfort.set_parameter(scene, "output.folder", str(tmp_path / "out"))
+    yarnfort.set_parameter(scene, "output.vtk_every", 4)
+    yarnfort.run_scene(yarnfort.write_scene(scene, tmp_path / "vnet.nml"))
+    figure = summary_figure(tmp_path / "out")
+    assert figure.axes[1].get_title() == ("largest force of the saved states: step 8\n"
+                                          "(the peak, step 10, has no saved state)")
+    marker = [line for line in figure.axes[0].get_lines() if line.get_gid() == "shown_step"]
+    assert marker[0].get_ydata()[0] == pytest.approx(0.8 * 0.5, rel=1e-12)

@@ -150,3 +150,52 @@ def test_minus_one_read_from_a_namelist_is_a_value(tmp_path):
     path.write_text(text.replace("stiffness = 10.0", "stiffness = -1.0"))
     with pytest.raises(SceneError, match=r"stiffness = -1.0 N: must be > 0"):
         Scene.read(path)
+
+
+def test_a_bool_or_a_string_is_no_number():
+    # float(True) is 1.0 and float('10') 10.0: they used to pass as a stiffness.
+    with pytest.raises(SceneError, match="'a' stiffness: expected a number, got True"):
+        scene().add_material("a", "linear", stiffness=True)
+    with pytest.raises(SceneError, match="prestress: expected a number, got '10'"):
+        scene().add_material("a", "linear", stiffness=1.0, prestress="10")
+
+
+def test_a_string_is_measured_in_bytes_and_holds_no_line_break(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+
+    def vnet(title: str) -> Scene:
+        built = Scene(title, output={"folder": "out"})
+        built.add_material("yarn", "linear", stiffness=10.0)
+        built.nodes = [[-1.0, 0, 0], [0, -0.2, 0], [1, 0, 0]]
+        built.add_yarn("yarn", [1, 2, 3])
+        built.add_support("ends", [1, 3])
+        built.add_support("plane", [2], fix="z")
+        built.add_load([2], force=[0, -0.5, 0])
+        built.path = LoadPath(time=[0, 1], p_force=[0, 1])
+        return built
+
+    # 'ü' is 2 bytes in UTF-8 and &control title holds 256: 128 fit, 129 do not.
+    vnet("\u00fc" * 128).check()  # the library agrees
+    with pytest.raises(SceneError, match="longer than 256 characters"):
+        vnet("\u00fc" * 129)
+    # f90nml would write the break as the two characters '\n'.
+    with pytest.raises(SceneError, match="title: 'two\\\\nlines' holds a line break"):
+        vnet("two\nlines")
+
+
+def test_a_path_of_another_shape_is_named_by_its_shape():
+    # A (2, 1) column of two values used to be '2 values for 2 knots'.
+    with pytest.raises(SceneError, match=r"p_force: shape \(2, 1\) for 2 knots"):
+        LoadPath(time=[0, 1], p_force=[[0], [1]])
+    with pytest.raises(SceneError, match=r"time: expected a list of at least two knots, got"
+                       r" shape \(1, 2\)"):
+        LoadPath(time=[[0, 1]])
+
+
+def test_an_output_folder_may_be_a_path(tmp_path):
+    built = Scene("path", output={"folder": tmp_path / "out"})
+    assert built.output["folder"] == str(tmp_path / "out")
+    built.control["title"] = Path("later")  # set after construction: written as text
+    built.add_material("yarn", "linear", stiffness=1.0)
+    built.path = LoadPath(time=[0, 1])
+    assert built.to_namelist()["control"]["title"] == "later"

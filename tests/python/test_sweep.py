@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import yarnfort
 from yarnfort import program_path, read_curve
 from yarnfort.results import read_contacts
-from yarnfort.sweep import parameter_grid, run_sweep
+from yarnfort.sweep import parameter_grid, run_patched, run_sweep
 
 TOP = Path(__file__).resolve().parents[2]
 CAPSTAN = TOP / "inputs" / "capstan.nml"
@@ -126,3 +127,52 @@ def test_default_summary_is_the_pulled_support(tmp_path):
     high = (low + beta * used) * np.exp(mu * (angle - used))
     assert table["max_reaction"][0] == pytest.approx(high, rel=1e-8)
     assert table["max_reaction"][0] > 2.0 * low  # not the fixed end's reaction
+
+
+def test_a_misspelled_group_or_variable_is_rejected_before_any_run(tmp_path):
+    # Each run would otherwise fail alone, as a bad_input row.
+    with pytest.raises(ValueError, match="no variable 'friction_coeficient'; did you mean"
+                       " 'friction_coefficient'"):
+        run_sweep(CAPSTAN, {"contact[0].friction_coeficient": [0.2]}, progress=False,
+                  work_dir=tmp_path)
+    with pytest.raises(ValueError, match="no group 'solvr'; did you mean 'solver'"):
+        run_sweep(CAPSTAN, {"solvr.max_step": [0.2]}, progress=False, work_dir=tmp_path)
+    assert not list(tmp_path.iterdir())  # nothing ran
+
+
+def test_a_failed_run_in_a_kept_folder_does_not_report_an_earlier_curve(tmp_path):
+    run_sweep(CAPSTAN, {MU: [0.25]}, workers=1, progress=False, work_dir=tmp_path)
+    earlier = tmp_path / "run_00000" / "out" / "curve.csv"
+    rows = len(read_curve(earlier))
+    assert rows > 1
+    text = earlier.read_bytes()
+    table = run_sweep(CAPSTAN, {MU: [-0.25]}, workers=1, progress=False,
+                      work_dir=tmp_path)
+    # Bad input writes nothing: the row has no step, the earlier curve stays as it was.
+    assert list(table["status"]) == ["bad_input"] and list(table["n_steps"]) == [0]
+    assert earlier.read_bytes() == text
+
+
+def test_a_string_is_not_a_list_of_values():
+    # list('table') would be five runs of laws 't', 'a', 'b', 'l', 'e'.
+    with pytest.raises(TypeError, match=r"'material\[0\].law': expected a list of values"):
+        parameter_grid({"material[0].law": "table"})
+    assert parameter_grid({"material[0].law": ["table"], MU: [0.1, 0.2]}) == [
+        {"material[0].law": "table", MU: 0.1}, {"material[0].law": "table", MU: 0.2}]
+
+
+def test_a_run_stopped_by_max_steps_is_not_ok(tmp_path):
+    # capstan's path ends at time 2; 3 steps of at most 0.1 end well before it.
+    runs = [{MU: 0.3, "control.max_steps": 3}, {MU: 0.3}]
+    table = run_sweep(CAPSTAN, runs, workers=1, progress=False, support="pull")
+    assert list(table["status"]) == ["max_steps", "ok"]
+    assert list(table["n_steps"])[0] == 4 and "incomplete run" in table["error"][0]
+    with pytest.raises(yarnfort.YarnfortError, match="incomplete run.*max_steps"):
+        run_patched(CAPSTAN, {"control.max_steps": 3}, tmp_path)
+
+
+def test_an_output_setting_the_sweep_makes_itself_is_refused():
+    for address, value in (("output.folder", "out/mine"), ("output.progress", True),
+                           ("output.vtk_every", 5)):
+        with pytest.raises(ValueError, match=f"'{address}': the sweep sets &output"):
+            run_sweep(CAPSTAN, {address: [value]}, progress=False)
