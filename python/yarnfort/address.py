@@ -194,7 +194,7 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def _from_first(instance: f90nml.Namelist, variable: str) -> Any:
+def entries_from_first(instance: f90nml.Namelist, variable: str) -> Any:
     """A variable's value counted from its first entry. f90nml keeps ``x(2) = 5`` as
     ``[5]`` with a start index 2: read as it is, entry 0 would be x(2). Entries before
     the start are None (null when written: the default stays)."""
@@ -222,7 +222,7 @@ def _entry(instance: f90nml.Namelist, where: Address) -> tuple[list, int]:
     if where.variable not in instance:
         raise AddressError(f"{where.text!r}: &{where.group} has no variable"
                            f" {where.variable!r} set (an entry needs the list set)")
-    value = _from_first(instance, where.variable)
+    value = entries_from_first(instance, where.variable)
     items = list(value) if isinstance(value, list) else [value]
     if not -len(items) <= where.element < len(items):
         raise AddressError(f"{where.text!r}: &{where.group} {where.variable} has"
@@ -258,7 +258,7 @@ def get_parameter(nml: f90nml.Namelist, address: str) -> Any:
     if where.variable not in instance:
         raise AddressError(f"{address!r}: &{where.group} has no variable"
                            f" {where.variable!r} set")
-    return _from_first(instance, where.variable)
+    return entries_from_first(instance, where.variable)
 
 
 def set_parameter(nml: f90nml.Namelist, address: str, value: Any) -> f90nml.Namelist:

@@ -57,6 +57,7 @@ import f90nml
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .address import AddressError, entries_from_first
 from .namelist import make_namelist, read_scene
 from .resources import input_description
 
@@ -235,17 +236,15 @@ def _variables(obj: Any, skip: tuple[str, ...] = ()) -> dict[str, Any]:
 
 
 def _expanded(group: f90nml.Namelist) -> dict[str, Any]:
-    """The variables of a read group, each array from its first entry: f90nml keeps
-    ``x(2) = 5`` as ``[5]`` with a start index; entries before it become None (a null
-    value when written, so the default stays)."""
-    starts = getattr(group, "start_index", {}) or {}
+    """The variables of a read group, each array from its first entry
+    (:func:`~yarnfort.address.entries_from_first`); one given from a start index in more
+    than one dimension as read."""
     out: dict[str, Any] = {}
-    for key, value in group.items():
-        start = starts.get(key)
-        if start and len(start) == 1 and start[0] is not None and start[0] > 1:
-            value = [None] * (start[0] - 1) + (list(value) if isinstance(value, list)
-                                                else [value])
-        out[key] = value
+    for key in group:
+        try:
+            out[key] = entries_from_first(group, key)
+        except AddressError:
+            out[key] = group[key]
     return out
 
 
