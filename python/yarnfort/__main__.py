@@ -8,6 +8,8 @@
 - ``python -m yarnfort plot-states <output folder> [-o FILE] [--strains 0 0.5 1] ...``
   writes a PNG of the deformed states nearest to the given strains, coloured by tension
   on one scale (:func:`yarnfort.plots.plot_states`);
+- ``python -m yarnfort plot-membrane <output folder> [-o FILE]`` writes a PNG of a
+  periodic-cell run's membrane forces against its strain (:func:`yarnfort.plots.plot_membrane`);
 - ``python -m yarnfort examples DIR [--force]`` writes the example scenes with their
   tables and models into ``DIR/inputs/`` (run one there: ``cd DIR && yarnfort <
   inputs/vnet.nml``);
@@ -318,7 +320,8 @@ def _ranges(steps: list[int]) -> str:
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m yarnfort",
-        description="yarnfort result tools: plot a run's output folder.")
+        description="yarnfort tools: plot a run's output folder, export a fabric's curves,"
+                    " write the example scenes, print the input reference.")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     plot = commands.add_parser(
         "plot", help="write a PNG: force-displacement loop, network at the peak, history",

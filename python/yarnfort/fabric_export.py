@@ -600,7 +600,8 @@ def export_fabric(runs: Mapping[str, str | Path] | Iterable[tuple[str, str | Pat
     Parameters
     ----------
     runs : mapping or iterable of (component, run folder)
-        Which run gives which component: ``{'1': 'out/knit', '2': 'out/knit_wale'}``.
+        Which run gives which component: ``{'1': 'out/knit', '2': 'out/knit_wale'}``
+        (with ``uniaxial=True`` when ``out/knit_wale`` is the cell turned by 90 degrees).
         One folder may give several components when its curve.csv has the membrane
         columns (see the module notes).
     out : str or Path

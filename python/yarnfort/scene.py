@@ -30,8 +30,9 @@ files, the output folder) are taken from the working directory of the run, as fo
 
 Example
 -------
-A V-shaped string under a point load (``inputs/vnet.nml`` built in Python; ``python -m
-yarnfort examples DIR`` writes the example scenes)::
+A string under a central point load, as in ``inputs/vnet.nml`` but straight at the start
+and loaded once, that the load draws into a V (``python -m yarnfort examples DIR`` writes
+the example scenes)::
 
     import numpy as np, yarnfort
     scene = yarnfort.Scene("V-net", output={"folder": "out/vnet_py"})

@@ -148,7 +148,7 @@ contains
             'Table files state their units: a header such as "Elongation (%),Force (cN)"', &
             'or &material strain_unit, force_unit (an elongation in mm: gauge_length);', &
             'none: strain and N. &geometry unit (or a unit line) converts a file to m.', &
-            'Examples: inputs/*.nml.', &
+            'Examples: inputs/*.nml (installed: python -m yarnfort examples DIR).', &
             ''
         write(output_unit, '(a)') (trim(input_help_lines(i)), i = 1, size(input_help_lines))
         write(output_unit, '(a)') &
@@ -157,8 +157,10 @@ contains
             'factors, reactions and displacements of the supports, load displacements),', &
             'state_NNNNN.vtu (5 or more digits; binary, or &output vtk_format = ''ascii'')', &
             'with its blocks holders_, links_, passages_NNNNN.vtu, state_NNNNN.vtm (the', &
-            'blocks by name) + states.pvd (ParaView: the series of .vtm)', &
-            'and input.nml (the effective input); it lists them in', &
+            'blocks by name) + states.pvd (ParaView: the series of .vtm),', &
+            'contacts.csv (one row per sliding passage and step; &output contact_state),', &
+            'reactions.csv (with &output node_reactions: one row per constrained node', &
+            'and step) and input.nml (the effective input); it lists them in', &
             '.yarnfort-manifest and deletes only files listed there, and holds the lock', &
             '.yarnfort-lock while it runs (a second run into the folder stops at once).', &
             'Progress lines go to stderr. Exit code 0 on success, 1 if the solve or a write', &

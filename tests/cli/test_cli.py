@@ -23,6 +23,10 @@ def test_help(run_yarnfort):
     run = run_yarnfort("", "--help")
     assert run.returncode == 0
     assert "usage: yarnfort" in run.stdout and "REFERENCE.md" in run.stdout
+    # Every table and file a run writes is named (README.md, *Outputs*).
+    for name in ("curve.csv", "contacts.csv", "reactions.csv", "input.nml", "restart.dat",
+                 "states.pvd", "state_NNNNN.vtu"):
+        assert name in run.stdout, name
 
 
 def test_version_matches_meson_project(run_yarnfort):

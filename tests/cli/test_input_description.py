@@ -26,7 +26,7 @@ def check_reference(path: Path) -> subprocess.CompletedProcess:
 def test_reference_tables_match_the_description():
     run = check_reference(REFERENCE)
     assert run.returncode == 0, ("inputs/REFERENCE.md and variables.py disagree; run "
-                                 "src/yarnfort/input/generate.py update inputs/REFERENCE.md"
+                                 "python src/yarnfort/input/generate.py update inputs/REFERENCE.md"
                                  "\n" + run.stdout + run.stderr)
 
 

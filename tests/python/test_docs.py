@@ -6,8 +6,10 @@ from __future__ import annotations
 import importlib
 import inspect
 import os
+import re
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -59,3 +61,37 @@ def test_api_docs_build_offline(tmp_path):
     assert "add_material" in page and "Parameters" in page
     runner = (tmp_path / "yarnfort" / "runner.html").read_text()
     assert "RunInterrupted" in runner and "step boundary" in runner
+
+
+def _github_anchor(heading: str) -> str:
+    """The anchor GitHub gives a Markdown heading: lowercase, punctuation dropped,
+    spaces as hyphens."""
+    text = re.sub(r"[^\w\- ]", "", heading.strip().lower())
+    return text.replace(" ", "-")
+
+
+def test_relative_markdown_links_resolve():
+    """Every relative link and image of the tracked Markdown files names a file that
+    exists, and a #fragment a heading of it."""
+    top = Path(__file__).resolve().parents[2]
+    listed = subprocess.run(["git", "ls-files", "*.md"], cwd=top, capture_output=True,
+                            text=True)
+    if listed.returncode != 0:
+        pytest.skip("not a git checkout")
+    link = re.compile(r"\]\(([^)\s]+)\)|<img src=\"([^\"]+)\"")
+    problems = []
+    for name in listed.stdout.split():
+        page = top / name
+        for match in link.finditer(page.read_text()):
+            target = match.group(1) or match.group(2)
+            if re.match(r"[a-z][a-z0-9+.-]*:", target):
+                continue  # https:, mailto: ...
+            path, _, fragment = target.partition("#")
+            linked = (page.parent / path) if path else page
+            if not linked.exists():
+                problems.append(f"{name}: {target}: no such file")
+            elif fragment and linked.suffix == ".md":
+                headings = re.findall(r"^#+ (.+)$", linked.read_text(), re.MULTILINE)
+                if fragment not in {_github_anchor(h) for h in headings}:
+                    problems.append(f"{name}: {target}: no such heading")
+    assert not problems, "\n".join(problems)
