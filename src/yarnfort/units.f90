@@ -14,6 +14,7 @@ module yarnfort_units
 
     public :: unit_type, find_unit, unit_names, to_scene_unit, get_header_unit
     public :: get_header_units, get_note_units, same_unit, note_unit_message
+    public :: find_note_conflict, unit_parser
     public :: header_shape_message
     public :: strain_kind, length_kind, force_kind
 
@@ -58,6 +59,18 @@ module yarnfort_units
         unit_type('gf', force_kind, standard_gravity, 1000.0_wp, .true.), &
         unit_type('kgf', force_kind, standard_gravity, 1.0_wp, .true.), &
         unit_type('lbf', force_kind, pound_force, 1.0_wp, .true.)]
+
+    abstract interface
+        !> The unit of a table's column `column` spelled `text` (`found` false for one
+        !> that column cannot take).
+        pure subroutine unit_parser(text, column, unit, found)
+            import :: unit_type
+            character(len=*), intent(in) :: text
+            integer, intent(in) :: column
+            type(unit_type), intent(out) :: unit
+            logical, intent(out) :: found
+        end subroutine unit_parser
+    end interface
 
 contains
 
@@ -213,6 +226,40 @@ contains
             if (scan(name, '0123456789') > 0) stated(:) = .false.
         end do
     end subroutine get_note_units
+
+    !> The first note before a table's rows (`notes`) that states, for a column whose
+    !> unit no header or setting gave (`open_column`), a unit (read by `parse`) other
+    !> than the one the column is read in (`units`): its index `note` and column
+    !> `column`, with the unit as written in `text`; `note` = 0 if there is none. Why:
+    !> such a note is a header the reader did not take, and its unit would be ignored.
+    subroutine find_note_conflict(notes, open_column, units, parse, note, column, text)
+        type(string_type), intent(in) :: notes(:)
+        logical, intent(in) :: open_column(2)
+        type(unit_type), intent(in) :: units(2)
+        procedure(unit_parser) :: parse
+        integer, intent(out) :: note, column
+        type(string_type), intent(out) :: text
+        type(string_type) :: fields(2), texts(2)
+        type(unit_type) :: unit
+        logical :: stated(2), found
+        integer :: c, k
+
+        note = 0
+        column = 0
+        do k = 1, size(notes)
+            call get_note_units(notes(k)%text, fields, texts, stated)
+            do c = 1, 2
+                if (.not. (stated(c) .and. open_column(c))) cycle
+                call parse(texts(c)%text, c, unit, found)
+                if (.not. found) cycle
+                if (same_unit(unit, units(c))) cycle
+                note = k
+                column = c
+                text = texts(c)
+                return
+            end do
+        end do
+    end subroutine find_note_conflict
 
     !> Whether two units measure the same kind with the same factor ('1' and '-').
     elemental logical function same_unit(a, b)

@@ -32,7 +32,7 @@ module yarnfort_friction_general
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
     use yarnfort_text, only: format_integer, format_real, quote_string, string_type
     use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &
-        get_header_units, get_note_units, same_unit, note_unit_message, &
+        get_header_units, get_note_units, find_note_conflict, note_unit_message, &
         header_shape_message, force_kind
     use yarnfort_friction_law, only: friction_law_type, tension_limit, rate_limit, no_kink, &
         scaled_exp, capped_product, capped_quotient, expm1, cap_critical_tension
@@ -333,26 +333,18 @@ contains
         character(len=*), intent(in) :: header
         type(unit_type), intent(in) :: units(2)
         type(error_type), allocatable, intent(out) :: error
-        type(string_type) :: fields(2), texts(2)
-        type(unit_type) :: unit
-        logical :: open_column(2), stated(2), found
-        integer :: c, k
+        type(string_type) :: fields(2), texts(2), text
+        logical :: stated(2)
+        integer :: k, c
 
         call get_header_units(header, fields, texts, stated)
-        open_column = .not. (stated .and. header_line > 0)
-        do k = 1, size(notes)
-            call get_note_units(notes(k)%text, fields, texts, stated)
-            do c = 1, 2
-                if (.not. (stated(c) .and. open_column(c))) cycle
-                call find_rate_unit(texts(c)%text, c, unit, found)
-                if (.not. found) cycle
-                if (same_unit(unit, units(c))) cycle
-                call fatal_error(error, note_unit_message(note_lines(k), c, fields(c)%text, &
-                    texts(c)%text, trim(units(c)%name), 'state the units in that header ' &
-                    // '(''T (cN),g (cN/rad)'')'))
-                return
-            end do
-        end do
+        call find_note_conflict(notes, .not. (stated .and. header_line > 0), units, &
+            find_rate_unit, k, c, text)
+        if (k == 0) return
+        call get_note_units(notes(k)%text, fields, texts, stated)
+        call fatal_error(error, note_unit_message(note_lines(k), c, fields(c)%text, &
+            text%text, trim(units(c)%name), 'state the units in that header ' &
+            // '(''T (cN),g (cN/rad)'')'))
     end subroutine check_rate_notes
 
     !> One row of a rate table on its own (the first: T = 0, g >= 0) or after the previous.

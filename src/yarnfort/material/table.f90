@@ -28,7 +28,7 @@ module yarnfort_material_table
     use yarnfort_text, only: format_real, format_integer, quote_string, string_type, to_lower
     use yarnfort_csv, only: csv_row_type, read_csv_pairs
     use yarnfort_units, only: unit_type, find_unit, unit_names, to_scene_unit, &
-        get_header_units, get_note_units, same_unit, note_unit_message, &
+        get_header_units, get_note_units, find_note_conflict, note_unit_message, &
         header_shape_message, strain_kind, length_kind, force_kind
     implicit none
     private
@@ -264,30 +264,33 @@ contains
         type(error_type), allocatable, intent(out) :: error
         character(len=*), parameter :: names(2) = [character(len=11) :: 'strain_unit', &
             'force_unit']
-        type(error_type), allocatable :: unknown
-        type(string_type) :: fields(2), texts(2)
-        type(unit_type) :: unit
+        type(string_type) :: fields(2), texts(2), text
         logical :: open_column(2), stated(2)
-        integer :: c, k
+        integer :: k, c
 
         call get_header_units(header, fields, texts, stated)
         open_column = .not. (stated .and. header_line > 0)
         if (present(strain_unit)) open_column(1) = open_column(1) .and. len_trim(strain_unit) == 0
         if (present(force_unit)) open_column(2) = open_column(2) .and. len_trim(force_unit) == 0
-        do k = 1, size(notes)
-            call get_note_units(notes(k)%text, fields, texts, stated)
-            do c = 1, 2
-                if (.not. (stated(c) .and. open_column(c))) cycle
-                call take_unit(texts(c)%text, c, unit, unknown)
-                if (allocated(unknown)) cycle
-                if (same_unit(unit, units(c))) cycle
-                call fatal_error(error, note_unit_message(note_lines(k), c, fields(c)%text, &
-                    texts(c)%text, trim(units(c)%name), 'set &material ' // trim(names(c)) &
-                    // ' = ' // quote_string(texts(c)%text)))
-                return
-            end do
-        end do
+        call find_note_conflict(notes, open_column, units, parse_unit, k, c, text)
+        if (k == 0) return
+        call get_note_units(notes(k)%text, fields, texts, stated)
+        call fatal_error(error, note_unit_message(note_lines(k), c, fields(c)%text, &
+            text%text, trim(units(c)%name), 'set &material ' // trim(names(c)) // ' = ' &
+            // quote_string(text%text)))
     end subroutine check_note_units
+
+    !> take_unit as a unit_parser (find_note_conflict).
+    pure subroutine parse_unit(text, column, unit, found)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: column
+        type(unit_type), intent(out) :: unit
+        logical, intent(out) :: found
+        type(error_type), allocatable :: unknown
+
+        call take_unit(text, column, unit, unknown)
+        found = .not. allocated(unknown)
+    end subroutine parse_unit
 
     !> The header's column names in the table's order, strain then force: a header that
     !> names a force in column 1 or a strain in column 2 ('Force,Elongation') is a table
